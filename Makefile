@@ -1,0 +1,44 @@
+# Quick start: `make demo` then `make test`. Both create .venv when missing.
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV := .venv
+BIN := $(VENV)/bin
+REPORT ?= report
+
+.PHONY: demo test lint typecheck pytest bench figures clean
+
+$(BIN)/python:
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "aura-ums needs Python >= 3.11, got " + sys.version.split()[0])'
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(VENV)/.stamp-install: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
+	@touch $@
+
+$(VENV)/.stamp-dev: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	@touch $@ $(VENV)/.stamp-install
+
+demo: $(VENV)/.stamp-install
+	$(BIN)/aura-ums demo --out $(REPORT)
+
+figures: $(VENV)/.stamp-install
+	$(BIN)/aura-ums figures --out $(REPORT)/figures
+
+lint: $(VENV)/.stamp-dev
+	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff format --check src tests benchmarks
+
+typecheck: $(VENV)/.stamp-dev
+	$(BIN)/mypy
+
+pytest: $(VENV)/.stamp-dev
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+
+test: lint typecheck pytest
+
+bench: $(VENV)/.stamp-dev
+	$(BIN)/python benchmarks/bench_growth.py
+
+clean:
+	rm -rf $(VENV) $(REPORT) build dist src/*.egg-info

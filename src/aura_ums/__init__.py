@@ -1,0 +1,48 @@
+"""aura-ums: guaranteed spatial uncertainty management for a mobile robot.
+
+A convex polygon of where the robot may be and a compass wedge of which way it may
+face, grown from turn-and-run commands and terrain statistics (Arkin, AuRA).
+
+Examples
+--------
+>>> import math
+>>> import aura_ums as ums
+>>> start = ums.SpatialUncertaintyMap.from_pose(ums.Pose(0, 0, 0), 0.3, math.radians(2))
+>>> grown = start.grow(ums.TurnAndRun(math.pi / 4, 30 * ums.FOOT), ums.TerrainTable.default()["concrete"])
+>>> grown.contains(grown.most_probable_pose())
+True
+"""
+
+from aura_ums.errors import AuraUmsError, FileFormatError, InputError, UnknownTerrainError
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
+from aura_ums.uncertainty import (
+    FOOT,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainStats,
+    TerrainTable,
+    TurnAndRun,
+    growth_tightness,
+    simulate_containment,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "FOOT",
+    "AuraUmsError",
+    "ConvexPolygon",
+    "FileFormatError",
+    "HeadingWedge",
+    "InputError",
+    "Pose",
+    "SpatialUncertaintyMap",
+    "TerrainStats",
+    "TerrainTable",
+    "TurnAndRun",
+    "UnknownTerrainError",
+    "__version__",
+    "growth_tightness",
+    "simulate_containment",
+    "wrap_angle",
+]

@@ -1,0 +1,36 @@
+"""Planar geometry: compass wedges, convex polygons and the convex operations growth needs.
+
+This package imports nothing else of aura-ums but its validation and errors.
+"""
+
+from aura_ums.geometry._angles import angle_difference, wrap_angle
+from aura_ums.geometry._convex import (
+    clip_halfplane,
+    convex_hull,
+    minkowski_sum,
+    outer_annular_sector,
+    outer_arc,
+    outer_disk,
+    polygon_area,
+    simplify_outer,
+)
+from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
+from aura_ums.geometry._wedge import ANGLE_TOLERANCE, HeadingWedge
+
+__all__ = [
+    "ANGLE_TOLERANCE",
+    "POSITION_TOLERANCE",
+    "ConvexPolygon",
+    "HeadingWedge",
+    "angle_difference",
+    "clip_halfplane",
+    "convex_hull",
+    "minkowski_sum",
+    "outer_annular_sector",
+    "outer_arc",
+    "outer_disk",
+    "polygon_area",
+    "regular_polygon",
+    "simplify_outer",
+    "wrap_angle",
+]

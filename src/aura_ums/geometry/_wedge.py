@@ -1,0 +1,150 @@
+"""The compass wedge: the interval of headings the robot may be facing."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import overload
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, float_array, nonnegative_float
+from aura_ums.errors import InputError
+from aura_ums.geometry._angles import TWO_PI, wrap_angle
+
+# Headings within this many radians of a wedge's edge count as inside it, so that
+# a bound computed in floating point is not refused by its own rounding.
+ANGLE_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class HeadingWedge:
+    """A compass wedge of headings: a centre and clockwise / counter-clockwise extents.
+
+    The wedge holds every heading from ``center - cw`` counter-clockwise to
+    ``center + ccw``. A wedge whose ``cw + ccw >= 2*pi`` is the full circle: a
+    valid state meaning "any heading".
+
+    Parameters
+    ----------
+    center : float
+        Most probable heading, radians, counter-clockwise from world +x. Wrapped to
+        (-pi, pi] on construction.
+    cw : float
+        Clockwise extent from the centre, radians, >= 0.
+    ccw : float
+        Counter-clockwise extent from the centre, radians, >= 0.
+
+    Examples
+    --------
+    >>> import math
+    >>> wedge = HeadingWedge(math.pi, cw=0.1, ccw=0.2)   # straddles the +-pi seam
+    >>> bool(wedge.contains(-math.pi + 0.15)), bool(wedge.contains(math.pi - 0.15))
+    (True, False)
+    >>> HeadingWedge(0.0, cw=4.0, ccw=3.0).is_full_circle
+    True
+    """
+
+    center: float
+    cw: float
+    ccw: float
+
+    def __post_init__(self) -> None:
+        center = finite_float(self.center, "HeadingWedge.center")
+        cw = nonnegative_float(self.cw, "HeadingWedge.cw")
+        ccw = nonnegative_float(self.ccw, "HeadingWedge.ccw")
+        object.__setattr__(self, "center", wrap_angle(center))
+        object.__setattr__(self, "cw", cw)
+        object.__setattr__(self, "ccw", ccw)
+
+    @classmethod
+    def full_circle(cls, center: float = 0.0) -> HeadingWedge:
+        """Return the wedge of every heading, with the given most probable heading."""
+        return cls(center, math.pi, math.pi)
+
+    @classmethod
+    def from_bounds(cls, lo: float, hi: float, center: float | None = None) -> HeadingWedge:
+        """Return the wedge from heading ``lo`` counter-clockwise to heading ``hi``.
+
+        Parameters
+        ----------
+        lo, hi : float
+            Clockwise-most and counter-clockwise-most headings, radians. The wedge runs
+            counter-clockwise from ``lo`` to ``hi`` (so ``lo = 3``, ``hi = -3`` is a
+            narrow wedge across the +-pi seam).
+        center : float, optional
+            Most probable heading; must lie in the wedge. Defaults to the bisector.
+
+        Examples
+        --------
+        >>> w = HeadingWedge.from_bounds(3.0, -3.0)
+        >>> round(w.width, 6), round(w.center, 6)
+        (0.283185, 3.141593)
+        """
+        lo = finite_float(lo, "lo")
+        hi = finite_float(hi, "hi")
+        width = (hi - lo) % TWO_PI
+        if center is None:
+            return cls(lo + width / 2.0, width / 2.0, width / 2.0)
+        center = finite_float(center, "center")
+        offset = (center - lo) % TWO_PI
+        if offset > width + ANGLE_TOLERANCE:
+            raise InputError(f"center: expected a heading inside [{lo}, {hi}], got {center}")
+        offset = min(offset, width)
+        return cls(lo + offset, offset, width - offset)
+
+    @property
+    def is_full_circle(self) -> bool:
+        """True when the wedge holds every heading."""
+        return self.cw + self.ccw >= TWO_PI
+
+    @property
+    def width(self) -> float:
+        """Angular width in radians, at most 2*pi."""
+        return min(self.cw + self.ccw, TWO_PI)
+
+    @property
+    def lo(self) -> float:
+        """Clockwise-most heading, wrapped to (-pi, pi] radians."""
+        return wrap_angle(self.center - self.cw)
+
+    @property
+    def hi(self) -> float:
+        """Counter-clockwise-most heading, wrapped to (-pi, pi] radians."""
+        return wrap_angle(self.center + self.ccw)
+
+    @overload
+    def contains(self, heading: float) -> bool: ...
+    @overload
+    def contains(self, heading: ArrayLike) -> bool | NDArray[np.bool_]: ...
+    def contains(self, heading: ArrayLike) -> bool | NDArray[np.bool_]:
+        """Tell whether heading(s), in radians and any winding, lie in the wedge.
+
+        Returns a Python ``bool`` for a scalar and a boolean array otherwise.
+        """
+        headings = float_array(heading, "heading")
+        if self.is_full_circle:
+            inside = np.ones(headings.shape, dtype=bool)
+        else:
+            offset = np.mod(headings - (self.center - self.cw), TWO_PI)
+            # Offsets just below 2*pi are headings a hair clockwise of lo.
+            inside = (offset <= self.width + ANGLE_TOLERANCE) | (offset >= TWO_PI - ANGLE_TOLERANCE)
+        if inside.ndim == 0:
+            return bool(inside)
+        return inside
+
+    def widened(self, cw: float, ccw: float) -> HeadingWedge:
+        """Return the wedge with ``cw`` and ``ccw`` radians (>= 0) added to its extents."""
+        return _normalized(self.center, self.cw + cw, self.ccw + ccw)
+
+    def rotated(self, angle: float) -> HeadingWedge:
+        """Return the wedge turned by ``angle`` radians (counter-clockwise positive)."""
+        return _normalized(self.center + angle, self.cw, self.ccw)
+
+
+def _normalized(center: float, cw: float, ccw: float) -> HeadingWedge:
+    """Build a wedge, folding any full circle to the canonical extents (pi, pi)."""
+    if cw + ccw >= TWO_PI:
+        return HeadingWedge(center, math.pi, math.pi)
+    return HeadingWedge(center, cw, ccw)

@@ -1,0 +1,51 @@
+"""The spatial uncertainty map, turn-and-run commands, terrain statistics and growth.
+
+This package imports nothing of aura-ums but geometry, validation and errors.
+"""
+
+from aura_ums.uncertainty._checks import (
+    ContainmentResult,
+    TightnessResult,
+    growth_tightness,
+    simulate_containment,
+)
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, MotionBounds, motion_bounds
+from aura_ums.uncertainty._landmarks import (
+    BearingObservation,
+    GroundLineLandmark,
+    GroundLineObservation,
+    Landmark,
+    LandmarkClass,
+    Observation,
+    PointLandmark,
+    RangeBearingObservation,
+    VerticalLineLandmark,
+)
+from aura_ums.uncertainty._map import SpatialUncertaintyMap
+from aura_ums.uncertainty._motion import FOOT, Pose, TurnAndRun
+from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
+
+__all__ = [
+    "DEFAULT_MAX_VERTICES",
+    "FOOT",
+    "BearingObservation",
+    "ContainmentResult",
+    "GroundLineLandmark",
+    "GroundLineObservation",
+    "Landmark",
+    "LandmarkClass",
+    "MotionBounds",
+    "Observation",
+    "PointLandmark",
+    "Pose",
+    "RangeBearingObservation",
+    "SpatialUncertaintyMap",
+    "TerrainStats",
+    "TerrainTable",
+    "TightnessResult",
+    "TurnAndRun",
+    "VerticalLineLandmark",
+    "growth_tightness",
+    "motion_bounds",
+    "simulate_containment",
+]

@@ -1,0 +1,321 @@
+"""Landmarks of the three classes, and the bounded observations made of them."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
+from aura_ums.errors import InputError
+
+
+class LandmarkClass(enum.Enum):
+    """The paper's three landmark classes."""
+
+    #: Class I: a vertical line (pole, door edge, building side); gives a bearing ray.
+    VERTICAL_LINE = "I"
+    #: Class II: an identifiable point of known height; gives bearing and bounded range.
+    POINT = "II"
+    #: Class III: a line on the ground (path edge); gives offset and relative angle.
+    GROUND_LINE = "III"
+
+
+def _identifier(value: object, name: str) -> str:
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{name}: expected a non-empty string, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True, slots=True)
+class VerticalLineLandmark:
+    """A Class I landmark: a vertical segment standing at (x, y).
+
+    Parameters
+    ----------
+    id : str
+        Instance name, e.g. ``"lamppost_107"``.
+    x, y : float
+        Position in the world frame, metres.
+    z_bottom, z_top : float
+        Heights of the segment's ends above the ground plane, metres, bottom <= top.
+    symbol : str
+        Symbolic class, e.g. ``"lamppost"``.
+    position_uncertainty : float
+        Radius (m) of the disk in which the landmark truly stands, >= 0.
+
+    Examples
+    --------
+    >>> VerticalLineLandmark("pole_1", 3.0, 4.0, 0.0, 6.0, symbol="telephone pole").landmark_class
+    <LandmarkClass.VERTICAL_LINE: 'I'>
+    """
+
+    id: str
+    x: float
+    y: float
+    z_bottom: float
+    z_top: float
+    symbol: str = ""
+    position_uncertainty: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "id", _identifier(self.id, "id"))
+        for name in ("x", "y", "z_bottom", "z_top"):
+            object.__setattr__(self, name, finite_float(getattr(self, name), f"{self.id}.{name}"))
+        if self.z_top < self.z_bottom:
+            raise InputError(f"{self.id}.z_top: expected >= z_bottom ({self.z_bottom}), got {self.z_top}")
+        object.__setattr__(
+            self,
+            "position_uncertainty",
+            nonnegative_float(self.position_uncertainty, f"{self.id}.position_uncertainty"),
+        )
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.VERTICAL_LINE`."""
+        return LandmarkClass.VERTICAL_LINE
+
+    @property
+    def position(self) -> NDArray[np.float64]:
+        """Ground position (x, y), metres."""
+        return np.array([self.x, self.y])
+
+
+@dataclass(frozen=True, slots=True)
+class PointLandmark:
+    """A Class II landmark: an identifiable point at (x, y, z).
+
+    Parameters
+    ----------
+    id : str
+        Instance name, e.g. ``"building_corner_3"``.
+    x, y, z : float
+        Position in the world frame, metres (z above the ground plane).
+    symbol : str
+        Symbolic class.
+    position_uncertainty : float
+        Radius (m) of the disk (in x, y) in which the point truly lies, >= 0.
+    """
+
+    id: str
+    x: float
+    y: float
+    z: float
+    symbol: str = ""
+    position_uncertainty: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "id", _identifier(self.id, "id"))
+        for name in ("x", "y", "z"):
+            object.__setattr__(self, name, finite_float(getattr(self, name), f"{self.id}.{name}"))
+        object.__setattr__(
+            self,
+            "position_uncertainty",
+            nonnegative_float(self.position_uncertainty, f"{self.id}.position_uncertainty"),
+        )
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.POINT`."""
+        return LandmarkClass.POINT
+
+    @property
+    def position(self) -> NDArray[np.float64]:
+        """Ground position (x, y), metres."""
+        return np.array([self.x, self.y])
+
+
+@dataclass(frozen=True, slots=True, init=False)
+class GroundLineLandmark:
+    """A Class III landmark: a segment on the ground plane from ``start`` to ``end``.
+
+    Parameters
+    ----------
+    id : str
+        Instance name, e.g. ``"sidewalk_left_edge"``.
+    start, end : array_like, shape (2,)
+        Ends (x, y) in the world frame, metres; distinct.
+    symbol : str
+        Symbolic class.
+    position_uncertainty : float
+        Distance (m) by which the true line may lie off the mapped one, >= 0.
+    """
+
+    id: str
+    start: NDArray[np.float64]
+    end: NDArray[np.float64]
+    symbol: str
+    position_uncertainty: float
+
+    def __init__(
+        self,
+        id: str,
+        start: ArrayLike,
+        end: ArrayLike,
+        symbol: str = "",
+        position_uncertainty: float = 0.0,
+    ) -> None:
+        ident = _identifier(id, "id")
+        a = points_array(start, f"{ident}.start", min_rows=1)
+        b = points_array(end, f"{ident}.end", min_rows=1)
+        if a.shape != (1, 2) or b.shape != (1, 2):
+            raise InputError(f"{ident}: expected start and end as single (x, y) points")
+        if np.array_equal(a, b):
+            raise InputError(f"{ident}.end: expected a point distinct from start, got {b[0].tolist()}")
+        object.__setattr__(self, "id", ident)
+        object.__setattr__(self, "start", read_only(a[0].copy()))
+        object.__setattr__(self, "end", read_only(b[0].copy()))
+        object.__setattr__(self, "symbol", symbol)
+        object.__setattr__(
+            self,
+            "position_uncertainty",
+            nonnegative_float(position_uncertainty, f"{ident}.position_uncertainty"),
+        )
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.GROUND_LINE`."""
+        return LandmarkClass.GROUND_LINE
+
+    @property
+    def direction(self) -> float:
+        """World direction of start -> end, radians in (-pi, pi]."""
+        d = self.end - self.start
+        return float(np.arctan2(d[1], d[0]))
+
+    @property
+    def length(self) -> float:
+        """Length in metres."""
+        return float(np.hypot(*(self.end - self.start)))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, GroundLineLandmark):
+            return NotImplemented
+        return (
+            self.id == other.id
+            and np.array_equal(self.start, other.start)
+            and np.array_equal(self.end, other.end)
+            and self.symbol == other.symbol
+            and self.position_uncertainty == other.position_uncertainty
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.id, tuple(self.start), tuple(self.end)))
+
+
+#: Any landmark that a reduction or the Expecter accepts.
+Landmark = VerticalLineLandmark | PointLandmark | GroundLineLandmark
+
+
+def _sensor_offset(value: ArrayLike, name: str) -> tuple[float, float]:
+    offset = points_array(value, name, min_rows=1)
+    if offset.shape != (1, 2):
+        raise InputError(f"{name}: expected (forward, left) metres, got shape {offset.shape}")
+    return (float(offset[0, 0]), float(offset[0, 1]))
+
+
+def _common(obs: object, landmark_id: object, time: object, offset: object) -> None:
+    object.__setattr__(obs, "landmark_id", _identifier(landmark_id, "landmark_id"))
+    object.__setattr__(obs, "time", finite_float(time, "time"))
+    object.__setattr__(obs, "sensor_offset", _sensor_offset(offset, "sensor_offset"))  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True, slots=True)
+class BearingObservation:
+    """A Class I observation: the bearing to a landmark, within +-``bearing_error``.
+
+    Parameters
+    ----------
+    landmark_id : str
+        Which landmark was seen.
+    time : float
+        When, seconds.
+    bearing : float
+        Angle from the robot's heading to the landmark, radians, counter-clockwise positive.
+    bearing_error : float
+        Bound on the bearing's error, radians, >= 0.
+    sensor_offset : tuple of float
+        Where the sensor sits on the robot (forward, left), metres.
+    """
+
+    landmark_id: str
+    time: float
+    bearing: float
+    bearing_error: float
+    sensor_offset: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        object.__setattr__(self, "bearing", finite_float(self.bearing, "bearing"))
+        object.__setattr__(self, "bearing_error", nonnegative_float(self.bearing_error, "bearing_error"))
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.VERTICAL_LINE`."""
+        return LandmarkClass.VERTICAL_LINE
+
+
+@dataclass(frozen=True, slots=True)
+class RangeBearingObservation:
+    """A Class II observation: bearing within +-``bearing_error`` and range in [range_min, range_max].
+
+    ``range`` is the horizontal distance (m) from the sensor to the landmark's (x, y).
+    """
+
+    landmark_id: str
+    time: float
+    bearing: float
+    bearing_error: float
+    range_min: float
+    range_max: float
+    sensor_offset: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        object.__setattr__(self, "bearing", finite_float(self.bearing, "bearing"))
+        object.__setattr__(self, "bearing_error", nonnegative_float(self.bearing_error, "bearing_error"))
+        object.__setattr__(self, "range_min", nonnegative_float(self.range_min, "range_min"))
+        object.__setattr__(self, "range_max", nonnegative_float(self.range_max, "range_max"))
+        if self.range_max < self.range_min:
+            raise InputError(f"range_max: expected >= range_min ({self.range_min}), got {self.range_max}")
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.POINT`."""
+        return LandmarkClass.POINT
+
+
+@dataclass(frozen=True, slots=True)
+class GroundLineObservation:
+    """A Class III observation of a ground line.
+
+    ``offset`` is the signed distance (m) from the sensor to the line, positive when
+    the sensor is to the left of start -> end, within +-``offset_error``; ``angle`` is
+    the direction start -> end relative to the heading (rad), within +-``angle_error``.
+    """
+
+    landmark_id: str
+    time: float
+    offset: float
+    offset_error: float
+    angle: float
+    angle_error: float
+    sensor_offset: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        object.__setattr__(self, "offset", finite_float(self.offset, "offset"))
+        object.__setattr__(self, "offset_error", nonnegative_float(self.offset_error, "offset_error"))
+        object.__setattr__(self, "angle", finite_float(self.angle, "angle"))
+        object.__setattr__(self, "angle_error", nonnegative_float(self.angle_error, "angle_error"))
+
+    @property
+    def landmark_class(self) -> LandmarkClass:
+        """Always :attr:`LandmarkClass.GROUND_LINE`."""
+        return LandmarkClass.GROUND_LINE
+
+
+#: Any observation a reduction accepts.
+Observation = BearingObservation | RangeBearingObservation | GroundLineObservation

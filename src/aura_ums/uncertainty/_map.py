@@ -1,0 +1,217 @@
+"""The spatial uncertainty map: a convex polygon of positions and a compass wedge of headings."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import overload
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import float_array, nonnegative_float, points_array, read_only
+from aura_ums.errors import InputError
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, outer_disk, wrap_angle
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, grow_polygon, grow_wedge, motion_bounds
+from aura_ums.uncertainty._motion import Pose, TurnAndRun
+from aura_ums.uncertainty._terrain import TerrainStats
+
+_START_DISK_SIDES = 16
+
+
+@dataclass(frozen=True, slots=True, eq=False, init=False)
+class SpatialUncertaintyMap:
+    """Where the robot may be (a convex polygon) and which way it may face (a wedge).
+
+    The map is a guaranteed region: every pose whose position lies in ``polygon``
+    and whose heading lies in ``wedge`` is possible, and no other is. ``center`` is
+    the most probable position and ``wedge.center`` the most probable heading.
+
+    Parameters
+    ----------
+    polygon : ConvexPolygon
+        Possible positions, metres, world frame.
+    center : array_like, shape (2,)
+        Most probable position (x, y), metres; must lie in ``polygon``.
+    wedge : HeadingWedge
+        Possible headings, radians.
+
+    Examples
+    --------
+    >>> import math
+    >>> from aura_ums.uncertainty import TerrainTable
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.3, math.radians(5))
+    >>> grown = start.grow(TurnAndRun(math.pi / 4, 9.0), TerrainTable.default()["concrete"])
+    >>> grown.area > start.area, grown.contains(Pose(6.0, 6.0, math.pi / 4))
+    (True, True)
+    >>> start.grow(TurnAndRun(0.0, 0.0), TerrainTable.default()["grass"]).area == start.area
+    True
+    """
+
+    polygon: ConvexPolygon
+    center: NDArray[np.float64]
+    wedge: HeadingWedge
+
+    def __init__(self, polygon: ConvexPolygon, center: ArrayLike, wedge: HeadingWedge) -> None:
+        if not isinstance(polygon, ConvexPolygon):
+            raise InputError(f"polygon: expected a ConvexPolygon, got {type(polygon).__name__}")
+        if not isinstance(wedge, HeadingWedge):
+            raise InputError(f"wedge: expected a HeadingWedge, got {type(wedge).__name__}")
+        point = points_array(center, "center", min_rows=1)
+        if point.shape != (1, 2):
+            raise InputError(f"center: expected one (x, y) point, got shape {point.shape}")
+        if not polygon.contains(point, tolerance=1e-6)[0]:
+            raise InputError(f"center: expected a point inside the polygon, got {point[0].tolist()}")
+        object.__setattr__(self, "polygon", polygon)
+        object.__setattr__(self, "center", read_only(point[0].copy()))
+        object.__setattr__(self, "wedge", wedge)
+
+    @classmethod
+    def _trusted(
+        cls, polygon: ConvexPolygon, center: NDArray[np.float64], wedge: HeadingWedge
+    ) -> SpatialUncertaintyMap:
+        result = object.__new__(cls)
+        object.__setattr__(result, "polygon", polygon)
+        object.__setattr__(result, "center", read_only(center))
+        object.__setattr__(result, "wedge", wedge)
+        return result
+
+    @classmethod
+    def from_pose(cls, pose: Pose, position_radius: float, heading_halfwidth: float) -> SpatialUncertaintyMap:
+        """Start a map around a pose.
+
+        Parameters
+        ----------
+        pose : Pose
+            Most probable pose.
+        position_radius : float
+            Radius of the disk of possible positions, metres, >= 0 (an outer polygon of
+            the disk is used; 0 gives a point).
+        heading_halfwidth : float
+            Half-width of the heading wedge, radians, >= 0 (pi or more: any heading).
+        """
+        radius = nonnegative_float(position_radius, "position_radius")
+        halfwidth = nonnegative_float(heading_halfwidth, "heading_halfwidth")
+        center = np.array([pose.x, pose.y])
+        polygon = ConvexPolygon._trusted(outer_disk(center, radius, _START_DISK_SIDES))
+        if halfwidth >= math.pi:
+            wedge = HeadingWedge.full_circle(pose.heading)
+        else:
+            wedge = HeadingWedge(pose.heading, halfwidth, halfwidth)
+        return cls._trusted(polygon, center, wedge)
+
+    @classmethod
+    def from_polygon(
+        cls, polygon: ConvexPolygon, center: ArrayLike, wedge: HeadingWedge
+    ) -> SpatialUncertaintyMap:
+        """Build a map from its parts (validated: the centre must lie in the polygon)."""
+        return cls(polygon, center, wedge)
+
+    @property
+    def area(self) -> float:
+        """Area of the position polygon, square metres."""
+        return self.polygon.area
+
+    @property
+    def heading(self) -> float:
+        """Most probable heading, radians in (-pi, pi]."""
+        return self.wedge.center
+
+    def most_probable_pose(self) -> Pose:
+        """Return the map's centre and most probable heading as a Pose."""
+        return Pose(float(self.center[0]), float(self.center[1]), self.wedge.center)
+
+    def grow(
+        self,
+        command: TurnAndRun,
+        terrain: TerrainStats,
+        *,
+        sigmas: float = 3.0,
+        max_vertices: int = DEFAULT_MAX_VERTICES,
+    ) -> SpatialUncertaintyMap:
+        """Return the map after a turn-and-run command on a terrain (the paper's growth).
+
+        Contains every outcome of :meth:`TerrainStats.sample_motion` whose standard
+        normals satisfy |z| <= ``sigmas``, from every pose of this map. The centre moves
+        by the mean motion; the wedge takes the range of the turn asymmetrically and
+        widens by the drift; the polygon is this one Minkowski-summed with the skitter
+        disk and the region of run endpoints, arcs replaced by outer polygons.
+
+        Parameters
+        ----------
+        command : TurnAndRun
+            The commanded motion.
+        terrain : TerrainStats
+            Statistics of the terrain the motion happens on.
+        sigmas : float
+            Number of standard deviations bounded, > 0 (3 keeps >= 99 % in practice).
+        max_vertices : int
+            Cap on the polygon's vertex count (>= 3); beyond it an outer approximation.
+        """
+        if not isinstance(command, TurnAndRun):
+            raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+        if not isinstance(terrain, TerrainStats):
+            raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+        if not (isinstance(sigmas, (int, float)) and math.isfinite(sigmas) and sigmas > 0):
+            raise InputError(f"sigmas: expected a positive finite number, got {sigmas!r}")
+        if max_vertices < 3:
+            raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
+        bounds = motion_bounds(terrain, command, float(sigmas))
+        wedge = self.wedge
+        heading_lo = wedge.center - wedge.cw
+        vertices = grow_polygon(
+            self.polygon.vertices, heading_lo, heading_lo + wedge.cw + wedge.ccw, bounds, max_vertices
+        )
+        heading, cw, ccw = grow_wedge(wedge.center, wedge.cw, wedge.ccw, bounds)
+        center = self.center + bounds.run_mean * np.array([math.cos(heading), math.sin(heading)])
+        return SpatialUncertaintyMap._trusted(
+            ConvexPolygon._trusted(vertices), center, HeadingWedge(wrap_angle(heading), cw, ccw)
+        )
+
+    @overload
+    def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...
+    @overload
+    def contains(self, pose: ArrayLike, y: ArrayLike, heading: ArrayLike) -> bool | NDArray[np.bool_]: ...
+    def contains(
+        self, pose: Pose | ArrayLike, y: ArrayLike | None = None, heading: ArrayLike | None = None
+    ) -> bool | NDArray[np.bool_]:
+        """Tell whether pose(s) lie in the map: position in the polygon and heading in the wedge.
+
+        Call it with a :class:`Pose`, or with ``x``, ``y`` and ``heading`` as scalars or
+        equally shaped arrays (metres, metres, radians). A boundary tolerance of
+        ``POSITION_TOLERANCE`` metres and ``ANGLE_TOLERANCE`` radians applies.
+        """
+        if isinstance(pose, Pose):
+            if y is not None or heading is not None:
+                raise InputError("contains: expected a Pose alone, or x, y and heading, got a Pose and more")
+            xs, ys, hs = np.array([pose.x]), np.array([pose.y]), np.array([pose.heading])
+            scalar = True
+        else:
+            if y is None or heading is None:
+                raise InputError("contains: expected a Pose, or x, y and heading, got x alone")
+            xs, ys, hs = float_array(pose, "x"), float_array(y, "y"), float_array(heading, "heading")
+            if not (xs.shape == ys.shape == hs.shape):
+                shapes = f"{xs.shape}, {ys.shape}, {hs.shape}"
+                raise InputError(f"contains: expected x, y and heading of one shape, got {shapes}")
+            scalar = xs.ndim == 0
+        shape = xs.shape
+        points = np.column_stack([xs.reshape(-1), ys.reshape(-1)])
+        inside = self.polygon.contains(points, tolerance=POSITION_TOLERANCE)
+        inside &= np.asarray(self.wedge.contains(hs.reshape(-1)), dtype=bool)
+        if scalar:
+            return bool(inside[0])
+        return inside.reshape(shape)
+
+    def sample_poses(self, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
+        """Draw ``count`` poses uniformly from the map: rows of x (m), y (m), heading (rad)."""
+        positions = self.polygon.sample(count, rng)
+        wedge = self.wedge
+        headings = wrap_angle(wedge.center - wedge.cw + rng.uniform(0.0, 1.0, count) * wedge.width)
+        return np.column_stack([positions, headings])
+
+    def __repr__(self) -> str:
+        return (
+            f"SpatialUncertaintyMap(center=({self.center[0]:.4g}, {self.center[1]:.4g}), "
+            f"area={self.area:.4g} m^2, vertices={self.polygon.vertex_count}, "
+            f"heading={self.wedge.center:.4g} rad -{self.wedge.cw:.3g}/+{self.wedge.ccw:.3g})"
+        )

@@ -1,0 +1,301 @@
+"""Terrain statistics, the turn-and-run generative model, and terrain tables from TOML."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, fields
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, float_array
+from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
+from aura_ums.uncertainty._motion import Pose, TurnAndRun
+
+_FRACTIONS = ("translation_loss", "rotation_loss")
+_ALTERNATE_UNITS = {"drift_deg_per_m": ("drift", math.pi / 180.0)}
+
+
+@dataclass(frozen=True, slots=True)
+class TerrainStats:
+    """Slippage statistics of the robot on one terrain type (DESIGN §3).
+
+    Parameters
+    ----------
+    translation_loss : float
+        Mean translational loss, fraction in [0, 1) (0.10: 20 m commanded, 18 m run).
+    translation_inertial_loss : float
+        Fixed loss per move from acceleration and braking, metres, >= 0.
+    translation_sd : float
+        Standard deviation of the translational error, fraction of the distance, >= 0.
+    drift : float
+        Bound on the heading change per metre run, either side, rad/m, >= 0.
+    rotation_loss : float
+        Mean rotational loss, fraction in [0, 1).
+    rotation_sd : float
+        Standard deviation of the rotational error, fraction of the turn, >= 0.
+    skitter : float
+        Mean translation per radian turned, m/rad, >= 0.
+    skitter_sd : float
+        Standard deviation of the skitter, m/rad, >= 0.
+
+    Examples
+    --------
+    >>> stats = TerrainStats(0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    >>> stats.sample_motion(Pose(0, 0, 0), TurnAndRun(0.0, 20.0), np.random.default_rng(0)).x
+    18.0
+    >>> TerrainStats(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: translation_loss: expected a fraction in [0, 1), got 1.0
+    """
+
+    translation_loss: float
+    translation_inertial_loss: float
+    translation_sd: float
+    drift: float
+    rotation_loss: float
+    rotation_sd: float
+    skitter: float
+    skitter_sd: float
+
+    def __post_init__(self) -> None:
+        for field in fields(self):
+            value = finite_float(getattr(self, field.name), field.name)
+            if field.name in _FRACTIONS and not 0.0 <= value < 1.0:
+                raise InputError(f"{field.name}: expected a fraction in [0, 1), got {value!r}")
+            if value < 0.0:
+                raise InputError(f"{field.name}: expected a non-negative number, got {value!r}")
+            object.__setattr__(self, field.name, value)
+
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        """Return the names of the statistics, in declaration order."""
+        return tuple(f.name for f in fields(cls))
+
+    @classmethod
+    def zero(cls) -> TerrainStats:
+        """Return statistics of a perfect terrain: every motion goes exactly as commanded."""
+        return cls(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+    def sample_motion(
+        self,
+        pose: Pose,
+        command: TurnAndRun,
+        rng: np.random.Generator,
+        *,
+        truncate: float | None = None,
+    ) -> Pose:
+        """Draw the true pose after ``command`` from ``pose`` under this terrain's model.
+
+        The model (DESIGN §3): the actual turn is ``turn * clip(1 - rotation_loss +
+        rotation_sd*z1, 0, 1)``; skitter moves the robot ``|turn| * max(0, skitter +
+        skitter_sd*z2)`` metres in a uniformly random direction; the actual run is
+        ``clip(run*(1 - translation_loss + translation_sd*z3) - translation_inertial_loss,
+        0, run)``, along a circular arc whose heading changes by ``drift * run * u``.
+
+        Parameters
+        ----------
+        pose : Pose
+            True pose before the command.
+        command : TurnAndRun
+            The commanded motion.
+        rng : numpy.random.Generator
+            Source of randomness.
+        truncate : float, optional
+            Clip the standard normals z1..z3 to +-``truncate``; None leaves them Gaussian.
+
+        Returns
+        -------
+        Pose
+            The true pose after the command.
+        """
+        result = self.sample_motions(pose.as_array(), command, rng, truncate=truncate)
+        return Pose(float(result[0, 0]), float(result[0, 1]), float(result[0, 2]))
+
+    def sample_motions(
+        self,
+        poses: ArrayLike,
+        command: TurnAndRun,
+        rng: np.random.Generator,
+        *,
+        truncate: float | None = None,
+    ) -> NDArray[np.float64]:
+        """Draw true poses after ``command`` for many poses at once (see :meth:`sample_motion`).
+
+        Parameters
+        ----------
+        poses : array_like, shape (n, 3) or (3,)
+            Rows of ``x`` (m), ``y`` (m), ``heading`` (rad).
+
+        Returns
+        -------
+        ndarray, shape (n, 3)
+            The poses after the command, headings wrapped to (-pi, pi].
+        """
+        state = float_array(poses, "poses")
+        if state.ndim == 1:
+            state = state.reshape(1, -1)
+        if state.ndim != 2 or state.shape[1] != 3:
+            raise InputError(f"poses: expected shape (n, 3), got {state.shape}")
+        if truncate is not None and not (math.isfinite(truncate) and truncate > 0.0):
+            raise InputError(f"truncate: expected a positive finite number or None, got {truncate!r}")
+        n = len(state)
+        z = rng.standard_normal((3, n))
+        if truncate is not None:
+            z = np.clip(z, -truncate, truncate)
+        skitter_direction = rng.uniform(-math.pi, math.pi, n)
+        drift_fraction = rng.uniform(-1.0, 1.0, n)
+
+        turn = command.turn * np.clip(1.0 - self.rotation_loss + self.rotation_sd * z[0], 0.0, 1.0)
+        skitter = abs(command.turn) * np.maximum(0.0, self.skitter + self.skitter_sd * z[1])
+        run = np.clip(
+            command.run * (1.0 - self.translation_loss + self.translation_sd * z[2])
+            - self.translation_inertial_loss,
+            0.0,
+            command.run,
+        )
+        heading_change = self.drift * run * drift_fraction
+        heading = state[:, 2] + turn
+        # A circular arc of length `run` turning by `heading_change` ends at a chord of
+        # length run*sinc(change/2) along the mean heading of the arc.
+        chord = run * np.sinc(heading_change / (2.0 * math.pi))
+        chord_direction = heading + heading_change / 2.0
+        out = np.empty_like(state)
+        out[:, 0] = state[:, 0] + skitter * np.cos(skitter_direction) + chord * np.cos(chord_direction)
+        out[:, 1] = state[:, 1] + skitter * np.sin(skitter_direction) + chord * np.sin(chord_direction)
+        wrapped = np.pi - np.mod(np.pi - (heading + heading_change), 2.0 * math.pi)
+        out[:, 2] = np.where(wrapped <= -np.pi, wrapped + 2.0 * math.pi, wrapped)
+        return out
+
+
+# Illustrative figures only: the paper's measured table is not in its text. They are
+# of plausible size for a slow wheeled robot; calibrate your own (`aura-ums calibrate`).
+_DEFAULT_TABLE: dict[str, TerrainStats] = {
+    "tile": TerrainStats(0.02, 0.01, 0.01, math.radians(0.3), 0.02, 0.02, 0.01, 0.005),
+    "concrete": TerrainStats(0.03, 0.015, 0.015, math.radians(0.5), 0.02, 0.03, 0.02, 0.01),
+    "grass": TerrainStats(0.10, 0.03, 0.04, math.radians(1.5), 0.06, 0.06, 0.05, 0.02),
+    "gravel": TerrainStats(0.07, 0.025, 0.03, math.radians(1.0), 0.05, 0.05, 0.04, 0.02),
+}
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TerrainTable(Mapping[str, TerrainStats]):
+    """A read-only mapping from terrain name to :class:`TerrainStats`.
+
+    Examples
+    --------
+    >>> table = TerrainTable.default()
+    >>> sorted(table)
+    ['concrete', 'grass', 'gravel', 'tile']
+    >>> table["sand"]
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.UnknownTerrainError: terrain: expected one of concrete, grass, gravel, tile, got 'sand'
+    """
+
+    entries: Mapping[str, TerrainStats]
+
+    def __post_init__(self) -> None:
+        checked: dict[str, TerrainStats] = {}
+        for name, stats in dict(self.entries).items():
+            if not isinstance(name, str) or not name:
+                raise InputError(f"terrain name: expected a non-empty string, got {name!r}")
+            if not isinstance(stats, TerrainStats):
+                raise InputError(f"terrain {name!r}: expected TerrainStats, got {type(stats).__name__}")
+            checked[name] = stats
+        object.__setattr__(self, "entries", MappingProxyType(checked))
+
+    @classmethod
+    def default(cls) -> TerrainTable:
+        """Return the built-in table: tile, concrete, grass and gravel.
+
+        The figures are illustrative (the paper's measured table is not in its text);
+        calibrate a table for your own robot and terrain.
+        """
+        return cls(_DEFAULT_TABLE)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> TerrainTable:
+        """Read a terrain table from a TOML file: one table per terrain, keys as in TerrainStats.
+
+        ``drift_deg_per_m`` may be given instead of ``drift`` (rad/m).
+
+        Raises
+        ------
+        FileFormatError
+            Naming the file, the terrain and the key, for unreadable files, malformed
+            TOML, unknown or missing keys and values out of range.
+        """
+        source = str(path)
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except OSError as exc:
+            raise FileFormatError(source, "", f"expected a readable TOML file, got {exc.strerror}") from exc
+        try:
+            document = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise FileFormatError(source, "", f"expected valid TOML, got {exc}") from exc
+        return cls.from_mapping(document, source=source)
+
+    @classmethod
+    def from_mapping(cls, document: Mapping[str, object], *, source: str = "<mapping>") -> TerrainTable:
+        """Build a table from nested mappings as TOML gives them (see :meth:`from_toml`)."""
+        if not document:
+            raise FileFormatError(source, "", "expected at least one terrain table, got none")
+        names = TerrainStats.field_names()
+        entries: dict[str, TerrainStats] = {}
+        for terrain, table in document.items():
+            where = f"[{terrain}]"
+            if not isinstance(table, Mapping):
+                raise FileFormatError(source, where, f"expected a table of statistics, got {table!r}")
+            values: dict[str, float] = {}
+            for key, raw in table.items():
+                target, scale = _ALTERNATE_UNITS.get(key, (key, 1.0))
+                if target not in names:
+                    raise FileFormatError(
+                        source,
+                        f"{where} {key}",
+                        f"expected one of {', '.join(names)}, got unknown key {key!r}",
+                    )
+                if target in values:
+                    raise FileFormatError(source, f"{where} {key}", f"expected {target} once, got it twice")
+                try:
+                    values[target] = finite_float(raw, key) * scale
+                except InputError as exc:
+                    raise FileFormatError(source, f"{where} {key}", str(exc).split(": ", 1)[1]) from exc
+            missing = [name for name in names if name not in values]
+            if missing:
+                raise FileFormatError(source, where, f"expected keys {', '.join(missing)}, got none for them")
+            try:
+                entries[terrain] = TerrainStats(**values)
+            except InputError as exc:
+                key, _, message = str(exc).partition(": ")
+                raise FileFormatError(source, f"{where} {key}", message) from exc
+        return cls(entries)
+
+    def to_toml(self) -> str:
+        """Return the table as TOML text that :meth:`from_toml` reads back exactly."""
+        lines: list[str] = []
+        for terrain, stats in self.entries.items():
+            lines.append(f'["{terrain}"]' if not terrain.replace("_", "").isalnum() else f"[{terrain}]")
+            lines.extend(f"{name} = {getattr(stats, name)!r}" for name in TerrainStats.field_names())
+            lines.append("")
+        return "\n".join(lines)
+
+    def __getitem__(self, name: str) -> TerrainStats:
+        try:
+            return self.entries[name]
+        except KeyError:
+            known = ", ".join(sorted(self.entries))
+            raise UnknownTerrainError(f"terrain: expected one of {known}, got {name!r}") from None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.entries)
+
+    def __len__(self) -> int:
+        return len(self.entries)

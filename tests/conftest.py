@@ -1,0 +1,41 @@
+"""Fixtures shared by the whole test suite."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+import aura_ums as ums
+
+settings.register_profile("ci", max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("dev", max_examples=50, deadline=None)
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+#: Where the published datasets live (never copied into the repository).
+SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261121)
+
+
+@pytest.fixture
+def terrains() -> ums.TerrainTable:
+    return ums.TerrainTable.default()
+
+
+@pytest.fixture
+def point_map() -> ums.SpatialUncertaintyMap:
+    return ums.SpatialUncertaintyMap.from_pose(ums.Pose(0.0, 0.0, 0.0), 0.0, 0.0)
+
+
+@pytest.fixture
+def figure5_map(terrains: ums.TerrainTable) -> ums.SpatialUncertaintyMap:
+    start = ums.SpatialUncertaintyMap.from_pose(ums.Pose(0.0, 0.0, 0.0), 0.0, 0.0)
+    return start.grow(ums.TurnAndRun(math.radians(45), 30 * ums.FOOT), terrains["concrete"])
