@@ -1,0 +1,220 @@
+"""The pinhole camera on its mount: frames, rotation and projection.
+
+Frames (DESIGN §1): world x east, y north, z up; robot x forward, y left, z up;
+camera as OpenCV (x right, y down, z forward). Pixel (0, 0) is the centre of the
+top-left pixel.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, float_array
+from aura_ums.errors import InputError
+from aura_ums.uncertainty import Pose
+
+#: Points closer to the camera plane than this (m, along the optical axis) count as behind it.
+NEAR_PLANE = 1e-6
+
+Array = NDArray[np.float64]
+
+
+def robot_from_camera_rotation(pan: float, tilt: float) -> Array:
+    """Return the 3x3 rotation whose columns are the camera's x, y, z axes in the robot frame.
+
+    ``pan`` turns the camera counter-clockwise (to the robot's left) and ``tilt``
+    points the optical axis below the horizon, both radians.
+
+    Examples
+    --------
+    >>> robot_from_camera_rotation(0.0, 0.0)[:, 2].tolist()   # optical axis: robot forward
+    [1.0, 0.0, 0.0]
+    """
+    ct, st = math.cos(tilt), math.sin(tilt)
+    cp, sp = math.cos(pan), math.sin(pan)
+    right = np.array([0.0, -1.0, 0.0])
+    down = np.array([-st, 0.0, -ct])
+    forward = np.array([ct, 0.0, -st])
+    pan_rotation = np.array([[cp, -sp, 0.0], [sp, cp, 0.0], [0.0, 0.0, 1.0]])
+    return np.asarray(pan_rotation @ np.column_stack([right, down, forward]), dtype=np.float64)
+
+
+def distort(
+    x: Array, y: Array, coefficients: tuple[float, float, float, float, float]
+) -> tuple[Array, Array]:
+    """Apply OpenCV's radial-tangential distortion (k1, k2, p1, p2, k3) to normalized coordinates."""
+    k1, k2, p1, p2, k3 = coefficients
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
+    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
+    return xd, yd
+
+
+@dataclass(frozen=True, slots=True)
+class CameraIntrinsics:
+    """Pinhole intrinsics, in pixels, with optional OpenCV distortion.
+
+    Parameters
+    ----------
+    fx, fy : float
+        Focal lengths, pixels, > 0.
+    cx, cy : float
+        Principal point, pixels ((0, 0) is the centre of the top-left pixel).
+    width, height : int
+        Image size, pixels, > 0.
+    distortion : tuple of 5 floats, optional
+        OpenCV coefficients (k1, k2, p1, p2, k3); None for an ideal pinhole.
+    """
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+    distortion: tuple[float, float, float, float, float] | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("fx", "fy"):
+            value = finite_float(getattr(self, name), f"CameraIntrinsics.{name}")
+            if value <= 0.0:
+                raise InputError(f"CameraIntrinsics.{name}: expected a positive focal length, got {value}")
+            object.__setattr__(self, name, value)
+        for name in ("cx", "cy"):
+            object.__setattr__(self, name, finite_float(getattr(self, name), f"CameraIntrinsics.{name}"))
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
+                raise InputError(f"CameraIntrinsics.{name}: expected a positive integer, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if self.distortion is not None:
+            coefficients = float_array(self.distortion, "CameraIntrinsics.distortion")
+            if coefficients.shape != (5,):
+                raise InputError(
+                    f"CameraIntrinsics.distortion: expected 5 coefficients (k1, k2, p1, p2, k3), "
+                    f"got shape {coefficients.shape}"
+                )
+            k1, k2, p1, p2, k3 = (float(c) for c in coefficients)
+            object.__setattr__(self, "distortion", (k1, k2, p1, p2, k3))
+
+    def matrix(self) -> Array:
+        """Return the 3x3 camera matrix K."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+
+@dataclass(frozen=True, slots=True)
+class CameraMount:
+    """Where the camera sits on the robot and where it points.
+
+    Parameters
+    ----------
+    height : float
+        Optical centre above the ground plane, metres.
+    forward, left : float
+        Optical centre's offset from the robot's reference point, metres (robot frame).
+    pan : float
+        Radians, counter-clockwise positive (towards the robot's left).
+    tilt : float
+        Radians, positive when the optical axis points below the horizon; |tilt| < pi/2.
+    """
+
+    height: float
+    forward: float = 0.0
+    left: float = 0.0
+    pan: float = 0.0
+    tilt: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("height", "forward", "left", "pan", "tilt"):
+            object.__setattr__(self, name, finite_float(getattr(self, name), f"CameraMount.{name}"))
+        if abs(self.tilt) >= math.pi / 2:
+            raise InputError(f"CameraMount.tilt: expected |tilt| < pi/2, got {self.tilt}")
+
+    @property
+    def sensor_offset(self) -> tuple[float, float]:
+        """(forward, left) of the optical centre in the robot frame, metres."""
+        return (self.forward, self.left)
+
+    def rotation(self) -> Array:
+        """Rotation from camera to robot axes (columns: camera x, y, z in the robot frame)."""
+        return robot_from_camera_rotation(self.pan, self.tilt)
+
+
+@dataclass(frozen=True, slots=True)
+class Camera:
+    """A calibrated camera on its mount.
+
+    Examples
+    --------
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(height=1.0))
+    >>> camera.project(Pose(0, 0, 0), [(10.0, 0.0, 1.0), (-10.0, 0.0, 1.0)]).tolist()
+    [[320.0, 240.0], [nan, nan]]
+    """
+
+    intrinsics: CameraIntrinsics
+    mount: CameraMount
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.intrinsics, CameraIntrinsics):
+            raise InputError(f"intrinsics: expected CameraIntrinsics, got {type(self.intrinsics).__name__}")
+        if not isinstance(self.mount, CameraMount):
+            raise InputError(f"mount: expected CameraMount, got {type(self.mount).__name__}")
+
+    def to_camera_frame(self, poses: ArrayLike, points_world: ArrayLike) -> Array:
+        """Return world points in the camera frame for each robot pose.
+
+        Parameters
+        ----------
+        poses : array_like, shape (m, 3) or (3,)
+            Robot poses: x (m), y (m), heading (rad).
+        points_world : array_like, shape (n, 3)
+            World points, metres.
+
+        Returns
+        -------
+        ndarray, shape (m, n, 3)
+            Camera-frame coordinates (x right, y down, z forward), metres.
+        """
+        state = float_array(poses, "poses").reshape(-1, 3)
+        points = float_array(points_world, "points_world")
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise InputError(f"points_world: expected shape (n, 3), got {points.shape}")
+        cos_h = np.cos(state[:, 2])[:, None]
+        sin_h = np.sin(state[:, 2])[:, None]
+        dx = points[None, :, 0] - state[:, 0, None]
+        dy = points[None, :, 1] - state[:, 1, None]
+        robot = np.empty((len(state), len(points), 3))
+        robot[..., 0] = cos_h * dx + sin_h * dy - self.mount.forward
+        robot[..., 1] = -sin_h * dx + cos_h * dy - self.mount.left
+        robot[..., 2] = points[None, :, 2] - self.mount.height
+        return np.asarray(robot @ self.mount.rotation(), dtype=np.float64)
+
+    def project_camera_frame(self, points_camera: ArrayLike) -> Array:
+        """Project camera-frame points ``(..., 3)`` to pixels ``(..., 2)``; NaN behind the camera."""
+        pts = np.asarray(points_camera, dtype=np.float64)
+        z = pts[..., 2]
+        in_front = z > NEAR_PLANE
+        with np.errstate(invalid="ignore", divide="ignore"):
+            x = np.where(in_front, pts[..., 0] / z, np.nan)
+            y = np.where(in_front, pts[..., 1] / z, np.nan)
+        k = self.intrinsics
+        if k.distortion is not None:
+            x, y = distort(x, y, k.distortion)
+        return np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1)
+
+    def project(self, pose: Pose | ArrayLike, points_world: ArrayLike) -> Array:
+        """Project world points ``(n, 3)`` (m) seen from a robot pose to pixels ``(n, 2)``.
+
+        Points behind the camera give NaN. ``pose`` may also be an ``(m, 3)`` array of
+        poses, giving an ``(m, n, 2)`` array.
+        """
+        if isinstance(pose, Pose):
+            return self.project_camera_frame(self.to_camera_frame(pose.as_array(), points_world))[0]
+        state = float_array(pose, "pose")
+        pixels = self.project_camera_frame(self.to_camera_frame(state, points_world))
+        return np.asarray(pixels[0] if state.ndim == 1 else pixels, dtype=np.float64)
