@@ -205,7 +205,7 @@ class Camera:
         k = self.intrinsics
         if k.distortion is not None:
             x, y = distort(x, y, k.distortion)
-        return np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1)
+        return np.asarray(np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1), dtype=np.float64)
 
     def project(self, pose: Pose | ArrayLike, points_world: ArrayLike) -> Array:
         """Project world points ``(n, 3)`` (m) seen from a robot pose to pixels ``(n, 2)``.
@@ -214,7 +214,8 @@ class Camera:
         poses, giving an ``(m, n, 2)`` array.
         """
         if isinstance(pose, Pose):
-            return self.project_camera_frame(self.to_camera_frame(pose.as_array(), points_world))[0]
+            pixels = self.project_camera_frame(self.to_camera_frame(pose.as_array(), points_world))
+            return np.asarray(pixels[0], dtype=np.float64)
         state = float_array(pose, "pose")
         pixels = self.project_camera_frame(self.to_camera_frame(state, points_world))
         return np.asarray(pixels[0] if state.ndim == 1 else pixels, dtype=np.float64)
