@@ -39,6 +39,8 @@ def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[n
         array = np.array(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name}: expected an (n, 2) array of numbers, got {value!r}") from exc
+    if array.size == 0:
+        array = array.reshape(0, 2)
     if array.ndim == 1 and array.shape == (2,):
         array = array.reshape(1, 2)
     if array.ndim != 2 or array.shape[1] != 2:

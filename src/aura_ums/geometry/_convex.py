@@ -23,6 +23,12 @@ ARC_STEP = math.pi / 16
 # Relative size below which a cross product counts as zero (a straight vertex).
 _COLLINEAR_EPS = 1e-12
 
+# Angular widths below this (radians) are a single direction.
+_TINY_ANGLE = 1e-12
+
+# Vertices closer than this fraction of the polygon's extent are merged.
+_MERGE_EPS = 1e-12
+
 # Point sets larger than this are thinned by Qhull before the exact monotone chain.
 _QHULL_PREFILTER = 200
 
@@ -46,35 +52,57 @@ def polygon_area(vertices: Array) -> float:
     """
     if len(vertices) < 3:
         return 0.0
-    x = vertices[:, 0]
-    y = vertices[:, 1]
+    # Relative to the first vertex: a small polygon far from the origin would
+    # otherwise lose its whole area to cancellation.
+    x = vertices[:, 0] - vertices[0, 0]
+    y = vertices[:, 1] - vertices[0, 1]
     return float(0.5 * (np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
 def remove_collinear(vertices: Array) -> Array:
-    """Drop repeated and straight (180 degree) vertices of a convex polygon."""
+    """Drop repeated, nearly coincident and straight (180 degree) vertices of a convex polygon.
+
+    Vertices closer than 1e-12 of the polygon's extent are merged: their rounding
+    noise would otherwise read as a reflex corner.
+    """
     n = len(vertices)
-    if n < 3:
-        if n == 2 and np.array_equal(vertices[0], vertices[1]):
-            return vertices[:1].copy()
+    if n < 2:
         return vertices
+    span = float(np.max(np.ptp(vertices, axis=0)))
     following = np.roll(vertices, -1, axis=0) - vertices
-    preceding = np.roll(following, 1, axis=0)
     length = np.hypot(following[:, 0], following[:, 1])
-    keep = length > 0.0
+    keep = length > _MERGE_EPS * span
     if not np.all(keep):
+        if not np.any(keep):
+            return vertices[:1].copy()
         vertices = vertices[keep]
         if len(vertices) < 3:
-            return remove_collinear(vertices)
+            return vertices
         following = np.roll(vertices, -1, axis=0) - vertices
-        preceding = np.roll(following, 1, axis=0)
         length = np.hypot(following[:, 0], following[:, 1])
-    scale = length * np.roll(length, 1)
+    if len(vertices) < 3:
+        return vertices
+    preceding = np.roll(following, 1, axis=0)
     turn = cross2(preceding, following)
-    straight = (np.abs(turn) <= _COLLINEAR_EPS * scale) & (np.einsum("ij,ij->i", preceding, following) > 0)
+    straight = (np.abs(turn) <= _cross_noise(vertices, length, np.roll(length, 1))) & (
+        np.einsum("ij,ij->i", preceding, following) > 0
+    )
     if np.any(straight):
         vertices = vertices[~straight]
     return vertices
+
+
+def _cross_noise(vertices: Array, length: Array, preceding_length: Array) -> Array:
+    """Return the size below which a corner's cross product is rounding noise.
+
+    The cross product of two edges carries rounding error proportional to the
+    coordinates' magnitude times the edge lengths, not only to the edge lengths.
+    """
+    magnitude = float(np.max(np.abs(vertices)))
+    return np.asarray(
+        _COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length),
+        dtype=np.float64,
+    )
 
 
 def convex_hull(points: Array) -> Array:
@@ -181,7 +209,7 @@ def clip_halfplane(vertices: Array, normal: Array, offset: float) -> Array:
     signed_following = np.roll(signed, -1)
     crossing = inside != (signed_following <= 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        t = signed / (signed - signed_following)
+        t = np.where(crossing, signed / (signed - signed_following), 0.0)
     cut = vertices + t[:, None] * (following - vertices)
     candidates = np.stack([vertices, cut], axis=1).reshape(-1, 2)
     mask = np.stack([inside, crossing], axis=1).reshape(-1)
@@ -244,7 +272,8 @@ def outer_annular_sector(
         return np.zeros((1, 2))
     if width >= TWO_PI:
         return outer_disk(np.zeros(2), outer, sides=32)
-    if width <= 0.0:
+    if width <= _TINY_ANGLE:
+        # Narrower than rounding can resolve at any sensible radius: a single ray.
         direction = np.array([math.cos(start), math.sin(start)])
         if inner >= outer:
             return (outer * direction).reshape(1, 2)
@@ -341,8 +370,10 @@ def convexity_defect(vertices: Array) -> str | None:
     angle = np.where((np.abs(turn) <= _COLLINEAR_EPS * scale) & (dot < 0.0), math.pi, angle)
     if polygon_area(vertices) < 0.0:
         return "clockwise order (reverse the vertices, or use ConvexPolygon.from_points)"
-    if np.any(turn < -1e-9 * scale):
-        bad = int(np.flatnonzero(turn < -1e-9 * scale)[0])
+    lengths = np.hypot(*edge.T)
+    reflex = turn < -(1e-9 * scale + 1e3 * _cross_noise(vertices, lengths, np.roll(lengths, 1)))
+    if np.any(reflex):
+        bad = int(np.flatnonzero(reflex)[0])
         return f"a reflex (non-convex) corner at vertex {bad} {vertices[bad].tolist()}"
     if abs(float(np.sum(angle)) - TWO_PI) > 1e-6:
         return "a boundary that winds around more than once"

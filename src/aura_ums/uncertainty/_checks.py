@@ -78,7 +78,7 @@ def simulate_containment(
 
     Examples
     --------
-    >>> from aura_ums.uncertainty import TerrainTable
+    >>> from aura_ums.uncertainty import Pose, TerrainTable
     >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.0, 0.0)
     >>> moves = [(TurnAndRun(0.5, 3.0), TerrainTable.default()["grass"])] * 3
     >>> simulate_containment(start, moves, np.random.default_rng(1), truncate=3.0).rate
@@ -145,7 +145,7 @@ def growth_tightness(
 
     Examples
     --------
-    >>> from aura_ums.uncertainty import TerrainTable
+    >>> from aura_ums.uncertainty import Pose, TerrainTable
     >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.0, 0.0)
     >>> result = growth_tightness(start, TurnAndRun(0.8, 9.0), TerrainTable.default()["tile"],
     ...                           np.random.default_rng(0), samples=5000)

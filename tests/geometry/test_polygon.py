@@ -1,0 +1,331 @@
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from numpy.typing import NDArray
+
+from aura_ums import ConvexPolygon, InputError
+from aura_ums.geometry import (
+    clip_halfplane,
+    convex_hull,
+    minkowski_sum,
+    outer_annular_sector,
+    outer_arc,
+    outer_disk,
+    polygon_area,
+    regular_polygon,
+    simplify_outer,
+)
+from aura_ums.geometry._convex import convexity_defect
+
+SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
+
+point_clouds = arrays(
+    np.float64,
+    st.tuples(st.integers(1, 30), st.just(2)),
+    elements=st.floats(min_value=-100, max_value=100, allow_nan=False, width=32),
+)
+
+
+def random_polygon(rng: np.random.Generator, count: int = 12, scale: float = 5.0) -> NDArray[np.float64]:
+    return convex_hull(rng.normal(0.0, scale, (count, 2)) * rng.uniform(0.1, 1.0, 2))
+
+
+def assert_convex_ccw(vertices: NDArray[np.float64]) -> None:
+    assert convexity_defect(vertices) is None
+
+
+# --- construction and validation ---------------------------------------------------------
+
+
+def test_square_basics() -> None:
+    square = ConvexPolygon(SQUARE)
+    assert square.area == 4.0
+    assert square.vertex_count == 4
+    assert square.bounds == (0.0, 0.0, 2.0, 2.0)
+    assert np.allclose(square.centroid, [1.0, 1.0])
+    assert not square.vertices.flags.writeable
+
+
+def test_closing_vertex_of_a_geojson_ring_is_dropped() -> None:
+    assert ConvexPolygon([*SQUARE, SQUARE[0]]).vertex_count == 4
+
+
+def test_degenerate_point_and_segment_are_valid() -> None:
+    point = ConvexPolygon([(1.0, 2.0)])
+    assert point.area == 0.0
+    assert point.contains([(1.0, 2.0), (1.0, 2.1)]).tolist() == [True, False]
+    segment = ConvexPolygon([(0.0, 0.0), (2.0, 0.0)])
+    assert segment.contains([(1.0, 0.0), (3.0, 0.0), (1.0, 0.1)]).tolist() == [True, False, False]
+    assert np.allclose(segment.centroid, [1.0, 0.0])
+
+
+def test_collinear_vertices_are_removed() -> None:
+    polygon = ConvexPolygon([(0, 0), (1, 0), (2, 0), (2, 2), (0, 2)])
+    assert polygon.vertex_count == 4
+
+
+@pytest.mark.parametrize(
+    ("vertices", "message"),
+    [
+        (list(reversed(SQUARE)), r"expected a convex counter-clockwise polygon, got clockwise order"),
+        ([(0, 0), (2, 0), (1, 0.5), (2, 2), (0, 2)], r"got a reflex \(non-convex\) corner at vertex 2"),
+        ([(0, 0), (float("nan"), 0), (1, 1)], r"expected finite coordinates, got \[nan, 0.0\] at row 1"),
+        ([], r"expected at least 1 points, got 0"),
+        ([(0, 0, 0)], r"expected an \(n, 2\) array, got shape \(1, 3\)"),
+        ("abc", r"expected an \(n, 2\) array of numbers"),
+    ],
+)
+def test_bad_polygons_are_refused(vertices: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        ConvexPolygon(vertices)  # type: ignore[arg-type]
+
+
+def test_a_pentagram_is_refused() -> None:
+    angles = np.arange(5) * 4 * math.pi / 5
+    with pytest.raises(InputError, match=r"winds around more than once"):
+        ConvexPolygon(np.column_stack([np.cos(angles), np.sin(angles)]))
+
+
+def test_from_points_takes_the_hull_of_anything() -> None:
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(500, 2))
+    polygon = ConvexPolygon.from_points(points)
+    assert np.all(polygon.contains(points))
+    assert math.isclose(polygon.area, shapely.MultiPoint(points).convex_hull.area, rel_tol=1e-12)
+
+
+@given(point_clouds)
+def test_hull_is_convex_ccw_and_contains_its_points(points: NDArray[np.float64]) -> None:
+    hull = convex_hull(points)
+    assert_convex_ccw(hull)
+    assert np.all(ConvexPolygon._trusted(hull).contains(points, tolerance=1e-6))
+    expected = shapely.MultiPoint(points).convex_hull.area
+    assert math.isclose(polygon_area(hull), expected, rel_tol=1e-9, abs_tol=1e-6)
+
+
+def test_hull_of_collinear_points_is_a_segment() -> None:
+    assert convex_hull(np.array([[0.0, 0.0], [1.0, 1.0], [3.0, 3.0], [2.0, 2.0]])).shape == (2, 2)
+    assert convex_hull(np.array([[5.0, 5.0]] * 4)).shape == (1, 2)
+    many = np.column_stack([np.linspace(0, 1, 500), np.linspace(0, 2, 500)])
+    assert convex_hull(many).shape == (2, 2)  # Qhull fails on these; the exact chain does not
+
+
+# --- containment --------------------------------------------------------------------------
+
+
+def test_contains_matches_shapely_away_from_the_boundary() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        polygon = ConvexPolygon._trusted(random_polygon(rng))
+        points = rng.normal(0.0, 6.0, (400, 2))
+        reference = shapely.contains_xy(polygon.to_shapely(), points[:, 0], points[:, 1])
+        distance = shapely.distance(shapely.Polygon(polygon.vertices).exterior, shapely.points(points))
+        clear = distance > 1e-6
+        assert np.array_equal(polygon.contains(points)[clear], reference[clear])
+
+
+def test_boundary_and_vertices_count_as_inside() -> None:
+    square = ConvexPolygon(SQUARE)
+    assert np.all(square.contains([(0, 0), (1, 0), (2, 2), (0, 1.5)]))
+    assert not square.contains([(2.0 + 1e-6, 1.0)])[0]
+
+
+def test_distance() -> None:
+    square = ConvexPolygon(SQUARE)
+    assert square.distance([(1, 1), (3, 1), (3, 3)]).tolist() == pytest.approx([0.0, 1.0, math.sqrt(2)])
+
+
+# --- Minkowski sum ---------------------------------------------------------------------------
+
+
+@given(point_clouds, point_clouds)
+def test_minkowski_sum_equals_hull_of_pairwise_sums(a: NDArray[np.float64], b: NDArray[np.float64]) -> None:
+    pa, pb = convex_hull(a), convex_hull(b)
+    result = minkowski_sum(pa, pb)
+    assert_convex_ccw(result)
+    brute = convex_hull((pa[:, None, :] + pb[None, :, :]).reshape(-1, 2))
+    assert math.isclose(polygon_area(result), polygon_area(brute), rel_tol=1e-9, abs_tol=1e-6)
+    assert np.all(ConvexPolygon._trusted(result).contains(brute, tolerance=1e-6))
+
+
+def test_minkowski_sum_with_points_and_segments() -> None:
+    square = np.array(SQUARE, dtype=float)
+    shifted = minkowski_sum(square, np.array([[1.0, -1.0]]))
+    assert polygon_area(shifted) == 4.0
+    assert np.allclose(shifted.min(axis=0), [1.0, -1.0])
+    capsule = minkowski_sum(np.array([[0.0, 0.0], [3.0, 0.0]]), np.array([[0.0, 0.0], [0.0, 1.0]]))
+    assert polygon_area(capsule) == pytest.approx(3.0)
+    assert minkowski_sum(np.array([[1.0, 1.0]]), np.array([[2.0, 3.0]])).tolist() == [[3.0, 4.0]]
+
+
+# --- half-plane clipping -----------------------------------------------------------------------
+
+
+def test_clip_matches_shapely() -> None:
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        vertices = random_polygon(rng)
+        angle = rng.uniform(-math.pi, math.pi)
+        normal = np.array([math.cos(angle), math.sin(angle)])
+        offset = rng.normal(0.0, 3.0)
+        clipped = clip_halfplane(vertices, normal, offset)
+        far = 1e4
+        tangent = np.array([-normal[1], normal[0]])
+        base = normal * offset
+        halfplane = shapely.Polygon(
+            [
+                base - far * tangent,
+                base + far * tangent,
+                base + far * tangent - far * normal,
+                base - far * tangent - far * normal,
+            ]
+        )
+        expected = shapely.Polygon(vertices).intersection(halfplane).area
+        if len(clipped) == 0:
+            assert expected < 1e-9
+        else:
+            assert_convex_ccw(clipped)
+            assert math.isclose(polygon_area(clipped), expected, rel_tol=1e-9, abs_tol=1e-9)
+
+
+def test_clip_to_nothing_and_to_everything() -> None:
+    square = np.array(SQUARE, dtype=float)
+    assert clip_halfplane(square, np.array([0.0, 1.0]), -1.0).shape == (0, 2)
+    assert clip_halfplane(square, np.array([0.0, 1.0]), 5.0) is square
+    assert ConvexPolygon(SQUARE).clipped((1, 0), -3) is None
+
+
+def test_clip_a_segment_and_a_point() -> None:
+    segment = np.array([[0.0, 0.0], [2.0, 0.0]])
+    assert clip_halfplane(segment, np.array([1.0, 0.0]), 1.0).tolist() == [[0.0, 0.0], [1.0, 0.0]]
+    assert clip_halfplane(np.array([[0.0, 0.0]]), np.array([1.0, 0.0]), -1.0).shape == (0, 2)
+
+
+def test_clipped_refuses_a_zero_normal() -> None:
+    with pytest.raises(InputError, match=r"normal: expected a non-zero vector"):
+        ConvexPolygon(SQUARE).clipped((0, 0), 1.0)
+
+
+def test_intersection_of_polygons() -> None:
+    a = ConvexPolygon(SQUARE)
+    b = a.translated(1.0, 1.0)
+    both = a.intersection(b)
+    assert both is not None
+    assert both.area == pytest.approx(1.0)
+    assert a.intersection(a.translated(5.0, 0.0)) is None
+    touching_segment = a.intersection(ConvexPolygon([(1.0, -1.0), (1.0, 3.0)]))
+    assert touching_segment is not None
+    assert touching_segment.area == 0.0
+
+
+# --- outer polygons of arcs -------------------------------------------------------------------------
+
+
+@given(
+    st.floats(min_value=0.01, max_value=100.0),
+    st.floats(min_value=-10.0, max_value=10.0),
+    st.floats(min_value=1e-4, max_value=2 * math.pi - 1e-3),
+)
+def test_outer_arc_region_contains_the_arc(radius: float, start: float, width: float) -> None:
+    polyline = outer_arc(radius, start, start + width)
+    region = ConvexPolygon._trusted(convex_hull(np.vstack([polyline, np.zeros((1, 2))])))
+    t = np.linspace(start, start + width, 2000)
+    arc = radius * np.column_stack([np.cos(t), np.sin(t)])
+    if width <= math.pi:
+        assert np.all(region.contains(arc, tolerance=1e-9 * radius + 1e-12))
+    # Every arc point lies within the polyline's reach of the origin.
+    assert np.max(np.hypot(*polyline.T)) <= radius / math.cos(math.pi / 32) * (1 + 1e-12)
+
+
+# Radii are either exactly zero or physically sized: subnormal radii underflow in products.
+radii = st.one_of(st.just(0.0), st.floats(min_value=1e-6, max_value=50.0))
+
+
+@given(
+    radii,
+    radii,
+    st.floats(min_value=-10.0, max_value=10.0),
+    st.one_of(st.just(0.0), st.floats(min_value=1e-9, max_value=7.0)),
+)
+def test_outer_annular_sector_contains_the_sector(a: float, b: float, start: float, width: float) -> None:
+    inner, outer = min(a, b), max(a, b)
+    vertices = outer_annular_sector(inner, outer, start, start + width)
+    assert_convex_ccw(vertices)
+    rng = np.random.default_rng(0)
+    radius = rng.uniform(inner, outer, 3000)
+    radius[:4] = [inner, outer, inner, outer]
+    angle = rng.uniform(start, start + width, 3000)
+    angle[:4] = [start, start, start + width, start + width]
+    points = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+    assert np.all(ConvexPolygon._trusted(vertices).contains(points, tolerance=1e-9 * max(outer, 1.0)))
+
+
+def test_outer_disk_contains_the_disk_and_is_tight() -> None:
+    disk = ConvexPolygon.disk((1.0, 2.0), 3.0, sides=16)
+    t = np.linspace(0, 2 * math.pi, 1000)
+    assert np.all(disk.contains(np.column_stack([1 + 3 * np.cos(t), 2 + 3 * np.sin(t)])))
+    assert disk.area / (math.pi * 9) < 1.03
+    assert outer_disk(np.zeros(2), 0.0).shape == (1, 2)
+    with pytest.raises(InputError, match=r"radius: expected a non-negative number"):
+        ConvexPolygon.disk((0, 0), -1.0)
+
+
+# --- outer simplification ---------------------------------------------------------------------------
+
+
+@given(st.integers(3, 40), st.integers(0, 10_000))
+def test_simplify_outer_contains_original_and_respects_the_cap(cap: int, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    vertices = random_polygon(rng, count=int(rng.integers(3, 200)))
+    simplified = simplify_outer(vertices, cap)
+    assert len(simplified) <= max(cap, 3) or len(simplified) == len(vertices)
+    assert_convex_ccw(simplified)
+    assert np.all(ConvexPolygon._trusted(simplified).contains(vertices, tolerance=1e-7))
+
+
+def test_simplify_outer_adds_little_area_to_a_smooth_shape() -> None:
+    circle = regular_polygon((0.0, 0.0), 10.0, 256)
+    simplified = circle.simplified_outer(32)
+    assert simplified.vertex_count <= 32
+    assert simplified.area / circle.area < 1.02
+    with pytest.raises(InputError, match=r"max_vertices: expected at least 3"):
+        circle.simplified_outer(2)
+
+
+def test_simplify_leaves_a_triangle_alone() -> None:
+    triangle = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    assert np.array_equal(simplify_outer(triangle, 3), triangle)
+
+
+# --- sampling and interop ----------------------------------------------------------------------------
+
+
+def test_samples_are_inside_and_uniform() -> None:
+    rng = np.random.default_rng(1)
+    square = ConvexPolygon(SQUARE)
+    samples = square.sample(40_000, rng)
+    assert np.all(square.contains(samples))
+    left = np.mean(samples[:, 0] < 1.0)
+    assert abs(left - 0.5) < 0.01
+    assert ConvexPolygon([(1.0, 1.0)]).sample(3, rng).tolist() == [[1.0, 1.0]] * 3
+    on_segment = ConvexPolygon([(0.0, 0.0), (4.0, 0.0)]).sample(100, rng)
+    assert np.all(on_segment[:, 1] == 0.0)
+    assert np.all((on_segment[:, 0] >= 0.0) & (on_segment[:, 0] <= 4.0))
+
+
+def test_shapely_round_trip_and_equality() -> None:
+    square = ConvexPolygon(SQUARE)
+    assert ConvexPolygon.from_shapely(square.to_shapely()).area == 4.0
+    assert ConvexPolygon([(1.0, 1.0)]).to_shapely().geom_type == "Point"
+    assert ConvexPolygon([(0, 0), (1, 1)]).to_shapely().geom_type == "LineString"
+    assert square == ConvexPolygon(SQUARE)
+    assert square != square.translated(0.1, 0.0)
+    with pytest.raises(InputError, match=r"expected a non-empty shapely geometry"):
+        ConvexPolygon.from_shapely(shapely.Polygon())

@@ -1,0 +1,110 @@
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from aura_ums import HeadingWedge, InputError
+
+angles = st.floats(min_value=-4 * math.pi, max_value=4 * math.pi, allow_nan=False)
+extents = st.floats(min_value=0.0, max_value=3.5, allow_nan=False)
+
+
+def test_wedge_across_the_seam() -> None:
+    wedge = HeadingWedge(math.pi - 0.05, cw=0.1, ccw=0.2)
+    assert wedge.contains(math.pi)
+    assert wedge.contains(-math.pi)
+    assert wedge.contains(-math.pi + 0.14)
+    assert not wedge.contains(-math.pi + 0.16)
+    assert wedge.contains(math.pi - 0.15)
+    assert not wedge.contains(math.pi - 0.16)
+    assert math.isclose(wedge.width, 0.3)
+
+
+def test_lo_hi_are_wrapped() -> None:
+    wedge = HeadingWedge(3.0, cw=0.1, ccw=0.5)
+    assert math.isclose(wedge.lo, 2.9)
+    assert math.isclose(wedge.hi, 3.5 - 2 * math.pi)
+
+
+def test_full_circle_contains_everything() -> None:
+    wedge = HeadingWedge(0.3, cw=4.0, ccw=3.0)
+    assert wedge.is_full_circle
+    assert wedge.width == 2 * math.pi
+    assert np.all(wedge.contains(np.linspace(-10, 10, 101)))
+    assert HeadingWedge.full_circle().is_full_circle
+
+
+def test_zero_width_wedge_holds_its_centre_only() -> None:
+    wedge = HeadingWedge(1.0, 0.0, 0.0)
+    assert wedge.contains(1.0)
+    assert wedge.contains(1.0 + 2 * math.pi)
+    assert not wedge.contains(1.0 + 1e-6)
+
+
+def test_contains_returns_bool_for_scalars_and_arrays_for_arrays() -> None:
+    wedge = HeadingWedge(0.0, 0.1, 0.1)
+    assert wedge.contains(0.0) is True
+    result = wedge.contains(np.array([[0.0, 1.0]]))
+    assert isinstance(result, np.ndarray)
+    assert result.shape == (1, 2)
+
+
+@given(angles, extents, extents, st.floats(min_value=0.0, max_value=1.0), st.integers(-3, 3))
+def test_every_heading_between_lo_and_hi_is_inside_at_any_winding(
+    center: float, cw: float, ccw: float, fraction: float, turns: int
+) -> None:
+    wedge = HeadingWedge(center, cw, ccw)
+    heading = center - cw + fraction * (cw + ccw) + turns * 2 * math.pi
+    assert wedge.contains(heading)
+
+
+@given(angles, extents, extents, st.floats(min_value=1e-6, max_value=1.0))
+def test_headings_outside_are_refused(center: float, cw: float, ccw: float, fraction: float) -> None:
+    wedge = HeadingWedge(center, cw, ccw)
+    gap = 2 * math.pi - (cw + ccw)
+    if gap <= 1e-6:
+        assert wedge.is_full_circle or wedge.contains(center + ccw + fraction * gap)
+        return
+    outside = center + ccw + 1e-7 + fraction * (gap - 2e-7)
+    assert not wedge.contains(outside)
+
+
+@given(angles, extents, extents)
+def test_extents_stay_non_negative_and_centre_wrapped(center: float, cw: float, ccw: float) -> None:
+    wedge = HeadingWedge(center, cw, ccw).widened(0.1, 0.2).rotated(5.0)
+    assert wedge.cw >= 0
+    assert wedge.ccw >= 0
+    assert -math.pi < wedge.center <= math.pi
+    assert wedge.contains(wedge.center)
+
+
+def test_from_bounds_across_seam_and_with_centre() -> None:
+    wedge = HeadingWedge.from_bounds(3.0, -3.0)
+    assert math.isclose(wedge.width, 2 * math.pi - 6.0)
+    assert wedge.contains(math.pi)
+    off_centre = HeadingWedge.from_bounds(3.0, -3.0, center=3.1)
+    assert math.isclose(off_centre.cw, 0.1)
+    with pytest.raises(InputError, match=r"center: expected a heading inside"):
+        HeadingWedge.from_bounds(0.0, 1.0, center=2.0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"center": float("nan"), "cw": 0.1, "ccw": 0.1}, r"HeadingWedge.center: expected a finite number"),
+        ({"center": 0.0, "cw": -0.1, "ccw": 0.1}, r"HeadingWedge.cw: expected a non-negative number"),
+        ({"center": 0.0, "cw": 0.1, "ccw": float("inf")}, r"HeadingWedge.ccw: expected a finite number"),
+    ],
+)
+def test_bad_wedges_are_refused(kwargs: dict[str, float], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        HeadingWedge(**kwargs)
+
+
+def test_contains_refuses_nan() -> None:
+    with pytest.raises(InputError, match=r"heading: expected finite numbers"):
+        HeadingWedge(0.0, 0.1, 0.1).contains(float("nan"))

@@ -1,0 +1,45 @@
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from aura_ums import FOOT, InputError, Pose, TurnAndRun
+
+
+def test_pose_wraps_heading_and_converts() -> None:
+    pose = Pose(1, 2, -3 * math.pi / 2)
+    assert pose.heading == pytest.approx(math.pi / 2)
+    assert pose.as_array().tolist() == pytest.approx([1.0, 2.0, math.pi / 2])
+    assert isinstance(pose.x, float)
+
+
+def test_foot_is_exact() -> None:
+    assert FOOT == 0.3048
+
+
+def test_zero_command_is_valid() -> None:
+    assert TurnAndRun(0.0, 0.0) == TurnAndRun(0, 0)
+
+
+@pytest.mark.parametrize(
+    ("turn", "run", "message"),
+    [
+        (float("nan"), 1.0, r"TurnAndRun.turn: expected a finite number, got nan"),
+        (0.0, float("inf"), r"TurnAndRun.run: expected a finite number, got inf"),
+        (0.0, -0.5, r"TurnAndRun.run: expected a non-negative number, got -0.5"),
+        ("1", 1.0, r"TurnAndRun.turn: expected a finite number, got '1'"),
+        (True, 1.0, r"TurnAndRun.turn: expected a finite number, got True"),
+    ],
+)
+def test_bad_commands_are_refused(turn: object, run: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        TurnAndRun(turn, run)  # type: ignore[arg-type]
+
+
+def test_bad_pose_is_refused() -> None:
+    with pytest.raises(InputError, match=r"Pose.y: expected a finite number, got nan"):
+        Pose(0.0, float("nan"), 0.0)
+    with pytest.raises(ValueError, match=r"Pose.heading"):
+        Pose(0.0, 0.0, np.inf)

@@ -1,0 +1,218 @@
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums import (
+    FileFormatError,
+    InputError,
+    Pose,
+    TerrainStats,
+    TerrainTable,
+    TurnAndRun,
+    UnknownTerrainError,
+)
+
+FIELDS = TerrainStats.field_names()
+
+
+def stats(**overrides: float) -> TerrainStats:
+    values = dict.fromkeys(FIELDS, 0.0)
+    values.update(overrides)
+    return TerrainStats(**values)
+
+
+# --- the generative model ----------------------------------------------------------------------
+
+
+def test_mean_translational_loss_matches_the_paper_example(rng: np.random.Generator) -> None:
+    # "if the mean translational loss is 0.10 and the robot is commanded to move 20.0 feet,
+    # the mean distance actually traveled would be 18.0 feet"
+    terrain = stats(translation_loss=0.10, translation_sd=0.02)
+    poses = terrain.sample_motions(np.zeros((50_000, 3)), TurnAndRun(0.0, 20.0), rng)
+    assert np.mean(poses[:, 0]) == pytest.approx(18.0, abs=0.01)
+    assert np.std(poses[:, 0]) == pytest.approx(0.4, rel=0.02)
+
+
+def test_never_farther_or_more_turned_than_commanded(rng: np.random.Generator) -> None:
+    terrain = stats(translation_sd=0.5, rotation_sd=0.5)
+    poses = terrain.sample_motions(np.zeros((20_000, 3)), TurnAndRun(1.0, 10.0), rng)
+    assert np.all(np.hypot(poses[:, 0], poses[:, 1]) <= 10.0 + 1e-12)
+    assert np.all(poses[:, 2] <= 1.0 + 1e-12)
+    assert np.all(poses[:, 2] >= 0.0)
+
+
+def test_inertial_loss_is_independent_of_distance(rng: np.random.Generator) -> None:
+    terrain = stats(translation_inertial_loss=0.25)
+    for run in (1.0, 100.0):
+        pose = terrain.sample_motion(Pose(0, 0, 0), TurnAndRun(0.0, run), rng)
+        assert pose.x == pytest.approx(run - 0.25)
+    # A run shorter than the inertial loss goes nowhere, never backwards.
+    assert terrain.sample_motion(Pose(0, 0, 0), TurnAndRun(0.0, 0.1), rng).x == 0.0
+
+
+def test_rotation_loss_and_skitter(rng: np.random.Generator) -> None:
+    terrain = stats(rotation_loss=0.1, skitter=0.02)
+    poses = terrain.sample_motions(np.zeros((1000, 3)), TurnAndRun(math.pi / 2, 0.0), rng)
+    assert np.allclose(poses[:, 2], 0.9 * math.pi / 2)
+    displacement = np.hypot(poses[:, 0], poses[:, 1])
+    assert np.allclose(displacement, 0.02 * math.pi / 2)
+    # Skitter goes in every direction, so it does not move the mean.
+    assert abs(np.mean(poses[:, 0])) < 0.003
+    assert abs(np.mean(poses[:, 1])) < 0.003
+
+
+def test_drift_bends_the_run_into_an_arc(rng: np.random.Generator) -> None:
+    terrain = stats(drift=0.05)
+    poses = terrain.sample_motions(np.zeros((5000, 3)), TurnAndRun(0.0, 10.0), rng)
+    # Heading change within drift * run either side, spread uniformly.
+    assert np.max(np.abs(poses[:, 2])) <= 0.5 + 1e-12
+    assert np.max(np.abs(poses[:, 2])) > 0.49
+    # The end lies on the arc: the chord subtends half the heading change.
+    assert np.allclose(np.arctan2(poses[:, 1], poses[:, 0]), poses[:, 2] / 2)
+    chord = np.hypot(poses[:, 0], poses[:, 1])
+    assert np.all(chord <= 10.0 + 1e-12)
+    assert np.allclose(chord, 10.0 * np.sinc(poses[:, 2] / (2 * math.pi)))
+
+
+def test_truncation_clips_the_normals(rng: np.random.Generator) -> None:
+    terrain = stats(translation_sd=0.1)
+    poses = terrain.sample_motions(np.zeros((20_000, 3)), TurnAndRun(0.0, 10.0), rng, truncate=1.0)
+    assert np.min(poses[:, 0]) == pytest.approx(9.0)
+    assert np.max(poses[:, 0]) == pytest.approx(10.0)
+    with pytest.raises(InputError, match=r"truncate: expected a positive finite number or None"):
+        terrain.sample_motions(np.zeros((1, 3)), TurnAndRun(0.0, 1.0), rng, truncate=-1.0)
+
+
+def test_same_seed_same_outcome() -> None:
+    terrain = TerrainTable.default()["grass"]
+    a = terrain.sample_motions(np.zeros((10, 3)), TurnAndRun(0.3, 2.0), np.random.default_rng(7))
+    b = terrain.sample_motions(np.zeros((10, 3)), TurnAndRun(0.3, 2.0), np.random.default_rng(7))
+    assert np.array_equal(a, b)
+
+
+def test_sample_motions_checks_its_array(rng: np.random.Generator) -> None:
+    with pytest.raises(InputError, match=r"poses: expected shape \(n, 3\), got \(2, 2\)"):
+        TerrainStats.zero().sample_motions(np.zeros((2, 2)), TurnAndRun(0, 1), rng)
+    with pytest.raises(InputError, match=r"poses: expected finite numbers"):
+        TerrainStats.zero().sample_motions([[0.0, np.nan, 0.0]], TurnAndRun(0, 1), rng)
+
+
+def test_headings_stay_wrapped(rng: np.random.Generator) -> None:
+    poses = TerrainStats.zero().sample_motions([[0.0, 0.0, 3.0]], TurnAndRun(1.0, 0.0), rng)
+    assert poses[0, 2] == pytest.approx(4.0 - 2 * math.pi)
+
+
+# --- validation ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"translation_loss": 1.0}, r"translation_loss: expected a fraction in \[0, 1\), got 1.0"),
+        ({"rotation_loss": -0.1}, r"rotation_loss: expected a fraction in \[0, 1\), got -0.1"),
+        ({"translation_sd": -0.01}, r"translation_sd: expected a non-negative number, got -0.01"),
+        ({"skitter_sd": float("nan")}, r"skitter_sd: expected a finite number, got nan"),
+        ({"drift": float("inf")}, r"drift: expected a finite number, got inf"),
+    ],
+)
+def test_bad_statistics_are_refused(overrides: dict[str, float], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        stats(**overrides)
+
+
+def test_default_table_is_illustrative_and_complete() -> None:
+    table = TerrainTable.default()
+    assert sorted(table) == ["concrete", "grass", "gravel", "tile"]
+    assert len(table) == 4
+    # Rougher terrain loses more.
+    assert table["grass"].translation_sd > table["tile"].translation_sd
+    assert table.get("sand") is None
+    assert "tile" in table
+    with pytest.raises(
+        UnknownTerrainError, match=r"terrain: expected one of concrete, grass, gravel, tile, got 'sand'"
+    ):
+        table["sand"]
+
+
+def test_table_is_read_only() -> None:
+    table = TerrainTable.default()
+    with pytest.raises(TypeError, match=r"does not support item assignment"):
+        table.entries["new"] = TerrainStats.zero()  # type: ignore[index]
+
+
+# --- TOML ------------------------------------------------------------------------------------------------
+
+
+def test_toml_round_trip(tmp_path: Path) -> None:
+    path = tmp_path / "terrain.toml"
+    path.write_text(TerrainTable.default().to_toml())
+    loaded = TerrainTable.from_toml(path)
+    assert dict(loaded) == dict(TerrainTable.default())
+
+
+def test_toml_accepts_degrees_per_metre(tmp_path: Path) -> None:
+    path = tmp_path / "terrain.toml"
+    body = "\n".join(f"{name} = 0.0" for name in FIELDS if name != "drift")
+    path.write_text(f"[carpet]\n{body}\ndrift_deg_per_m = 2.0\n")
+    assert TerrainTable.from_toml(path)["carpet"].drift == pytest.approx(math.radians(2.0))
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    return path
+
+
+def _complete(**overrides: str) -> str:
+    lines = dict.fromkeys(FIELDS, "0.01")
+    lines.update(overrides)
+    return "[tile]\n" + "\n".join(f"{key} = {value}" for key, value in lines.items()) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[tile\n", r"bad.toml: expected valid TOML, got"),
+        ("", r"bad.toml: expected at least one terrain table, got none"),
+        ("tile = 3\n", r"bad.toml: \[tile\]: expected a table of statistics, got 3"),
+        (
+            _complete(wheel_slip="0.1"),
+            r"bad.toml: \[tile\] wheel_slip: expected one of translation_loss, .*got unknown key 'wheel_sl",
+        ),
+        (
+            _complete(translation_sd="-0.1"),
+            r"bad.toml: \[tile\] translation_sd: expected a non-negative number, got -0.1",
+        ),
+        (
+            _complete(rotation_loss="1.5"),
+            r"bad.toml: \[tile\] rotation_loss: expected a fraction in \[0, 1\), got 1.5",
+        ),
+        (_complete(drift="nan"), r"bad.toml: \[tile\] drift: expected a finite number, got nan"),
+        (_complete(skitter='"much"'), r"bad.toml: \[tile\] skitter: expected a finite number, got 'much'"),
+        (
+            _complete(drift_deg_per_m="1.0"),
+            r"bad.toml: \[tile\] drift_deg_per_m: expected drift once, got it twice",
+        ),
+        (
+            "[tile]\ntranslation_loss = 0.1\n",
+            r"bad.toml: \[tile\]: expected keys translation_inertial_loss, .*got none for them",
+        ),
+    ],
+)
+def test_malformed_toml_names_file_terrain_and_key(tmp_path: Path, text: str, message: str) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        TerrainTable.from_toml(_write(tmp_path, text))
+
+
+def test_missing_file_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(FileFormatError, match=r"nope.toml: expected a readable TOML file, got No such file"):
+        TerrainTable.from_toml(tmp_path / "nope.toml")
+
+
+def test_file_errors_are_value_errors_too(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"expected valid TOML"):
+        TerrainTable.from_toml(_write(tmp_path, "= 1"))
