@@ -14,7 +14,8 @@ import aura_ums as ums
 
 settings.register_profile("ci", max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile("dev", max_examples=50, deadline=None)
-settings.load_profile("ci" if os.environ.get("CI") else "dev")
+settings.register_profile("thorough", max_examples=1000, deadline=None)
+settings.load_profile(os.environ.get("AURA_HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "dev"))
 
 #: Where the published datasets live (never copied into the repository).
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

@@ -59,6 +59,15 @@ class HeadingWedge:
         object.__setattr__(self, "ccw", ccw)
 
     @classmethod
+    def _trusted(cls, center: float, cw: float, ccw: float) -> HeadingWedge:
+        """Build from values the library computed: finite, extents >= 0; wraps the centre."""
+        wedge = object.__new__(cls)
+        object.__setattr__(wedge, "center", wrap_angle(center))
+        object.__setattr__(wedge, "cw", cw)
+        object.__setattr__(wedge, "ccw", ccw)
+        return wedge
+
+    @classmethod
     def full_circle(cls, center: float = 0.0) -> HeadingWedge:
         """Return the wedge of every heading, with the given most probable heading."""
         return cls(center, math.pi, math.pi)
