@@ -4,6 +4,7 @@ This package imports nothing else of aura-ums but its validation and errors.
 """
 
 from aura_ums.geometry._angles import angle_difference, wrap_angle
+from aura_ums.geometry._arcs import intersect_arcs, subtended_arc
 from aura_ums.geometry._convex import (
     clip_halfplane,
     convex_hull,
@@ -25,6 +26,7 @@ __all__ = [
     "angle_difference",
     "clip_halfplane",
     "convex_hull",
+    "intersect_arcs",
     "minkowski_sum",
     "outer_annular_sector",
     "outer_arc",
@@ -32,5 +34,6 @@ __all__ = [
     "polygon_area",
     "regular_polygon",
     "simplify_outer",
+    "subtended_arc",
     "wrap_angle",
 ]

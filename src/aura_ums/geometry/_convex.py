@@ -23,6 +23,9 @@ ARC_STEP = math.pi / 16
 # Relative size below which a cross product counts as zero (a straight vertex).
 _COLLINEAR_EPS = 1e-12
 
+# Cut parameters this close to an edge's end are that end.
+_SAME_POINT = 1e-12
+
 # Edge directions closer than this (radians) are joined into one edge.
 _PARALLEL_EPS = 1e-12
 
@@ -239,16 +242,58 @@ def minkowski_sum(*polygons: Array) -> Array:
 def clip_halfplane(vertices: Array, normal: Array, offset: float) -> Array:
     """Return the part of a convex polygon where ``normal . p <= offset``.
 
-    Returns an empty ``(0, 2)`` array when nothing is left.
+    A line meets a convex polygon's boundary in one entry and one exit edge, so the
+    result is the run of inside vertices between two cut points, sliced rather than
+    masked. Returns an empty ``(0, 2)`` array when nothing is left.
 
     Examples
     --------
     >>> square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
     >>> clip_halfplane(square, np.array([1.0, 0.0]), 1.0).tolist()
-    [[0.0, 0.0], [1.0, 0.0], [1.0, 2.0], [0.0, 2.0]]
+    [[1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [1.0, 0.0]]
     >>> clip_halfplane(square, np.array([1.0, 0.0]), -1.0).shape   # empty
     (0, 2)
     """
+    signed = vertices @ normal - offset
+    outside = signed > 0.0
+    count = len(vertices)
+    outside_count = int(np.count_nonzero(outside))
+    if outside_count == 0:
+        return vertices
+    if outside_count == count:
+        return np.empty((0, 2))
+    if count < 3:
+        return _clip_halfplane_masked(vertices, normal, offset)
+    edges = np.flatnonzero(outside[:-1] != outside[1:]).tolist()
+    if outside[-1] != outside[0]:
+        edges.append(count - 1)
+    if len(edges) != 2:  # a segment, a point, or rounding on a degenerate polygon
+        return _clip_halfplane_masked(vertices, normal, offset)
+    first, second = edges
+    exit_edge, entry_edge = (second, first) if outside[first] else (first, second)
+
+    def cut(edge: int, keep_at: float) -> Array:
+        following = edge + 1 if edge + 1 < count else 0
+        s0, s1 = float(signed[edge]), float(signed[following])
+        t = s0 / (s0 - s1)
+        if abs(t - keep_at) <= _SAME_POINT:
+            # The cut is the inside vertex itself, up to rounding: an edge that short
+            # would have no reliable direction, so the vertex stands for it.
+            return np.empty((0, 2))
+        (ax, ay), (bx, by) = vertices[[edge, following]].tolist()
+        return np.array([[ax + t * (bx - ax), ay + t * (by - ay)]])
+
+    start = entry_edge + 1
+    if start <= exit_edge:
+        run = vertices[start : exit_edge + 1]
+    else:
+        run = np.concatenate((vertices[start:], vertices[: exit_edge + 1]))
+    # Entry edges run from outside to inside (the inside end is t = 1), exit edges back.
+    return np.concatenate((cut(entry_edge, 1.0), run, cut(exit_edge, 0.0)))
+
+
+def _clip_halfplane_masked(vertices: Array, normal: Array, offset: float) -> Array:
+    """Clip by masking every vertex and cut point: slower, but right for degenerate input."""
     signed = vertices @ normal - offset
     inside = signed <= 0.0
     if np.all(inside):

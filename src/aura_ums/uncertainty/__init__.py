@@ -23,6 +23,7 @@ from aura_ums.uncertainty._landmarks import (
 )
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import FOOT, Pose, TurnAndRun
+from aura_ums.uncertainty._reduce import Reduction
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 
 __all__ = [
@@ -39,6 +40,7 @@ __all__ = [
     "PointLandmark",
     "Pose",
     "RangeBearingObservation",
+    "Reduction",
     "SpatialUncertaintyMap",
     "TerrainStats",
     "TerrainTable",

@@ -13,7 +13,9 @@ from aura_ums._validate import float_array, nonnegative_float, points_array, rea
 from aura_ums.errors import InputError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, outer_disk, wrap_angle
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, grow_polygon, grow_wedge, motion_bounds
+from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
+from aura_ums.uncertainty._reduce import Reduction, reduce_map
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _START_DISK_SIDES = 16
@@ -165,8 +167,71 @@ class SpatialUncertaintyMap:
         heading, cw, ccw = grow_wedge(wedge.center, wedge.cw, wedge.ccw, bounds)
         center = self.center + bounds.run_mean * np.array([math.cos(heading), math.sin(heading)])
         return SpatialUncertaintyMap._trusted(
-            ConvexPolygon._trusted(vertices), center, HeadingWedge(wrap_angle(heading), cw, ccw)
+            ConvexPolygon._trusted(vertices), center, HeadingWedge._trusted(heading, cw, ccw)
         )
+
+    def reduce(
+        self, observation: Observation, landmark: Landmark, *, max_vertices: int = DEFAULT_MAX_VERTICES
+    ) -> Reduction:
+        """Return the map reduced by one observation of a landmark (the paper's reductions).
+
+        A set-membership intersection: the reduced map keeps every pose of this map
+        that agrees with the observation within its error bounds (where the exact set
+        is not a convex polygon and a wedge, an outer bound of it), and lies inside
+        this map.
+
+        - Class I (:class:`BearingObservation` of a :class:`VerticalLineLandmark`): the
+          positions from which the landmark is seen at the bearing for some heading of
+          the wedge form a cone at the landmark; the polygon is cut by it, then the
+          wedge narrows to the headings that see the landmark at the bearing from what
+          remains. Position, heading or both shrink, depending on which is larger.
+        - Class II (:class:`RangeBearingObservation` of a :class:`PointLandmark`): the
+          same cone, also cut by the range annulus, so the extent along the line of
+          sight shrinks too; then the wedge narrows as in Class I.
+        - Class III (:class:`GroundLineObservation` of a :class:`GroundLineLandmark`):
+          the angle narrows the wedge directly, the offset cuts a strip parallel to the
+          line (the true line is taken parallel to the mapped one, within its
+          ``position_uncertainty``).
+
+        Landmark position uncertainty and the observation's ``sensor_offset`` are
+        allowed for (soundly, possibly loosely). The centre is kept when it is still
+        possible, else moved to the nearest possible position and heading.
+
+        Parameters
+        ----------
+        observation : BearingObservation or RangeBearingObservation or GroundLineObservation
+            What the robot observed, with its error bounds.
+        landmark : VerticalLineLandmark or PointLandmark or GroundLineLandmark
+            The landmark observed: of the observation's class and with its ``landmark_id``.
+        max_vertices : int
+            Cap on the polygon's vertex count (>= 3); it may be exceeded only by a prior
+            that already has more vertices, since the result must stay inside the prior.
+
+        Returns
+        -------
+        Reduction
+            The reduced map with what changed; ``consistent=False`` and this very map
+            when no pose agrees with the observation (the caller decides what that means).
+
+        Raises
+        ------
+        InputError
+            When the observation and landmark are of different classes or ids.
+
+        Examples
+        --------
+        >>> import math
+        >>> from aura_ums.uncertainty import BearingObservation, VerticalLineLandmark
+        >>> prior = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 2.0, math.radians(1))
+        >>> pole = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 5.0)
+        >>> seen = prior.reduce(BearingObservation("pole", 0.0, 0.0, math.radians(1)), pole)
+        >>> seen.consistent, seen.area_after < 0.5 * seen.area_before, seen.map.contains(Pose(0, 0, 0))
+        (True, True, True)
+        >>> behind = prior.reduce(BearingObservation("pole", 0.0, math.pi, 0.01), pole)
+        >>> behind.consistent, behind.map is prior, behind.reason != ""   # empty intersection
+        (False, True, True)
+        """
+        return reduce_map(self, observation, landmark, max_vertices)
 
     @overload
     def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...

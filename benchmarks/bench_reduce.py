@@ -1,0 +1,125 @@
+"""Benchmark: the three landmark reductions against filterpy's EKF range-bearing update.
+
+Run ``python benchmarks/bench_reduce.py``. Prints the median time of one reduction of
+each class on a 16- and a 64-vertex map, next to the median time of one
+``ExtendedKalmanFilter.update`` (3 states: x, y, heading) with a range-bearing
+measurement of a landmark, its Jacobian and measurement function written in Python
+as a user would write them, measured in the same run.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+from collections.abc import Callable
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter
+from numpy.typing import NDArray
+
+from aura_ums.geometry import HeadingWedge, regular_polygon
+from aura_ums.uncertainty import (
+    BearingObservation,
+    GroundLineLandmark,
+    GroundLineObservation,
+    PointLandmark,
+    RangeBearingObservation,
+    SpatialUncertaintyMap,
+    VerticalLineLandmark,
+)
+
+REPEATS = 2000
+ROUNDS = 7
+
+LANDMARK = np.array([20.0, 5.0])
+
+
+def median_microseconds(call: Callable[[], object], repeats: int = REPEATS, rounds: int = ROUNDS) -> float:
+    """Median over ``rounds`` of the mean time per call of ``repeats`` calls, microseconds."""
+    for _ in range(50):
+        call()
+    samples = []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        for _ in range(repeats):
+            call()
+        samples.append((time.perf_counter() - start) / repeats * 1e6)
+    return statistics.median(samples)
+
+
+def prior_map(sides: int) -> SpatialUncertaintyMap:
+    polygon = regular_polygon((0.0, 0.0), 2.0, sides, phase=0.1)
+    return SpatialUncertaintyMap.from_polygon(polygon, (0.0, 0.0), HeadingWedge(0.0, 0.05, 0.05))
+
+
+def reduction_calls(prior: SpatialUncertaintyMap) -> dict[str, Callable[[], object]]:
+    bearing = math.atan2(LANDMARK[1] - 0.3, LANDMARK[0] - 0.2) - 0.05  # true pose (0.2, 0.3, 0.05)
+    distance = math.hypot(LANDMARK[0] - 0.2, LANDMARK[1] - 0.3)
+    x, y = float(LANDMARK[0]), float(LANDMARK[1])
+    pole = VerticalLineLandmark("pole", x, y, 0.0, 6.0, "lamppost", 0.05)
+    corner = PointLandmark("corner", x, y, 3.0, "building corner", 0.05)
+    edge = GroundLineLandmark("edge", (-10.0, -1.0), (30.0, 1.0), "path edge", 0.05)
+    normal = np.array([-math.sin(edge.direction), math.cos(edge.direction)])
+    offset = float(normal @ (np.array([0.2, 0.3]) - edge.start))
+    class_one = BearingObservation("pole", 0.0, bearing, math.radians(1.0))
+    class_two = RangeBearingObservation(
+        "corner", 0.0, bearing, math.radians(1.0), distance - 1.0, distance + 1.0
+    )
+    class_three = GroundLineObservation("edge", 0.0, offset, 0.3, edge.direction - 0.05, math.radians(2.0))
+    return {
+        "Class I": lambda: prior.reduce(class_one, pole),
+        "Class II": lambda: prior.reduce(class_two, corner),
+        "Class III": lambda: prior.reduce(class_three, edge),
+    }
+
+
+def ekf_update_call() -> Callable[[], object]:
+    ekf = ExtendedKalmanFilter(dim_x=3, dim_z=2)
+    ekf.x = np.array([0.0, 0.0, 0.0])
+    ekf.P = np.diag([0.5**2, 0.5**2, 0.05**2])
+    ekf.R = np.diag([0.3**2, math.radians(1.0) ** 2])
+    state = (ekf.x.copy(), ekf.P.copy())
+    z = np.array(
+        [math.hypot(*(LANDMARK - [0.2, 0.3])), math.atan2(LANDMARK[1] - 0.3, LANDMARK[0] - 0.2) - 0.05]
+    )
+
+    def jacobian(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        dx, dy = LANDMARK[0] - x[0], LANDMARK[1] - x[1]
+        q = dx * dx + dy * dy
+        r = math.sqrt(q)
+        return np.array([[-dx / r, -dy / r, 0.0], [dy / q, -dx / q, -1.0]])
+
+    def measure(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        dx, dy = LANDMARK[0] - x[0], LANDMARK[1] - x[1]
+        return np.array([math.hypot(dx, dy), math.atan2(dy, dx) - x[2]])
+
+    def residual(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+        y = a - b
+        y[1] = (y[1] + math.pi) % (2 * math.pi) - math.pi
+        return y
+
+    def update() -> None:
+        # Reset so every call updates the same prior (as every reduction does).
+        ekf.x, ekf.P = state[0].copy(), state[1].copy()
+        ekf.update(z, jacobian, measure, residual=residual)
+
+    return update
+
+
+def main() -> None:
+    ekf = median_microseconds(ekf_update_call())
+    print(f"filterpy ExtendedKalmanFilter.update (range-bearing, 3 states): {ekf:8.1f} us")
+    print()
+    print(f"{'reduction':<12}{'vertices':>9}{'median us':>12}{'vs EKF':>9}{'area after/before':>19}")
+    for sides in (16, 64):
+        prior = prior_map(sides)
+        for name, call in reduction_calls(prior).items():
+            reduction = call()
+            elapsed = median_microseconds(call)
+            ratio = reduction.area_after / reduction.area_before  # type: ignore[attr-defined]
+            print(f"{name:<12}{sides:>9}{elapsed:>12.1f}{elapsed / ekf:>8.2f}x{ratio:>19.3f}")
+
+
+if __name__ == "__main__":
+    main()
