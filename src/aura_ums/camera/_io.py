@@ -1,0 +1,725 @@
+"""Camera files: aura-ums' TOML, and OpenCV ``cv::FileStorage`` calibrations in YAML or JSON.
+
+Neither OpenCV nor a YAML library is needed: the FileStorage YAML subset (a ``%YAML:1.0``
+header, block mappings and sequences, flow ``[...]``/``{...}`` collections over several
+lines, ``!!opencv-matrix`` tags, quoted and plain scalars, comments) is parsed here.
+Every error is a :class:`~aura_ums.errors.FileFormatError` naming the file and the place.
+
+The TOML camera file::
+
+    [intrinsics]              # pixels; (0, 0) is the centre of the top-left pixel
+    fx = 674.9
+    fy = 674.9
+    cx = 307.55
+    cy = 251.45
+    width = 640
+    height = 480
+    distortion = [-0.1, 0.01, 0.0, 0.0, 0.0]   # optional: k1, k2, p1, p2[, k3]
+
+    [mount]                   # metres; pan/tilt in radians, or pan_deg/tilt_deg in degrees
+    height = 1.2
+    forward = 0.0             # optional, default 0
+    left = 0.0                # optional, default 0
+    pan_deg = 0.0             # optional, default 0
+    tilt_deg = 5.0            # optional, default 0
+
+    [calibration_bounds]      # optional: half-widths, see CalibrationBounds
+    fx = 3.0
+    pan_deg = 0.5
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import tomllib
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
+from aura_ums.camera._observe import CalibrationBounds
+from aura_ums.errors import FileFormatError, InputError
+
+Array = NDArray[np.float64]
+
+#: Distortion vector lengths OpenCV writes (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]]).
+_DISTORTION_LENGTHS = (4, 5, 8, 12, 14)
+
+_INTRINSIC_KEYS = ("fx", "fy", "cx", "cy", "width", "height", "distortion")
+_ANGLES = ("pan", "tilt")
+
+
+# ------------------------------------------------------------------------------ shared
+
+
+def _read_text(path: str | Path, kind: str) -> str:
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileFormatError(str(path), "", f"expected an existing {kind} file, got no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) else "bytes that are not UTF-8"
+        raise FileFormatError(str(path), "", f"expected a readable {kind} file, got {reason}") from None
+
+
+def _number(value: object, source: str, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FileFormatError(source, where, f"expected a number, got {value!r}")
+    result = float(value)
+    if not math.isfinite(result):
+        raise FileFormatError(source, where, f"expected a finite number, got {value!r}")
+    return result
+
+
+def _integer(value: object, source: str, where: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+        raise FileFormatError(source, where, f"expected a positive integer, got {value!r}")
+    return value
+
+
+def _distortion(values: Array, source: str, where: str) -> tuple[float, float, float, float, float]:
+    """OpenCV's distortion vector as (k1, k2, p1, p2, k3); the thin-prism/tilt terms must be zero."""
+    if values.size not in _DISTORTION_LENGTHS:
+        raise FileFormatError(
+            source, where, f"expected 4, 5, 8, 12 or 14 distortion coefficients, got {values.size}"
+        )
+    if values.size > 5 and np.any(values[5:] != 0.0):
+        raise FileFormatError(
+            source,
+            where,
+            "expected the coefficients beyond k3 (k4-k6, s1-s4, tau) to be zero (aura-ums models k1, k2, "
+            f"p1, p2, k3 only), got {values[5:].tolist()}",
+        )
+    k = [float(v) for v in values[:5]] + [0.0] * (5 - min(values.size, 5))
+    return (k[0], k[1], k[2], k[3], k[4])
+
+
+def _reraise(source: str, where: str, exc: InputError) -> FileFormatError:
+    field, _, message = str(exc).partition(": ")
+    key = field.rsplit(".", 1)[-1]
+    return FileFormatError(source, f"{where} {key}".strip(), message or str(exc))
+
+
+# ------------------------------------------------------------------------------ TOML
+
+
+def _table(document: Mapping[str, object], name: str, source: str, *, required: bool) -> dict[str, object]:
+    table = document.get(name)
+    if table is None:
+        if required:
+            raise FileFormatError(source, f"[{name}]", "expected this table, got none")
+        return {}
+    if not isinstance(table, dict):
+        raise FileFormatError(source, f"[{name}]", f"expected a table, got {table!r}")
+    return table
+
+
+def _angle(table: Mapping[str, object], name: str, source: str, where: str) -> float | None:
+    radians, degrees = table.get(name), table.get(f"{name}_deg")
+    if radians is not None and degrees is not None:
+        raise FileFormatError(source, f"{where} {name}_deg", f"expected {name} or {name}_deg, got both")
+    if degrees is not None:
+        return math.radians(_number(degrees, source, f"{where} {name}_deg"))
+    if radians is not None:
+        return _number(radians, source, f"{where} {name}")
+    return None
+
+
+def _check_keys(table: Mapping[str, object], allowed: tuple[str, ...], source: str, where: str) -> None:
+    for key in table:
+        if key not in allowed:
+            raise FileFormatError(
+                source,
+                f"{where} {key}".strip(),
+                f"expected one of {', '.join(allowed)}, got unknown key {key!r}",
+            )
+
+
+def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
+    source = str(path)
+    text = _read_text(path, "TOML")
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = re.search(r"line (\d+)", str(exc))
+        raise FileFormatError(
+            source, f"line {line.group(1)}" if line else "", f"expected TOML, got {exc}"
+        ) from None
+    _check_keys(document, ("intrinsics", "mount", "calibration_bounds"), source, "")
+
+    table = _table(document, "intrinsics", source, required=True)
+    _check_keys(table, _INTRINSIC_KEYS, source, "[intrinsics]")
+    missing = [key for key in _INTRINSIC_KEYS[:6] if key not in table]
+    if missing:
+        raise FileFormatError(
+            source, "[intrinsics]", f"expected keys {', '.join(missing)}, got none for them"
+        )
+    fx, fy, cx, cy = (_number(table[key], source, f"[intrinsics] {key}") for key in ("fx", "fy", "cx", "cy"))
+    width, height = (_integer(table[key], source, f"[intrinsics] {key}") for key in ("width", "height"))
+    distortion = None
+    if "distortion" in table:
+        raw = table["distortion"]
+        if not isinstance(raw, list):
+            raise FileFormatError(
+                source, "[intrinsics] distortion", f"expected a list of numbers, got {raw!r}"
+            )
+        numbers = [_number(v, source, f"[intrinsics] distortion[{i}]") for i, v in enumerate(raw)]
+        distortion = _distortion(np.array(numbers, dtype=np.float64), source, "[intrinsics] distortion")
+    try:
+        intrinsics = CameraIntrinsics(fx, fy, cx, cy, width, height, distortion)
+    except InputError as exc:
+        raise _reraise(source, "[intrinsics]", exc) from None
+
+    table = _table(document, "mount", source, required=True)
+    _check_keys(table, ("height", "forward", "left", "pan", "pan_deg", "tilt", "tilt_deg"), source, "[mount]")
+    if "height" not in table:
+        raise FileFormatError(source, "[mount]", "expected key height, got none for it")
+    mount_values: dict[str, float] = {
+        key: _number(table[key], source, f"[mount] {key}")
+        for key in ("height", "forward", "left")
+        if key in table
+    }
+    for name in _ANGLES:
+        angle = _angle(table, name, source, "[mount]")
+        if angle is not None:
+            mount_values[name] = angle
+    try:
+        mount = CameraMount(**mount_values)
+    except InputError as exc:
+        raise _reraise(source, "[mount]", exc) from None
+
+    table = _table(document, "calibration_bounds", source, required=False)
+    _check_keys(
+        table,
+        ("fx", "fy", "cx", "cy", "pan", "pan_deg", "tilt", "tilt_deg", "height"),
+        source,
+        "[calibration_bounds]",
+    )
+    bound_values: dict[str, float] = {
+        key: _number(table[key], source, f"[calibration_bounds] {key}")
+        for key in ("fx", "fy", "cx", "cy", "height")
+        if key in table
+    }
+    for name in _ANGLES:
+        angle = _angle(table, name, source, "[calibration_bounds]")
+        if angle is not None:
+            bound_values[name] = angle
+    try:
+        bounds = CalibrationBounds(**bound_values)
+    except InputError as exc:
+        raise _reraise(source, "[calibration_bounds]", exc) from None
+    return Camera(intrinsics, mount), bounds
+
+
+def load_camera(path: str | Path) -> Camera:
+    r"""Read a camera (intrinsics and mount) from a TOML file.
+
+    The format is in this module's documentation: ``[intrinsics]`` (fx, fy, cx, cy in
+    pixels; width, height integers; optional ``distortion`` list of 4 or 5 OpenCV
+    coefficients, or 8/12/14 whose extra terms are zero), ``[mount]`` (height, forward,
+    left in metres; ``pan``/``tilt`` in radians or ``pan_deg``/``tilt_deg`` in degrees)
+    and the optional ``[calibration_bounds]`` (read by :func:`load_calibration_bounds`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    Camera
+        The camera it describes.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the table/key: missing or unreadable file, malformed TOML,
+        missing or unknown keys, wrong types, non-finite or out-of-range values.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "cam.toml").write_text(
+    ...     "[intrinsics]\nfx = 500\nfy = 500\ncx = 320\ncy = 240\nwidth = 640\nheight = 480\n"
+    ...     "[mount]\nheight = 1.0\ntilt_deg = 10\n"
+    ... )
+    >>> round(load_camera(folder / "cam.toml").mount.tilt, 6)
+    0.174533
+    >>> _ = (folder / "bad.toml").write_text("[intrinsics]\nfx = 500\n")
+    >>> load_camera(folder / "bad.toml")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...bad.toml: [intrinsics]: expected keys fy, cx, cy, width, height, ...
+    """
+    return _parse_toml(path)[0]
+
+
+def load_calibration_bounds(path: str | Path) -> CalibrationBounds:
+    """Read the ``[calibration_bounds]`` table of a TOML camera file (all zero when absent).
+
+    Keys: ``fx``, ``fy``, ``cx``, ``cy`` (pixels), ``pan``/``tilt`` (radians) or
+    ``pan_deg``/``tilt_deg`` (degrees), ``height`` (metres); each optional, default 0.
+    The whole file is validated as by :func:`load_camera`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    CalibrationBounds
+        The bounds on the calibration.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`load_camera`.
+    """
+    return _parse_toml(path)[1]
+
+
+def camera_to_toml(camera: Camera, bounds: CalibrationBounds | None = None) -> str:
+    """Return TOML text that :func:`load_camera` and :func:`load_calibration_bounds` read back exactly.
+
+    Parameters
+    ----------
+    camera : Camera
+        The camera to write.
+    bounds : CalibrationBounds, optional
+        Written as ``[calibration_bounds]`` when given.
+
+    Returns
+    -------
+    str
+        The TOML document (angles in radians).
+    """
+    if not isinstance(camera, Camera):
+        raise InputError(f"camera: expected Camera, got {type(camera).__name__}")
+    k, m = camera.intrinsics, camera.mount
+    lines = ["[intrinsics]"]
+    lines += [f"{name} = {getattr(k, name)!r}" for name in ("fx", "fy", "cx", "cy", "width", "height")]
+    if k.distortion is not None:
+        lines.append(f"distortion = [{', '.join(repr(c) for c in k.distortion)}]")
+    lines += ["", "[mount]"]
+    lines += [f"{name} = {getattr(m, name)!r}" for name in ("height", "forward", "left", "pan", "tilt")]
+    if bounds is not None:
+        if not isinstance(bounds, CalibrationBounds):
+            raise InputError(f"bounds: expected CalibrationBounds, got {type(bounds).__name__}")
+        lines += ["", "[calibration_bounds]"]
+        lines += [f"{name} = {getattr(bounds, name)!r}" for name in CalibrationBounds.field_names()]
+    return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------- FileStorage YAML subset
+
+
+class _Matrix(dict[str, object]):
+    """A mapping tagged ``!!opencv-matrix`` in YAML."""
+
+
+_INT = re.compile(r"[-+]?(0|[1-9][0-9]*)")
+_FLOAT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+_SPECIAL = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan}
+
+
+def _scalar(text: str) -> object:
+    """Convert a plain YAML scalar to int, float (OpenCV writes ``1.``, ``.Inf``, ``.Nan``) or string."""
+    if _INT.fullmatch(text):
+        return int(text)
+    if _FLOAT.fullmatch(text):
+        return float(text)
+    return _SPECIAL.get(text.lower(), text)
+
+
+class _Flow:
+    """Recursive-descent reader of one flow value (``[...]``, ``{...}``, quoted or plain scalar)."""
+
+    def __init__(self, text: str, fail: Callable[[str], FileFormatError]) -> None:
+        self.text, self.pos, self.fail = text, 0, fail
+
+    def _skip(self) -> None:
+        while self.pos < len(self.text) and self.text[self.pos].isspace():
+            self.pos += 1
+
+    def _peek(self) -> str:
+        self._skip()
+        return self.text[self.pos] if self.pos < len(self.text) else ""
+
+    def value(self, stops: str) -> object:
+        char = self._peek()
+        if char == "[":
+            return self._sequence()
+        if char == "{":
+            return self._mapping()
+        if char in "\"'":
+            return self._quoted()
+        start = self.pos
+        while self.pos < len(self.text) and self.text[self.pos] not in stops:
+            self.pos += 1
+        plain = self.text[start : self.pos].strip()
+        if not plain:
+            raise self.fail(f"expected a value, got {self.text[start : start + 20]!r}")
+        return _scalar(plain)
+
+    def _quoted(self) -> str:
+        quote = self.text[self.pos]
+        self.pos += 1
+        out: list[str] = []
+        while self.pos < len(self.text):
+            char = self.text[self.pos]
+            self.pos += 1
+            if char == quote:
+                if quote == "'" and self.text[self.pos : self.pos + 1] == "'":
+                    out.append("'")
+                    self.pos += 1
+                    continue
+                return "".join(out)
+            if char == "\\" and quote == '"' and self.pos < len(self.text):
+                escaped = self.text[self.pos]
+                self.pos += 1
+                out.append({"n": "\n", "t": "\t", '"': '"', "\\": "\\"}.get(escaped, escaped))
+                continue
+            out.append(char)
+        raise self.fail(f"expected a closing {quote}, got the end of the value")
+
+    def _sequence(self) -> list[object]:
+        self.pos += 1
+        items: list[object] = []
+        if self._peek() == "]":
+            self.pos += 1
+            return items
+        while True:
+            items.append(self.value(",]"))
+            char = self._peek()
+            self.pos += 1
+            if char == "]":
+                return items
+            if char != ",":
+                raise self.fail(f"expected ',' or ']' in a list, got {char or 'the end of the value'!r}")
+
+    def _mapping(self) -> dict[str, object]:
+        self.pos += 1
+        items: dict[str, object] = {}
+        if self._peek() == "}":
+            self.pos += 1
+            return items
+        while True:
+            key = self._quoted() if self._peek() in "\"'" else str(self.value(":,}"))
+            if self._peek() != ":":
+                raise self.fail(f"expected ':' after the key {key!r}, got {self._peek() or 'the end'!r}")
+            self.pos += 1
+            items[key] = self.value(",}")
+            char = self._peek()
+            self.pos += 1
+            if char == "}":
+                return items
+            if char != ",":
+                raise self.fail(f"expected ',' or '}}' in a mapping, got {char or 'the end of the value'!r}")
+
+    def finish(self) -> None:
+        if self._peek():
+            raise self.fail(f"expected the end of the value, got {self.text[self.pos :]!r}")
+
+
+def _strip_comment(line: str) -> str:
+    quote = ""
+    for i, char in enumerate(line):
+        if quote:
+            if char == quote:
+                quote = ""
+        elif char in "\"'":
+            quote = char
+        elif char == "#" and (i == 0 or line[i - 1].isspace()):
+            return line[:i].rstrip()
+    return line.rstrip()
+
+
+def _balance(text: str) -> int:
+    depth, quote = 0, ""
+    for char in text:
+        if quote:
+            if char == quote:
+                quote = ""
+        elif char in "\"'":
+            quote = char
+        elif char in "[{":
+            depth += 1
+        elif char in "]}":
+            depth -= 1
+    return depth
+
+
+class _YamlReader:
+    """Block structure of a FileStorage YAML document: (line number, indent, text) items."""
+
+    def __init__(self, text: str, source: str) -> None:
+        self.source = source
+        raw = text.splitlines()
+        first = next((i for i, line in enumerate(raw) if line.strip()), None)
+        if first is None or not re.match(r"%YAML[: ]1\.\d", raw[first].strip()):
+            found = raw[first].strip() if first is not None else "an empty file"
+            raise FileFormatError(
+                source,
+                "line 1",
+                f"expected the '%YAML:1.0' header of an OpenCV FileStorage file, got {found!r}",
+            )
+        self.lines: list[tuple[int, int, str]] = []
+        i = first + 1
+        while i < len(raw):
+            number, content = i + 1, _strip_comment(raw[i])
+            i += 1
+            if not content.strip() or content.strip() in ("---", "..."):
+                continue
+            if "\t" in content[: len(content) - len(content.lstrip())]:
+                raise FileFormatError(source, f"line {number}", "expected spaces for indentation, got a tab")
+            while _balance(content) > 0 and i < len(raw):  # a flow collection over several lines
+                content += " " + _strip_comment(raw[i]).strip()
+                i += 1
+            if _balance(content) != 0:
+                raise FileFormatError(
+                    source, f"line {number}", "expected balanced brackets, got unbalanced ones"
+                )
+            self.lines.append((number, len(content) - len(content.lstrip()), content.strip()))
+        self.pos = 0
+
+    def fail(self, number: int, message: str) -> FileFormatError:
+        return FileFormatError(self.source, f"line {number}", message)
+
+    def flow(self, text: str, number: int) -> object:
+        reader = _Flow(text, lambda message: self.fail(number, message))
+        if text[0] in "[{\"'":
+            value = reader.value("")
+            reader.finish()
+            return value
+        return _scalar(text)
+
+    def block(self, indent: int) -> object:
+        text = self.lines[self.pos][2]
+        if text == "-" or text.startswith("- "):
+            return self._sequence(indent)
+        return self._mapping(indent)
+
+    def _nested(self, indent: int, number: int) -> object:
+        if self.pos < len(self.lines):
+            _, next_indent, text = self.lines[self.pos]
+            is_item = text == "-" or text.startswith("- ")
+            if next_indent > indent or (next_indent == indent and is_item and indent >= 0):
+                return self.block(next_indent)
+        return None
+
+    def _sequence(self, indent: int) -> list[object]:
+        items: list[object] = []
+        while self.pos < len(self.lines):
+            number, current, text = self.lines[self.pos]
+            if current != indent or not (text == "-" or text.startswith("- ")):
+                break
+            self.pos += 1
+            rest = text[1:].strip()
+            items.append(self.flow(rest, number) if rest else self._nested(indent, number))
+        return items
+
+    def _mapping(self, indent: int) -> dict[str, object]:
+        items: dict[str, object] = {}
+        while self.pos < len(self.lines):
+            number, current, text = self.lines[self.pos]
+            if current < indent:
+                break
+            if current > indent:
+                raise self.fail(number, f"expected indentation {indent}, got {current}")
+            if text == "-" or text.startswith("- "):
+                break
+            match = re.match(r"""("[^"]*"|'[^']*'|[^:\s][^:]*?)\s*:(\s+|$)""", text)
+            if match is None:
+                raise self.fail(number, f"expected 'key: value', got {text!r}")
+            key = match.group(1).strip("\"'")
+            rest = text[match.end() :].strip()
+            self.pos += 1
+            tag = ""
+            if rest.startswith("!!"):
+                tag, _, rest = rest.partition(" ")
+                rest = rest.strip()
+            value = self.flow(rest, number) if rest else self._nested(indent, number)
+            if tag == "!!opencv-matrix":
+                if not isinstance(value, dict):
+                    raise self.fail(number, f"expected a mapping under !!opencv-matrix, got {value!r}")
+                value = _Matrix(value, type_id="opencv-matrix")
+            if key in items:
+                raise self.fail(number, f"expected the key {key!r} once, got it twice")
+            items[key] = value
+        return items
+
+
+def _parse_yaml(text: str, source: str) -> dict[str, object]:
+    reader = _YamlReader(text, source)
+    if not reader.lines:
+        return {}
+    document = reader.block(reader.lines[0][1])
+    if reader.pos < len(reader.lines):
+        number, _, found = reader.lines[reader.pos]
+        raise reader.fail(number, f"expected a top-level 'key: value', got {found!r}")
+    if not isinstance(document, dict):
+        raise FileFormatError(source, "", f"expected a top-level mapping, got {type(document).__name__}")
+    return document
+
+
+def _parse_json(text: str, source: str) -> dict[str, object]:
+    try:
+        document = json.loads(text)
+    except json.JSONDecodeError as first:
+        # OpenCV before 4.x writes reals such as ``1.`` that strict JSON refuses: try once more
+        tolerant = re.sub(r"(?<=\d)\.(?=\s*[,\]}\s])", ".0", text)
+        try:
+            document = json.loads(tolerant)
+        except json.JSONDecodeError:
+            raise FileFormatError(source, f"line {first.lineno}", f"expected JSON, got {first.msg}") from None
+    if not isinstance(document, dict):
+        raise FileFormatError(source, "", f"expected a top-level JSON object, got {type(document).__name__}")
+    return document
+
+
+# --------------------------------------------------------------- FileStorage contents
+
+
+def _normalized(name: str) -> str:
+    return name.replace("_", "").lower()
+
+
+#: Spelling in messages, and accepted spellings (lower case, no underscores), of each key.
+_NAMES = {
+    "camera_matrix": ("cameramatrix", "k"),
+    "distortion_coefficients": ("distortioncoefficients", "distcoeffs", "distortion", "d"),
+    "image_width": ("imagewidth",),
+    "image_height": ("imageheight",),
+}
+
+
+def _find(document: Mapping[str, object], label: str, source: str) -> tuple[str, object]:
+    names = _NAMES[label]
+    found = [(key, value) for key, value in document.items() if _normalized(key) in names]
+    if not found:
+        raise FileFormatError(source, label, f"expected the key {label}, got no such key")
+    if len(found) > 1:
+        keys = ", ".join(key for key, _ in found)
+        raise FileFormatError(source, found[1][0], f"expected one {label}, got {keys}")
+    return found[0]
+
+
+def _matrix(value: object, source: str, key: str) -> Array:
+    if not isinstance(value, dict):
+        raise FileFormatError(source, key, f"expected an opencv-matrix mapping, got {value!r}")
+    if value.get("type_id") != "opencv-matrix":
+        raise FileFormatError(source, key, f"expected type_id opencv-matrix, got {value.get('type_id')!r}")
+    for field in ("rows", "cols", "dt", "data"):
+        if field not in value:
+            raise FileFormatError(
+                source, f"{key}.{field}", "expected this field of an opencv-matrix, got none"
+            )
+    rows = _integer(value["rows"], source, f"{key}.rows")
+    cols = _integer(value["cols"], source, f"{key}.cols")
+    dt = value["dt"]
+    if not isinstance(dt, str) or not re.fullmatch(r"[ucswifd]", dt):
+        raise FileFormatError(
+            source, f"{key}.dt", f"expected a one-channel element type (d, f, i...), got {dt!r}"
+        )
+    data = value["data"]
+    if not isinstance(data, list):
+        raise FileFormatError(source, f"{key}.data", f"expected a list of numbers, got {data!r}")
+    if len(data) != rows * cols:
+        raise FileFormatError(
+            source, f"{key}.data", f"expected rows x cols = {rows * cols} numbers, got {len(data)}"
+        )
+    numbers = [_number(v, source, f"{key}.data[{i}]") for i, v in enumerate(data)]
+    return np.array(numbers, dtype=np.float64).reshape(rows, cols)
+
+
+def _camera_from_filestorage(document: Mapping[str, object], source: str, mount: CameraMount) -> Camera:
+    key, value = _find(document, "camera_matrix", source)
+    k = _matrix(value, source, key)
+    if k.shape != (3, 3):
+        raise FileFormatError(source, key, f"expected a 3x3 matrix, got {k.shape[0]}x{k.shape[1]}")
+    if k[1, 0] != 0.0 or k[2, 0] != 0.0 or k[2, 1] != 0.0 or k[2, 2] != 1.0:
+        raise FileFormatError(
+            source, key, f"expected [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], got {k.tolist()}"
+        )
+    if k[0, 1] != 0.0:
+        raise FileFormatError(source, key, f"expected zero skew (element [0][1]), got {k[0, 1]}")
+    dkey, dvalue = _find(document, "distortion_coefficients", source)
+    d = _matrix(dvalue, source, dkey)
+    if 1 not in d.shape:
+        raise FileFormatError(source, dkey, f"expected a 1xN or Nx1 matrix, got {d.shape[0]}x{d.shape[1]}")
+    distortion = _distortion(d.ravel(), source, dkey)
+    wkey, width = _find(document, "image_width", source)
+    hkey, height = _find(document, "image_height", source)
+    size = (_integer(width, source, wkey), _integer(height, source, hkey))
+    try:
+        intrinsics = CameraIntrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2], size[0], size[1], distortion)
+    except InputError as exc:
+        raise _reraise(source, key, exc) from None
+    return Camera(intrinsics, mount)
+
+
+def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
+    """Read an OpenCV ``cv::FileStorage`` calibration (YAML or JSON) and put it on a mount.
+
+    Reads ``camera_matrix`` (an ``opencv-matrix``: rows, cols, dt, data; zero skew),
+    ``distortion_coefficients`` (4 or 5 coefficients, or 8/12/14 whose terms beyond k3
+    are zero), ``image_width`` and ``image_height``. Key names are matched ignoring case
+    and underscores, and OpenCV's other spellings are accepted (``cameraMatrix``,
+    ``Camera_Matrix``, ``distCoeffs``, ``Distortion_Coefficients``); other keys are
+    ignored. The format is told by the content (a ``%YAML`` header or a JSON object).
+
+    Parameters
+    ----------
+    path : str or Path
+        The calibration file.
+    mount : CameraMount
+        Where the camera sits on the robot (a calibration file does not say).
+
+    Returns
+    -------
+    Camera
+        The calibrated camera.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line or key: missing file, malformed YAML/JSON, missing
+        keys, wrong matrix shapes, non-finite values, unsupported distortion terms.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> file = pathlib.Path(tempfile.mkdtemp()) / "calib.json"
+    >>> _ = file.write_text('{"image_width": 640, "image_height": 480, '
+    ...     '"camera_matrix": {"type_id": "opencv-matrix", "rows": 3, "cols": 3, "dt": "d", '
+    ...     '"data": [674.9, 0.0, 307.55, 0.0, 674.9, 251.45, 0.0, 0.0, 1.0]}, '
+    ...     '"distortion_coefficients": {"type_id": "opencv-matrix", "rows": 1, "cols": 4, "dt": "d", '
+    ...     '"data": [0.0, 0.0, 0.0, 0.0]}}')
+    >>> load_opencv_calibration(file, CameraMount(1.0)).intrinsics.distortion  # 4 given: k3 = 0
+    (0.0, 0.0, 0.0, 0.0, 0.0)
+    >>> load_opencv_calibration(file.with_name("missing.yml"), CameraMount(1.0))
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...missing.yml: expected an existing calibration file, got no such file
+    """
+    if not isinstance(mount, CameraMount):
+        raise InputError(f"mount: expected CameraMount, got {type(mount).__name__}")
+    source = str(path)
+    text = _read_text(path, "calibration")
+    start, suffix = text.lstrip(), Path(path).suffix.lower()
+    if start.startswith("%YAML") or (suffix in (".yml", ".yaml") and not start.startswith("{")):
+        document = _parse_yaml(text, source)
+    elif start.startswith("{") or suffix == ".json":
+        document = _parse_json(text, source)
+    else:
+        found = start.splitlines()[0][:40] if start else "an empty file"
+        raise FileFormatError(
+            source, "line 1", f"expected a FileStorage YAML ('%YAML:1.0') or JSON ('{{') file, got {found!r}"
+        )
+    return _camera_from_filestorage(document, source, mount)

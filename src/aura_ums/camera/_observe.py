@@ -1,0 +1,870 @@
+"""Pixels turned into bounded observations of the three landmark classes.
+
+The observer knows a *nominal* camera and, in :class:`CalibrationBounds`, how far each
+calibrated parameter may be off; it knows how far a measured pixel may be off
+(``pixel_error``). Every observation it returns carries an error bound that holds for
+*every* camera and pixel within those bounds (a set-membership bound, not a standard
+deviation), so that the reductions of the spatial uncertainty map stay sound.
+
+Error propagation
+-----------------
+The bounds are computed with interval arithmetic on the parameter box, arranged so that
+every step is either exact or an outer enclosure:
+
+1. Normalized distorted coordinates ``xd = (u - cx) / fx``, ``yd = (v - cy) / fy``: each
+   variable appears once, so the interval result is the exact range over the box
+   (``|du|, |dv| <= pixel_error``: the pixel error is a square, which contains the disk).
+2. Undistortion: the set of undistorted points whose distortion falls in that box is
+   enclosed by the Krawczyk interval-Newton operator (an enclosure of every solution of
+   ``distort(x) = b`` for every ``b`` in the box, with existence and uniqueness in the
+   enclosing box proved by ``K(X) ⊂ X``).
+3. From the undistorted (x, y) the ray in the robot frame is summarized by two numbers:
+   ``psi = tilt + atan(y)``, the depression of the ray's projection on the camera's
+   vertical plane, and ``w = x / sqrt(1 + y^2)``. The azimuth of the ray (before pan) is
+   ``atan2(-w, cos psi)`` and, for a plane ``delta`` metres below the optical centre, the
+   ray meets it at forward ``delta * cot psi``, left ``-delta * w / sin psi``, horizontal
+   range ``|delta| * sqrt((1 + w^2) / sin^2 psi - 1)``. Each of these is evaluated with
+   monotone interval functions (range: increasing in ``w^2``, decreasing in
+   ``sin^2 psi``; azimuth: extreme at a corner of the (w, cos psi) box, which is convex
+   and, unless it holds the origin, spans less than half a turn).
+4. Pan only rotates, camera height only scales: both are applied exactly at the end.
+5. Ground lines (Class III) use one enclosure per end; the calibration parameters the two
+   ends share (fx, fy, cx, cy, tilt) are split into sub-boxes so that the decorrelation
+   costs little, and the direction is split into pieces in which the two ends must agree
+   on the line's offset (an exact test for boxes of points).
+
+Floating-point rounding is not directed; it is covered by a documented safety margin:
+every error bound is multiplied by ``1 + SAFETY_RELATIVE`` and increased by
+``SAFETY_ABSOLUTE`` (radians or metres), and intermediate boxes are padded by ``1e-12``.
+
+Assumptions: the distortion model is one-to-one over the image (true of any usable
+calibration; OpenCV's iterative undistortion assumes the same); the distortion
+coefficients and the mount's ``forward``/``left`` are exact; the landmark is where the
+landmark says (its own ``position_uncertainty`` is for the reduction to handle).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, nonnegative_float, points_array
+from aura_ums.camera._model import Camera, CameraIntrinsics, distort
+from aura_ums.errors import InputError
+from aura_ums.geometry import wrap_angle
+from aura_ums.uncertainty import (
+    BearingObservation,
+    GroundLineLandmark,
+    GroundLineObservation,
+    PointLandmark,
+    RangeBearingObservation,
+    VerticalLineLandmark,
+)
+
+Array = NDArray[np.float64]
+Coefficients = tuple[float, float, float, float, float]
+
+#: Every error bound is multiplied by ``1 + SAFETY_RELATIVE`` ...
+SAFETY_RELATIVE = 1e-6
+#: ... and increased by ``SAFETY_ABSOLUTE`` (rad or m) to cover floating-point rounding.
+SAFETY_ABSOLUTE = 1e-9
+#: Fixed-point iterations of the undistortion (as cv::undistortPoints' default criteria).
+UNDISTORT_ITERATIONS = 20
+#: Largest accepted residual of the undistortion, normalized image units (about 1e-7 px).
+UNDISTORT_TOLERANCE = 1e-10
+#: Splits per shared calibration parameter when bounding a ground line.
+GROUND_LINE_SPLITS = 3
+_ANGLE_PIECES = 12
+_NEWTON_STEPS = 8
+_KRAWCZYK_STEPS = 12
+_PAD = 1e-12
+
+
+# --------------------------------------------------------------------------- intervals
+
+
+@dataclass(frozen=True, slots=True)
+class _Interval:
+    """Element-wise intervals [lo, hi] over numpy arrays (no directed rounding)."""
+
+    lo: Array
+    hi: Array
+
+    # numpy must hand ``array - interval`` to the interval's reflected operators
+    __array_ufunc__ = None
+
+    @staticmethod
+    def around(center: ArrayLike, radius: ArrayLike) -> _Interval:
+        c = np.asarray(center, dtype=np.float64)
+        r = np.asarray(radius, dtype=np.float64)
+        return _Interval(c - r, c + r)
+
+    @staticmethod
+    def point(value: ArrayLike) -> _Interval:
+        v = np.asarray(value, dtype=np.float64)
+        return _Interval(v, v)
+
+    @property
+    def mid(self) -> Array:
+        return np.asarray(0.5 * (self.lo + self.hi), dtype=np.float64)
+
+    @property
+    def rad(self) -> Array:
+        return np.asarray(0.5 * (self.hi - self.lo), dtype=np.float64)
+
+    def __add__(self, other: _Interval | float | Array) -> _Interval:
+        if isinstance(other, _Interval):
+            return _Interval(self.lo + other.lo, self.hi + other.hi)
+        return _Interval(self.lo + other, self.hi + other)
+
+    def __radd__(self, other: float | Array) -> _Interval:
+        return self + other
+
+    def __neg__(self) -> _Interval:
+        return _Interval(-self.hi, -self.lo)
+
+    def __sub__(self, other: _Interval | float | Array) -> _Interval:
+        return self + (-other)
+
+    def __rsub__(self, other: float | Array) -> _Interval:
+        return (-self) + other
+
+    def __mul__(self, other: _Interval | float | Array) -> _Interval:
+        if isinstance(other, _Interval):
+            products = (self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi)
+            return _Interval(np.minimum.reduce(products), np.maximum.reduce(products))
+        a, b = self.lo * other, self.hi * other
+        return _Interval(np.minimum(a, b), np.maximum(a, b))
+
+    def __rmul__(self, other: float | Array) -> _Interval:
+        return self * other
+
+    def __truediv__(self, other: _Interval) -> _Interval:
+        """Divide by an interval that excludes zero (callers guarantee it)."""
+        return self * _Interval(1.0 / other.hi, 1.0 / other.lo)
+
+    def sqr(self) -> _Interval:
+        a, b = self.lo * self.lo, self.hi * self.hi
+        low = np.where((self.lo <= 0.0) & (self.hi >= 0.0), 0.0, np.minimum(a, b))
+        return _Interval(low, np.maximum(a, b))
+
+    def abs(self) -> _Interval:
+        a, b = np.abs(self.lo), np.abs(self.hi)
+        low = np.where((self.lo <= 0.0) & (self.hi >= 0.0), 0.0, np.minimum(a, b))
+        return _Interval(low, np.maximum(a, b))
+
+    def padded(self, pad: float | Array) -> _Interval:
+        return _Interval(self.lo - pad, self.hi + pad)
+
+    def intersect(self, other: _Interval) -> _Interval:
+        return _Interval(np.maximum(self.lo, other.lo), np.minimum(self.hi, other.hi))
+
+    def contains_zero(self) -> NDArray[np.bool_]:
+        return np.asarray((self.lo <= 0.0) & (self.hi >= 0.0))
+
+
+def _isin(x: _Interval) -> _Interval:
+    """Exact range of sin over each interval."""
+    s_lo, s_hi = np.sin(x.lo), np.sin(x.hi)
+    low, high = np.minimum(s_lo, s_hi), np.maximum(s_lo, s_hi)
+    peak = math.pi / 2 + 2 * math.pi * np.ceil((x.lo - math.pi / 2) / (2 * math.pi))
+    trough = -math.pi / 2 + 2 * math.pi * np.ceil((x.lo + math.pi / 2) / (2 * math.pi))
+    return _Interval(np.where(trough <= x.hi, -1.0, low), np.where(peak <= x.hi, 1.0, high))
+
+
+def _icos(x: _Interval) -> _Interval:
+    """Exact range of cos over each interval."""
+    c_lo, c_hi = np.cos(x.lo), np.cos(x.hi)
+    low, high = np.minimum(c_lo, c_hi), np.maximum(c_lo, c_hi)
+    peak = 2 * math.pi * np.ceil(x.lo / (2 * math.pi))
+    trough = math.pi + 2 * math.pi * np.ceil((x.lo - math.pi) / (2 * math.pi))
+    return _Interval(np.where(trough <= x.hi, -1.0, low), np.where(peak <= x.hi, 1.0, high))
+
+
+def _atan2_range(y: _Interval, x: _Interval) -> tuple[Array, Array, Array, NDArray[np.bool_]]:
+    """Directions of the points of the boxes ``y x x``: (reference, min, max relative, holds origin).
+
+    A box that excludes the origin is convex and spans less than half a turn, so its
+    extreme directions are at corners and lie within (-pi, pi) of its centre's direction.
+    """
+    reference = np.arctan2(y.mid, x.mid)
+    relative = [
+        wrap_angle(np.arctan2(yy, xx) - reference) for yy, xx in itertools.product((y.lo, y.hi), (x.lo, x.hi))
+    ]
+    low = np.minimum.reduce(relative)
+    high = np.maximum.reduce(relative)
+    return reference, low, high, y.contains_zero() & x.contains_zero()
+
+
+# ----------------------------------------------------------------------- undistortion
+
+
+def _distortion_jacobian(
+    x: _Interval, y: _Interval, k: Coefficients
+) -> tuple[_Interval, _Interval, _Interval, _Interval]:
+    """Enclose the Jacobian of :func:`distort` over the boxes ``x x y`` (exact for points)."""
+    k1, k2, p1, p2, k3 = k
+    x2, y2 = x.sqr(), y.sqr()
+    r2 = x2 + y2
+    rho = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    drho = k1 + r2 * (2.0 * k2 + r2 * (3.0 * k3))
+    cross = 2.0 * (x * y) * drho + 2.0 * p1 * x + 2.0 * p2 * y
+    j00 = rho + 2.0 * x2 * drho + 2.0 * p1 * y + 6.0 * p2 * x
+    j11 = rho + 2.0 * y2 * drho + 6.0 * p1 * y + 2.0 * p2 * x
+    return j00, cross, cross, j11
+
+
+def _point_jacobian(x: Array, y: Array, k: Coefficients) -> tuple[Array, Array, Array, Array]:
+    """Return the Jacobian of :func:`distort` at points (the same formulas as the interval version)."""
+    k1, k2, p1, p2, k3 = k
+    x2, y2 = x * x, y * y
+    r2 = x2 + y2
+    rho = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    drho = k1 + r2 * (2.0 * k2 + r2 * (3.0 * k3))
+    cross = 2.0 * x * y * drho + 2.0 * p1 * x + 2.0 * p2 * y
+    j00 = rho + 2.0 * x2 * drho + 2.0 * p1 * y + 6.0 * p2 * x
+    j11 = rho + 2.0 * y2 * drho + 6.0 * p1 * y + 2.0 * p2 * x
+    return j00, cross, cross, j11
+
+
+def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int) -> tuple[Array, Array]:
+    """Invert :func:`distort` point by point; NaN where it does not converge to the principal branch."""
+    k1, k2, p1, p2, k3 = k
+    x, y = xd.copy(), yd.copy()
+    with np.errstate(all="ignore"):
+        for _ in range(iterations):  # cv::undistortPoints' fixed-point iteration
+            r2 = x * x + y * y
+            icdist = 1.0 / (1.0 + r2 * (k1 + r2 * (k2 + r2 * k3)))
+            dx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
+            dy = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
+            x_next, y_next = (xd - dx) * icdist, (yd - dy) * icdist
+            step = np.max(np.abs(x_next - x) + np.abs(y_next - y), initial=0.0)
+            x, y = x_next, y_next
+            if not step > 1e-3 * UNDISTORT_TOLERANCE:  # converged (or NaN: left to the check below)
+                break
+        fx, fy = distort(x, y, k)
+        for _ in range(_NEWTON_STEPS):  # polish: Newton converges quadratically near the solution
+            ex, ey = fx - xd, fy - yd
+            if not np.any(np.hypot(ex, ey) > 1e-3 * UNDISTORT_TOLERANCE):
+                break
+            j00, j01, j10, j11 = _point_jacobian(x, y, k)
+            det = j00 * j11 - j01 * j10
+            x, y = x - (j11 * ex - j01 * ey) / det, y - (j00 * ey - j10 * ex) / det
+            fx, fy = distort(x, y, k)
+        j00, j01, j10, j11 = _point_jacobian(x, y, k)
+        good = (np.hypot(fx - xd, fy - yd) <= UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
+    return np.where(good, x, np.nan), np.where(good, y, np.nan)
+
+
+def undistort_points(intrinsics: CameraIntrinsics, pixels: ArrayLike, *, iterations: int = 20) -> Array:
+    """Turn pixels into normalized undistorted image coordinates (the inverse of the projection).
+
+    The iterative inverse of OpenCV's radial-tangential model, as ``cv::undistortPoints``
+    (``iterations`` fixed-point steps), polished by Newton steps and checked: a pixel
+    whose residual exceeds :data:`UNDISTORT_TOLERANCE`, or that lies beyond the fold of
+    the distortion polynomial, gives NaN.
+
+    Parameters
+    ----------
+    intrinsics : CameraIntrinsics
+        The camera's intrinsics.
+    pixels : array_like, shape (n, 2) or (2,)
+        Pixel coordinates (u, v), finite.
+    iterations : int
+        Fixed-point iterations before the Newton polish, >= 1.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        Normalized coordinates (x/z, y/z) of the rays in the camera frame (dimensionless).
+
+    Examples
+    --------
+    >>> k = CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(-0.2, 0.05, 0.0, 0.0, 0.0))
+    >>> undistort_points(k, [(320, 240)]).tolist()   # the principal point is its own image
+    [[0.0, 0.0]]
+    >>> bad = CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(-1.0, 0.0, 0.0, 0.0, 0.0))
+    >>> undistort_points(bad, [(639, 479)]).tolist()  # beyond the fold of r(1 - r^2): no ray
+    [[nan, nan]]
+    """
+    if not isinstance(intrinsics, CameraIntrinsics):
+        raise InputError(f"intrinsics: expected CameraIntrinsics, got {type(intrinsics).__name__}")
+    if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
+        raise InputError(f"iterations: expected a positive integer, got {iterations!r}")
+    uv = points_array(pixels, "pixels")
+    xd = (uv[:, 0] - intrinsics.cx) / intrinsics.fx
+    yd = (uv[:, 1] - intrinsics.cy) / intrinsics.fy
+    if intrinsics.distortion is None:
+        return np.column_stack([xd, yd])
+    x, y = _undistort_normalized(xd, yd, intrinsics.distortion, iterations)
+    return np.column_stack([x, y])
+
+
+def _undistort_box(xd: _Interval, yd: _Interval, k: Coefficients | None) -> tuple[_Interval, _Interval]:
+    """Enclose every undistorted point whose distorted image lies in the boxes ``xd x yd``."""
+    if k is None:
+        return xd, yd
+    mx, my = _undistort_normalized(xd.mid, yd.mid, k, UNDISTORT_ITERATIONS)
+    if not (np.all(np.isfinite(mx)) and np.all(np.isfinite(my))):
+        raise InputError("pixel: expected a pixel the distortion model can invert, got one beyond its fold")
+    j00, j01, j10, j11 = _point_jacobian(mx, my, k)
+    det = j00 * j11 - j01 * j10
+    y00, y01, y10, y11 = j11 / det, -j01 / det, -j10 / det, j00 / det
+    dmx, dmy = distort(mx, my, k)
+    rx = _Interval(dmx - xd.hi, dmx - xd.lo)
+    ry = _Interval(dmy - yd.hi, dmy - yd.lo)
+    c0 = mx - (rx * y00 + ry * y01)
+    c1 = my - (rx * y10 + ry * y11)
+    pad = _PAD * (1.0 + np.abs(mx) + np.abs(my))
+    x0 = _Interval.around(mx, 2.0 * (np.abs(y00) * xd.rad + np.abs(y01) * yd.rad) + pad)
+    x1 = _Interval.around(my, 2.0 * (np.abs(y10) * xd.rad + np.abs(y11) * yd.rad) + pad)
+
+    def krawczyk(x0: _Interval, x1: _Interval) -> tuple[_Interval, _Interval]:
+        a00, a01, a10, a11 = _distortion_jacobian(x0, x1, k)
+        m00 = 1.0 - (a00 * y00 + a10 * y01)
+        m01 = -(a01 * y00 + a11 * y01)
+        m10 = -(a00 * y10 + a10 * y11)
+        m11 = 1.0 - (a01 * y10 + a11 * y11)
+        d0, d1 = x0 - mx, x1 - my
+        return (c0 + m00 * d0 + m01 * d1).padded(pad), (c1 + m10 * d0 + m11 * d1).padded(pad)
+
+    for _ in range(_KRAWCZYK_STEPS):
+        k0, k1 = krawczyk(x0, x1)
+        inside = (k0.lo >= x0.lo) & (k0.hi <= x0.hi) & (k1.lo >= x1.lo) & (k1.hi <= x1.hi)
+        if np.all(inside):
+            break
+        # epsilon-inflation of the boxes that failed, keeping the ones that passed
+        grow0 = k0.padded(0.5 * (k0.hi - k0.lo) + pad)
+        grow1 = k1.padded(0.5 * (k1.hi - k1.lo) + pad)
+        x0 = _Interval(np.where(inside, x0.lo, np.minimum(grow0.lo, mx)), np.where(inside, x0.hi, grow0.hi))
+        x1 = _Interval(np.where(inside, x1.lo, np.minimum(grow1.lo, my)), np.where(inside, x1.hi, grow1.hi))
+        x0 = _Interval(x0.lo, np.maximum(x0.hi, mx))
+        x1 = _Interval(x1.lo, np.maximum(x1.hi, my))
+    else:
+        raise InputError(
+            "pixel: expected error bounds small enough to bound the undistortion, "
+            "got a box that reaches the fold of the distortion model"
+        )
+    # Every solution in X lies in K(X): tighten twice.
+    for _ in range(2):
+        x0, x1 = k0.intersect(x0), k1.intersect(x1)
+        k0, k1 = krawczyk(x0, x1)
+    return k0.intersect(x0), k1.intersect(x1)
+
+
+# ------------------------------------------------------------------ calibration bounds
+
+
+@dataclass(frozen=True, slots=True)
+class CalibrationBounds:
+    """Half-widths of the uncertainty of each calibration parameter (guaranteed bounds).
+
+    The true parameter lies within ``nominal +- bound``. Distortion coefficients and the
+    mount's ``forward``/``left`` are taken as exact.
+
+    Parameters
+    ----------
+    fx, fy : float
+        Focal lengths, pixels, >= 0 (and less than the focal length they bound).
+    cx, cy : float
+        Principal point, pixels, >= 0.
+    pan, tilt : float
+        Mount angles, radians, >= 0.
+    height : float
+        Height of the optical centre above the ground, metres, >= 0.
+
+    Examples
+    --------
+    >>> CalibrationBounds(fx=5.0, tilt=0.01).cx
+    0.0
+    >>> CalibrationBounds(pan=-0.1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: CalibrationBounds.pan: expected a non-negative number, got -0.1
+    """
+
+    fx: float = 0.0
+    fy: float = 0.0
+    cx: float = 0.0
+    cy: float = 0.0
+    pan: float = 0.0
+    tilt: float = 0.0
+    height: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("fx", "fy", "cx", "cy", "pan", "tilt", "height"):
+            value = nonnegative_float(getattr(self, name), f"CalibrationBounds.{name}")
+            object.__setattr__(self, name, value)
+
+    @staticmethod
+    def field_names() -> tuple[str, ...]:
+        """Names of the bounded parameters, in order."""
+        return ("fx", "fy", "cx", "cy", "pan", "tilt", "height")
+
+
+# --------------------------------------------------------------------------- the rays
+
+
+def _check_camera(camera: object, bounds: object) -> tuple[Camera, CalibrationBounds]:
+    if not isinstance(camera, Camera):
+        raise InputError(f"camera: expected Camera, got {type(camera).__name__}")
+    if bounds is None:
+        bounds = CalibrationBounds()
+    if not isinstance(bounds, CalibrationBounds):
+        raise InputError(f"bounds: expected CalibrationBounds, got {type(bounds).__name__}")
+    k = camera.intrinsics
+    for name in ("fx", "fy"):
+        if getattr(bounds, name) >= getattr(k, name):
+            raise InputError(
+                f"bounds.{name}: expected less than the focal length {name} ({getattr(k, name)}), "
+                f"got {getattr(bounds, name)}"
+            )
+    return camera, bounds
+
+
+def _check_pixels(camera: Camera, pixels: ArrayLike, name: str, rows: int) -> Array:
+    k = camera.intrinsics
+    uv = points_array(pixels, name)
+    if uv.shape != (rows, 2):
+        expected = "(u, v)" if rows == 1 else "(u1, v1, u2, v2)"
+        raise InputError(f"{name}: expected {expected}, got shape {np.shape(pixels)}")
+    for row in uv:
+        u, v = float(row[0]), float(row[1])
+        if not (-0.5 <= u <= k.width - 0.5 and -0.5 <= v <= k.height - 0.5):
+            raise InputError(
+                f"{name}: expected a pixel inside the {k.width}x{k.height} image "
+                f"([-0.5, {k.width - 0.5}] x [-0.5, {k.height - 0.5}]), got ({u}, {v})"
+            )
+    return uv
+
+
+@dataclass(frozen=True, slots=True)
+class _Rays:
+    """Ray summaries: ``w`` and ``psi`` (see the module notes) as enclosures and nominal values."""
+
+    w: _Interval
+    psi: _Interval
+    w0: Array
+    psi0: Array
+
+
+def _param(nominal: float, bound: float, splits: int) -> _Interval:
+    edges = nominal - bound + 2.0 * bound * np.linspace(0.0, 1.0, splits + 1 if bound > 0.0 else 2)
+    return _Interval(edges[:-1], edges[1:])
+
+
+def _rays(
+    camera: Camera, bounds: CalibrationBounds, uv: Array, pixel_error: float, *, splits: int = 1
+) -> _Rays:
+    """Enclose (w, psi) for each pixel row over the calibration box, split ``splits`` ways.
+
+    Returns intervals of shape (number of sub-boxes, number of pixels).
+    """
+    k, mount = camera.intrinsics, camera.mount
+    names = ("fx", "fy", "cx", "cy", "tilt")
+    nominal = (k.fx, k.fy, k.cx, k.cy, mount.tilt)
+    parts = [_param(value, getattr(bounds, name), splits) for name, value in zip(names, nominal, strict=True)]
+    grids_lo = np.meshgrid(*[p.lo for p in parts], indexing="ij")
+    grids_hi = np.meshgrid(*[p.hi for p in parts], indexing="ij")
+    fx, fy, cx, cy, tilt = (
+        _Interval(lo.reshape(-1, 1), hi.reshape(-1, 1)) for lo, hi in zip(grids_lo, grids_hi, strict=True)
+    )
+    u = _Interval.around(uv[None, :, 0], pixel_error)
+    v = _Interval.around(uv[None, :, 1], pixel_error)
+    xd, yd = (u - cx) / fx, (v - cy) / fy
+    shape = np.broadcast_shapes(xd.lo.shape, yd.lo.shape)
+    xd = _Interval(np.broadcast_to(xd.lo, shape).ravel(), np.broadcast_to(xd.hi, shape).ravel())
+    yd = _Interval(np.broadcast_to(yd.lo, shape).ravel(), np.broadcast_to(yd.hi, shape).ravel())
+    x, y = _undistort_box(xd, yd, k.distortion)
+    x = _Interval(x.lo.reshape(shape), x.hi.reshape(shape))
+    y = _Interval(y.lo.reshape(shape), y.hi.reshape(shape))
+    s = y.sqr() + 1.0
+    w = x / _Interval(np.sqrt(s.lo), np.sqrt(s.hi))
+    psi = tilt + _Interval(np.arctan(y.lo), np.arctan(y.hi))
+    # nominal values (no error): the nominal camera, the measured pixel
+    nominal_xy = undistort_points(k, uv)
+    if not np.all(np.isfinite(nominal_xy)):
+        raise InputError("pixel: expected a pixel the distortion model can invert, got one beyond its fold")
+    x0, y0 = nominal_xy[:, 0], nominal_xy[:, 1]
+    return _Rays(w, psi, x0 / np.sqrt(1.0 + y0 * y0), mount.tilt + np.arctan(y0))
+
+
+def _widen(error: float) -> float:
+    return error * (1.0 + SAFETY_RELATIVE) + SAFETY_ABSOLUTE
+
+
+def _bearing_bound(camera: Camera, bounds: CalibrationBounds, rays: _Rays) -> tuple[float, float]:
+    """(bearing, bearing_error) of the first pixel's ray over the whole box; error pi when unbounded."""
+    reference, low, high, full = _atan2_range(-rays.w, _icos(rays.psi))
+    nominal = wrap_angle(camera.mount.pan + float(np.arctan2(-rays.w0[0], np.cos(rays.psi0[0]))))
+    if bool(np.any(full)):
+        return nominal, math.pi
+    # one sub-box and one pixel here
+    lo = float(reference.ravel()[0] + low.ravel()[0]) - bounds.pan
+    hi = float(reference.ravel()[0] + high.ravel()[0]) + bounds.pan
+    error = _widen(0.5 * (hi - lo))
+    if error >= math.pi:
+        return nominal, math.pi
+    return wrap_angle(camera.mount.pan + 0.5 * (lo + hi)), error
+
+
+# ------------------------------------------------------------------ the three classes
+
+
+def _common_inputs(pixel_error: object, time: object) -> tuple[float, float]:
+    return nonnegative_float(pixel_error, "pixel_error"), finite_float(time, "time")
+
+
+def observe_vertical_line(
+    camera: Camera,
+    landmark: VerticalLineLandmark,
+    pixel: ArrayLike,
+    *,
+    time: float,
+    pixel_error: float = 0.5,
+    bounds: CalibrationBounds | None = None,
+) -> BearingObservation:
+    """Turn a pixel on the image of a vertical line into a bounded bearing (Class I).
+
+    The pixel's back-projected ray lies in the vertical plane through the optical centre
+    and the line, whatever the tilt, so its horizontal component points at the line: the
+    bearing is its azimuth in the robot frame (counter-clockwise from robot forward),
+    measured from the optical centre (``sensor_offset = mount.sensor_offset``).
+
+    Parameters
+    ----------
+    camera : Camera
+        The nominal camera.
+    landmark : VerticalLineLandmark
+        The landmark seen (its id names the observation).
+    pixel : array_like, shape (2,)
+        (u, v) of any point of the line's image, inside the image.
+    time : float
+        Time of the image, seconds.
+    pixel_error : float
+        Bound on the pixel's error in u and in v, pixels, >= 0.
+    bounds : CalibrationBounds, optional
+        Bounds on the calibration; None for an exact calibration.
+
+    Returns
+    -------
+    BearingObservation
+        ``bearing`` is the centre of the guaranteed interval (radians), ``bearing_error``
+        its half-width, pi when the ray may be vertical (no bearing information).
+
+    Raises
+    ------
+    InputError
+        For a pixel outside the image or not finite, a negative error, a landmark of
+        another class, or bounds that make a focal length non-positive.
+
+    Examples
+    --------
+    >>> from aura_ums.camera import CameraMount
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, pan=0.5))
+    >>> pole = VerticalLineLandmark("pole", 5.0, 0.0, 0.0, 3.0)
+    >>> obs = observe_vertical_line(camera, pole, (320, 100), time=0.0, pixel_error=0.0)
+    >>> round(obs.bearing, 6), obs.bearing_error < 1e-8    # the optical axis, tilted or not
+    (0.5, True)
+    >>> observe_vertical_line(camera, pole, (640, 100), time=0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: pixel: expected a pixel inside the 640x480 image \
+([-0.5, 639.5] x [-0.5, 479.5]), got (640.0, 100.0)
+    """
+    camera, checked = _check_camera(camera, bounds)
+    if not isinstance(landmark, VerticalLineLandmark):
+        raise InputError(f"landmark: expected VerticalLineLandmark, got {type(landmark).__name__}")
+    error, when = _common_inputs(pixel_error, time)
+    uv = _check_pixels(camera, pixel, "pixel", 1)
+    bearing, bearing_error = _bearing_bound(camera, checked, _rays(camera, checked, uv, error))
+    return BearingObservation(landmark.id, when, bearing, bearing_error, camera.mount.sensor_offset)
+
+
+def observe_point(
+    camera: Camera,
+    landmark: PointLandmark,
+    pixel: ArrayLike,
+    *,
+    time: float,
+    pixel_error: float = 0.5,
+    bounds: CalibrationBounds | None = None,
+    max_range: float | None = None,
+) -> RangeBearingObservation:
+    """Turn the pixel of a point landmark of known height into bounded bearing and range (Class II).
+
+    The range is the horizontal distance from the optical centre to where the
+    back-projected ray meets the horizontal plane at the landmark's height ``z`` (the
+    ground-plane assumption), bounded over every camera and pixel within the bounds.
+
+    Near the horizon the range grows without bound. A pixel whose nominal ray does not
+    meet the plane (at or above the horizon for that height) is an error. When the ray
+    meets the plane but the error bounds reach the horizon, the range is unbounded
+    above: that is an error unless ``max_range`` is given, which the caller asserts is
+    a bound on the true range (e.g. the landmark's activation range) and which then caps
+    ``range_max`` (it caps it in every case).
+
+    Parameters
+    ----------
+    camera : Camera
+        The nominal camera.
+    landmark : PointLandmark
+        The landmark seen; its ``z`` is used.
+    pixel : array_like, shape (2,)
+        (u, v) of the landmark's image, inside the image.
+    time : float
+        Time of the image, seconds.
+    pixel_error : float
+        Bound on the pixel's error in u and in v, pixels, >= 0.
+    bounds : CalibrationBounds, optional
+        Bounds on the calibration; None for an exact calibration.
+    max_range : float, optional
+        Known bound on the true range, metres, > 0.
+
+    Returns
+    -------
+    RangeBearingObservation
+        Bearing as in :func:`observe_vertical_line`, ``[range_min, range_max]`` in metres.
+
+    Raises
+    ------
+    InputError
+        As :func:`observe_vertical_line`; also for a pixel at or above the horizon, error
+        bounds reaching the horizon without ``max_range``, a camera height bound that
+        reaches the landmark's height, or a range_min beyond ``max_range``.
+
+    Examples
+    --------
+    >>> from aura_ums.camera import CameraMount
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, tilt=0.1))
+    >>> corner = PointLandmark("corner", 10.0, 0.0, 0.0)
+    >>> obs = observe_point(camera, corner, (320, 240), time=0.0, pixel_error=0.0)
+    >>> round(obs.range_min, 6), round(obs.range_max, 6)    # 1 m / tan(0.1)
+    (9.966644, 9.966644)
+    >>> observe_point(camera, corner, (320, 100), time=0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: pixel: expected a pixel below the horizon for a landmark at \
+height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that plane
+    """
+    camera, checked = _check_camera(camera, bounds)
+    if not isinstance(landmark, PointLandmark):
+        raise InputError(f"landmark: expected PointLandmark, got {type(landmark).__name__}")
+    error, when = _common_inputs(pixel_error, time)
+    cap = math.inf
+    if max_range is not None:
+        cap = finite_float(max_range, "max_range")
+        if cap <= 0.0:
+            raise InputError(f"max_range: expected a positive number, got {cap}")
+    uv = _check_pixels(camera, pixel, "pixel", 1)
+    height = camera.mount.height
+    drop = _Interval.around(height - landmark.z, checked.height)
+    if bool(drop.contains_zero()):
+        raise InputError(
+            f"bounds.height: expected the camera height {height} +- {checked.height} m to exclude the "
+            f"landmark's height {landmark.z} m, got an interval that reaches it"
+        )
+    sign = 1.0 if drop.lo > 0.0 else -1.0
+    rays = _rays(camera, checked, uv, error)
+    if sign * math.sin(float(rays.psi0[0])) <= 0.0:
+        raise InputError(
+            f"pixel: expected a pixel {'below' if sign > 0 else 'above'} the horizon for a landmark at "
+            f"height {landmark.z} m (camera at {height} m), got ({uv[0, 0]}, {uv[0, 1]}) whose ray "
+            "never meets that plane"
+        )
+    bearing, bearing_error = _bearing_bound(camera, checked, rays)
+    sine = _isin(rays.psi) * sign  # positive where the ray meets the plane
+    s_max = float(sine.hi.ravel()[0])
+    s_min = float(sine.lo.ravel()[0])
+    w2 = rays.w.sqr()
+    d_abs = drop.abs()
+    w2_lo, w2_hi = float(w2.lo.ravel()[0]), float(w2.hi.ravel()[0])
+    low = float(d_abs.lo) * math.sqrt(max((1.0 + w2_lo) / (s_max * s_max) - 1.0, 0.0))
+    if s_min > 0.0:
+        high = float(d_abs.hi) * math.sqrt(max((1.0 + w2_hi) / (s_min * s_min) - 1.0, 0.0))
+    else:
+        high = math.inf
+    margin = _widen(0.5 * (high - low)) - 0.5 * (high - low) if math.isfinite(high) else 0.0
+    range_min = max(0.0, low - margin - _PAD * low)
+    range_max = high + margin + _PAD * high
+    if math.isinf(range_max) and math.isinf(cap):
+        raise InputError(
+            f"max_range: expected a bound on the range, because the error bounds of pixel "
+            f"({uv[0, 0]}, {uv[0, 1]}) reach the horizon (unbounded range), got None"
+        )
+    if range_min > cap:
+        raise InputError(f"max_range: expected at least the smallest possible range {range_min} m, got {cap}")
+    return RangeBearingObservation(
+        landmark.id, when, bearing, bearing_error, range_min, min(range_max, cap), camera.mount.sensor_offset
+    )
+
+
+def _ground_boxes(camera: Camera, bounds: CalibrationBounds, uv: Array, pixel_error: float) -> _Rays:
+    return _rays(camera, bounds, uv, pixel_error, splits=GROUND_LINE_SPLITS)
+
+
+def observe_ground_line(
+    camera: Camera,
+    landmark: GroundLineLandmark,
+    segment: ArrayLike,
+    *,
+    expected_angle: float,
+    time: float,
+    pixel_error: float = 0.5,
+    bounds: CalibrationBounds | None = None,
+) -> GroundLineObservation:
+    """Turn an image segment of a known ground line into bounded offset and angle (Class III).
+
+    Both ends are back-projected to the ground plane z = 0, giving the line in the robot
+    frame. ``offset`` is the signed distance from the optical centre (the
+    ``sensor_offset``) to the line, positive when it is left of the landmark's start ->
+    end direction; ``angle`` is that direction relative to the heading.
+
+    The image does not say which end is ``start``: the line is oriented along whichever
+    of its two directions is closer to ``expected_angle`` (robot frame, radians), e.g.
+    ``landmark.direction - heading`` for a heading estimate; it must be within 90 degrees
+    of the truth.
+
+    Parameters
+    ----------
+    camera : Camera
+        The nominal camera.
+    landmark : GroundLineLandmark
+        The landmark seen.
+    segment : array_like, shape (4,) or (2, 2)
+        (u1, v1, u2, v2): two image points of the line, inside the image, both below
+        the horizon.
+    expected_angle : float
+        Roughly expected direction start -> end relative to the heading, radians.
+    time : float
+        Time of the image, seconds.
+    pixel_error : float
+        Bound on each end's error in u and in v, pixels, >= 0.
+    bounds : CalibrationBounds, optional
+        Bounds on the calibration; None for an exact calibration.
+
+    Returns
+    -------
+    GroundLineObservation
+        ``offset`` (m) and ``angle`` (rad, wrapped) at the centres of their guaranteed
+        intervals, with the half-widths as errors.
+
+    Raises
+    ------
+    InputError
+        For bad pixels, errors or landmark type as :func:`observe_vertical_line`; an end
+        at or above the horizon, or whose error bounds reach it; a camera height bound
+        that reaches the ground; a segment too short for its error bounds to fix a
+        direction.
+
+    Examples
+    --------
+    >>> from aura_ums import Pose
+    >>> from aura_ums.camera import CameraMount
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, tilt=0.3))
+    >>> edge = GroundLineLandmark("edge", (0.0, -2.0), (10.0, -2.0))
+    >>> # the images of the ground points (3, -2) and (6, -2) seen from the origin, heading 0
+    >>> uv = camera.project(Pose(0, 0, 0), [(3.0, -2.0, 0.0), (6.0, -2.0, 0.0)])
+    >>> obs = observe_ground_line(camera, edge, uv[::-1], expected_angle=0.0, time=0.0, pixel_error=0.0)
+    >>> round(obs.offset, 6), round(obs.angle, 6) + 0.0      # ends given in either order
+    (2.0, 0.0)
+    >>> observe_ground_line(camera, edge, (0, 0, 10, 10), expected_angle=0.0, time=0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: segment: expected both ends below the horizon, got end 1 at (0.0, 0.0)
+    """
+    camera, checked = _check_camera(camera, bounds)
+    if not isinstance(landmark, GroundLineLandmark):
+        raise InputError(f"landmark: expected GroundLineLandmark, got {type(landmark).__name__}")
+    error, when = _common_inputs(pixel_error, time)
+    hint = finite_float(expected_angle, "expected_angle")
+    try:
+        flat = np.asarray(segment, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"segment: expected (u1, v1, u2, v2) numbers, got {segment!r}") from exc
+    if flat.size != 4:
+        raise InputError(f"segment: expected (u1, v1, u2, v2), got shape {flat.shape}")
+    uv = _check_pixels(camera, flat.reshape(2, 2), "segment", 2)
+    mount = camera.mount
+    height = _Interval.around(np.float64(mount.height), checked.height)
+    if height.lo <= 0.0:
+        raise InputError(
+            f"bounds.height: expected the camera height {mount.height} +- {checked.height} m to stay above "
+            "the ground, got an interval that reaches it"
+        )
+    rays = _ground_boxes(camera, checked, uv, error)
+    for end in range(2):
+        if math.sin(float(rays.psi0[end])) <= 0.0:
+            raise InputError(
+                f"segment: expected both ends below the horizon, got end {end + 1} at "
+                f"({uv[end, 0]}, {uv[end, 1]})"
+            )
+    # nominal ground points, per unit height, pan-free robot frame
+    p0 = np.column_stack([1.0 / np.tan(rays.psi0), -rays.w0 / np.sin(rays.psi0)])
+    chord = p0[1] - p0[0]
+    theta0 = math.atan2(float(chord[1]), float(chord[0]))
+    swap = abs(wrap_angle(theta0 + mount.pan - hint)) > math.pi / 2
+    if swap:
+        theta0 = wrap_angle(theta0 + math.pi)
+    first, second = (1, 0) if swap else (0, 1)
+
+    sine = _isin(rays.psi)
+    if bool(np.any(sine.lo <= 0.0)) or bool(np.any(rays.psi.hi >= math.pi)):
+        raise InputError(
+            "segment: expected error bounds that keep both ends below the horizon, got bounds that "
+            "reach it (the ground point is unbounded)"
+        )
+    px = _Interval(1.0 / np.tan(rays.psi.hi), 1.0 / np.tan(rays.psi.lo))
+    py = -rays.w / sine
+    pad = _PAD * (1.0 + np.abs(px.lo) + np.abs(px.hi) + np.abs(py.lo) + np.abs(py.hi))
+    px, py = px.padded(pad), py.padded(pad)
+    ax, ay = _Interval(px.lo[:, first], px.hi[:, first]), _Interval(py.lo[:, first], py.hi[:, first])
+    bx, by = _Interval(px.lo[:, second], px.hi[:, second]), _Interval(py.lo[:, second], py.hi[:, second])
+    reference, low, high, full = _atan2_range(by - ay, bx - ax)
+    if bool(np.any(full)):
+        raise InputError(
+            "segment: expected a segment long enough for its error bounds to fix the line's direction, "
+            f"got ends ({uv[0, 0]}, {uv[0, 1]}) and ({uv[1, 0]}, {uv[1, 1]})"
+        )
+    shift = wrap_angle(reference - theta0)
+    rel_lo, rel_hi = shift + low - _PAD, shift + high + _PAD
+    fractions = np.linspace(0.0, 1.0, _ANGLE_PIECES + 1)
+    edges = rel_lo[:, None] + (rel_hi - rel_lo)[:, None] * fractions[None, :]
+    pieces = _Interval(theta0 + edges[:, :-1], theta0 + edges[:, 1:])  # (sub-boxes, pieces)
+
+    def offsets(bx_: _Interval, by_: _Interval) -> _Interval:
+        # cross(p, d(theta)) = |p| sin(theta - angle(p)); linear in p: extreme at a corner
+        lows, highs = [], []
+        for cx_, cy_ in itertools.product((bx_.lo, bx_.hi), (by_.lo, by_.hi)):
+            radius, angle = np.hypot(cx_, cy_)[:, None], np.arctan2(cy_, cx_)[:, None]
+            s = _isin(pieces - angle) * radius
+            lows.append(s.lo)
+            highs.append(s.hi)
+        return _Interval(np.minimum.reduce(lows), np.maximum.reduce(highs))
+
+    both = offsets(ax, ay).intersect(offsets(bx, by))
+    feasible = both.lo <= both.hi
+    if not bool(np.any(feasible)):  # cannot happen but for rounding beyond the padding
+        raise InputError("segment: expected a consistent line, got ends that no line through both fits")
+    angle_lo = float(np.min(np.where(feasible, pieces.lo, np.inf))) - checked.pan + mount.pan
+    angle_hi = float(np.max(np.where(feasible, pieces.hi, -np.inf))) + checked.pan + mount.pan
+    unit = _Interval(
+        np.asarray(np.min(np.where(feasible, both.lo, np.inf)), dtype=np.float64),
+        np.asarray(np.max(np.where(feasible, both.hi, -np.inf)), dtype=np.float64),
+    )
+    offset = unit * height
+    angle_error = min(_widen(0.5 * (angle_hi - angle_lo)), math.pi)
+    offset_error = _widen(float(offset.rad))
+    return GroundLineObservation(
+        landmark.id,
+        when,
+        float(offset.mid),
+        offset_error,
+        wrap_angle(0.5 * (angle_lo + angle_hi)),
+        angle_error,
+        mount.sensor_offset,
+    )

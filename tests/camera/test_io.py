@@ -1,0 +1,393 @@
+"""Camera files: TOML round trip, OpenCV FileStorage YAML/JSON, and every malformed-input error."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums.camera import (
+    CalibrationBounds,
+    Camera,
+    CameraIntrinsics,
+    CameraMount,
+    camera_to_toml,
+    load_calibration_bounds,
+    load_camera,
+    load_opencv_calibration,
+)
+from aura_ums.errors import FileFormatError
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "camera.toml"
+MOUNT = CameraMount(height=1.1, forward=0.2, pan=0.1, tilt=0.05)
+
+# ------------------------------------------------------------------------------ TOML
+
+GOOD_TOML = """\
+[intrinsics]
+fx = 500.0
+fy = 505.0
+cx = 320.0
+cy = 240.0
+width = 640
+height = 480
+distortion = [-0.1, 0.01, 0.001, -0.002]
+
+[mount]
+height = 1.2
+left = 0.1
+pan_deg = 90.0
+tilt = 0.1
+
+[calibration_bounds]
+fx = 3.0
+tilt_deg = 1.0
+"""
+
+
+def write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_toml_round_trip(tmp_path: Path) -> None:
+    camera = Camera(
+        CameraIntrinsics(612.5, 611.25, 318.7, 241.3, 640, 480, (-0.21, 0.04, 1e-3, -2e-3, 0.003)),
+        CameraMount(height=1.37, forward=0.25, left=-0.05, pan=0.3, tilt=0.12),
+    )
+    bounds = CalibrationBounds(fx=2.5, fy=2.0, cx=1.5, cy=1.0, pan=0.01, tilt=0.02, height=0.03)
+    path = write(tmp_path, "camera.toml", camera_to_toml(camera, bounds))
+    assert load_camera(path) == camera
+    assert load_calibration_bounds(path) == bounds
+    pinhole = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0))
+    path = write(tmp_path, "pinhole.toml", camera_to_toml(pinhole))
+    assert load_camera(path) == pinhole
+    assert load_calibration_bounds(path) == CalibrationBounds()
+
+
+def test_toml_units_and_defaults(tmp_path: Path) -> None:
+    path = write(tmp_path, "camera.toml", GOOD_TOML)
+    camera = load_camera(path)
+    assert camera.intrinsics.distortion == (-0.1, 0.01, 0.001, -0.002, 0.0)  # 4 given: k3 = 0
+    assert camera.mount.pan == pytest.approx(math.pi / 2)
+    assert camera.mount.forward == 0.0
+    bounds = load_calibration_bounds(path)
+    assert bounds.tilt == pytest.approx(math.radians(1.0))
+    assert (bounds.fx, bounds.cy) == (3.0, 0.0)
+
+
+def test_example_camera_file_is_the_york_urban_camera() -> None:
+    camera = load_camera(EXAMPLE)
+    k = camera.intrinsics
+    assert (k.fx, k.cx, k.cy, k.width, k.height) == (674.9, 307.55, 251.45, 640, 480)
+    assert load_calibration_bounds(EXAMPLE).fx > 0.0
+
+
+def edit(old: str, new: str) -> str:
+    assert old in GOOD_TOML
+    return GOOD_TOML.replace(old, new)
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "match"),
+    [
+        ("[intrinsics\nfx = 1", "line 1", "expected TOML"),
+        (
+            "[mount]" + GOOD_TOML.split("[mount]")[1],
+            "intrinsics",
+            r"\[intrinsics\]: expected this table, got none",
+        ),
+        (edit("[mount]\nheight = 1.2\n", "[mount]\n"), "mount", r"\[mount\]: expected key height"),
+        (edit("fx = 500.0\n", ""), "intrinsics", r"\[intrinsics\]: expected keys fx, got none"),
+        (edit("cx = 320.0", "cx = 320.0\nskew = 0.0"), "skew", r"\[intrinsics\] skew: .*unknown key 'skew'"),
+        (GOOD_TOML + "\n[lens]\nmodel = 1\n", "lens", r"lens: expected one of .*unknown key 'lens'"),
+        (edit("width = 640", "width = 640.0"), "width", r"\[intrinsics\] width: expected a positive integer"),
+        (edit("fy = 505.0", "fy = nan"), "fy", r"\[intrinsics\] fy: expected a finite number, got nan"),
+        (edit("fy = 505.0", 'fy = "505"'), "fy", r"\[intrinsics\] fy: expected a number, got '505'"),
+        (edit("fx = 500.0", "fx = -500.0"), "fx", r"\[intrinsics\] fx: expected a positive focal length"),
+        (edit("-0.002]", "-0.002, 0.0, 0.0]"), "distortion", "expected 4, 5, 8, 12 or 14 distortion"),
+        (edit("-0.002]", "-0.002, 0.0, 0.1, 0.0, 0.0]"), "distortion", "beyond k3 .* to be zero"),
+        (edit("distortion = [", "distortion = 3 #"), "distortion", "distortion: expected a list of numbers"),
+        (edit("tilt = 0.1", "tilt = 0.1\ntilt_deg = 5.0"), "tilt_deg", "expected tilt or tilt_deg, got both"),
+        (edit("tilt = 0.1", "tilt_deg = 95.0"), "tilt", r"\[mount\] tilt: expected \|tilt\| < pi/2"),
+        (edit("fx = 3.0", "fx = -3.0"), "fx", r"\[calibration_bounds\] fx: expected a non-negative number"),
+        ("intrinsics = 3\n", "intrinsics", r"\[intrinsics\]: expected a table, got 3"),
+    ],
+)
+def test_toml_errors_name_file_and_key(tmp_path: Path, text: str, where: str, match: str) -> None:
+    path = write(tmp_path, "bad.toml", text)
+    with pytest.raises(FileFormatError, match=match) as caught:
+        load_camera(path)
+    assert caught.value.path == str(path)
+    assert where in caught.value.where
+
+
+def test_missing_files_are_named(tmp_path: Path) -> None:
+    with pytest.raises(FileFormatError, match=r"nowhere\.toml: expected an existing TOML file"):
+        load_camera(tmp_path / "nowhere.toml")
+    with pytest.raises(FileFormatError, match=r"nowhere\.yml: expected an existing calibration file"):
+        load_opencv_calibration(tmp_path / "nowhere.yml", MOUNT)
+
+
+# -------------------------------------------------------------------- FileStorage YAML
+
+# As cv::FileStorage writes it (OpenCV 4, the calibration sample's output).
+GOOD_YAML = """\
+%YAML:1.0
+---
+calibration_time: "Fri 21 Nov 2026 10:12:01 CET"
+nframes: 20
+image_width: 640
+image_height: 480
+board_width: 9
+board_height: 6
+square_size: 2.5000000000000000e-02
+# flags: +fix_k3
+flags: 128
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 6.7490000000000009e+02, 0., 3.0755000000000001e+02, 0.,
+       6.7489999999999998e+02, 2.5145000000000002e+02, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 5
+   cols: 1
+   dt: d
+   data: [ -1.2345678901234567e-01, 4.5000000000000001e-02,
+       1.0000000000000000e-03, -2.0000000000000000e-03, 0. ]
+avg_reprojection_error: 2.1345678901234567e-01
+per_view_reprojection_errors: !!opencv-matrix
+   rows: 2
+   cols: 1
+   dt: f
+   data: [ 2.11e-01, 2.15e-01 ]
+features:
+   - { x:167, y:49, lbp:[ 1, 0, 0, 1, 0, 0, 1, 1 ] }
+   - { x: 298, y: 130, lbp: [ 0, 0, 0, 1, 0, 0, 1, 1 ] }
+"""
+
+
+def test_opencv_yaml(tmp_path: Path) -> None:
+    camera = load_opencv_calibration(write(tmp_path, "calib.yml", GOOD_YAML), MOUNT)
+    k = camera.intrinsics
+    assert (k.fx, k.fy, k.cx, k.cy) == (
+        674.90000000000009,
+        674.89999999999998,
+        307.55000000000001,
+        251.45000000000002,
+    )
+    assert (k.width, k.height) == (640, 480)
+    assert k.distortion == (-0.12345678901234567, 0.045, 0.001, -0.002, 0.0)
+    assert camera.mount == MOUNT
+
+
+def test_opencv_yaml_tutorial_spelling_and_eight_coefficients(tmp_path: Path) -> None:
+    text = (
+        "%YAML:1.0\n"
+        "image_Width: 640\nimage_Height: 480\n"
+        "Camera_Matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+        "  data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n"
+        "Distortion_Coefficients: !!opencv-matrix\n  rows: 8\n  cols: 1\n  dt: d\n"
+        "  data: [ 0.1, -0.01, 0., 0., 0.001, 0., 0., 0. ]\n"
+    )
+    camera = load_opencv_calibration(write(tmp_path, "out_camera_data.yml", text), MOUNT)
+    assert camera.intrinsics.distortion == (0.1, -0.01, 0.0, 0.0, 0.001)
+
+
+def yaml_edit(old: str, new: str) -> str:
+    assert old in GOOD_YAML
+    return GOOD_YAML.replace(old, new, 1)
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "match"),
+    [
+        (GOOD_YAML.replace("%YAML:1.0\n", ""), "line 1", "expected the '%YAML:1.0' header"),
+        (yaml_edit("camera_matrix:", "cam_matrix:"), "camera_matrix", "expected the key camera_matrix"),
+        (yaml_edit("image_height: 480\n", ""), "image_height", "expected the key image_height"),
+        (yaml_edit("image_width: 640", "image_width: 640.5"), "image_width", "expected a positive integer"),
+        (
+            yaml_edit(" 0., 0., 1. ]", " 0., 0. ]"),
+            "camera_matrix.data",
+            r"expected rows x cols = 9 numbers, got 8",
+        ),
+        (
+            yaml_edit("rows: 3\n   cols: 3", "rows: 1\n   cols: 9"),
+            "camera_matrix",
+            "expected a 3x3 matrix, got 1x9",
+        ),
+        (
+            yaml_edit("6.7490000000000009e+02, 0.,", "6.7490000000000009e+02, 1.,"),
+            "camera_matrix",
+            "zero skew",
+        ),
+        (yaml_edit("0., 0., 1. ]", "0., 0., 2. ]"), "camera_matrix", r"expected \[\[fx, 0, cx\]"),
+        (yaml_edit("4.5000000000000001e-02", ".Nan"), "distortion_coefficients.data[1]", "expected a finite"),
+        (
+            yaml_edit("6.7490000000000009e+02", "-.Inf"),
+            "camera_matrix.data[0]",
+            "expected a finite number, got -inf",
+        ),
+        (
+            yaml_edit("-2.0000000000000000e-03, 0. ]", "0. ]"),
+            "distortion_coefficients.data",
+            "rows x cols = 5",
+        ),
+        (
+            yaml_edit("camera_matrix: !!opencv-matrix", "camera_matrix:"),
+            "camera_matrix",
+            "type_id opencv-matrix",
+        ),
+        (yaml_edit("   dt: d\n   data: [ 6", "   data: [ 6"), "camera_matrix.dt", "expected this field"),
+        (yaml_edit("dt: d", "dt: 3d"), "camera_matrix.dt", "one-channel element type"),
+        (yaml_edit("0., 0., 1. ]", "0., 0., 1. "), "line", "expected balanced brackets"),
+        (yaml_edit("nframes: 20", "nframes 20"), "line 4", "expected 'key: value', got 'nframes 20'"),
+        (yaml_edit("flags: 128", "   flags: 128"), "line 11", "expected indentation 0, got 3"),
+        (yaml_edit("board_width: 9", "image_width: 9"), "line 7", "expected the key 'image_width' once"),
+        (yaml_edit("1, 1 ] }", "1, 1 } }"), "line 31", r"expected ',' or '\]' in a list"),
+        (yaml_edit("{ x:167,", "{ x 167,"), "line 31", r"expected ':' after the key 'x 167'"),
+        (
+            yaml_edit("rows: 5\n   cols: 1", "rows: 1\n   cols: 5")
+            .replace("rows: 1\n   cols: 5", "rows: 1\n   cols: 8", 1)
+            .replace("-2.0000000000000000e-03, 0. ]", "-2.0000000000000000e-03, 0., 0., 0.5, 0. ]"),
+            "distortion_coefficients",
+            "beyond k3",
+        ),
+    ],
+)
+def test_opencv_yaml_errors(tmp_path: Path, text: str, where: str, match: str) -> None:
+    path = write(tmp_path, "calib.yml", text)
+    with pytest.raises(FileFormatError, match=match) as caught:
+        load_opencv_calibration(path, MOUNT)
+    assert caught.value.path == str(path)
+    assert where in caught.value.where
+
+
+# -------------------------------------------------------------------- FileStorage JSON
+
+
+def opencv_matrix(rows: int, cols: int, data: list[float]) -> dict[str, object]:
+    return {"type_id": "opencv-matrix", "rows": rows, "cols": cols, "dt": "d", "data": data}
+
+
+GOOD_JSON = {
+    "calibration_time": "Fri 21 Nov 2026 10:12:01 CET",
+    "image_width": 640,
+    "image_height": 480,
+    "camera_matrix": opencv_matrix(3, 3, [674.9, 0.0, 307.55, 0.0, 674.9, 251.45, 0.0, 0.0, 1.0]),
+    "distortion_coefficients": opencv_matrix(1, 5, [-0.1, 0.02, 0.0, 0.0, 0.0]),
+}
+
+
+def test_opencv_json(tmp_path: Path) -> None:
+    path = write(tmp_path, "calib.json", json.dumps(GOOD_JSON, indent=4))
+    camera = load_opencv_calibration(path, MOUNT)
+    assert camera.intrinsics == CameraIntrinsics(
+        674.9, 674.9, 307.55, 251.45, 640, 480, (-0.1, 0.02, 0, 0, 0)
+    )
+
+
+def test_opencv_json_with_bare_trailing_dots(tmp_path: Path) -> None:
+    # OpenCV 3 writes reals like "1." in JSON too: accepted
+    text = json.dumps(GOOD_JSON, indent=4).replace("0.0", "0.").replace("1.0]", "1.]")
+    assert " 0.," in text
+    camera = load_opencv_calibration(write(tmp_path, "calib.json", text), MOUNT)
+    assert camera.intrinsics.fx == 674.9
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "match"),
+    [
+        ('{"image_width": 640,', "line 1", "expected JSON"),
+        ("[1, 2]", "", "expected a top-level JSON object, got list"),
+        (
+            json.dumps({**GOOD_JSON, "image_width": -640}),
+            "image_width",
+            "expected a positive integer, got -640",
+        ),
+        (
+            json.dumps({k: v for k, v in GOOD_JSON.items() if k != "camera_matrix"}),
+            "camera_matrix",
+            "no such key",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, [math.nan] * 9)}),
+            "camera_matrix.data[0]",
+            "expected a finite number, got nan",
+        ),
+        (
+            json.dumps(
+                {**GOOD_JSON, "camera_matrix": {**opencv_matrix(3, 3, []), "type_id": "opencv-nd-matrix"}}
+            ),
+            "camera_matrix",
+            "expected type_id opencv-matrix, got 'opencv-nd-matrix'",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "distortion_coefficients": opencv_matrix(2, 3, [0.0] * 6)}),
+            "distortion_coefficients",
+            "expected a 1xN or Nx1 matrix, got 2x3",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "distortion_coefficients": opencv_matrix(1, 3, [0.0] * 3)}),
+            "distortion_coefficients",
+            "expected 4, 5, 8, 12 or 14 distortion coefficients, got 3",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, ["a"] * 9)}),  # type: ignore[list-item]
+            "camera_matrix.data[0]",
+            "expected a number, got 'a'",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "cameraMatrix": GOOD_JSON["camera_matrix"]}),
+            "cameraMatrix",
+            "expected one camera_matrix, got camera_matrix, cameraMatrix",
+        ),
+        (
+            json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, [-5.0, 0, 1, 0, 5, 1, 0, 0, 1])}),
+            "camera_matrix fx",
+            "expected a positive focal length",
+        ),
+    ],
+)
+def test_opencv_json_errors(tmp_path: Path, text: str, where: str, match: str) -> None:
+    path = write(tmp_path, "calib.json", text)
+    with pytest.raises(FileFormatError, match=match) as caught:
+        load_opencv_calibration(path, MOUNT)
+    assert caught.value.path == str(path)
+    assert where in caught.value.where
+
+
+def test_opencv_loader_refuses_other_formats(tmp_path: Path) -> None:
+    path = write(tmp_path, "calib.xml", '<?xml version="1.0"?>\n<opencv_storage>\n</opencv_storage>\n')
+    with pytest.raises(FileFormatError, match=r"line 1: expected a FileStorage YAML \('%YAML:1.0'\) or JSON"):
+        load_opencv_calibration(path, MOUNT)
+
+
+def test_opencv_loader_refuses_a_bad_mount(tmp_path: Path) -> None:
+    path = write(tmp_path, "calib.json", json.dumps(GOOD_JSON))
+    with pytest.raises(ValueError, match="mount: expected CameraMount, got float"):
+        load_opencv_calibration(path, 1.0)  # type: ignore[arg-type]
+
+
+def test_yaml_and_json_agree(tmp_path: Path) -> None:
+    as_json = {
+        **GOOD_JSON,
+        "camera_matrix": opencv_matrix(3, 3, [674.9, 0.0, 307.55, 0.0, 674.9, 251.45, 0.0, 0.0, 1.0]),
+        "distortion_coefficients": opencv_matrix(5, 1, [-0.1, 0.02, 0.001, -0.002, 0.0]),
+    }
+    yaml = (
+        "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+        "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 674.9, 0., 307.55, 0., 674.9, 251.45, 0., 0., 1. ]\n"
+        "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+        "   data: [ -0.1, 0.02, 0.001, -0.002, 0. ]\n"
+    )
+    from_json = load_opencv_calibration(write(tmp_path, "a.json", json.dumps(as_json)), MOUNT)
+    from_yaml = load_opencv_calibration(write(tmp_path, "a.yml", yaml), MOUNT)
+    assert from_json == from_yaml
+    np.testing.assert_array_equal(from_json.intrinsics.matrix(), from_yaml.intrinsics.matrix())

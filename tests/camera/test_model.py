@@ -1,0 +1,107 @@
+"""Projection basics: principal point, pan and tilt signs, behind the camera, distortion round trip."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from aura_ums.camera import CalibrationBounds, Camera, CameraIntrinsics, CameraMount, undistort_points
+from aura_ums.errors import InputError
+from aura_ums.uncertainty import Pose
+
+INTRINSICS = CameraIntrinsics(500.0, 480.0, 320.0, 240.0, 640, 480)
+
+
+def camera(**mount: float) -> Camera:
+    return Camera(INTRINSICS, CameraMount(**{"height": 1.0, **mount}))
+
+
+def test_point_straight_ahead_projects_to_principal_point() -> None:
+    # heading north: robot left is west, so the optical centre is at (2.2, 3.3)
+    pixel = camera(forward=0.3, left=-0.2).project(Pose(2.0, 3.0, math.pi / 2), [(2.2, 13.0, 1.0)])
+    np.testing.assert_allclose(pixel, [[320.0, 240.0]], atol=1e-9)
+
+
+def test_pan_is_counter_clockwise() -> None:
+    left_point = [(10.0, 10.0, 1.0)]  # 45 degrees to the robot's left
+    assert camera().project(Pose(0, 0, 0), left_point)[0, 0] < 320.0  # seen on the left of the image
+    np.testing.assert_allclose(camera(pan=math.pi / 4).project(Pose(0, 0, 0), left_point)[0], [320.0, 240.0])
+
+
+def test_tilt_is_positive_below_the_horizon() -> None:
+    low_point = [(10.0, 0.0, 1.0 - 10.0 * math.tan(0.2))]
+    assert camera().project(Pose(0, 0, 0), low_point)[0, 1] > 240.0  # below the centre of the image
+    np.testing.assert_allclose(camera(tilt=0.2).project(Pose(0, 0, 0), low_point)[0], [320.0, 240.0])
+
+
+def test_point_behind_the_camera_is_nan() -> None:
+    pixels = camera(pan=0.4, tilt=0.3).project(Pose(0, 0, 0), [(-5.0, 1.0, 0.0), (5.0, 0.0, 0.0)])
+    assert np.isnan(pixels[0]).all()
+    assert np.isfinite(pixels[1]).all()
+
+
+def test_undistort_without_distortion_is_the_pinhole_inverse() -> None:
+    result = undistort_points(INTRINSICS, [(820.0, 0.0), (320.0, 240.0)])
+    np.testing.assert_allclose(result, [[1.0, -0.5], [0.0, 0.0]])
+
+
+distortions = st.tuples(
+    st.floats(-0.3, 0.1),
+    st.floats(-0.05, 0.05),
+    st.floats(-0.003, 0.003),
+    st.floats(-0.003, 0.003),
+    st.floats(-0.01, 0.01),
+)
+
+
+@given(distortion=distortions, x=st.floats(-0.6, 0.6), y=st.floats(-0.5, 0.5))
+def test_undistort_inverts_the_distortion(
+    distortion: tuple[float, float, float, float, float], x: float, y: float
+) -> None:
+    intrinsics = CameraIntrinsics(500.0, 505.0, 320.0, 240.0, 640, 480, distortion)
+    pixel = Camera(intrinsics, CameraMount(1.0)).project_camera_frame([(2 * x, 2 * y, 2.0)])
+    np.testing.assert_allclose(undistort_points(intrinsics, pixel), [[x, y]], atol=1e-10)
+
+
+def test_undistort_beyond_the_fold_is_nan() -> None:
+    strong = CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480, (-1.0, 0.0, 0.0, 0.0, 0.0))
+    result = undistort_points(strong, [(639.0, 479.0), (330.0, 250.0)])
+    assert np.isnan(result[0]).all()
+    assert np.isfinite(result[1]).all()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"intrinsics": "camera", "pixels": [(0, 0)]}, "intrinsics: expected CameraIntrinsics"),
+        ({"intrinsics": INTRINSICS, "pixels": [(0, 0, 0)]}, r"pixels: expected an \(n, 2\) array"),
+        ({"intrinsics": INTRINSICS, "pixels": [(0, math.nan)]}, "pixels: expected finite coordinates"),
+        ({"intrinsics": INTRINSICS, "pixels": [(0, 0)], "iterations": 0}, "iterations: expected a positive"),
+    ],
+)
+def test_undistort_refuses_bad_input(kwargs: dict[str, object], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        undistort_points(**kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "match"),
+    [
+        ("fx", -1.0, "CalibrationBounds.fx: expected a non-negative number"),
+        ("tilt", math.nan, "CalibrationBounds.tilt: expected a finite number"),
+        ("height", math.inf, "CalibrationBounds.height: expected a finite number"),
+        ("pan", "0.1", "CalibrationBounds.pan: expected a finite number"),
+    ],
+)
+def test_calibration_bounds_are_validated(field: str, value: object, match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        CalibrationBounds(**{field: value})  # type: ignore[arg-type]
+
+
+def test_calibration_bounds_default_to_an_exact_calibration() -> None:
+    bounds = CalibrationBounds()
+    assert all(getattr(bounds, name) == 0.0 for name in CalibrationBounds.field_names())

@@ -1,0 +1,552 @@
+"""Pixels to bounded observations: soundness (Monte Carlo against a true camera) and input errors."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+import pytest
+
+from aura_ums.camera import (
+    CalibrationBounds,
+    Camera,
+    CameraIntrinsics,
+    CameraMount,
+    observe_ground_line,
+    observe_point,
+    observe_vertical_line,
+    undistort_points,
+)
+from aura_ums.errors import InputError
+from aura_ums.geometry import wrap_angle
+from aura_ums.uncertainty import (
+    GroundLineLandmark,
+    PointLandmark,
+    Pose,
+    VerticalLineLandmark,
+)
+
+CASES = 2000
+WIDTH, HEIGHT = 640, 480
+
+
+# ------------------------------------------------------------------ random scenes
+
+
+def random_camera(rng: np.random.Generator) -> Camera:
+    """A tilted, panned, offset and (mostly) distorted camera."""
+    f = rng.uniform(450.0, 900.0)
+    distortion = None
+    if rng.random() < 0.75:
+        distortion = (
+            rng.uniform(-0.15, 0.05),
+            rng.uniform(-0.02, 0.05),
+            rng.uniform(-2e-3, 2e-3),
+            rng.uniform(-2e-3, 2e-3),
+            rng.uniform(-5e-3, 5e-3),
+        )
+    intrinsics = CameraIntrinsics(
+        f,
+        f * rng.uniform(0.98, 1.02),
+        WIDTH / 2 + rng.uniform(-20.0, 20.0),
+        HEIGHT / 2 + rng.uniform(-20.0, 20.0),
+        WIDTH,
+        HEIGHT,
+        distortion,
+    )
+    mount = CameraMount(
+        height=rng.uniform(0.6, 2.0),
+        forward=rng.uniform(-0.5, 0.5),
+        left=rng.uniform(-0.3, 0.3),
+        pan=rng.uniform(-math.pi, math.pi),
+        tilt=rng.uniform(-0.2, 0.6),
+    )
+    return Camera(intrinsics, mount)
+
+
+def random_bounds(rng: np.random.Generator) -> CalibrationBounds:
+    if rng.random() < 0.1:
+        return CalibrationBounds()
+    return CalibrationBounds(
+        fx=rng.uniform(0.0, 10.0),
+        fy=rng.uniform(0.0, 10.0),
+        cx=rng.uniform(0.0, 5.0),
+        cy=rng.uniform(0.0, 5.0),
+        pan=rng.uniform(0.0, 0.02),
+        tilt=rng.uniform(0.0, 0.02),
+        height=rng.uniform(0.0, 0.05),
+    )
+
+
+def deviation(rng: np.random.Generator, bound: float) -> float:
+    """A deviation within +-bound, at an end of the interval one time in two."""
+    if rng.random() < 0.5:
+        return bound * float(rng.choice([-1.0, 1.0]))
+    return bound * rng.uniform(-1.0, 1.0)
+
+
+def true_camera(nominal: Camera, bounds: CalibrationBounds, rng: np.random.Generator) -> Camera:
+    k, m = nominal.intrinsics, nominal.mount
+    intrinsics = replace(
+        k,
+        fx=k.fx + deviation(rng, bounds.fx),
+        fy=k.fy + deviation(rng, bounds.fy),
+        cx=k.cx + deviation(rng, bounds.cx),
+        cy=k.cy + deviation(rng, bounds.cy),
+    )
+    mount = replace(
+        m,
+        pan=m.pan + deviation(rng, bounds.pan),
+        tilt=m.tilt + deviation(rng, bounds.tilt),
+        height=m.height + deviation(rng, bounds.height),
+    )
+    return Camera(intrinsics, mount)
+
+
+def perturbed(rng: np.random.Generator, pixel: np.ndarray, error: float) -> np.ndarray | None:
+    """The measured pixel: within +-error of the true one in u and v; None when it leaves the image."""
+    measured = pixel + np.array([deviation(rng, error), deviation(rng, error)])
+    if not (-0.5 <= measured[0] <= WIDTH - 0.5 and -0.5 <= measured[1] <= HEIGHT - 0.5):
+        return None
+    return np.asarray(measured, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Scene:
+    nominal: Camera
+    bounds: CalibrationBounds
+    truth: Camera
+    pose: Pose
+    pixel_error: float
+
+
+def random_scene(rng: np.random.Generator) -> Scene:
+    nominal = random_camera(rng)
+    bounds = random_bounds(rng)
+    pose = Pose(rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(-math.pi, math.pi))
+    error = 0.0 if rng.random() < 0.1 else rng.uniform(0.0, 2.0)
+    return Scene(nominal, bounds, true_camera(nominal, bounds, rng), pose, error)
+
+
+def ray_world(scene: Scene, pixel: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Optical centre and ray direction (world) of a pixel seen by the TRUE camera, or None off its model."""
+    camera = scene.truth
+    normalized = undistort_points(camera.intrinsics, pixel[None, :])[0]
+    if not np.all(np.isfinite(normalized)):
+        return None
+    direction_robot = camera.mount.rotation() @ np.array([normalized[0], normalized[1], 1.0])
+    c, s = math.cos(scene.pose.heading), math.sin(scene.pose.heading)
+    rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    m = camera.mount
+    centre = np.array([scene.pose.x, scene.pose.y, 0.0]) + rotation @ np.array([m.forward, m.left, m.height])
+    return centre, rotation @ direction_robot
+
+
+def true_pixel(scene: Scene, point: np.ndarray) -> np.ndarray | None:
+    """The TRUE camera's image of a world point, or None when it is off the distortion model's domain."""
+    pixel = scene.truth.project(scene.pose, point[None, :])[0]
+    if not np.all(np.isfinite(pixel)):
+        return None
+    back = ray_world(scene, pixel)
+    if back is None:
+        return None
+    centre, direction = back
+    to_point = point - centre
+    # principal branch only: the back-projected ray must point at the point
+    if np.linalg.norm(np.cross(direction, to_point)) > 1e-6 * np.linalg.norm(direction) * np.linalg.norm(
+        to_point
+    ):
+        return None
+    return np.asarray(pixel, dtype=np.float64)
+
+
+def sensor_xy(scene: Scene) -> np.ndarray:
+    c, s = math.cos(scene.pose.heading), math.sin(scene.pose.heading)
+    forward, left = scene.truth.mount.sensor_offset
+    return np.array([scene.pose.x + c * forward - s * left, scene.pose.y + s * forward + c * left])
+
+
+def random_image_pixel(rng: np.random.Generator) -> np.ndarray:
+    return np.array([rng.uniform(-0.5, WIDTH - 0.5), rng.uniform(-0.5, HEIGHT - 0.5)])
+
+
+def plane_point(scene: Scene, pixel: np.ndarray, z: float, max_range: float) -> np.ndarray | None:
+    ray = ray_world(scene, pixel)
+    if ray is None:
+        return None
+    centre, direction = ray
+    if direction[2] * (z - centre[2]) <= 0.0 or abs(direction[2]) < 1e-9:
+        return None
+    point = centre + direction * (z - centre[2]) / direction[2]
+    if math.hypot(*(point[:2] - centre[:2])) > max_range:
+        return None
+    return np.asarray(point, dtype=np.float64)
+
+
+# ------------------------------------------------------------------ soundness
+
+
+@dataclass
+class Tally:
+    checked: int = 0
+    worst_ratio: float = 0.0  # largest |true - stated| / error: <= 1 is sound
+
+    def add(self, deviation: float, error: float) -> None:
+        self.worst_ratio = max(self.worst_ratio, abs(deviation) / error if error > 0 else math.inf)
+
+
+def test_bearing_bound_is_sound(rng: np.random.Generator) -> None:
+    tally = Tally()
+    while tally.checked < CASES:
+        scene = random_scene(rng)
+        ray = ray_world(scene, random_image_pixel(rng))
+        if ray is None:
+            continue
+        centre, direction = ray
+        point = centre + direction / np.linalg.norm(direction) * rng.uniform(1.0, 40.0)
+        if math.hypot(*(point[:2] - centre[:2])) < 0.3:
+            continue
+        pixel = true_pixel(scene, point)
+        measured = None if pixel is None else perturbed(rng, pixel, scene.pixel_error)
+        if measured is None:
+            continue
+        pole = VerticalLineLandmark("pole", point[0], point[1], min(point[2], 0.0), max(point[2], 0.0) + 1.0)
+        obs = observe_vertical_line(
+            scene.nominal, pole, measured, time=1.0, pixel_error=scene.pixel_error, bounds=scene.bounds
+        )
+        assert obs.sensor_offset == scene.nominal.mount.sensor_offset
+        sensor = sensor_xy(scene)
+        truth = wrap_angle(math.atan2(point[1] - sensor[1], point[0] - sensor[0]) - scene.pose.heading)
+        miss = wrap_angle(truth - obs.bearing)
+        assert abs(miss) <= obs.bearing_error, (scene, measured, truth, obs)
+        tally.add(miss, obs.bearing_error)
+        tally.checked += 1
+    assert tally.worst_ratio <= 1.0
+
+
+def test_range_bearing_bound_is_sound(rng: np.random.Generator) -> None:
+    tally, range_tally = Tally(), Tally()
+    refusals: list[str] = []
+    while tally.checked < CASES:
+        scene = random_scene(rng)
+        z = rng.uniform(0.0, 3.0)
+        if abs(scene.truth.mount.height - z) < 0.2:
+            continue
+        point = plane_point(scene, random_image_pixel(rng), z, 60.0)
+        if point is None:
+            continue
+        pixel = true_pixel(scene, point)
+        measured = None if pixel is None else perturbed(rng, pixel, scene.pixel_error)
+        if measured is None:
+            continue
+        corner = PointLandmark("corner", point[0], point[1], z)
+        try:
+            obs = observe_point(
+                scene.nominal,
+                corner,
+                measured,
+                time=2.0,
+                pixel_error=scene.pixel_error,
+                bounds=scene.bounds,
+                max_range=60.0,
+            )
+        except InputError as exc:  # the nominal camera puts the pixel above the horizon
+            refusals.append(str(exc))
+            continue
+        sensor = sensor_xy(scene)
+        true_bearing = wrap_angle(math.atan2(point[1] - sensor[1], point[0] - sensor[0]) - scene.pose.heading)
+        true_range = math.hypot(point[0] - sensor[0], point[1] - sensor[1])
+        miss = wrap_angle(true_bearing - obs.bearing)
+        assert abs(miss) <= obs.bearing_error, (scene, measured, true_bearing, obs)
+        assert obs.range_min <= true_range <= obs.range_max, (scene, measured, true_range, obs)
+        centre = 0.5 * (obs.range_min + obs.range_max)
+        range_tally.add(true_range - centre, 0.5 * (obs.range_max - obs.range_min))
+        tally.add(miss, obs.bearing_error)
+        tally.checked += 1
+    assert len(refusals) < CASES // 10
+    assert all("horizon" in message for message in refusals)
+    assert tally.worst_ratio <= 1.0
+    assert range_tally.worst_ratio <= 1.0
+
+
+def test_ground_line_bound_is_sound(rng: np.random.Generator) -> None:
+    angle_tally, offset_tally = Tally(), Tally()
+    refusals: list[str] = []
+    while angle_tally.checked < CASES:
+        scene = random_scene(rng)
+        a = plane_point(scene, random_image_pixel(rng), 0.0, 30.0)
+        b = plane_point(scene, random_image_pixel(rng), 0.0, 30.0)
+        if a is None or b is None or np.linalg.norm(b[:2] - a[:2]) < 1.0:
+            continue
+        pixel_a, pixel_b = true_pixel(scene, a), true_pixel(scene, b)
+        if pixel_a is None or pixel_b is None:
+            continue
+        measured_a, measured_b = (
+            perturbed(rng, pixel_a, scene.pixel_error),
+            perturbed(rng, pixel_b, scene.pixel_error),
+        )
+        if measured_a is None or measured_b is None:
+            continue
+        unit = (b[:2] - a[:2]) / np.linalg.norm(b[:2] - a[:2])
+        start, end = (a[:2] - 2 * unit, b[:2] + 2 * unit)
+        if rng.random() < 0.5:
+            start, end, unit = end, start, -unit
+        edge = GroundLineLandmark("edge", start, end)
+        sensor = sensor_xy(scene)
+        true_angle = wrap_angle(edge.direction - scene.pose.heading)
+        true_offset = float(unit[0] * (sensor[1] - start[1]) - unit[1] * (sensor[0] - start[0]))
+        ends = (measured_a, measured_b) if rng.random() < 0.5 else (measured_b, measured_a)
+        segment = np.concatenate(ends)
+        try:
+            obs = observe_ground_line(
+                scene.nominal,
+                edge,
+                segment,
+                expected_angle=true_angle + rng.uniform(-1.2, 1.2),
+                time=3.0,
+                pixel_error=scene.pixel_error,
+                bounds=scene.bounds,
+            )
+        except InputError as exc:  # horizon within the bounds, or too short a segment
+            refusals.append(str(exc))
+            continue
+        miss = wrap_angle(true_angle - obs.angle)
+        assert abs(miss) <= obs.angle_error, (scene, segment, true_angle, obs)
+        assert abs(true_offset - obs.offset) <= obs.offset_error, (scene, segment, true_offset, obs)
+        angle_tally.add(miss, obs.angle_error)
+        offset_tally.add(true_offset - obs.offset, obs.offset_error)
+        angle_tally.checked += 1
+    assert len(refusals) < CASES // 5
+    assert all("horizon" in message or "long enough" in message for message in refusals)
+    assert angle_tally.worst_ratio <= 1.0
+    assert offset_tally.worst_ratio <= 1.0
+
+
+# ------------------------------------------------------------------ exactness and tightness
+
+FLAT = Camera(CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480), CameraMount(1.0, forward=0.4, left=0.1))
+POLE = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 3.0)
+CORNER = PointLandmark("corner", 10.0, 0.0, 0.0)
+EDGE = GroundLineLandmark("edge", (0.0, -2.0), (20.0, -2.0))
+
+
+def test_exact_calibration_and_pixel_give_the_true_values() -> None:
+    tilted = Camera(FLAT.intrinsics, replace(FLAT.mount, tilt=0.2, pan=0.3))
+    pose = Pose(0.0, 0.0, 0.0)
+    pixel = tilted.project(pose, [(9.0, 4.0, 0.0)])[0]
+    obs = observe_point(tilted, replace(CORNER, x=9.0, y=4.0), pixel, time=0.0, pixel_error=0.0)
+    assert obs.bearing == pytest.approx(math.atan2(4.0 - 0.1, 9.0 - 0.4), abs=1e-9)
+    assert obs.bearing_error < 1e-8
+    assert obs.range_min == pytest.approx(math.hypot(8.6, 3.9), abs=1e-8)
+    assert obs.range_max - obs.range_min < 1e-8
+    assert obs.sensor_offset == (0.4, 0.1)
+
+
+def test_pan_bound_adds_exactly_to_the_bearing_error() -> None:
+    obs = observe_vertical_line(
+        FLAT, POLE, (200.0, 100.0), time=0.0, pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
+    )
+    assert obs.bearing_error == pytest.approx(0.01, rel=1e-5)
+    line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
+    ground = observe_ground_line(
+        FLAT, EDGE, line, expected_angle=0.0, time=0.0, pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
+    )
+    assert ground.angle_error == pytest.approx(0.01, rel=1e-5)
+    assert ground.offset_error < 1e-8  # a rotation about the sensor keeps the distance to the line
+
+
+def test_height_bound_scales_the_ground_offset() -> None:
+    line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
+    obs = observe_ground_line(
+        FLAT, EDGE, line, expected_angle=0.0, time=0.0, pixel_error=0.0, bounds=CalibrationBounds(height=0.1)
+    )
+    assert obs.offset == pytest.approx(2.1, abs=1e-8)  # 2 m from the robot, the sensor 0.1 m to its left
+    assert obs.offset_error == pytest.approx(0.21, rel=1e-5)  # +-10 % of the height
+    assert obs.angle_error < 1e-8
+
+
+def test_ground_line_orientation_follows_the_expected_angle() -> None:
+    line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
+    forward = observe_ground_line(FLAT, EDGE, line, expected_angle=1.4, time=0.0, pixel_error=0.0)
+    backward = observe_ground_line(FLAT, EDGE, line, expected_angle=1.8, time=0.0, pixel_error=0.0)
+    assert forward.angle == pytest.approx(0.0, abs=1e-6)
+    assert abs(backward.angle) == pytest.approx(math.pi, abs=1e-6)
+    assert backward.offset == pytest.approx(-forward.offset)
+    assert backward.offset_error == pytest.approx(forward.offset_error)
+
+
+def test_range_capped_by_max_range_near_the_horizon() -> None:
+    pixel = FLAT.project(Pose(0, 0, 0), [(60.0, 0.1, 0.0)])[0]  # 1 m below the horizon at 60 m
+    with pytest.raises(InputError, match=r"max_range: expected a bound on the range, .* reach the horizon"):
+        observe_point(FLAT, CORNER, pixel, time=0.0, pixel_error=10.0)
+    obs = observe_point(FLAT, CORNER, pixel, time=0.0, pixel_error=10.0, max_range=80.0)
+    assert obs.range_max == 80.0
+    assert 0.0 < obs.range_min < 60.0
+
+
+def test_landmark_above_the_camera() -> None:
+    lamp = PointLandmark("lamp", 10.0, 0.0, 3.0)
+    pixel = FLAT.project(Pose(0, 0, 0), [(10.0, 0.0, 3.0)])[0]
+    obs = observe_point(FLAT, lamp, pixel, time=0.0, pixel_error=1.0, bounds=CalibrationBounds(height=0.05))
+    assert obs.range_min <= 9.6 <= obs.range_max
+    with pytest.raises(InputError, match=r"expected a pixel above the horizon for a landmark at height 3\.0"):
+        observe_point(FLAT, lamp, (320.0, 400.0), time=0.0)
+
+
+# ------------------------------------------------------------------ input errors
+
+GOOD_PIXEL = (320.0, 300.0)
+# wrongly typed arguments, as a caller without a type checker might pass them
+WRONG_CORNER: Any = CORNER
+WRONG_POLE: Any = POLE
+WRONG_CAMERA: Any = "camera"
+WRONG_BOUNDS: Any = 0.1
+GOOD_SEGMENT = (100.0, 400.0, 200.0, 300.0)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        (
+            lambda: observe_vertical_line(FLAT, POLE, (640.0, 10.0), time=0.0),
+            InputError,
+            r"pixel: expected a pixel inside the 640x480 image \(\[-0.5, 639.5\]",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, (10.0, -0.6), time=0.0),
+            InputError,
+            "pixel: expected a pixel inside",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, (math.nan, 10.0), time=0.0),
+            InputError,
+            "pixel: expected finite coordinates",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, (1.0, 2.0, 3.0), time=0.0),
+            InputError,
+            "pixel: expected an \\(n, 2\\) array",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, [(1.0, 2.0), (3.0, 4.0)], time=0.0),
+            InputError,
+            r"pixel: expected \(u, v\)",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=0.0, pixel_error=-1.0),
+            InputError,
+            "pixel_error: expected a non-negative number",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=math.inf),
+            InputError,
+            "time: expected a finite number",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, WRONG_CORNER, GOOD_PIXEL, time=0.0),
+            InputError,
+            "landmark: expected VerticalLineLandmark, got PointLandmark",
+        ),
+        (
+            lambda: observe_point(FLAT, WRONG_POLE, GOOD_PIXEL, time=0.0),
+            InputError,
+            "landmark: expected PointLandmark, got VerticalLineLandmark",
+        ),
+        (
+            lambda: observe_ground_line(FLAT, WRONG_POLE, GOOD_SEGMENT, expected_angle=0.0, time=0.0),
+            InputError,
+            "landmark: expected GroundLineLandmark",
+        ),
+        (
+            lambda: observe_vertical_line(WRONG_CAMERA, POLE, GOOD_PIXEL, time=0.0),
+            InputError,
+            "camera: expected Camera, got str",
+        ),
+        (
+            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=0.0, bounds=WRONG_BOUNDS),
+            InputError,
+            "bounds: expected CalibrationBounds, got float",
+        ),
+        (
+            lambda: observe_vertical_line(
+                FLAT, POLE, GOOD_PIXEL, time=0.0, bounds=CalibrationBounds(fy=500.0)
+            ),
+            InputError,
+            r"bounds.fy: expected less than the focal length fy \(500.0\)",
+        ),
+        (
+            lambda: observe_point(FLAT, CORNER, (320.0, 100.0), time=0.0),
+            InputError,
+            "pixel: expected a pixel below the horizon",
+        ),
+        (
+            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, bounds=CalibrationBounds(height=1.0)),
+            InputError,
+            "bounds.height: expected the camera height 1.0 .* to exclude",
+        ),
+        (
+            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, max_range=-1.0),
+            InputError,
+            "max_range: expected a positive number",
+        ),
+        (
+            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, max_range=1.0),
+            InputError,
+            "max_range: expected at least the smallest possible range",
+        ),
+        (
+            lambda: observe_ground_line(FLAT, EDGE, (1.0, 2.0, 3.0), expected_angle=0.0, time=0.0),
+            InputError,
+            r"segment: expected \(u1, v1, u2, v2\), got shape \(3,\)",
+        ),
+        (
+            lambda: observe_ground_line(FLAT, EDGE, (1.0, 2.0, 3.0, 900.0), expected_angle=0.0, time=0.0),
+            InputError,
+            "segment: expected a pixel inside",
+        ),
+        (
+            lambda: observe_ground_line(FLAT, EDGE, ("a", 1, 2, 3), expected_angle=0.0, time=0.0),
+            InputError,
+            "segment: expected",
+        ),
+        (
+            lambda: observe_ground_line(FLAT, EDGE, GOOD_SEGMENT, expected_angle=math.nan, time=0.0),
+            InputError,
+            "expected_angle: expected a finite number",
+        ),
+        (
+            lambda: observe_ground_line(
+                FLAT, EDGE, (100.0, 400.0, 200.0, 100.0), expected_angle=0.0, time=0.0
+            ),
+            InputError,
+            "segment: expected both ends below the horizon, got end 2",
+        ),
+        (
+            lambda: observe_ground_line(
+                FLAT, EDGE, (100.0, 400.0, 200.0, 250.0), expected_angle=0.0, time=0.0, pixel_error=20.0
+            ),
+            InputError,
+            "segment: expected error bounds that keep both ends below the horizon",
+        ),
+        (
+            lambda: observe_ground_line(
+                FLAT, EDGE, (100.0, 400.0, 101.0, 401.0), expected_angle=0.0, time=0.0, pixel_error=2.0
+            ),
+            InputError,
+            "segment: expected a segment long enough",
+        ),
+        (
+            lambda: observe_ground_line(
+                FLAT, EDGE, GOOD_SEGMENT, expected_angle=0.0, time=0.0, bounds=CalibrationBounds(height=1.5)
+            ),
+            InputError,
+            "bounds.height: expected the camera height 1.0 .* to stay above the ground",
+        ),
+    ],
+)
+def test_bad_input_is_refused_naming_the_argument(call: object, error: type[Exception], match: str) -> None:
+    assert callable(call)
+    with pytest.raises(error, match=match):
+        call()
