@@ -1,0 +1,38 @@
+"""The Expecter: image windows in which expected landmarks must appear.
+
+From the spatial uncertainty map (polygon and wedge), a landmark of any class and a
+calibrated camera, :class:`Expecter` computes a window guaranteed to hold the landmark's
+projection for every pose of the map, then grows it by the margin its perceptual strategy
+needs and clips it to the image. Baselines (the disk model, an EKF's 3-sigma box) use the
+same machinery, for side-by-side comparisons.
+"""
+
+from aura_ums.expecter._baselines import (
+    DISK_SIDES,
+    disk_model_map,
+    disk_model_window,
+    gaussian_box_map,
+    gaussian_window,
+)
+from aura_ums.expecter._expecter import Expecter
+from aura_ums.expecter._window import (
+    DEFAULT_MARGINS,
+    UNBOUNDED_PIXELS,
+    ImageWindow,
+    PerceptualStrategy,
+    margin_pixels,
+)
+
+__all__ = [
+    "DEFAULT_MARGINS",
+    "DISK_SIDES",
+    "UNBOUNDED_PIXELS",
+    "Expecter",
+    "ImageWindow",
+    "PerceptualStrategy",
+    "disk_model_map",
+    "disk_model_window",
+    "gaussian_box_map",
+    "gaussian_window",
+    "margin_pixels",
+]

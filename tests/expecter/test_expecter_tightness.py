@@ -1,0 +1,58 @@
+"""Tightness: the window is barely larger than the projections of sampled poses.
+
+Per class, over random maps with the landmark in front of the camera, the median of
+window area / area of the bounding box of projections from 5,000 sampled poses must be
+at most 1.25. The reference from the map's extreme poses (vertices with the wedge's ends)
+shows that the remaining gap is the sampling's, not the window's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from expecter_helpers import (
+    CAMERAS,
+    extreme_poses,
+    landmark_points,
+    random_landmark,
+    random_map,
+    visible_pixels,
+)
+
+from aura_ums.expecter import Expecter
+
+MAPS = 12
+SAMPLED_POSES = 5000
+
+
+def _box_area(pixels: np.ndarray) -> float:
+    return float(np.ptp(pixels[:, 0]) * np.ptp(pixels[:, 1]))
+
+
+@pytest.mark.parametrize("camera_name", ["tilted_panned_offset", "distorted"])
+@pytest.mark.parametrize("kind", ["I", "II", "III"])
+def test_median_area_ratio(kind: str, camera_name: str, rng: np.random.Generator) -> None:
+    camera = CAMERAS[camera_name]
+    expecter = Expecter(camera)
+    sampled_ratios: list[float] = []
+    extreme_ratios: list[float] = []
+    while len(sampled_ratios) < MAPS:
+        the_map = random_map(rng)
+        landmark = random_landmark(rng, kind, the_map.center)
+        points = landmark_points(landmark, rng, count=9)
+        poses = the_map.sample_poses(SAMPLED_POSES, rng)
+        if np.any(camera.to_camera_frame(poses, points)[..., 2] <= 0.05):
+            continue  # keep the landmark wholly in front: near the camera plane no box is finite
+        window = expecter.bounds(the_map, landmark)
+        assert window is not None
+        sampled = visible_pixels(camera, poses, points)
+        extremes = np.vstack([sampled, visible_pixels(camera, extreme_poses(the_map, per_edge=16), points)])
+        sampled_ratios.append(window.area / _box_area(sampled))
+        extreme_ratios.append(window.area / _box_area(extremes))
+    median = float(np.median(sampled_ratios))
+    print(
+        f"class {kind} {camera_name}: median area ratio {median:.3f} (vs sampled poses), "
+        f"{float(np.median(extreme_ratios)):.4f} (vs samples + extreme poses), max {max(sampled_ratios):.3f}"
+    )
+    assert min(sampled_ratios) >= 1.0 - 1e-9  # sound
+    assert median <= 1.25
