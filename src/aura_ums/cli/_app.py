@@ -24,10 +24,10 @@ def figures(
     ),
     seed: Annotated[int, typer.Option(help="Seed of the sampled true outcomes drawn over the maps.")] = 0,
 ) -> None:
-    """Draw the paper's growth figures (5, 6, 7) with sampled true outcomes over them."""
-    from aura_ums.plot import draw_growth_figures
+    """Draw the paper's figures 3-7 (maps, windows, growth) with sampled true outcomes over them."""
+    from aura_ums.plot import draw_all_figures
 
-    written = draw_growth_figures(out, seed=seed)
+    written = draw_all_figures(out, seed=seed)
     for path in written:
         _console.print(f"wrote {path}")
 

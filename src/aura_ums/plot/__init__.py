@@ -1,5 +1,15 @@
-"""Matplotlib figures of maps, wedges and sampled outcomes, and the demo report."""
+"""Matplotlib figures of maps, wedges, windows and sampled outcomes, and the demo report."""
 
-from aura_ums.plot._growth import draw_growth_figures, write_growth_report
+from aura_ums.plot._expecter import draw_expecter_figures
+from aura_ums.plot._growth import draw_all_figures, draw_growth_figures, write_growth_report
+from aura_ums.plot._reduction import PathRunStep, draw_path_figure, run_down_path
 
-__all__ = ["draw_growth_figures", "write_growth_report"]
+__all__ = [
+    "PathRunStep",
+    "draw_all_figures",
+    "draw_expecter_figures",
+    "draw_growth_figures",
+    "draw_path_figure",
+    "run_down_path",
+    "write_growth_report",
+]

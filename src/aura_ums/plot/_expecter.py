@@ -22,8 +22,8 @@ _COLORS = ("tab:blue", "tab:orange")
 def draw_expecter_figures(out_dir: str | Path, *, seed: int = 0) -> list[Path]:
     """Draw the paper's Figure 4 (polygon versus disk windows) and save it as PNG files.
 
-    Two files: ``expecter_fig4_map.png`` (top view: the elongated polygonal map, its
-    disk model and the two landmarks) and ``expecter_fig4_windows.png`` (the 640 x 480
+    Two files: ``figure4_top_view.png`` (top view: the elongated polygonal map, its
+    disk model and the two landmarks) and ``figure4_windows.png`` (the 640 x 480
     image: for each landmark the guaranteed window of the polygon map, solid, and of the
     disk model, dashed, with the projections from poses sampled in each map as dots).
     Landmark 1, ahead on the path, gets a tall window; landmark 2, beside it, a wide one.
@@ -45,7 +45,7 @@ def draw_expecter_figures(out_dir: str | Path, *, seed: int = 0) -> list[Path]:
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     [p.name for p in draw_expecter_figures(folder)]
-    ['expecter_fig4_map.png', 'expecter_fig4_windows.png']
+    ['figure4_top_view.png', 'figure4_windows.png']
     """
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)
@@ -57,7 +57,7 @@ def draw_expecter_figures(out_dir: str | Path, *, seed: int = 0) -> list[Path]:
     map_figure = Figure(figsize=(7.0, 4.5))
     FigureCanvasAgg(map_figure)
     _draw_top_view(map_figure.add_subplot(1, 1, 1), scenario.map, disk, scenario.landmarks)
-    map_path = folder / "expecter_fig4_map.png"
+    map_path = folder / "figure4_top_view.png"
     map_figure.savefig(map_path, dpi=110)
 
     image_figure = Figure(figsize=(11.0, 4.6))
@@ -74,7 +74,7 @@ def draw_expecter_figures(out_dir: str | Path, *, seed: int = 0) -> list[Path]:
             if window is not None:
                 _rectangle(ax, window, color, "-" if model is scenario.map else "--", landmark.id)
         ax.legend(loc="lower left", fontsize=8)
-    windows_path = folder / "expecter_fig4_windows.png"
+    windows_path = folder / "figure4_windows.png"
     image_figure.savefig(windows_path, dpi=110)
     return [map_path, windows_path]
 

@@ -145,6 +145,25 @@ def draw_growth_figures(out: str | Path, *, seed: int = 0, terrain: str = PAPER_
     return [figure5(folder, rng, stats), figure6(folder, rng, stats), figure7(folder, rng, stats)]
 
 
+def draw_all_figures(out: str | Path, *, seed: int = 0) -> list[Path]:
+    """Draw every figure of the paper that aura-ums reproduces so far (3, 4, 5, 6, 7) into ``out``.
+
+    Returns
+    -------
+    list of Path
+        The written PNG files.
+    """
+    from aura_ums.plot._expecter import draw_expecter_figures
+    from aura_ums.plot._reduction import draw_path_figure
+
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [draw_path_figure(folder, np.random.default_rng(seed))]
+    written.extend(draw_expecter_figures(folder, seed=seed))
+    written.extend(draw_growth_figures(folder, seed=seed))
+    return written
+
+
 def _random_moves(rng: np.random.Generator, table: TerrainTable) -> list[tuple[TurnAndRun, TerrainStats]]:
     names = sorted(table)
     return [
@@ -157,7 +176,7 @@ def _random_moves(rng: np.random.Generator, table: TerrainTable) -> list[tuple[T
 
 
 def write_growth_report(out: str | Path, *, seed: int = 0) -> Path:
-    """Write the growth report: the three figures and ``summary.md`` with measured figures.
+    """Write the report: the paper's figures and ``summary.md`` with measured figures.
 
     The summary holds soundness (truncated noise), calibration (untruncated noise at
     2 and 3 sigma) and tightness per terrain, each measured on seeded samples.
@@ -168,7 +187,7 @@ def write_growth_report(out: str | Path, *, seed: int = 0) -> Path:
         The written ``summary.md``.
     """
     folder = Path(out)
-    figures = draw_growth_figures(folder / "figures", seed=seed)
+    figures = draw_all_figures(folder / "figures", seed=seed)
     table = TerrainTable.default()
     rng = np.random.default_rng(seed)
     started = time.perf_counter()

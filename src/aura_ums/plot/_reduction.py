@@ -1,0 +1,114 @@
+"""The paper's Figure 3: a disk model against the convex polygon as a robot runs down a path."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from aura_ums.plot._draw import draw_map, draw_samples
+from aura_ums.uncertainty import (
+    GroundLineLandmark,
+    GroundLineObservation,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainTable,
+    TurnAndRun,
+)
+
+#: The path's right-hand edge, 1.5 m to the right of a robot driving east along y = 0.
+PATH_EDGE = GroundLineLandmark("path_edge", (-10.0, -1.5), (100.0, -1.5), symbol="path edge")
+_OFFSET_ERROR = 0.10  # m: where the edge line falls in the image, after calibration error
+_ANGLE_ERROR = math.radians(2.0)
+
+
+@dataclass(frozen=True, slots=True)
+class PathRunStep:
+    """One position of the run down the path: the map and its disk model."""
+
+    distance: float
+    uncertainty_map: SpatialUncertaintyMap
+    disk_radius: float
+    truth: Pose
+
+    @property
+    def disk_area(self) -> float:
+        """Area of the disk model around the map's centre that encloses the polygon, m^2."""
+        return math.pi * self.disk_radius**2
+
+
+def run_down_path(
+    rng: np.random.Generator, *, steps: int = 6, step_length: float = 4.0, terrain: str = "concrete"
+) -> list[PathRunStep]:
+    """Drive east down a path, growing the map each step and reducing it by the seen path edge.
+
+    The truth moves by the terrain's own model; the edge observation is synthesised
+    from the true pose with errors anywhere inside its bounds.
+    """
+    stats = TerrainTable.default()[terrain]
+    truth = Pose(0.0, 0.0, 0.0)
+    current = SpatialUncertaintyMap.from_pose(truth, 0.3, math.radians(3))
+    result = []
+    command = TurnAndRun(0.0, step_length)
+    for index in range(steps):
+        moved = stats.sample_motions(truth.as_array(), command, rng, truncate=3.0)[0]
+        truth = Pose(float(moved[0]), float(moved[1]), float(moved[2]))
+        current = current.grow(command, stats)
+        # Seen from the truth: distance left of the edge, edge direction relative to heading.
+        offset = truth.y - PATH_EDGE.start[1]
+        angle = PATH_EDGE.direction - truth.heading
+        observation = GroundLineObservation(
+            PATH_EDGE.id,
+            float(index),
+            offset + float(rng.uniform(-_OFFSET_ERROR, _OFFSET_ERROR)),
+            _OFFSET_ERROR,
+            angle + float(rng.uniform(-_ANGLE_ERROR, _ANGLE_ERROR)),
+            _ANGLE_ERROR,
+        )
+        reduction = current.reduce(observation, PATH_EDGE)
+        if reduction.consistent:
+            current = reduction.map
+        radius = float(np.max(np.hypot(*(current.polygon.vertices - current.center).T)))
+        result.append(PathRunStep(step_length * (index + 1), current, radius, truth))
+    return result
+
+
+def draw_path_figure(out: Path, rng: np.random.Generator) -> Path:
+    """Figure 3: disk model versus convex polygon down a path whose edge is seen."""
+    steps = run_down_path(rng)
+    figure = Figure(figsize=(12, 4.2))
+    axes = figure.add_subplot()
+    axes.axhline(PATH_EDGE.start[1], color="0.3", lw=2, label="path edge (Class III landmark)")
+    axes.axhline(1.5, color="0.7", lw=1, ls=":")
+    for step in steps:
+        draw_map(axes, step.uncertainty_map, wedge_length=0.8)
+        axes.add_patch(
+            Circle(tuple(step.uncertainty_map.center), step.disk_radius, fill=False, color="tab:red", ls="--")
+        )
+        axes.plot([step.truth.x], [step.truth.y], "k.", ms=4)
+        axes.annotate(
+            f"{step.uncertainty_map.area / step.disk_area:.0%}",
+            (step.uncertainty_map.center[0], step.uncertainty_map.center[1] + step.disk_radius + 0.1),
+            ha="center",
+            fontsize=8,
+        )
+    draw_samples(axes, np.array([[s.truth.x, s.truth.y, s.truth.heading] for s in steps]), label="true poses")
+    axes.plot([], [], "--", color="tab:red", label="disk model (encloses the polygon)")
+    axes.set_aspect("equal", adjustable="datalim")
+    axes.set_xlabel("x (m)")
+    axes.set_ylabel("y (m)")
+    axes.grid(True, lw=0.3)
+    axes.legend(loc="upper left", fontsize=8)
+    axes.set_title(
+        "Figure 3: disk model versus convex polygon, running down a path whose edge is seen "
+        "(labels: polygon area / disk area)",
+        fontsize=10,
+    )
+    figure.tight_layout()
+    path = out / "figure3_disk_vs_polygon.png"
+    figure.savefig(path, dpi=130)
+    return path
