@@ -16,7 +16,7 @@ $(VENV)/.stamp-install: pyproject.toml | $(BIN)/python
 	@touch $@
 
 $(VENV)/.stamp-dev: pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	$(BIN)/python -m pip install --quiet -e ".[dev,opencv]"
 	@touch $@ $(VENV)/.stamp-install
 
 demo: $(VENV)/.stamp-install
