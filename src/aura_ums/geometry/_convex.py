@@ -26,6 +26,16 @@ _COLLINEAR_EPS = 1e-12
 # Cut parameters this close to an edge's end are that end.
 _SAME_POINT = 1e-12
 
+# Only edges longer than this fraction of the coordinates' magnitude are extended to
+# replace a removed neighbour: their directions are then good to ~1e-10 rad.
+_EXTENDABLE = 1e-6
+
+# A merged vertex may lie at most this many polygon extents from the vertex it replaces.
+_FARTHEST_MERGE = 10.0
+
+# Edges shorter than this fraction of the largest have directions that are rounding noise.
+_NOISE_EDGE = 1e-12
+
 # Edge directions closer than this (radians) are joined into one edge.
 _PARALLEL_EPS = 1e-12
 
@@ -219,9 +229,10 @@ def minkowski_sum(*polygons: Array) -> Array:
     if not edges:
         return start.reshape(1, 2)
     merged = np.concatenate(edges) if len(edges) > 1 else edges[0]
-    # Edges below a few ulps of the coordinates vanish when added to them anyway.
+    # Edges below a few ulps of the coordinates vanish when added to them anyway, and
+    # edges below 1e-12 of the largest have directions that are mostly rounding noise.
     size = np.abs(merged).max(axis=1)
-    merged = merged[size > 4e-16 * max(float(np.abs(start).max()), float(size.max()))]
+    merged = merged[size > max(4e-16 * float(np.abs(start).max()), _NOISE_EDGE * float(size.max()))]
     if len(merged) == 0:
         return start.reshape(1, 2)
     direction = np.arctan2(merged[:, 1], merged[:, 0])
@@ -389,7 +400,9 @@ def simplify_outer(vertices: Array, max_vertices: int) -> Array:
 
     Removes the edges whose removal (extending both neighbouring edges until they
     meet) adds the least area, greedily and never two adjacent edges in one pass.
-    Polygons that cannot lose an edge (a triangle) are returned as they are.
+    An edge whose neighbours would meet more than 10 extents of the polygon away is
+    never removed, so a polygon may keep more vertices than asked for (a triangle
+    always does) rather than gain a far-off vertex.
     """
     while len(vertices) > max(max_vertices, 3):
         n = len(vertices)
@@ -397,11 +410,23 @@ def simplify_outer(vertices: Array, max_vertices: int) -> Array:
         preceding = _preceding(edge)
         following = _following(edge)
         denominator = cross2(preceding, following)
-        # Removing an edge needs its neighbours to turn by less than pi, or they never meet.
-        removable = denominator > 0.0
+        # Removing an edge needs its neighbours to turn by less than pi, or they never meet;
+        # and neighbours long enough that their lines are not rounding noise.
+        # An edge's direction is good to ~1e-16 * |coordinates| / length radians.
+        length = np.abs(edge).max(axis=1)
+        usable = length > _EXTENDABLE * max(float(np.abs(vertices).max()), float(length.max()))
+        removable = (denominator > 0.0) & _preceding(usable) & _following(usable)
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(removable, cross2(edge, following) / denominator, 0.0)
-        cost = np.where(removable & (t >= 0.0), 0.5 * t * cross2(preceding, edge), np.inf)
+        # Nearly parallel neighbours meet far away: such a vertex is useless and its
+        # coordinates swamp the polygon's, so the cap yields instead.
+        reach = t * np.abs(preceding).max(axis=1)
+        removable &= (t >= 0.0) & (reach <= _FARTHEST_MERGE * float(np.ptp(vertices, axis=0).max()))
+        # Both corners of the edge must turn left: after a rounding-level right turn the
+        # neighbours' lines meet beyond the following edge's start, on the wrong side.
+        turn_in = cross2(preceding, edge)
+        removable &= turn_in >= 0.0
+        cost = np.where(removable, 0.5 * t * turn_in, np.inf)
         needed = n - max_vertices
         chosen: list[int] = []
         blocked = [False] * n

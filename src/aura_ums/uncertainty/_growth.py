@@ -7,7 +7,8 @@ Every bound here holds for every outcome of the generative model of
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,6 +17,18 @@ from aura_ums.geometry import minkowski_sum, outer_annular_sector, outer_disk, s
 from aura_ums.geometry._angles import TWO_PI
 from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._terrain import TerrainStats
+
+_compiled_grow_polygon: Callable[..., bytes] | None
+try:  # the compiled kernel, when the build had a C compiler
+    from aura_ums.geometry._kernels import grow_polygon as _compiled_grow_polygon
+except ImportError:  # pragma: no cover - exercised on machines without a compiler
+    _compiled_grow_polygon = None
+
+
+def compiled_kernel() -> Callable[..., bytes] | None:
+    """Return the compiled growth kernel, or None when the extension was not built."""
+    return _compiled_grow_polygon
+
 
 #: Largest vertex count a grown map keeps; beyond it an outer approximation merges edges.
 DEFAULT_MAX_VERTICES = 64
@@ -27,8 +40,7 @@ def _clip(value: float, lo: float, hi: float) -> float:
     return lo if value < lo else hi if value > hi else value
 
 
-@dataclass(frozen=True, slots=True)
-class MotionBounds:
+class MotionBounds(NamedTuple):
     """Bounds on one turn-and-run outcome at a given number of standard deviations.
 
     Attributes
@@ -136,6 +148,32 @@ def grow_polygon(
     ndarray, shape (m, 2)
         The polygon ``P + skitter disk + hull(run endpoints)``, counter-clockwise.
     """
+    if _compiled_grow_polygon is not None:
+        grown = _compiled_grow_polygon(
+            np.ascontiguousarray(vertices, dtype=np.float64),
+            heading_lo,
+            heading_hi,
+            bounds.turn_min,
+            bounds.turn_max,
+            bounds.drift_max,
+            bounds.chord_min,
+            bounds.run_max,
+            bounds.skitter_radius,
+            max_vertices,
+        )
+        # Bytes are immutable, so the array is read-only as map values must be.
+        return np.frombuffer(grown, dtype=np.float64).reshape(-1, 2)
+    return grow_polygon_reference(vertices, heading_lo, heading_hi, bounds, max_vertices)
+
+
+def grow_polygon_reference(
+    vertices: NDArray[np.float64],
+    heading_lo: float,
+    heading_hi: float,
+    bounds: MotionBounds,
+    max_vertices: int = DEFAULT_MAX_VERTICES,
+) -> NDArray[np.float64]:
+    """Pure-numpy :func:`grow_polygon`: the reference the compiled kernel is tested against."""
     parts = [vertices]
     if bounds.run_max > 0.0:
         # Run endpoints: chords of length chord_min..run_max whose direction is the

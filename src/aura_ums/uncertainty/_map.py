@@ -165,7 +165,8 @@ class SpatialUncertaintyMap:
             self.polygon.vertices, heading_lo, heading_lo + wedge.cw + wedge.ccw, bounds, max_vertices
         )
         heading, cw, ccw = grow_wedge(wedge.center, wedge.cw, wedge.ccw, bounds)
-        center = self.center + bounds.run_mean * np.array([math.cos(heading), math.sin(heading)])
+        x, y = self.center.tolist()
+        center = np.array([x + bounds.run_mean * math.cos(heading), y + bounds.run_mean * math.sin(heading)])
         return SpatialUncertaintyMap._trusted(
             ConvexPolygon._trusted(vertices), center, HeadingWedge._trusted(heading, cw, ccw)
         )
