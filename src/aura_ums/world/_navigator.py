@@ -1,0 +1,432 @@
+"""The navigator: routes through the meadow graph, and terrain along a straight run.
+
+:func:`plan_route` turns a start and a goal into straight legs through the portals between
+meadows (the paper's "linear piecewise segments"). :func:`split_run` cuts one straight run
+where it crosses meadow boundaries, and :func:`commands_for` turns a turn-and-run command
+into one growth step per meadow, so that :meth:`SpatialUncertaintyMap.grow` applies each
+meadow's terrain statistics to the part of the run made on it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from itertools import pairwise
+
+import networkx as nx
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
+from aura_ums.errors import InputError
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
+from aura_ums.world._ltm import MeadowMap
+
+#: Stretches of a run shorter than this (m) are rounding, not a meadow crossed.
+RUN_TOLERANCE = 1e-9
+
+_START = -1
+_GOAL = -2
+
+
+def _point(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    array = points_array(value, name, min_rows=1)
+    if array.shape != (1, 2):
+        raise InputError(f"{name}: expected one (x, y) point, got shape {array.shape}")
+    return np.array(array[0], dtype=np.float64)
+
+
+def _xy(point: NDArray[np.float64]) -> str:
+    return f"({float(point[0])!r}, {float(point[1])!r})"
+
+
+@dataclass(frozen=True, slots=True, eq=False, init=False)
+class Route:
+    """A route of straight legs through the meadow map.
+
+    Parameters
+    ----------
+    waypoints : array_like, shape (n, 2)
+        Start, the portal midpoints crossed, goal; metres; no two consecutive equal.
+    meadow_ids : sequence of str
+        The meadow containing each leg (``n - 1`` ids); a route of one waypoint (start
+        equals goal) has no leg and names the one meadow it is in.
+
+    Examples
+    --------
+    >>> route = Route([(0, 0), (3, 4), (3, 10)], ["a", "b"])
+    >>> route.length, route.legs.shape
+    (11.0, (2, 2, 2))
+    >>> Route([(1, 1)], ["a"]).length        # start == goal: no leg
+    0.0
+    """
+
+    waypoints: NDArray[np.float64]
+    meadow_ids: tuple[str, ...]
+
+    def __init__(self, waypoints: ArrayLike, meadow_ids: tuple[str, ...] | list[str]) -> None:
+        points = points_array(waypoints, "waypoints", min_rows=1)
+        ids = tuple(meadow_ids)
+        expected = max(len(points) - 1, 1)
+        if len(ids) != expected:
+            raise InputError(f"meadow_ids: expected {expected} ids (one per leg), got {len(ids)}")
+        for index, ident in enumerate(ids):
+            if not isinstance(ident, str) or not ident:
+                raise InputError(f"meadow_ids[{index}]: expected a non-empty string, got {ident!r}")
+        if len(points) > 1 and np.any(np.all(points[1:] == points[:-1], axis=1)):
+            raise InputError("waypoints: expected no two consecutive waypoints equal, got a repeat")
+        object.__setattr__(self, "waypoints", read_only(points.copy()))
+        object.__setattr__(self, "meadow_ids", ids)
+
+    @property
+    def legs(self) -> NDArray[np.float64]:
+        """The legs as a read-only ``(n - 1, 2, 2)`` array: ``legs[i] = (start_i, end_i)``."""
+        legs = np.stack([self.waypoints[:-1], self.waypoints[1:]], axis=1)
+        return read_only(legs)
+
+    @property
+    def leg_lengths(self) -> NDArray[np.float64]:
+        """Length of each leg, metres."""
+        return np.asarray(np.hypot(*(self.waypoints[1:] - self.waypoints[:-1]).T), dtype=np.float64)
+
+    @property
+    def length(self) -> float:
+        """Total length, metres."""
+        return float(self.leg_lengths.sum())
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Route):
+            return NotImplemented
+        return self.meadow_ids == other.meadow_ids and np.array_equal(self.waypoints, other.waypoints)
+
+    def __repr__(self) -> str:
+        return f"Route({len(self.waypoints) - 1} legs, {self.length:.6g} m, meadows {list(self.meadow_ids)})"
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def plan_route(meadow_map: MeadowMap, start: ArrayLike, goal: ArrayLike) -> Route:
+    """Plan a shortest route of straight legs through portal midpoints (A* with networkx).
+
+    The search runs on the portal graph (the line graph of meadow adjacency): its nodes
+    are the midpoints of the portals, start and goal; two of them are joined when one
+    meadow holds both, by a straight leg inside that (convex) meadow, weighted by its
+    length. The heuristic is the straight-line distance to the goal, so the route is the
+    shortest among those through portal midpoints. Every leg lies in one meadow, so the
+    route stays in free space.
+
+    Parameters
+    ----------
+    meadow_map : MeadowMap
+        The map.
+    start, goal : array_like, shape (2,)
+        Points (x, y) in metres, each inside some meadow.
+
+    Returns
+    -------
+    Route
+        Waypoints start, portal midpoints, goal; the meadow of each leg.
+
+    Raises
+    ------
+    InputError
+        When start or goal lies outside every meadow, or no chain of adjacent meadows
+        joins them.
+
+    Examples
+    --------
+    >>> from aura_ums.world import make_grid_world
+    >>> world = make_grid_world(3, 3, cell=5.0)
+    >>> route = plan_route(world, (2.5, 2.5), (12.5, 2.5))
+    >>> route.waypoints.tolist(), route.meadow_ids
+    ([[2.5, 2.5], [5.0, 2.5], [10.0, 2.5], [12.5, 2.5]], ('cell_0_0', 'cell_0_1', 'cell_0_2'))
+    >>> plan_route(world, (2.5, 2.5), (40.0, 2.5))
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: goal: expected a point inside a meadow, got (40.0, 2.5)
+    """
+    if not isinstance(meadow_map, MeadowMap):
+        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+    source = _point(start, "start")
+    target = _point(goal, "goal")
+    start_meadows = meadow_map.meadows_containing(float(source[0]), float(source[1]))
+    if not start_meadows:
+        raise InputError(f"start: expected a point inside a meadow, got {_xy(source)}")
+    goal_meadows = meadow_map.meadows_containing(float(target[0]), float(target[1]))
+    if not goal_meadows:
+        raise InputError(f"goal: expected a point inside a meadow, got {_xy(target)}")
+    goal_ids = {m.id for m in goal_meadows}
+    for meadow in start_meadows:
+        if meadow.id in goal_ids:
+            if np.array_equal(source, target):
+                return Route([source], [meadow.id])
+            return Route([source, target], [meadow.id])
+
+    positions: list[NDArray[np.float64]] = []
+    by_meadow: dict[str, list[int]] = {m.id: [] for m in meadow_map.meadows}
+    for a, b, segment in meadow_map.portals():
+        node = len(positions)
+        positions.append(0.5 * (segment[0] + segment[1]))
+        by_meadow[a].append(node)
+        by_meadow[b].append(node)
+    points = {node: positions[node] for node in range(len(positions))}
+    points[_START] = source
+    points[_GOAL] = target
+
+    graph = nx.Graph()
+    graph.add_nodes_from(points)
+    for meadow_id, nodes in by_meadow.items():
+        for i, u in enumerate(nodes):
+            for v in nodes[i + 1 :]:
+                graph.add_edge(u, v, weight=float(np.hypot(*(positions[u] - positions[v]))), meadow=meadow_id)
+    for end, meadows in ((_START, start_meadows), (_GOAL, goal_meadows)):
+        for meadow in meadows:
+            for node in by_meadow[meadow.id]:
+                if not graph.has_edge(end, node):
+                    weight = float(np.hypot(*(points[end] - positions[node])))
+                    graph.add_edge(end, node, weight=weight, meadow=meadow.id)
+
+    def heuristic(u: int, v: int) -> float:
+        return float(np.hypot(*(points[u] - points[v])))
+
+    try:
+        found: list[int] = [int(node) for node in nx.astar_path(graph, _START, _GOAL, heuristic, "weight")]
+    except nx.NetworkXNoPath:
+        raise InputError(
+            f"goal: expected a point reachable from start through adjacent meadows, got "
+            f"{_xy(target)} in {goal_meadows[0].id!r}, "
+            f"not connected to {start_meadows[0].id!r}"
+        ) from None
+    waypoints = [points[found[0]]]
+    meadow_ids: list[str] = []
+    for u, v in pairwise(found):
+        if np.array_equal(points[v], waypoints[-1]):
+            continue  # start or goal exactly on a portal midpoint: no leg
+        waypoints.append(points[v])
+        meadow_ids.append(str(graph.edges[u, v]["meadow"]))
+    if not meadow_ids:
+        meadow_ids.append(start_meadows[0].id)
+    return Route(np.array(waypoints), meadow_ids)
+
+
+@dataclass(frozen=True, slots=True)
+class RunPiece:
+    """One part of a straight run, made in one meadow on one terrain.
+
+    Parameters
+    ----------
+    distance : float
+        Length of the part, metres, >= 0.
+    terrain : str
+        The meadow's terrain.
+    meadow_id : str
+        The meadow.
+
+    Examples
+    --------
+    >>> RunPiece(2.5, "grass", "lawn")
+    RunPiece(distance=2.5, terrain='grass', meadow_id='lawn')
+    >>> RunPiece(-1.0, "grass", "lawn")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: RunPiece.distance: expected a non-negative number, got -1.0
+    """
+
+    distance: float
+    terrain: str
+    meadow_id: str
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "distance", nonnegative_float(self.distance, "RunPiece.distance"))
+
+
+def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance: float) -> list[RunPiece]:
+    """Cut a straight run where it crosses meadow boundaries, in order along the run.
+
+    The run goes ``distance`` metres from ``start`` in direction ``heading`` (radians,
+    counter-clockwise from +x). It is intersected (shapely) with the meadows it meets;
+    each maximal part inside one meadow is a piece. Consecutive pieces on the same terrain
+    stay separate when their meadows differ (one piece per meadow crossed). Where the run
+    follows a boundary shared by two meadows, the first in map order takes it.
+
+    Parts of the run outside every meadow (a gap, or the run leaving the map) are added to
+    the piece before them: the robot is taken to stay on the terrain of the last meadow it
+    was in. A run that *starts* outside every meadow takes the first meadow it enters.
+
+    Parameters
+    ----------
+    meadow_map : MeadowMap
+        The map.
+    start : array_like, shape (2,)
+        Where the run starts, metres.
+    heading : float
+        Direction of the run, radians.
+    distance : float
+        Length of the run, metres, >= 0. A zero-length run gives one zero piece in the
+        start meadow.
+
+    Returns
+    -------
+    list of RunPiece
+        Pieces in order; their distances add up to ``distance`` (to rounding).
+
+    Raises
+    ------
+    InputError
+        When the run meets no meadow at all.
+
+    Examples
+    --------
+    >>> from aura_ums.world import make_grid_world
+    >>> world = make_grid_world(1, 3, cell=5.0)      # terrains concrete, grass, gravel
+    >>> [(p.distance, p.terrain) for p in split_run(world, (2.5, 2.5), 0.0, 10.0)]
+    [(2.5, 'concrete'), (5.0, 'grass'), (2.5, 'gravel')]
+    >>> [(p.distance, p.meadow_id) for p in split_run(world, (2.5, 2.5), 0.0, 0.0)]
+    [(0.0, 'cell_0_0')]
+    """
+    if not isinstance(meadow_map, MeadowMap):
+        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+    origin = _point(start, "start")
+    angle = finite_float(heading, "heading")
+    length = nonnegative_float(distance, "distance")
+    if length == 0.0:
+        meadow = meadow_map.meadow_at(float(origin[0]), float(origin[1]))
+        if meadow is None:
+            raise InputError(
+                f"start: expected a point inside a meadow for a zero-length run, got {_xy(origin)}"
+            )
+        return [RunPiece(0.0, meadow.terrain, meadow.id)]
+    direction = np.array([math.cos(angle), math.sin(angle)])
+    line = shapely.LineString([origin, origin + length * direction])
+    candidates = np.sort(meadow_map._tree.query(line, predicate="intersects"))
+    spans: list[tuple[float, float, int]] = []
+    if len(candidates):
+        shapes = np.array(meadow_map._shapes, dtype=object)[candidates]
+        for index, piece in zip(candidates, shapely.intersection(line, shapes), strict=True):
+            coordinates = shapely.get_coordinates(piece)
+            if len(coordinates) == 0:
+                continue
+            along = (coordinates - origin) @ direction
+            lo = min(max(float(along.min()), 0.0), length)
+            hi = min(max(float(along.max()), 0.0), length)
+            if hi - lo > RUN_TOLERANCE:
+                spans.append((lo, hi, int(index)))
+    if not spans:
+        raise InputError(
+            f"start, heading, distance: expected a run that meets a meadow, got one from "
+            f"{_xy(origin)} of {length!r} m at heading {angle!r} outside every meadow"
+        )
+    cuts = sorted({0.0, length, *(lo for lo, _, _ in spans), *(hi for _, hi, _ in spans)})
+    owners: list[int | None] = []
+    for lo, hi in pairwise(cuts):
+        owner = None
+        if hi - lo > RUN_TOLERANCE:
+            covering = [i for a, b, i in spans if a <= lo + RUN_TOLERANCE and b >= hi - RUN_TOLERANCE]
+            owner = min(covering) if covering else None
+        owners.append(owner)
+    first = next(owner for owner in owners if owner is not None)
+    filled: list[int] = []
+    for owner in owners:
+        filled.append(owner if owner is not None else (filled[-1] if filled else first))
+    pieces: list[RunPiece] = []
+    begin = 0.0
+    for k, owner in enumerate(filled):
+        if k + 1 == len(filled) or filled[k + 1] != owner:
+            end = cuts[k + 1]
+            meadow = meadow_map.meadows[owner]
+            pieces.append(RunPiece(end - begin, meadow.terrain, meadow.id))
+            begin = end
+    return pieces
+
+
+def commands_for(
+    meadow_map: MeadowMap, pose: Pose, command: TurnAndRun, table: TerrainTable
+) -> list[tuple[TurnAndRun, TerrainStats]]:
+    """Split a turn-and-run command into one growth step per meadow crossed.
+
+    The run is split (:func:`split_run`) along the commanded direction ``pose.heading +
+    command.turn`` from ``(pose.x, pose.y)`` (typically the map's most probable pose).
+    The turn happens in the start meadow, so the first step carries the turn and the first
+    piece; each later piece is ``TurnAndRun(0.0, piece)`` with its own meadow's terrain.
+    Parts outside every meadow count on the terrain of the meadow before them (see
+    :func:`split_run`). Growing through the steps in order applies each terrain's
+    statistics to its part of the run; it is conservative compared with one step, since
+    each step bounds its own fixed (inertial) loss and noise.
+
+    Parameters
+    ----------
+    meadow_map : MeadowMap
+        The map.
+    pose : Pose
+        Where the command starts (metres, radians).
+    command : TurnAndRun
+        The command.
+    table : TerrainTable
+        Statistics of the meadows' terrains.
+
+    Returns
+    -------
+    list of (TurnAndRun, TerrainStats)
+        The growth steps, in order; the runs add up to ``command.run``.
+
+    Raises
+    ------
+    UnknownTerrainError
+        When a meadow's terrain is not in ``table``.
+    InputError
+        When the run meets no meadow.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose, TerrainTable, TurnAndRun
+    >>> from aura_ums.world import make_grid_world
+    >>> world, table = make_grid_world(1, 3), TerrainTable.default()
+    >>> steps = commands_for(world, Pose(2.5, 2.5, 0.5), TurnAndRun(-0.5, 10.0), table)
+    >>> [command for command, _ in steps]
+    [TurnAndRun(turn=-0.5, run=2.5), TurnAndRun(turn=0.0, run=5.0), TurnAndRun(turn=0.0, run=2.5)]
+    >>> steps[1][1] == table["grass"]
+    True
+    >>> commands_for(world, Pose(7.0, 2.5, 0.0), TurnAndRun(1.0, 0.0), table) == [
+    ...     (TurnAndRun(1.0, 0.0), table["grass"])]                      # a turn only
+    True
+    """
+    if not isinstance(pose, Pose):
+        raise InputError(f"pose: expected a Pose, got {type(pose).__name__}")
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+    pieces = split_run(meadow_map, (pose.x, pose.y), pose.heading + command.turn, command.run)
+    steps = [(TurnAndRun(command.turn, pieces[0].distance), table[pieces[0].terrain])]
+    steps.extend((TurnAndRun(0.0, piece.distance), table[piece.terrain]) for piece in pieces[1:])
+    return steps
+
+
+def grow_through(
+    uncertainty_map: SpatialUncertaintyMap,
+    meadow_map: MeadowMap,
+    command: TurnAndRun,
+    table: TerrainTable,
+    *,
+    sigmas: float = 3.0,
+) -> SpatialUncertaintyMap:
+    """Grow a spatial uncertainty map by a command, meadow by meadow (:func:`commands_for`).
+
+    The run is split from the map's most probable pose.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+    >>> from aura_ums.world import make_grid_world
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+    >>> grown = grow_through(start, make_grid_world(1, 3), TurnAndRun(0.0, 10.0), TerrainTable.default())
+    >>> bool(grown.area > start.area)
+    True
+    """
+    if not isinstance(uncertainty_map, SpatialUncertaintyMap):
+        raise InputError(
+            f"uncertainty_map: expected a SpatialUncertaintyMap, got {type(uncertainty_map).__name__}"
+        )
+    result = uncertainty_map
+    for step, terrain in commands_for(meadow_map, uncertainty_map.most_probable_pose(), command, table):
+        result = result.grow(step, terrain, sigmas=sigmas)
+    return result

@@ -1,0 +1,280 @@
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+import pytest
+import shapely
+
+from aura_ums import (
+    ConvexPolygon,
+    InputError,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainTable,
+    TurnAndRun,
+    UnknownTerrainError,
+)
+from aura_ums.world import (
+    Meadow,
+    MeadowMap,
+    Route,
+    RunPiece,
+    commands_for,
+    grow_through,
+    make_grid_world,
+    plan_route,
+    sample_world,
+    split_run,
+)
+
+# A 25 x 42 grid with two walls (each with one gap) removed: exactly 1,000 meadows.
+WALL_A = [(r, 14) for r in range(25) if r != 3]  # 24 cells, gap at row 3
+WALL_B = [(r, 28) for r in range(25) if r not in (21, 22)]  # 23 cells, gap at rows 21-22
+OBSTACLES = [*WALL_A, *WALL_B, (10, 5), (11, 5), (12, 5)]
+
+
+def box(x0: float, y0: float, x1: float, y1: float) -> ConvexPolygon:
+    return ConvexPolygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+
+
+@pytest.fixture(scope="module")
+def big_world() -> MeadowMap:
+    world = make_grid_world(25, 42, cell=5.0, remove=OBSTACLES)
+    assert len(world) == 1000
+    return world
+
+
+def assert_route_in_free_space(world: MeadowMap, route: Route) -> None:
+    assert all(m is not None for m in world.meadows_at(route.waypoints))
+    union = shapely.union_all([world.shape(m.id) for m in world.meadows]).buffer(1e-9)
+    for (a, b), meadow_id in zip(route.legs, route.meadow_ids, strict=True):
+        polygon = world.meadow(meadow_id).polygon
+        along = a + np.linspace(0.0, 1.0, 11)[:, None] * (b - a)
+        assert polygon.contains(along).all(), f"leg {a} -> {b} leaves {meadow_id}"
+        assert union.covers(shapely.LineString([a, b]))
+    for first, second in zip(route.meadow_ids, route.meadow_ids[1:], strict=False):
+        if first != second:
+            assert second in [m.id for m in world.neighbours(first)]
+
+
+# --- routes ------------------------------------------------------------------------------------
+
+
+def test_route_through_a_thousand_meadows(big_world: MeadowMap) -> None:
+    start, goal = (2.5, 2.5), (207.5, 122.5)
+    began = time.perf_counter()
+    route = plan_route(big_world, start, goal)
+    elapsed = time.perf_counter() - began
+    assert elapsed < 2.0
+    np.testing.assert_array_equal(route.waypoints[0], start)
+    np.testing.assert_array_equal(route.waypoints[-1], goal)
+    assert route.meadow_ids[0] == "cell_0_0"
+    assert route.meadow_ids[-1] == "cell_24_41"
+    assert route.length >= math.dist(start, goal)
+    assert len(route.legs) == len(route.meadow_ids) == len(route.waypoints) - 1
+    assert route.length == pytest.approx(route.leg_lengths.sum())
+    # The walls force the route through their gaps.
+    assert "cell_3_14" in route.meadow_ids
+    assert {"cell_21_28", "cell_22_28"} & set(route.meadow_ids)
+    assert_route_in_free_space(big_world, route)
+
+
+def test_route_is_shortest_through_portal_midpoints() -> None:
+    # An L-shaped corridor: the route turns the corner through the portals.
+    world = MeadowMap(
+        [
+            Meadow("south", box(0, 0, 10, 2), "tile"),
+            Meadow("corner", box(10, 0, 12, 2), "tile"),
+            Meadow("east", box(10, 2, 12, 12), "tile"),
+            Meadow("shortcut_blocked", box(4, 6, 8, 12), "tile"),
+        ]
+    )
+    route = plan_route(world, (1, 1), (11, 11))
+    assert route.meadow_ids == ("south", "corner", "east")
+    np.testing.assert_array_equal(route.waypoints, [[1, 1], [10, 1], [11, 2], [11, 11]])
+    with pytest.raises(InputError, match=r"goal: expected a point reachable from start .* \(6.0, 8.0\) in"):
+        plan_route(world, (1, 1), (6, 8))
+
+
+def test_unreachable_goal_is_an_input_error() -> None:
+    sealed = make_grid_world(5, 5, remove=[(r, 2) for r in range(5)])
+    with pytest.raises(
+        InputError,
+        match=r"^goal: expected a point reachable from start through adjacent meadows, "
+        r"got \(22.5, 2.5\) in 'cell_0_4', not connected to 'cell_0_0'",
+    ):
+        plan_route(sealed, (2.5, 2.5), (22.5, 2.5))
+
+
+def test_start_or_goal_outside_every_meadow_is_an_input_error() -> None:
+    world = make_grid_world(2, 2)
+    with pytest.raises(InputError, match=r"^start: expected a point inside a meadow, got \(-1.0, 2.0\)"):
+        plan_route(world, (-1, 2), (2, 2))
+    with pytest.raises(InputError, match=r"^goal: expected a point inside a meadow, got \(2.0, 30.0\)"):
+        plan_route(world, (2, 2), (2, 30))
+    with pytest.raises(InputError, match=r"^start: expected one \(x, y\) point, got shape \(2, 2\)"):
+        plan_route(world, [(1, 1), (2, 2)], (2, 2))
+    with pytest.raises(InputError, match="meadow_map: expected a MeadowMap, got str"):
+        plan_route("map", (1, 1), (2, 2))  # type: ignore[arg-type]
+
+
+def test_routes_within_one_meadow() -> None:
+    world = make_grid_world(2, 2)
+    direct = plan_route(world, (1, 1), (4, 3))
+    np.testing.assert_array_equal(direct.waypoints, [[1, 1], [4, 3]])
+    assert direct.meadow_ids == ("cell_0_0",)
+    stay = plan_route(world, (1, 1), (1, 1))
+    assert (len(stay.waypoints), len(stay.legs), stay.length, stay.meadow_ids) == (1, 0, 0.0, ("cell_0_0",))
+    # On a shared boundary, start and goal share a meadow even if meadow_at picks another.
+    assert plan_route(world, (5, 2), (8, 2)).meadow_ids == ("cell_0_1",)
+
+
+def test_start_on_a_portal_midpoint_gives_no_empty_leg() -> None:
+    world = make_grid_world(1, 3)
+    route = plan_route(world, (5.0, 2.5), (12.5, 2.5))
+    np.testing.assert_array_equal(route.waypoints, [[5.0, 2.5], [10.0, 2.5], [12.5, 2.5]])
+    assert route.meadow_ids == ("cell_0_1", "cell_0_2")
+    assert np.all(route.leg_lengths > 0)
+
+
+def test_sidewalk_route_follows_the_walk() -> None:
+    world = sample_world("paper_sidewalk")
+    route = plan_route(world, (0.0, 0.0), (12.192, 0.0))
+    assert route.meadow_ids == ("sidewalk_west", "sidewalk_middle", "sidewalk_east")
+    assert route.length == pytest.approx(12.192)
+
+
+def test_route_validates_and_compares() -> None:
+    route = Route([(0, 0), (3, 4)], ("a",))
+    assert route == Route(np.array([[0.0, 0.0], [3.0, 4.0]]), ["a"])
+    assert route != Route([(0, 0), (3, 4)], ("b",))
+    assert route != "route"
+    assert not route.waypoints.flags.writeable
+    assert "1 legs, 5 m" in repr(route)
+    with pytest.raises(InputError, match="meadow_ids: expected 1 ids"):
+        Route([(0, 0), (3, 4)], ("a", "b"))
+    with pytest.raises(InputError, match="expected no two consecutive waypoints equal"):
+        Route([(0, 0), (0, 0)], ("a",))
+    with pytest.raises(InputError, match=r"meadow_ids\[0\]: expected a non-empty string"):
+        Route([(0, 0)], ("",))
+
+
+# --- terrain along a run ---------------------------------------------------------------------------
+
+
+def test_run_crossing_three_terrains_is_split_in_three() -> None:
+    world = make_grid_world(1, 4, cell=5.0)  # concrete, grass, gravel, tile
+    pieces = split_run(world, (2.5, 2.5), 0.0, 10.0)
+    assert pieces == [
+        RunPiece(2.5, "concrete", "cell_0_0"),
+        RunPiece(5.0, "grass", "cell_0_1"),
+        RunPiece(2.5, "gravel", "cell_0_2"),
+    ]
+
+
+def test_sidewalk_run_from_the_grass_over_the_walk_onto_gravel() -> None:
+    world = sample_world("paper_sidewalk")
+    heading = math.atan2(2.0, 10.0)
+    pieces = split_run(world, (10.0, -2.0), heading, math.hypot(10.0, 2.0))
+    assert [(p.terrain, p.meadow_id) for p in pieces] == [
+        ("grass", "grass_south"),
+        ("concrete", "sidewalk_east"),
+        ("gravel", "gravel_path"),
+    ]
+    scale = math.hypot(10.0, 2.0) / 10.0
+    np.testing.assert_allclose([p.distance for p in pieces], [5 * scale, 1 * scale, 4 * scale], rtol=1e-12)
+
+
+def test_growing_through_commands_equals_growing_piecewise(terrains: TerrainTable) -> None:
+    world = make_grid_world(1, 4, cell=5.0)
+    pose = Pose(2.5, 2.5, 0.3)
+    command = TurnAndRun(-0.3, 10.0)
+    steps = commands_for(world, pose, command, terrains)
+    assert [step for step, _ in steps] == [TurnAndRun(-0.3, 2.5), TurnAndRun(0.0, 5.0), TurnAndRun(0.0, 2.5)]
+    assert [stats for _, stats in steps] == [terrains["concrete"], terrains["grass"], terrains["gravel"]]
+
+    start = SpatialUncertaintyMap.from_pose(pose, 0.2, math.radians(2.0))
+    by_hand = (
+        start.grow(TurnAndRun(-0.3, 2.5), terrains["concrete"])
+        .grow(TurnAndRun(0.0, 5.0), terrains["grass"])
+        .grow(TurnAndRun(0.0, 2.5), terrains["gravel"])
+    )
+    through = start
+    for step, stats in steps:
+        through = through.grow(step, stats)
+    np.testing.assert_array_equal(through.polygon.vertices, by_hand.polygon.vertices)
+    np.testing.assert_array_equal(through.center, by_hand.center)
+    assert through.wedge == by_hand.wedge
+    helped = grow_through(start, world, command, terrains)
+    np.testing.assert_array_equal(helped.polygon.vertices, by_hand.polygon.vertices)
+    # Splitting is conservative: the split map holds the one-step map's mean position.
+    single = start.grow(command, terrains["concrete"])
+    assert through.polygon.contains(single.center)[0]
+
+
+def test_a_turn_only_command_uses_the_start_meadow(terrains: TerrainTable) -> None:
+    steps = commands_for(make_grid_world(1, 2), Pose(7, 2, 0), TurnAndRun(1.0, 0.0), terrains)
+    assert steps == [(TurnAndRun(1.0, 0.0), terrains["grass"])]
+
+
+def test_run_along_a_shared_boundary_goes_to_the_first_meadow() -> None:
+    world = make_grid_world(2, 3)
+    pieces = split_run(world, (1.0, 5.0), 0.0, 12.0)
+    assert [p.meadow_id for p in pieces] == ["cell_0_0", "cell_0_1", "cell_0_2"]
+    assert sum(p.distance for p in pieces) == pytest.approx(12.0)
+
+
+def test_parts_outside_every_meadow_take_the_last_meadow() -> None:
+    world = MeadowMap([Meadow("a", box(0, 0, 4, 2), "tile"), Meadow("b", box(6, 0, 10, 2), "grass")])
+    # Gap between a and b, and a run past the end of b.
+    assert split_run(world, (1, 1), 0.0, 12.0) == [RunPiece(5.0, "tile", "a"), RunPiece(7.0, "grass", "b")]
+    # A run starting in the gap takes the first meadow it enters.
+    assert split_run(world, (5, 1), 0.0, 3.0) == [RunPiece(3.0, "grass", "b")]
+    with pytest.raises(InputError, match=r"^start, heading, distance: expected a run that meets a meadow"):
+        split_run(world, (1, 5), 0.0, 3.0)
+    with pytest.raises(InputError, match=r"^start: expected a point inside a meadow for a zero-length run"):
+        split_run(world, (5, 1), 0.0, 0.0)
+
+
+def test_piece_distances_add_up_along_random_runs(rng: np.random.Generator) -> None:
+    world = make_grid_world(6, 6, cell=3.0, rng=rng, remove=[(2, 2), (3, 3)])
+    for _ in range(200):
+        start = rng.uniform(0.0, 18.0, 2)
+        heading = rng.uniform(-math.pi, math.pi)
+        distance = rng.uniform(0.0, 25.0)
+        try:
+            pieces = split_run(world, start, heading, distance)
+        except InputError:
+            continue
+        assert sum(p.distance for p in pieces) == pytest.approx(distance, abs=1e-9)
+        assert all(p.distance >= 0.0 for p in pieces)
+        assert all(a.meadow_id != b.meadow_id for a, b in itertools.pairwise(pieces))
+
+
+def test_split_run_validates_its_arguments() -> None:
+    world = make_grid_world(1, 1)
+    with pytest.raises(InputError, match=r"distance: expected a non-negative number, got -1\.0"):
+        split_run(world, (1, 1), 0.0, -1.0)
+    with pytest.raises(InputError, match="heading: expected a finite number, got nan"):
+        split_run(world, (1, 1), math.nan, 1.0)
+    with pytest.raises(InputError, match="meadow_map: expected a MeadowMap"):
+        split_run(None, (1, 1), 0.0, 1.0)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"RunPiece\.distance: expected a non-negative number"):
+        RunPiece(-1.0, "tile", "a")
+
+
+def test_commands_for_needs_every_terrain_in_the_table(terrains: TerrainTable) -> None:
+    world = MeadowMap([Meadow("a", box(0, 0, 4, 2), "tile"), Meadow("b", box(4, 0, 8, 2), "sand")])
+    with pytest.raises(
+        UnknownTerrainError, match="terrain: expected one of concrete, grass, gravel, tile, got 'sand'"
+    ):
+        commands_for(world, Pose(1, 1, 0), TurnAndRun(0.0, 5.0), terrains)
+    with pytest.raises(InputError, match="pose: expected a Pose, got tuple"):
+        commands_for(world, (1, 1, 0), TurnAndRun(0.0, 5.0), terrains)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="command: expected a TurnAndRun, got float"):
+        commands_for(world, Pose(1, 1, 0), 5.0, terrains)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="uncertainty_map: expected a SpatialUncertaintyMap"):
+        grow_through(None, world, TurnAndRun(0.0, 1.0), terrains)  # type: ignore[arg-type]
