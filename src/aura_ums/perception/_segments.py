@@ -1,0 +1,125 @@
+"""Line segments found in an image, with the attributes that evaluation needs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums.errors import InputError
+
+
+def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the direction of each segment ``(n, 4)`` in ``[0, pi)``, radians.
+
+    The angle of ``(x2 - x1, y2 - y1)`` in pixel coordinates (u right, v down), modulo
+    pi: 0 is horizontal, pi/2 vertical; a segment going down and to the right has an
+    angle in ``(0, pi/2)`` (clockwise on the screen).
+    """
+    angle = np.arctan2(segments[:, 3] - segments[:, 1], segments[:, 2] - segments[:, 0])
+    return np.asarray(np.mod(angle, math.pi), dtype=np.float64)
+
+
+def angle_difference(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Return the difference of line directions ``a`` and ``b`` modulo pi, in ``[0, pi/2]``.
+
+    Examples
+    --------
+    >>> angle_difference([0.1, 3.1], 0.0).round(4).tolist()
+    [0.1, 0.0416]
+    """
+    d = np.mod(np.asarray(a, dtype=np.float64) - np.asarray(b, dtype=np.float64), math.pi)
+    return np.asarray(np.minimum(d, math.pi - d), dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True, eq=False, init=False)
+class LineSegments:
+    """Line segments in full-image pixel coordinates, with their contrast.
+
+    Parameters
+    ----------
+    segments : array_like, shape (n, 4)
+        ``x1, y1, x2, y2`` per segment, pixels (u, v; (0, 0) is the top-left pixel's centre).
+    contrast : array_like, shape (n,)
+        Mean gradient magnitude along each segment's support, gray levels per pixel.
+
+    Raises
+    ------
+    InputError
+        When the shapes disagree or a value is not finite.
+
+    Notes
+    -----
+    Both arrays are read-only copies; values compare by identity (they hold arrays).
+
+    Examples
+    --------
+    >>> lines = LineSegments([[10.0, 0.0, 10.0, 40.0], [0.0, 5.0, 3.0, 9.0]], [20.0, 4.0])
+    >>> lines.length.tolist(), lines.orientation.round(4).tolist(), lines.strength.tolist()
+    ([40.0, 5.0], [1.5708, 0.9273], [800.0, 20.0])
+    >>> len(LineSegments.empty()), LineSegments.empty().segments.shape
+    (0, (0, 4))
+    """
+
+    segments: NDArray[np.float64]
+    contrast: NDArray[np.float64]
+
+    def __init__(self, segments: ArrayLike, contrast: ArrayLike) -> None:
+        try:
+            array = np.array(segments, dtype=np.float64)
+            values = np.array(contrast, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"LineSegments: expected numeric arrays, got {segments!r}") from exc
+        if array.size == 0:
+            array = array.reshape(0, 4)
+        if array.ndim != 2 or array.shape[1] != 4:
+            raise InputError(f"LineSegments.segments: expected shape (n, 4), got {array.shape}")
+        values = values.reshape(-1) if values.ndim == 0 else values
+        if values.shape != (array.shape[0],):
+            raise InputError(f"LineSegments.contrast: expected shape ({array.shape[0]},), got {values.shape}")
+        if not (np.isfinite(array).all() and np.isfinite(values).all()):
+            raise InputError("LineSegments: expected finite values, got NaN or infinity")
+        array.setflags(write=False)
+        values.setflags(write=False)
+        object.__setattr__(self, "segments", array)
+        object.__setattr__(self, "contrast", values)
+
+    @classmethod
+    def empty(cls) -> LineSegments:
+        """Return no segments: ``segments`` of shape ``(0, 4)``."""
+        return cls(np.zeros((0, 4)), np.zeros(0))
+
+    def __len__(self) -> int:
+        return int(self.segments.shape[0])
+
+    @property
+    def length(self) -> NDArray[np.float64]:
+        """Length of each segment, pixels, shape ``(n,)``."""
+        d = self.segments[:, 2:] - self.segments[:, :2]
+        return np.asarray(np.hypot(d[:, 0], d[:, 1]), dtype=np.float64)
+
+    @property
+    def orientation(self) -> NDArray[np.float64]:
+        """Direction of each segment, radians in ``[0, pi)`` (see :func:`segment_orientation`)."""
+        return segment_orientation(self.segments)
+
+    @property
+    def midpoints(self) -> NDArray[np.float64]:
+        """Midpoint ``(u, v)`` of each segment, pixels, shape ``(n, 2)``."""
+        return np.asarray(0.5 * (self.segments[:, :2] + self.segments[:, 2:]), dtype=np.float64)
+
+    @property
+    def strength(self) -> NDArray[np.float64]:
+        """``length * contrast`` per segment: the paper's line strength (Class I)."""
+        return np.asarray(self.length * self.contrast, dtype=np.float64)
+
+    def select(self, keep: ArrayLike) -> LineSegments:
+        """Return the segments picked by a boolean mask or an index array."""
+        index = np.asarray(keep)
+        return LineSegments(self.segments[index], self.contrast[index])
+
+    def within(self, orientation: float, tolerance: float) -> LineSegments:
+        """Return the segments within ``tolerance`` of direction ``orientation`` (radians, mod pi)."""
+        return self.select(angle_difference(self.orientation, orientation) <= tolerance)
