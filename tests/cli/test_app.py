@@ -29,7 +29,7 @@ def test_figures_command_writes_three_files(tmp_path: Path) -> None:
 def test_demo_writes_the_report(tmp_path: Path) -> None:
     result = runner.invoke(app, ["demo", "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
-    assert (tmp_path / "summary.md").read_text().startswith("# aura-ums growth report")
+    assert (tmp_path / "summary.md").read_text().startswith("# aura-ums report")
 
 
 def test_unknown_option_is_a_usage_error() -> None:

@@ -164,6 +164,27 @@ def draw_all_figures(out: str | Path, *, seed: int = 0) -> list[Path]:
     return written
 
 
+def _figure4_window_rows() -> list[str]:
+    """Rows of the report's window table: polygon against disk model, Figure 4 scenario."""
+    from aura_ums.expecter import Expecter, disk_model_map
+    from aura_ums.expecter._scenario import figure4_scenario
+
+    scenario = figure4_scenario()
+    expecter = Expecter(scenario.camera)
+    disk = disk_model_map(scenario.map)
+    rows = []
+    for landmark in scenario.landmarks:
+        ours = expecter.bounds(scenario.map, landmark)
+        theirs = expecter.bounds(disk, landmark)
+        if ours is None or theirs is None:
+            rows.append(f"| {landmark.id} | not in view | not in view | - |")
+            continue
+        polygon_size = f"{ours.width:.0f} x {ours.height:.0f}"
+        disk_size = f"{theirs.width:.0f} x {theirs.height:.0f}"
+        rows.append(f"| {landmark.id} | {polygon_size} | {disk_size} | {ours.area / theirs.area:.3f} |")
+    return rows
+
+
 def _random_moves(rng: np.random.Generator, table: TerrainTable) -> list[tuple[TurnAndRun, TerrainStats]]:
     names = sorted(table)
     return [
@@ -217,9 +238,10 @@ def write_growth_report(out: str | Path, *, seed: int = 0) -> Path:
         tightness.append(
             f"| {name} | {result.map_area:.3f} | {result.sample_hull_area:.3f} | {result.ratio:.3f} |"
         )
+    windows = _figure4_window_rows()
     elapsed = time.perf_counter() - started
     lines = [
-        "# aura-ums growth report",
+        "# aura-ums report",
         "",
         f"Seed {seed}. Terrain statistics: the built-in illustrative table (`TerrainTable.default()`).",
         "",
@@ -242,6 +264,15 @@ def write_growth_report(out: str | Path, *, seed: int = 0) -> Path:
         "| terrain | map area (m^2) | hull of 20,000 truncated samples (m^2) | ratio |",
         "| --- | --- | --- | --- |",
         *tightness,
+        "",
+        "## Expectation windows in the Figure 4 scenario",
+        "",
+        "Guaranteed windows (before margins, not clipped) of the elongated polygonal map and of",
+        "the paper's disk model (a circle around the centre enclosing the polygon, same wedge).",
+        "",
+        "| landmark | polygon window (px) | disk-model window (px) | polygon / disk area |",
+        "| --- | --- | --- | --- |",
+        *windows,
         "",
         f"Measured in {elapsed:.1f} s. Reproduce with `aura-ums demo --out report --seed {seed}`.",
         "",
