@@ -1,0 +1,89 @@
+"""One camera frame as the find-landmark schemas see it: time, image and the map snapshot."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float
+from aura_ums.errors import InputError
+from aura_ums.uncertainty import SpatialUncertaintyMap
+
+
+@dataclass(frozen=True, slots=True, eq=False, init=False)
+class Frame:
+    """A time-stamped grayscale image with the spatial uncertainty map at that time.
+
+    Parameters
+    ----------
+    time : float
+        When the image was taken, seconds.
+    image : array_like, shape (h, w)
+        Grayscale image: integers or finite floats (gray levels, 0-255 for the default
+        thresholds). Kept as a read-only array (copied when the caller's is writable).
+    map : SpatialUncertaintyMap
+        The map snapshot for that time (read-only: the schemas never change it).
+
+    Notes
+    -----
+    Frames compare by identity (they hold an image array).
+
+    Raises
+    ------
+    InputError
+        For a non-finite time, an image that is not a 2-D array of numbers, or a map of
+        the wrong type.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose
+    >>> snapshot = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.2, 0.05)
+    >>> frame = Frame(0.5, np.zeros((48, 64), dtype=np.uint8), snapshot)
+    >>> frame.image.shape, frame.image.flags.writeable
+    ((48, 64), False)
+    >>> Frame(0.5, np.zeros(64), snapshot)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: image: expected a 2-D grayscale array (h, w), got shape (64,)
+    """
+
+    time: float
+    image: NDArray[np.generic]
+    map: SpatialUncertaintyMap
+
+    def __init__(self, time: float, image: ArrayLike, map: SpatialUncertaintyMap) -> None:
+        when = finite_float(time, "time")
+        try:
+            array = np.asarray(image)
+        except (TypeError, ValueError) as exc:  # pragma: no cover - numpy accepts nearly anything
+            raise InputError(f"image: expected a 2-D grayscale array (h, w), got {image!r}") from exc
+        if array.ndim != 2:
+            raise InputError(f"image: expected a 2-D grayscale array (h, w), got shape {array.shape}")
+        if array.dtype.kind not in "uif" or array.size == 0:
+            raise InputError(
+                f"image: expected a non-empty array of integers or floats, got dtype {array.dtype} "
+                f"and shape {array.shape}"
+            )
+        if array.flags.writeable:
+            array = array.copy()
+            array.setflags(write=False)
+        if not isinstance(map, SpatialUncertaintyMap):
+            raise InputError(f"map: expected a SpatialUncertaintyMap, got {type(map).__name__}")
+        object.__setattr__(self, "time", when)
+        object.__setattr__(self, "image", array)
+        object.__setattr__(self, "map", map)
+
+    @property
+    def width(self) -> int:
+        """Image width, pixels."""
+        return int(self.image.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Image height, pixels."""
+        return int(self.image.shape[0])
+
+    def __repr__(self) -> str:
+        return f"Frame(time={self.time:g}, image={self.width}x{self.height}, map={self.map!r})"

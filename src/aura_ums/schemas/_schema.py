@@ -1,0 +1,302 @@
+"""The find-landmark schema: one landmark's perceptual strategy, evaluation and life cycle."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from aura_ums._validate import nonnegative_float
+from aura_ums.camera import CalibrationBounds
+from aura_ums.errors import InputError
+from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow
+from aura_ums.schemas._frame import Frame
+from aura_ums.schemas._perceive import (
+    Detector,
+    build_detector,
+    detect,
+    intersection,
+    may_be_within,
+    observe,
+    predicted_shift,
+)
+from aura_ums.schemas._state import Detection, SchemaReport, SchemaState, SchemaStatus
+from aura_ums.uncertainty import Observation
+from aura_ums.world import LandmarkRecord
+
+#: Pixels added on every side of the last detection's extent to make the tracking window.
+TRACKING_MARGIN = 16.0
+#: Consecutive tracking frames without a match after which a tracked landmark becomes suspect.
+DEFAULT_LOST_FRAMES = 2
+
+
+@dataclass(frozen=True, slots=True)
+class FindLandmarkSchema:
+    """A find-landmark schema, slot-filled for one landmark by the pilot (the paper's schema).
+
+    The schema is an immutable value: its parameters and a pure :meth:`step` from one
+    frame and the previous :class:`SchemaStatus` to a :class:`SchemaReport` carrying the
+    next status. The :class:`SchemaManager` keeps each instantiation's status.
+
+    Life cycle, per frame:
+
+    - **HIBERNATING** while no position of the map is within ``activation_range`` of
+      where the landmark may be (the distance from the map's polygon, edges included,
+      to the landmark's point or segment, less its ``position_uncertainty``). The
+      perceptual strategy does not run. Any state returns here when the robot leaves
+      the range.
+    - **DISCOVERING**: the Expecter's window (None: the landmark cannot be in view
+      this frame); the perceptual strategy runs on that window only and the evaluation
+      function scores what it found. A *hit* is a value >= the recognition threshold
+      with a detection that the camera can turn into a bounded observation. Discovery is
+      confirmed after ``confirm_frames`` consecutive hits; a miss, or a frame where the
+      landmark cannot be in view, resets the count; nothing is posted before the
+      confirming frame, so a match in fewer frames (a transient) is never posted.
+    - **TRACKING**: the window follows the last detection (see *Tracking window*); every
+      hit gives an observation. After ``lost_frames`` consecutive misses the landmark is
+      **SUSPECT** for that frame (the map may be partially invalid) and the schema
+      discovers again, in the Expecter's window, from the next frame. A landmark that
+      leaves the view (the Expecter or the prediction puts it outside the image) goes
+      back to discovering without becoming suspect.
+
+    Tracking window
+    ---------------
+    The extent of the last detection (its segment's bounding box, or its point) is
+    shifted by the predicted image motion and grown by ``tracking_margin`` pixels, then
+    cut to the Expecter's window (nothing outside it can be the landmark; when they do
+    not overlap the Expecter's window is searched). The motion model: the detection's
+    pixel is back-projected from the map's most probable pose at detection time to a
+    world point at the landmark's known distance (Class I and II: its horizontal range
+    from the camera; Class III: the ground plane) and projected from the current most
+    probable pose; the difference is the shift. It is exact for the change of the most
+    probable pose; the margin absorbs the rest (the true motion's departure from it).
+
+    Observations
+    ------------
+    Made by the camera with the frame's time: Class I from the detected line's midpoint
+    (:func:`observe_vertical_line`); Class II from the interest point
+    (:func:`observe_point`, pixel error increased by Moravec's ``size // 2`` localization
+    bound, range capped by the farthest position of the map); Class III from the segment
+    (:func:`observe_ground_line`, ``expected_angle`` from the map's most probable heading).
+
+    Parameters
+    ----------
+    record : LandmarkRecord
+        The landmark, its perceptual strategy and parameters, activation range,
+        recognition threshold and confirm count (see :mod:`aura_ums.schemas` for the
+        supported strategies and parameter names per class).
+    expecter : Expecter
+        Predicts windows; its camera makes the observations.
+    lost_frames : int
+        Consecutive tracking misses that make a landmark suspect (>= 1).
+    tracking_margin : float
+        Pixels (>= 0) around the predicted detection.
+    pixel_error : float
+        Bound on a detected pixel's error, pixels (>= 0).
+    bounds : CalibrationBounds or None
+        Bounds on the camera's calibration; None for an exact calibration.
+
+    Attributes
+    ----------
+    detector : FastLineFinder or MoravecOperator or RegionSegmenter
+        The perceptual strategy, parameterized from the record (a line finder's buckets
+        tuned to the record's ``orientation``).
+    margin : float
+        Pixels the Expecter adds to its window for this strategy (:data:`DEFAULT_MARGINS`).
+
+    Raises
+    ------
+    InputError
+        For arguments of the wrong type or out of range, a strategy the landmark's class
+        has no schema for, or an unknown parameter name.
+
+    Examples
+    --------
+    >>> import math
+    >>> import numpy as np
+    >>> from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
+    >>> from aura_ums.expecter import PerceptualStrategy
+    >>> from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, VerticalLineLandmark
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(height=1.0))
+    >>> pole = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 4.0, position_uncertainty=0.1)
+    >>> record = LandmarkRecord(pole, PerceptualStrategy.LINE_FINDER,
+    ...                         {"orientation": math.pi / 2, "min_length": 30.0}, 20.0, 500.0, 2)
+    >>> schema = FindLandmarkSchema(record, Expecter(camera))
+    >>> snapshot = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.3, math.radians(2))
+    >>> image = np.full((480, 640), 60, dtype=np.uint8)
+    >>> image[140:240, 318:323] = 200                       # the pole, 5 px wide at u = 320
+    >>> first = schema.step(Frame(0.0, image, snapshot))
+    >>> first.state, first.hit, first.observation           # one hit: not yet posted
+    (<SchemaState.DISCOVERING: 'discovering'>, True, None)
+    >>> second = schema.step(Frame(0.1, image, snapshot), first.status)
+    >>> second.state, abs(second.observation.bearing) < 0.01   # confirmed: posted, bearing ~ 0
+    (<SchemaState.TRACKING: 'tracking'>, True)
+    >>> far = SpatialUncertaintyMap.from_pose(Pose(-50, 0, 0), 0.3, 0.0)
+    >>> schema.step(Frame(0.2, image, far), second.status).state    # out of range
+    <SchemaState.HIBERNATING: 'hibernating'>
+    """
+
+    record: LandmarkRecord
+    expecter: Expecter
+    lost_frames: int = DEFAULT_LOST_FRAMES
+    tracking_margin: float = TRACKING_MARGIN
+    pixel_error: float = 0.5
+    bounds: CalibrationBounds | None = None
+    detector: Detector = field(init=False, repr=False)
+    margin: float = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.record, LandmarkRecord):
+            raise InputError(f"record: expected a LandmarkRecord, got {type(self.record).__name__}")
+        if not isinstance(self.expecter, Expecter):
+            raise InputError(f"expecter: expected an Expecter, got {type(self.expecter).__name__}")
+        frames = self.lost_frames
+        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
+            raise InputError(f"lost_frames: expected an integer >= 1, got {frames!r}")
+        object.__setattr__(
+            self, "tracking_margin", nonnegative_float(self.tracking_margin, "tracking_margin")
+        )
+        object.__setattr__(self, "pixel_error", nonnegative_float(self.pixel_error, "pixel_error"))
+        if self.bounds is not None and not isinstance(self.bounds, CalibrationBounds):
+            raise InputError(f"bounds: expected CalibrationBounds or None, got {type(self.bounds).__name__}")
+        object.__setattr__(self, "detector", build_detector(self.record))
+        object.__setattr__(self, "margin", DEFAULT_MARGINS[self.record.strategy])
+
+    @property
+    def landmark_id(self) -> str:
+        """The landmark's id."""
+        return self.record.id
+
+    @property
+    def confirm_frames(self) -> int:
+        """Consecutive hits that confirm a discovery (the record's ``confirm_frames``)."""
+        return self.record.confirm_frames
+
+    @property
+    def recognition_threshold(self) -> float:
+        """The evaluation value a match must reach."""
+        return self.record.recognition_threshold
+
+    @property
+    def activation_range(self) -> float:
+        """Metres: the schema wakes when the robot may be this close to the landmark."""
+        return self.record.activation_range
+
+    def is_active(self, frame: Frame) -> bool:
+        """Whether the robot may be within the activation range in this frame's map."""
+        return may_be_within(frame.map, self.record.landmark, self.record.activation_range)
+
+    def step(self, frame: Frame, status: SchemaStatus | None = None) -> SchemaReport:
+        """Process one frame: wake or hibernate, search the window, evaluate, identify.
+
+        Parameters
+        ----------
+        frame : Frame
+            The image (of the camera's size), its time and the map snapshot.
+        status : SchemaStatus or None
+            The status after the previous frame; None for a new instantiation.
+
+        Returns
+        -------
+        SchemaReport
+            The window, the evaluation value, whether it was a hit, the observation to
+            post (if any) and the new status.
+
+        Raises
+        ------
+        InputError
+            For a frame or status of the wrong type, or an image whose size is not the
+            camera's.
+        """
+        if not isinstance(frame, Frame):
+            raise InputError(f"frame: expected a Frame, got {type(frame).__name__}")
+        if status is None:
+            status = SchemaStatus()
+        elif not isinstance(status, SchemaStatus):
+            raise InputError(f"status: expected a SchemaStatus or None, got {type(status).__name__}")
+        k = self.expecter.camera.intrinsics
+        if (frame.width, frame.height) != (k.width, k.height):
+            raise InputError(
+                f"frame.image: expected the camera's {k.width}x{k.height} image, "
+                f"got {frame.width}x{frame.height}"
+            )
+        ident = self.record.id
+        if not self.is_active(frame):
+            return SchemaReport(ident, SchemaStatus(SchemaState.HIBERNATING), None, None, False, None, None)
+        guaranteed = self.expecter.window(frame.map, self.record.landmark, margin=self.margin)
+        if status.state is SchemaState.TRACKING and status.detection is not None:
+            return self._track(frame, status, status.detection, guaranteed)
+        if guaranteed is None:  # awake, but the landmark cannot be in view
+            return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
+        value, detection, observation = self._look(frame, guaranteed)
+        if detection is None or observation is None:
+            return SchemaReport(
+                ident, SchemaStatus(SchemaState.DISCOVERING), guaranteed, value, False, None, None
+            )
+        hits = status.hits + 1 if status.state is SchemaState.DISCOVERING else 1
+        if hits >= self.record.confirm_frames:
+            confirmed = SchemaStatus(SchemaState.TRACKING, hits, 0, detection)
+            return SchemaReport(ident, confirmed, guaranteed, value, True, observation, detection)
+        pending = SchemaStatus(SchemaState.DISCOVERING, hits, 0, detection)
+        return SchemaReport(ident, pending, guaranteed, value, True, None, detection)
+
+    # -- internals ---------------------------------------------------------------------
+
+    def _track(
+        self, frame: Frame, status: SchemaStatus, last: Detection, guaranteed: ImageWindow | None
+    ) -> SchemaReport:
+        ident = self.record.id
+        window = None if guaranteed is None else self.tracking_window(frame, last, guaranteed)
+        if guaranteed is None or window is None:  # left the view: discover again, not suspect
+            return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
+        value, detection, observation = self._look(frame, window)
+        if detection is not None and observation is not None:
+            kept = SchemaStatus(SchemaState.TRACKING, status.hits + 1, 0, detection)
+            return SchemaReport(ident, kept, window, value, True, observation, detection)
+        misses = status.misses + 1
+        if misses >= self.lost_frames:
+            return SchemaReport(
+                ident, SchemaStatus(SchemaState.SUSPECT, 0, misses), window, value, False, None, None
+            )
+        waiting = SchemaStatus(SchemaState.TRACKING, status.hits, misses, last)
+        return SchemaReport(ident, waiting, window, value, False, None, None)
+
+    def tracking_window(self, frame: Frame, last: Detection, guaranteed: ImageWindow) -> ImageWindow | None:
+        """Return the window in which a tracked landmark is searched (see *Tracking window* above).
+
+        None when the prediction puts the landmark behind the camera or off the image.
+        """
+        camera = self.expecter.camera
+        shift = predicted_shift(camera, self.record.landmark, last, frame.map.most_probable_pose())
+        if shift is None:
+            return None
+        du, dv = shift
+        box = last.box
+        moved = ImageWindow(box.u_min + du, box.v_min + dv, box.u_max + du, box.v_max + dv)
+        k = camera.intrinsics
+        around = moved.expanded(self.tracking_margin).clipped(k.width, k.height)
+        if around is None:
+            return None
+        overlap = intersection(around, guaranteed)
+        return guaranteed if overlap is None else overlap
+
+    def _look(self, frame: Frame, window: ImageWindow) -> tuple[float, Detection | None, Observation | None]:
+        """Run the strategy in the window; return the value, and the detection and observation of a hit."""
+        camera = self.expecter.camera
+        value, detection = detect(
+            self.detector, self.record, frame.image, window, camera=camera, map=frame.map, time=frame.time
+        )
+        if detection is None or not value >= self.record.recognition_threshold or not math.isfinite(value):
+            return value, None, None
+        try:
+            observation = observe(
+                camera,
+                self.record,
+                detection,
+                frame.map,
+                pixel_error=self.pixel_error,
+                bounds=self.bounds,
+                detector=self.detector,
+            )
+        except InputError:  # e.g. a "corner" above the horizon: not a view of this landmark
+            return value, None, None
+        return value, detection, observation

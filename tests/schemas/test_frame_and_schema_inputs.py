@@ -1,0 +1,166 @@
+"""Frames and find-landmark schemas: validation at entry, parameterization from records."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from schema_scenes import CAMERA, map_around, pole_record
+
+from aura_ums.camera import CalibrationBounds
+from aura_ums.errors import InputError
+from aura_ums.expecter import DEFAULT_MARGINS, Expecter, PerceptualStrategy
+from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
+from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaStatus
+from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, Pose, VerticalLineLandmark
+from aura_ums.world import LandmarkRecord
+
+EXPECTER = Expecter(CAMERA)
+POLE = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 4.0)
+CORNER = PointLandmark("corner", 12.0, 2.0, 3.0)
+EDGE = GroundLineLandmark("edge", (0.0, -1.0), (20.0, -1.0))
+SNAPSHOT = map_around(Pose(0.0, 0.0, 0.0))
+
+
+def test_frame_keeps_a_read_only_copy_of_the_image() -> None:
+    image = np.zeros((480, 640), dtype=np.uint8)
+    frame = Frame(1, image, SNAPSHOT)
+    assert frame.time == 1.0
+    assert isinstance(frame.time, float)
+    assert frame.image is not image
+    assert image.flags.writeable
+    assert not frame.image.flags.writeable
+    image[0, 0] = 9
+    assert frame.image[0, 0] == 0
+    frozen = np.zeros((4, 5))
+    frozen.setflags(write=False)
+    assert Frame(0.0, frozen, SNAPSHOT).image is frozen  # already read-only: not copied
+    assert (frame.width, frame.height) == (640, 480)
+    assert "640x480" in repr(frame)
+    with pytest.raises(dataclasses.FrozenInstanceError, match="cannot assign"):
+        frame.time = 2.0  # type: ignore[misc]
+
+
+def test_frame_validates_its_inputs() -> None:
+    with pytest.raises(InputError, match="time: expected a finite number, got inf"):
+        Frame(math.inf, np.zeros((4, 4)), SNAPSHOT)
+    with pytest.raises(
+        InputError, match=r"image: expected a 2-D grayscale array \(h, w\), got shape \(4, 4, 3\)"
+    ):
+        Frame(0.0, np.zeros((4, 4, 3)), SNAPSHOT)
+    with pytest.raises(
+        InputError, match="image: expected a non-empty array of integers or floats, got dtype <U1"
+    ):
+        Frame(0.0, np.array([["a"]]), SNAPSHOT)
+    with pytest.raises(InputError, match=r"non-empty array.*shape \(0, 4\)"):
+        Frame(0.0, np.zeros((0, 4)), SNAPSHOT)
+    with pytest.raises(InputError, match="map: expected a SpatialUncertaintyMap, got Pose"):
+        Frame(0.0, np.zeros((4, 4)), Pose(0, 0, 0))  # type: ignore[arg-type]
+
+
+def test_line_finder_is_tuned_from_the_record() -> None:
+    record = LandmarkRecord(
+        POLE,
+        PerceptualStrategy.LINE_FINDER,
+        {"orientation": 1.5, "tolerance": 0.1, "min_length": 25.0, "min_gradient": 6.0, "buckets": 16.0},
+        20.0,
+        400.0,
+        4,
+    )
+    schema = FindLandmarkSchema(record, EXPECTER)
+    assert schema.detector == FastLineFinder(
+        orientation=1.5, tolerance=0.1, min_length=25.0, min_gradient=6.0, buckets=16
+    )
+    assert schema.margin == DEFAULT_MARGINS[PerceptualStrategy.LINE_FINDER]
+    assert (schema.confirm_frames, schema.recognition_threshold, schema.activation_range) == (4, 400.0, 20.0)
+    assert schema.landmark_id == "pole"
+    default = FindLandmarkSchema(
+        LandmarkRecord(POLE, PerceptualStrategy.LINE_FINDER, {}, 20.0, 1.0), EXPECTER
+    )
+    assert isinstance(default.detector, FastLineFinder)
+    assert default.detector.orientation == pytest.approx(math.pi / 2)  # a vertical line by default
+
+
+def test_interest_operator_and_region_segmenter_are_parameterized() -> None:
+    corner = LandmarkRecord(
+        CORNER,
+        PerceptualStrategy.INTEREST_OPERATOR,
+        {"window": 7.0, "min_interest": 150.0, "suppression": 2.0},
+        30.0,
+        1.0,
+    )
+    assert FindLandmarkSchema(corner, EXPECTER).detector == MoravecOperator(
+        size=7, threshold=150.0, suppression=2
+    )
+    region = LandmarkRecord(
+        POLE, PerceptualStrategy.REGION_SEGMENTER, {"threshold": 120.0, "min_area": 30.0}, 30.0, 1.0
+    )
+    schema = FindLandmarkSchema(region, EXPECTER)
+    assert schema.detector == RegionSegmenter(threshold=120.0, min_area=30)
+    assert schema.margin == DEFAULT_MARGINS[PerceptualStrategy.REGION_SEGMENTER]
+
+
+@pytest.mark.parametrize(
+    ("record", "message"),
+    [
+        (
+            LandmarkRecord(CORNER, PerceptualStrategy.LINE_FINDER, {}, 30.0, 1.0),
+            "corner.strategy: expected interest_operator for a Class II landmark, got line_finder",
+        ),
+        (
+            LandmarkRecord(EDGE, PerceptualStrategy.REGION_SEGMENTER, {}, 30.0, 1.0),
+            "edge.strategy: expected line_finder for a Class III landmark, got region_segmenter",
+        ),
+        (
+            LandmarkRecord(POLE, PerceptualStrategy.INTEREST_OPERATOR, {}, 30.0, 1.0),
+            "pole.strategy: expected line_finder, region_segmenter for a Class I landmark, got "
+            "interest_operator",
+        ),
+        (
+            LandmarkRecord(POLE, PerceptualStrategy.LINE_FINDER, {"orientaton": 1.0}, 30.0, 1.0),
+            "pole.parameters: expected names among orientation, .*, got 'orientaton'",
+        ),
+        (
+            LandmarkRecord(CORNER, PerceptualStrategy.INTEREST_OPERATOR, {"window": 5.5}, 30.0, 1.0),
+            "corner.parameters.window: expected an integer, got 5.5",
+        ),
+        (
+            LandmarkRecord(CORNER, PerceptualStrategy.INTEREST_OPERATOR, {"window": 4.0}, 30.0, 1.0),
+            "size: expected an odd integer, got 4",
+        ),
+        (
+            LandmarkRecord(POLE, PerceptualStrategy.REGION_SEGMENTER, {"min_aspect": 0.0}, 30.0, 1.0),
+            "pole.parameters.min_aspect: expected a positive number, got 0.0",
+        ),
+    ],
+)
+def test_schema_refuses_what_it_cannot_parameterize(record: LandmarkRecord, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        FindLandmarkSchema(record, EXPECTER)
+
+
+def test_schema_validates_its_arguments() -> None:
+    record = pole_record(POLE)
+    with pytest.raises(InputError, match="record: expected a LandmarkRecord, got VerticalLineLandmark"):
+        FindLandmarkSchema(POLE, EXPECTER)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="expecter: expected an Expecter, got Camera"):
+        FindLandmarkSchema(record, CAMERA)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="lost_frames: expected an integer >= 1, got 0"):
+        FindLandmarkSchema(record, EXPECTER, lost_frames=0)
+    with pytest.raises(InputError, match="lost_frames: expected an integer >= 1, got True"):
+        FindLandmarkSchema(record, EXPECTER, lost_frames=True)
+    with pytest.raises(InputError, match=r"tracking_margin: expected a non-negative number, got -1\.0"):
+        FindLandmarkSchema(record, EXPECTER, tracking_margin=-1.0)
+    with pytest.raises(InputError, match="pixel_error: expected a finite number, got nan"):
+        FindLandmarkSchema(record, EXPECTER, pixel_error=math.nan)
+    with pytest.raises(InputError, match="bounds: expected CalibrationBounds or None, got dict"):
+        FindLandmarkSchema(record, EXPECTER, bounds={})  # type: ignore[arg-type]
+    schema = FindLandmarkSchema(record, EXPECTER, bounds=CalibrationBounds(fx=2.0))
+    frame = Frame(0.0, np.zeros((480, 640), dtype=np.uint8), SNAPSHOT)
+    with pytest.raises(InputError, match="frame: expected a Frame, got ndarray"):
+        schema.step(frame.image)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="status: expected a SchemaStatus or None, got str"):
+        schema.step(frame, "tracking")  # type: ignore[arg-type]
+    assert schema.step(frame, SchemaStatus()).value == 0.0  # a blank image: nothing fits
