@@ -84,7 +84,8 @@ class LandmarkRecord:
         within this distance of the landmark.
     recognition_threshold : float
         Evaluation value (>= 0, on the scale of the strategy's evaluation function) that
-        an image structure must reach to count as the landmark.
+        an image structure must reach to count as the landmark: for lines, length (px) times
+        contrast (gray levels per px); for corners, the Moravec response.
     confirm_frames : int
         Number of consecutive frames (>= 1) that must confirm a discovery.
 
