@@ -24,9 +24,18 @@ from aura_ums.camera import (
     observe_point,
     observe_vertical_line,
 )
-from aura_ums.errors import AuraUmsError, FileFormatError, InputError, UnknownTerrainError
+from aura_ums.errors import (
+    AuraUmsError,
+    FileFormatError,
+    InputError,
+    MissingDependencyError,
+    UnknownTerrainError,
+)
 from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
+from aura_ums.manager import IdentifiedLandmarkBuffer
+from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
+from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
 from aura_ums.uncertainty import (
     FOOT,
     BearingObservation,
@@ -47,6 +56,7 @@ from aura_ums.uncertainty import (
     growth_tightness,
     simulate_containment,
 )
+from aura_ums.world import LandmarkRecord, Meadow, MeadowMap, ShortTermMemory, plan_route, sample_world
 
 __version__ = "0.1.0"
 
@@ -60,20 +70,34 @@ __all__ = [
     "CameraMount",
     "ConvexPolygon",
     "Expecter",
+    "FastLineFinder",
     "FileFormatError",
+    "FindLandmarkSchema",
+    "Frame",
     "GroundLineLandmark",
     "GroundLineObservation",
     "HeadingWedge",
+    "IdentifiedLandmarkBuffer",
     "ImageWindow",
     "InputError",
     "Landmark",
     "LandmarkClass",
+    "LandmarkRecord",
+    "Meadow",
+    "MeadowMap",
+    "MissingDependencyError",
+    "MoravecOperator",
     "Observation",
     "PerceptualStrategy",
+    "Pilot",
     "PointLandmark",
     "Pose",
     "RangeBearingObservation",
     "Reduction",
+    "RegionSegmenter",
+    "SchemaManager",
+    "SchemaState",
+    "ShortTermMemory",
     "SpatialUncertaintyMap",
     "TerrainStats",
     "TerrainTable",
@@ -87,6 +111,8 @@ __all__ = [
     "observe_ground_line",
     "observe_point",
     "observe_vertical_line",
+    "plan_route",
+    "sample_world",
     "simulate_containment",
     "wrap_angle",
 ]

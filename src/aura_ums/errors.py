@@ -12,6 +12,7 @@ __all__ = [
     "AuraUmsError",
     "FileFormatError",
     "InputError",
+    "MissingDependencyError",
     "UnknownTerrainError",
 ]
 
@@ -22,6 +23,10 @@ class AuraUmsError(Exception):
 
 class InputError(AuraUmsError, ValueError):
     """An argument or a value given to aura-ums is not what it expects."""
+
+
+class MissingDependencyError(AuraUmsError, ImportError):
+    """An optional dependency (an extra such as ``opencv``) is needed but not installed."""
 
 
 class FileFormatError(InputError):

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from aura_ums.errors import AuraUmsError, InputError
+from aura_ums.errors import InputError, MissingDependencyError
 from aura_ums.expecter import ImageWindow
 from aura_ums.perception import FastLineFinder, LineBackend, LineSegments, angle_difference
 
@@ -280,7 +280,9 @@ def test_opencv_backend_matches_numpy() -> None:
 
 def test_missing_opencv_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "cv2", None)
-    with pytest.raises(AuraUmsError, match=r"optional 'opencv' extra \(pip install 'aura-ums\[opencv\]'\)"):
+    with pytest.raises(
+        MissingDependencyError, match=r"optional 'opencv' extra \(pip install 'aura-ums\[opencv\]'\)"
+    ):
         FastLineFinder(backend=LineBackend.OPENCV)
 
 

@@ -15,13 +15,8 @@ from aura_ums.expecter._baselines import (
     gaussian_window,
 )
 from aura_ums.expecter._expecter import Expecter
-from aura_ums.expecter._window import (
-    DEFAULT_MARGINS,
-    UNBOUNDED_PIXELS,
-    ImageWindow,
-    PerceptualStrategy,
-    margin_pixels,
-)
+from aura_ums.expecter._window import DEFAULT_MARGINS, PerceptualStrategy, margin_pixels
+from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
 
 __all__ = [
     "DEFAULT_MARGINS",

@@ -15,8 +15,8 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError
 from aura_ums.expecter._expecter import Expecter
-from aura_ums.expecter._window import ImageWindow, PerceptualStrategy, margin_pixels
-from aura_ums.geometry import ConvexPolygon, HeadingWedge, outer_disk
+from aura_ums.expecter._window import PerceptualStrategy, margin_pixels
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, ImageWindow, outer_disk
 from aura_ums.uncertainty import Landmark, Pose, SpatialUncertaintyMap
 
 #: Sides of the outer polygon that stands for the disk model's circle.

@@ -46,8 +46,8 @@ from numpy.typing import NDArray
 from aura_ums.camera import NEAR_PLANE, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter._distortion import distorted_range
-from aura_ums.expecter._window import UNBOUNDED_PIXELS, ImageWindow, PerceptualStrategy, margin_pixels
-from aura_ums.geometry import convex_hull, minkowski_sum, outer_disk
+from aura_ums.expecter._window import PerceptualStrategy, margin_pixels
+from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow, convex_hull, minkowski_sum, outer_disk
 from aura_ums.uncertainty import (
     GroundLineLandmark,
     Landmark,

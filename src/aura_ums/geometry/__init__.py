@@ -17,12 +17,15 @@ from aura_ums.geometry._convex import (
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
 from aura_ums.geometry._wedge import ANGLE_TOLERANCE, HeadingWedge
+from aura_ums.geometry._window import UNBOUNDED_PIXELS, ImageWindow
 
 __all__ = [
     "ANGLE_TOLERANCE",
     "POSITION_TOLERANCE",
+    "UNBOUNDED_PIXELS",
     "ConvexPolygon",
     "HeadingWedge",
+    "ImageWindow",
     "angle_difference",
     "clip_halfplane",
     "convex_hull",

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.expecter._window import ImageWindow
+from aura_ums.geometry import ImageWindow
 
 #: ITU-R BT.601 luma weights (red, green, blue), as OpenCV's ``COLOR_RGB2GRAY`` uses.
 _LUMA = np.array([0.299, 0.587, 0.114])

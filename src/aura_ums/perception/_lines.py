@@ -37,7 +37,7 @@ from scipy import ndimage
 
 from aura_ums._validate import finite_float, nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.expecter._window import ImageWindow
+from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
 from aura_ums.perception._opencv import import_cv2
 from aura_ums.perception._segments import LineSegments, angle_difference
@@ -105,7 +105,7 @@ class FastLineFinder:
     ------
     InputError
         When a parameter is out of range.
-    AuraUmsError
+    MissingDependencyError
         When ``backend`` is :attr:`LineBackend.OPENCV` and OpenCV is not installed.
 
     Examples

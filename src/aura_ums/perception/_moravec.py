@@ -10,7 +10,7 @@ from scipy import ndimage
 
 from aura_ums._validate import nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.expecter._window import ImageWindow
+from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
 
 #: Four of the eight shifts (rows, columns) of Moravec's operator; the other four are their opposites.

@@ -10,18 +10,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float
-from aura_ums.errors import AuraUmsError
-from aura_ums.expecter._window import ImageWindow
+from aura_ums.errors import MissingDependencyError
+from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import prepare
 from aura_ums.perception._segments import LineSegments, angle_difference
 
 
 def import_cv2(what: str) -> ModuleType:
-    """Import OpenCV, or raise :class:`AuraUmsError` naming the ``opencv`` extra."""
+    """Import OpenCV, or raise :class:`MissingDependencyError` naming the ``opencv`` extra."""
     try:
         import cv2
     except ImportError as exc:
-        raise AuraUmsError(
+        raise MissingDependencyError(
             f"{what}: expected OpenCV from the optional 'opencv' extra "
             f"(pip install 'aura-ums[opencv]'), got {exc}"
         ) from exc
@@ -70,7 +70,7 @@ class OpenCvLineFinder:
 
     Raises
     ------
-    AuraUmsError
+    MissingDependencyError
         When OpenCV is not installed (on first use).
 
     Examples

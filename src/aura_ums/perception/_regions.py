@@ -10,7 +10,7 @@ from scipy import ndimage
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError
-from aura_ums.expecter._window import ImageWindow
+from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import as_image, int_at_least, prepare
 
 _EIGHT = np.ones((3, 3), dtype=bool)
