@@ -1,6 +1,7 @@
-"""The optional C growth kernel; everything else is configured in pyproject.toml.
+"""The optional C kernels of growth and the landmark reductions.
 
-Without a C compiler the build skips the extension and the numpy reference runs instead.
+Everything else is configured in pyproject.toml. Without a C compiler the build skips the
+extension and the numpy reference runs instead.
 """
 
 from setuptools import Extension, setup
@@ -11,7 +12,7 @@ setup(
             "aura_ums.geometry._kernels",
             sources=["src/aura_ums/geometry/_kernels.c"],
             optional=True,
-            extra_compile_args=["-O2"],
+            extra_compile_args=["-O2", "-Wall"],
         )
     ]
 )

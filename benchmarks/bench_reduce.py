@@ -1,7 +1,8 @@
 """Benchmark: the three landmark reductions against filterpy's EKF range-bearing update.
 
 Run ``python benchmarks/bench_reduce.py``. Prints the median time of one reduction of
-each class on a 16- and a 64-vertex map, next to the median time of one
+each class on a 16- and a 64-vertex map, with the compiled kernels (when the C
+extension was built) and with the numpy reference, next to the median time of one
 ``ExtendedKalmanFilter.update`` (3 states: x, y, heading) with a range-bearing
 measurement of a landmark, its Jacobian and measurement function written in Python
 as a user would write them, measured in the same run.
@@ -27,6 +28,7 @@ from aura_ums.uncertainty import (
     RangeBearingObservation,
     SpatialUncertaintyMap,
     VerticalLineLandmark,
+    _reduce,
 )
 
 REPEATS = 2000
@@ -107,18 +109,42 @@ def ekf_update_call() -> Callable[[], object]:
     return update
 
 
+def numpy_only(call: Callable[[], object]) -> Callable[[], object]:
+    """Return ``call`` run with the compiled reduction kernels switched off (the numpy reference)."""
+
+    def run() -> object:
+        saved = _reduce._compiled_reduce_cone, _reduce._compiled_reduce_strip
+        _reduce._compiled_reduce_cone = _reduce._compiled_reduce_strip = None
+        try:
+            return call()
+        finally:
+            _reduce._compiled_reduce_cone, _reduce._compiled_reduce_strip = saved
+
+    return run
+
+
 def main() -> None:
     ekf = median_microseconds(ekf_update_call())
+    compiled = _reduce.compiled_kernels() is not None
     print(f"filterpy ExtendedKalmanFilter.update (range-bearing, 3 states): {ekf:8.1f} us")
+    if not compiled:
+        print("(the C extension was not built: the compiled columns repeat the numpy reference)")
     print()
-    print(f"{'reduction':<12}{'vertices':>9}{'median us':>12}{'vs EKF':>9}{'area after/before':>19}")
+    print(
+        f"{'reduction':<12}{'vertices':>9}{'compiled us':>13}{'vs EKF':>8}{'numpy us':>10}{'vs EKF':>8}"
+        f"{'speed-up':>10}{'area after/before':>19}"
+    )
     for sides in (16, 64):
         prior = prior_map(sides)
         for name, call in reduction_calls(prior).items():
             reduction = call()
-            elapsed = median_microseconds(call)
+            fast = median_microseconds(call)
+            slow = median_microseconds(numpy_only(call), repeats=REPEATS // 4)
             ratio = reduction.area_after / reduction.area_before  # type: ignore[attr-defined]
-            print(f"{name:<12}{sides:>9}{elapsed:>12.1f}{elapsed / ekf:>8.2f}x{ratio:>19.3f}")
+            print(
+                f"{name:<12}{sides:>9}{fast:>13.1f}{fast / ekf:>7.2f}x{slow:>10.1f}{slow / ekf:>7.2f}x"
+                f"{slow / fast:>9.1f}x{ratio:>19.3f}"
+            )
 
 
 if __name__ == "__main__":

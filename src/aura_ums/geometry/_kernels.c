@@ -323,6 +323,7 @@ static Py_ssize_t simplify_outer(double *v, Py_ssize_t n, Py_ssize_t max_vertice
 }
 
 static PyObject *grow_polygon(PyObject *self, PyObject *args) {
+    (void)self;
     Py_buffer buffer;
     double heading_lo, heading_hi, turn_min, turn_max, drift_max, chord_min, run_max, skitter_radius;
     Py_ssize_t max_vertices;
@@ -389,15 +390,1000 @@ done:
     return result;
 }
 
+/* ===========================================================================
+ * Compiled kernels of the three landmark reductions.
+ *
+ * They mirror, operation for operation, the numpy functions of uncertainty/_reduce.py
+ * (clip_halfplanes, clip_convex, sector_halfplanes, clip_to_sector, sensor_arc,
+ * _sensor_constrained, _bearing_headings, _cone_reduction, reduce_ground_line,
+ * cos_range, cap_inside and the tail of reduce_map), geometry/_arcs.py
+ * (intersect_arcs, nearest_on_polygon, subtended_arc) and geometry/_convex.py
+ * (clip_halfplane, convex_hull, remove_collinear, polygon_area, points_in_convex),
+ * which stay the reference implementation and the fallback. One call runs a whole
+ * reduction: from the prior's vertices to the reduced vertices, heading arc, centre
+ * and areas. Every buffer's capacity is computed from the sizes of its inputs.
+ * ========================================================================= */
+
+#define TOLERANCE 1e-9
+#define SAME_POINT 1e-12
+#define MERGE_EPS 1e-12
+#define COLLINEAR_EPS 1e-12
+#define TANGENT_STEP (M_PI / 8.0)
+#define SENSOR_ARC_SIDES 16
+
+/* fmin and fmax without the libm calls (no NaN reaches them from checked input). */
+static inline double lesser(double a, double b) { return b < a ? b : a; }
+static inline double greater(double a, double b) { return b > a ? b : a; }
+
+/* Why a reduction is empty: _reduce.py maps these codes to its messages. */
+enum {
+    NO_POSITION = 0,
+    NO_SENSOR_POSITION = 1,
+    NO_BEARING_HEADING = 2,
+    NO_LINE_HEADING = 3,
+    NO_OFFSET_POSITION = 4,
+};
+
+/* A polygon (or point list) of n vertices stored x0, y0, x1, y1, ... with room for cap. */
+typedef struct {
+    double *v;
+    Py_ssize_t n, cap;
+} Poly;
+
+/* A growable scratch array. */
+typedef struct {
+    void *data;
+    size_t bytes;
+} Scratch;
+
+typedef struct {
+    double x, y;
+} Point;
+
+/* Every buffer one reduction uses; all start empty and are freed by work_free. */
+typedef struct {
+    Poly ping, pong;       /* clip_halfplanes: alternate clip results */
+    Poly part, parts;      /* clip_to_sector: one piece's part, every part */
+    Poly arc_points;       /* sensor_arc: the outer arc before its hull */
+    Poly arc, mirrored;    /* the sensor arc polygon and its negation */
+    Poly sum;              /* Minkowski sums */
+    Poly sensors, positions, narrowed;
+    Scratch values, flags, cuts, planes, points, edges;
+} Work;
+
+static void work_free(Work *w) {
+    Poly *polys[] = {&w->ping,  &w->pong, &w->part,    &w->parts,     &w->arc_points, &w->arc,
+                     &w->mirrored, &w->sum, &w->sensors, &w->positions, &w->narrowed};
+    Scratch *scratches[] = {&w->values, &w->flags, &w->cuts, &w->planes, &w->points, &w->edges};
+    for (size_t i = 0; i < sizeof(polys) / sizeof(polys[0]); i++) PyMem_Free(polys[i]->v);
+    for (size_t i = 0; i < sizeof(scratches) / sizeof(scratches[0]); i++) PyMem_Free(scratches[i]->data);
+}
+
+/* Make room for `count` vertices (their values are kept); -1 with MemoryError set on failure. */
+static int reserve(Poly *p, Py_ssize_t count) {
+    if (count < 1) count = 1;
+    if (count <= p->cap) return 0;
+    if ((size_t)count > (size_t)PY_SSIZE_T_MAX / (2 * sizeof(double))) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    double *grown = PyMem_Realloc(p->v, 2 * sizeof(double) * (size_t)count);
+    if (!grown) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    p->v = grown;
+    p->cap = count;
+    return 0;
+}
+
+/* Room for `count` items of `size` bytes (old contents are not kept); NULL with MemoryError set. */
+static void *scratch(Scratch *s, Py_ssize_t count, size_t size) {
+    if (count < 1) count = 1;
+    if ((size_t)count > (size_t)PY_SSIZE_T_MAX / size) {
+        PyErr_NoMemory();
+        return NULL;
+    }
+    size_t bytes = (size_t)count * size;
+    if (bytes <= s->bytes) return s->data;
+    PyMem_Free(s->data);
+    s->data = PyMem_Malloc(bytes);
+    s->bytes = s->data ? bytes : 0;
+    if (!s->data) PyErr_NoMemory();
+    return s->data;
+}
+
+/* Copy n vertices into dst; src must not point into dst's buffer unless it is its start. */
+static int copy_into(Poly *dst, const double *src, Py_ssize_t n) {
+    if (src != dst->v) {
+        if (reserve(dst, n) < 0) return -1;
+        if (n > 0) memcpy(dst->v, src, 2 * sizeof(double) * (size_t)n);
+    }
+    dst->n = n;
+    return 0;
+}
+
+/* Python's (and numpy's) float remainder: the result takes the divisor's sign. */
+static double floor_mod(double a, double b) {
+    double mod = fmod(a, b);
+    if (mod != 0.0) {
+        if ((b < 0.0) != (mod < 0.0)) mod += b;
+    } else {
+        mod = copysign(0.0, b);
+    }
+    return mod;
+}
+
+/* See _convex.polygon_area. */
+static double polygon_area(const double *v, Py_ssize_t n) {
+    if (n < 3) return 0.0;
+    double x0 = v[0], y0 = v[1], xy = 0.0, yx = 0.0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        double x = v[2 * i] - x0, y = v[2 * i + 1] - y0;
+        xy += x * (v[2 * j + 1] - y0);
+        yx += y * (v[2 * j] - x0);
+    }
+    return 0.5 * (xy - yx);
+}
+
+/* See _convex.remove_collinear; works in place. */
+static int remove_collinear(Poly *p, Work *w) {
+    Py_ssize_t n = p->n;
+    double *v = p->v;
+    if (n < 2) return 0;
+    double xmin = v[0], xmax = v[0], ymin = v[1], ymax = v[1];
+    for (Py_ssize_t i = 1; i < n; i++) {
+        xmin = lesser(xmin, v[2 * i]);
+        xmax = greater(xmax, v[2 * i]);
+        ymin = lesser(ymin, v[2 * i + 1]);
+        ymax = greater(ymax, v[2 * i + 1]);
+    }
+    double span = greater(xmax - xmin, ymax - ymin);
+    /* Drop each vertex too close to the next; the write index never passes the read one,
+       and the first vertex (which the last edge needs) is saved first. */
+    double x0 = v[0], y0 = v[1];
+    Py_ssize_t m = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double nx = i + 1 < n ? v[2 * i + 2] : x0, ny = i + 1 < n ? v[2 * i + 3] : y0;
+        if (hypot(nx - v[2 * i], ny - v[2 * i + 1]) > MERGE_EPS * span) {
+            double x = v[2 * i], y = v[2 * i + 1];
+            v[2 * m] = x;
+            v[2 * m + 1] = y;
+            m++;
+        }
+    }
+    if (m < n) {
+        if (m == 0) {
+            v[0] = x0;
+            v[1] = y0;
+            p->n = 1;
+            return 0;
+        }
+        n = m;
+        p->n = n;
+    }
+    if (n < 3) return 0;
+    double magnitude = 0.0;
+    for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
+    char *straight = scratch(&w->flags, n, 1);
+    if (!straight) return -1;
+    Py_ssize_t count = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
+        double fx = v[2 * next] - v[2 * i], fy = v[2 * next + 1] - v[2 * i + 1];
+        double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
+        double length = hypot(fx, fy), preceding_length = hypot(px, py);
+        double turn = px * fy - py * fx;
+        double noise =
+            COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length);
+        straight[i] = fabs(turn) <= noise && px * fx + py * fy > 0.0;
+        count += straight[i];
+    }
+    if (count == 0) return 0;
+    m = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (straight[i]) continue;
+        v[2 * m] = v[2 * i];
+        v[2 * m + 1] = v[2 * i + 1];
+        m++;
+    }
+    p->n = m;
+    return 0;
+}
+
+/* Cut point on edge `edge` where the signed value is zero, unless it is the inside end itself. */
+static Py_ssize_t cut_point(const double *v, const double *s, Py_ssize_t count, Py_ssize_t edge, double keep_at,
+                            double *out, Py_ssize_t m) {
+    Py_ssize_t following = edge + 1 < count ? edge + 1 : 0;
+    double s0 = s[edge], s1 = s[following];
+    double t = s0 / (s0 - s1);
+    if (fabs(t - keep_at) <= SAME_POINT) return m;
+    double ax = v[2 * edge], ay = v[2 * edge + 1], bx = v[2 * following], by = v[2 * following + 1];
+    out[2 * m] = ax + t * (bx - ax);
+    out[2 * m + 1] = ay + t * (by - ay);
+    return m + 1;
+}
+
+/* See _convex.clip_halfplane (and _clip_halfplane_masked): the part of a convex polygon
+   where nx x + ny y <= offset, written to `out` (which must not hold `v`). */
+static int clip_halfplane(const double *v, Py_ssize_t count, double nx, double ny, double offset, Poly *out,
+                          Work *w) {
+    double *s = scratch(&w->values, count, sizeof(double));
+    if (!s) return -1;
+    Py_ssize_t outside = 0;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        s[i] = v[2 * i] * nx + v[2 * i + 1] * ny - offset;
+        outside += s[i] > 0.0;
+    }
+    if (outside == 0) return copy_into(out, v, count);
+    if (outside == count) {
+        out->n = 0;
+        return 0;
+    }
+    if (count >= 3) {
+        Py_ssize_t found = 0, edges[2] = {0, 0};
+        for (Py_ssize_t i = 0; i < count; i++) {
+            Py_ssize_t j = i + 1 < count ? i + 1 : 0;
+            if ((s[i] > 0.0) != (s[j] > 0.0)) {
+                if (found < 2) edges[found] = i;
+                found++;
+            }
+        }
+        if (found == 2) {
+            /* One entry edge (outside to inside) and one exit edge: keep the run between. */
+            Py_ssize_t entry = s[edges[0]] > 0.0 ? edges[0] : edges[1];
+            Py_ssize_t exit = s[edges[0]] > 0.0 ? edges[1] : edges[0];
+            if (reserve(out, count + 2) < 0) return -1;
+            double *o = out->v;
+            Py_ssize_t m = cut_point(v, s, count, entry, 1.0, o, 0);
+            Py_ssize_t i = entry + 1 < count ? entry + 1 : 0;
+            for (;;) {
+                o[2 * m] = v[2 * i];
+                o[2 * m + 1] = v[2 * i + 1];
+                m++;
+                if (i == exit) break;
+                i = i + 1 < count ? i + 1 : 0;
+            }
+            out->n = cut_point(v, s, count, exit, 0.0, o, m);
+            return 0;
+        }
+    }
+    /* A segment, a point, or rounding on a degenerate polygon: mask every vertex and cut. */
+    if (reserve(out, 2 * count) < 0) return -1;
+    double *o = out->v;
+    Py_ssize_t m = 0;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        Py_ssize_t j = i + 1 < count ? i + 1 : 0;
+        int inside = s[i] <= 0.0, next_inside = s[j] <= 0.0;
+        if (inside) {
+            o[2 * m] = v[2 * i];
+            o[2 * m + 1] = v[2 * i + 1];
+            m++;
+        }
+        if (inside != next_inside) {
+            double t = s[i] / (s[i] - s[j]);
+            o[2 * m] = v[2 * i] + t * (v[2 * j] - v[2 * i]);
+            o[2 * m + 1] = v[2 * i + 1] + t * (v[2 * j + 1] - v[2 * i + 1]);
+            m++;
+        }
+    }
+    out->n = m;
+    return remove_collinear(out, w);
+}
+
+/* See _reduce.clip_halfplanes: planes are (nx, ny, offset) triples. `v` and `out` must not
+   be w->ping or w->pong. */
+static int clip_halfplanes(const double *v, Py_ssize_t n, const double *planes, Py_ssize_t k, Poly *out,
+                           Work *w) {
+    if (n == 0) {
+        out->n = 0;
+        return 0;
+    }
+    char *cuts = scratch(&w->cuts, k, 1);
+    if (!cuts) return -1;
+    /* Half-planes are judged on the input polygon: one that holds none of it empties it,
+       one that holds all of it holds every part of it too. */
+    for (Py_ssize_t j = 0; j < k; j++) {
+        double nx = planes[3 * j], ny = planes[3 * j + 1], offset = planes[3 * j + 2];
+        int some_inside = 0, some_outside = 0;
+        /* Stop once both are seen: min > 0 and max > 0 are then settled. */
+        for (Py_ssize_t i = 0; i < n && !(some_inside && some_outside); i++) {
+            double s = v[2 * i] * nx + v[2 * i + 1] * ny - offset;
+            if (s > 0.0)
+                some_outside = 1;
+            else
+                some_inside = 1;
+        }
+        if (!some_inside) {
+            out->n = 0;
+            return 0;
+        }
+        cuts[j] = (char)some_outside;
+    }
+    const double *current = v;
+    Py_ssize_t current_n = n;
+    Poly *target = &w->ping, *spare = &w->pong;
+    for (Py_ssize_t j = 0; j < k; j++) {
+        if (!cuts[j]) continue;
+        if (clip_halfplane(current, current_n, planes[3 * j], planes[3 * j + 1], planes[3 * j + 2], target, w) < 0)
+            return -1;
+        current = target->v;
+        current_n = target->n;
+        Poly *swap = target;
+        target = spare;
+        spare = swap;
+        if (current_n == 0) break;
+    }
+    return copy_into(out, current, current_n);
+}
+
+/* See _reduce.clip_convex: `v` clipped by `other` widened by `margin`. */
+static int clip_convex(const double *v, Py_ssize_t n, const double *other, Py_ssize_t m, double margin, Poly *out,
+                       Work *w) {
+    double *planes = scratch(&w->planes, 3 * m, sizeof(double));
+    if (!planes) return -1;
+    double magnitude = 1.0;
+    for (Py_ssize_t i = 0; i < 2 * m; i++) magnitude = greater(magnitude, fabs(other[i]));
+    Py_ssize_t k = 0;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        Py_ssize_t j = i + 1 < m ? i + 1 : 0;
+        double ex = other[2 * j] - other[2 * i], ey = other[2 * j + 1] - other[2 * i + 1];
+        double length = hypot(ex, ey);
+        /* Edges too short for a reliable direction are left out: that only loosens the bound. */
+        if (!(length > 1e-9 * magnitude)) continue;
+        double nx = ey / length, ny = -ex / length;
+        planes[3 * k] = nx;
+        planes[3 * k + 1] = ny;
+        planes[3 * k + 2] = nx * other[2 * i] + ny * other[2 * i + 1] + margin;
+        k++;
+    }
+    return clip_halfplanes(v, n, planes, k, out, w);
+}
+
+static int compare_points(const void *a, const void *b) {
+    const Point *p = a, *q = b;
+    if (p->x != q->x) return (p->x > q->x) - (p->x < q->x);
+    return (p->y > q->y) - (p->y < q->y);
+}
+
+/* See _convex.convex_hull (Andrew's monotone chain); `pts` must not be in `out`'s buffer. */
+static int convex_hull(const double *pts, Py_ssize_t m, Poly *out, Work *w) {
+    Point *p = scratch(&w->points, m, sizeof(Point));
+    if (!p) return -1;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        p[i].x = pts[2 * i];
+        p[i].y = pts[2 * i + 1];
+    }
+    qsort(p, (size_t)m, sizeof(Point), compare_points);
+    Py_ssize_t u = 0;
+    for (Py_ssize_t i = 0; i < m; i++)
+        if (u == 0 || p[i].x != p[u - 1].x || p[i].y != p[u - 1].y) p[u++] = p[i];
+    if (reserve(out, 2 * u) < 0) return -1;
+    double *h = out->v;
+    if (u <= 2) {
+        for (Py_ssize_t i = 0; i < u; i++) {
+            h[2 * i] = p[i].x;
+            h[2 * i + 1] = p[i].y;
+        }
+        out->n = u;
+        return 0;
+    }
+    Py_ssize_t size = 0;
+    for (Py_ssize_t i = 0; i < u; i++) {
+        while (size >= 2) {
+            double ax = h[2 * size - 4], ay = h[2 * size - 3], bx = h[2 * size - 2], by = h[2 * size - 1];
+            if ((bx - ax) * (p[i].y - ay) - (by - ay) * (p[i].x - ax) > 0.0) break;
+            size--;
+        }
+        h[2 * size] = p[i].x;
+        h[2 * size + 1] = p[i].y;
+        size++;
+    }
+    /* The upper chain overwrites the lower one's last vertex, which the hull drops anyway. */
+    Py_ssize_t base = size - 1, upper = 0;
+    for (Py_ssize_t i = u; i-- > 0;) {
+        while (upper >= 2) {
+            double *a = h + 2 * (base + upper - 2), *b = h + 2 * (base + upper - 1);
+            if ((b[0] - a[0]) * (p[i].y - a[1]) - (b[1] - a[1]) * (p[i].x - a[0]) > 0.0) break;
+            upper--;
+        }
+        h[2 * (base + upper)] = p[i].x;
+        h[2 * (base + upper) + 1] = p[i].y;
+        upper++;
+    }
+    out->n = base + upper - 1;
+    return remove_collinear(out, w);
+}
+
+/* See _convex.minkowski_sum, for two operands; neither may be in `out`'s buffer. */
+static int minkowski_pair(const double *a, Py_ssize_t na, const double *b, Py_ssize_t nb, Poly *out, Work *w) {
+    Edge *edges = scratch(&w->edges, 2 * (na + nb), sizeof(Edge));
+    if (!edges || reserve(out, na + nb) < 0) return -1;
+    const double *parts[3] = {a, b, NULL};
+    Py_ssize_t sizes[3] = {na, nb, 0};
+    out->n = minkowski_sum(parts, sizes, 2, edges, out->v);
+    return 0;
+}
+
+/* Number of tangents of a sector's outer arc (see _reduce.sector_halfplanes). */
+static Py_ssize_t tangent_count(double width) {
+    double count = ceil(width / TANGENT_STEP);
+    return count > 1.0 ? (Py_ssize_t)count : 1;
+}
+
+static void add_plane(double *planes, Py_ssize_t *k, double nx, double ny, double reach, double ax, double ay,
+                      double margin) {
+    planes[3 * *k] = nx;
+    planes[3 * *k + 1] = ny;
+    planes[3 * *k + 2] = nx * ax + ny * ay + reach + margin;
+    (*k)++;
+}
+
+/* See _reduce.sector_halfplanes; `planes` holds 3 + (tangent_count(width) + 1) triples. */
+static Py_ssize_t sector_halfplanes(double ax, double ay, double lo, double width, double widen, double r_min,
+                                    double r_max, double *planes) {
+    double hi = lo + width, middle = lo + width / 2.0, margin = widen + TOLERANCE;
+    Py_ssize_t k = 0;
+    add_plane(planes, &k, sin(lo), -cos(lo), 0.0, ax, ay, margin);
+    add_plane(planes, &k, -sin(hi), cos(hi), 0.0, ax, ay, margin);
+    add_plane(planes, &k, -cos(middle), -sin(middle), -r_min * cos(width / 2.0), ax, ay, margin);
+    if (isfinite(r_max)) {
+        /* np.linspace(lo, hi, count + 1): k * step + lo, the last one exactly hi. */
+        Py_ssize_t count = tangent_count(width);
+        double step = (hi - lo) / (double)count;
+        for (Py_ssize_t j = 0; j <= count; j++) {
+            double angle = j == count ? hi : (double)j * step + lo;
+            add_plane(planes, &k, cos(angle), sin(angle), r_max, ax, ay, margin);
+        }
+    }
+    return k;
+}
+
+/* See _reduce.clip_to_sector; `v` and `out` must not be w->part or w->parts. */
+static int clip_to_sector(const double *v, Py_ssize_t n, double ax, double ay, double lo, double width,
+                          double widen, double r_min, double r_max, double piece, Poly *out, Work *w) {
+    double span = TWO_PI < width ? TWO_PI : width;
+    double pieces = ceil(span / piece);
+    Py_ssize_t count = pieces > 1.0 ? (Py_ssize_t)pieces : 1;
+    double step = span / (double)count;
+    double *planes = scratch(&w->planes, 3 * (4 + tangent_count(step)), sizeof(double));
+    if (!planes) return -1;
+    Py_ssize_t kept = 0;
+    w->parts.n = 0;
+    for (Py_ssize_t j = 0; j < count; j++) {
+        Py_ssize_t k = sector_halfplanes(ax, ay, lo + (double)j * step, step, widen, r_min, r_max, planes);
+        if (clip_halfplanes(v, n, planes, k, &w->part, w) < 0) return -1;
+        if (w->part.n == 0) continue;
+        if (reserve(&w->parts, w->parts.n + w->part.n) < 0) return -1;
+        memcpy(w->parts.v + 2 * w->parts.n, w->part.v, 2 * sizeof(double) * (size_t)w->part.n);
+        w->parts.n += w->part.n;
+        kept++;
+    }
+    if (kept == 0) {
+        out->n = 0;
+        return 0;
+    }
+    if (kept == 1) return copy_into(out, w->parts.v, w->parts.n);
+    return convex_hull(w->parts.v, w->parts.n, out, w);
+}
+
+/* See _reduce.sensor_arc: 0 when the sensor is at the reference point, 1 with the polygon
+   in `out`, -1 on error. */
+static int sensor_arc(double forward, double left, double lo, double width, Poly *out, Work *w) {
+    double radius = hypot(forward, left);
+    if (radius == 0.0) return 0;
+    lo += atan2(left, forward);
+    if (width >= TWO_PI) {
+        if (reserve(out, SENSOR_ARC_SIDES) < 0) return -1;
+        out->n = outer_disk(radius, SENSOR_ARC_SIDES, out->v);
+        return 1;
+    }
+    if (width <= 0.0) {
+        if (reserve(out, 1) < 0) return -1;
+        out->v[0] = radius * cos(lo);
+        out->v[1] = radius * sin(lo);
+        out->n = 1;
+        return 1;
+    }
+    double stop = lo + width;
+    /* outer_arc writes max(1, ceil((stop - lo) / ARC_STEP)) + 2 points. */
+    double steps = ceil((stop - lo) / ARC_STEP);
+    if (reserve(&w->arc_points, (steps > 1.0 ? (Py_ssize_t)steps : 1) + 2) < 0) return -1;
+    w->arc_points.n = outer_arc(radius, lo, stop, w->arc_points.v);
+    return convex_hull(w->arc_points.v, w->arc_points.n, out, w) < 0 ? -1 : 1;
+}
+
+/* See _arcs.nearest_on_polygon. */
+static void nearest_on_polygon(const double *v, Py_ssize_t n, double px, double py, double *distance, double *qx,
+                               double *qy) {
+    if (n == 1) {
+        *distance = hypot(px - v[0], py - v[1]);
+        *qx = v[0];
+        *qy = v[1];
+        return;
+    }
+    if (n >= 3) {
+        double lowest = HUGE_VAL, highest = -HUGE_VAL;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+            double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
+            double side = ex * (py - v[2 * i + 1]) - ey * (px - v[2 * i]);
+            lowest = lesser(lowest, side);
+            highest = greater(highest, side);
+        }
+        if (lowest >= 0.0 && highest > 0.0) {
+            *distance = 0.0;
+            *qx = px;
+            *qy = py;
+            return;
+        }
+    }
+    Py_ssize_t best = 0;
+    double best_squared = HUGE_VAL, best_t = 0.0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
+        double rx = px - v[2 * i], ry = py - v[2 * i + 1];
+        double squared = ex * ex + ey * ey;
+        double t = squared > 0.0 ? (rx * ex + ry * ey) / squared : 0.0;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+        double gx = rx - t * ex, gy = ry - t * ey;
+        double gap = gx * gx + gy * gy;
+        if (i == 0 || gap < best_squared) {
+            best = i;
+            best_squared = gap;
+            best_t = t;
+        }
+    }
+    Py_ssize_t j = best + 1 < n ? best + 1 : 0;
+    *distance = sqrt(best_squared);
+    *qx = v[2 * best] + best_t * (v[2 * j] - v[2 * best]);
+    *qy = v[2 * best + 1] + best_t * (v[2 * j + 1] - v[2 * best + 1]);
+}
+
+/* See _arcs.subtended_arc. */
+static void subtended_arc(const double *v, Py_ssize_t n, double px, double py, double radius, double *lo,
+                          double *width) {
+    double distance, qx, qy;
+    nearest_on_polygon(v, n, px, py, &distance, &qx, &qy);
+    if (distance <= radius) {
+        *lo = 0.0;
+        *width = TWO_PI;
+        return;
+    }
+    /* The polygon does not hold the point: its directions unwrap around the first one's. */
+    double reference = atan2(v[1] - py, v[0] - px);
+    double lowest = HUGE_VAL, highest = -HUGE_VAL;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double angle = atan2(v[2 * i + 1] - py, v[2 * i] - px);
+        angle = floor_mod(angle - (reference - M_PI), TWO_PI) - M_PI;
+        lowest = lesser(lowest, angle);
+        highest = greater(highest, angle);
+    }
+    double spread = radius > 0.0 ? asin(radius / distance) : 0.0;
+    double low = reference + lowest - spread, high = reference + highest + spread;
+    *lo = low;
+    *width = high - low;
+}
+
+/* See _arcs.intersect_arcs: 1 with the result in (lo, width), 0 when the arcs do not meet. */
+static int intersect_arcs(double a_lo, double a_width, double b_lo, double b_width, double *lo, double *width) {
+    if (b_width >= TWO_PI) {
+        *lo = a_lo;
+        *width = TWO_PI < a_width ? TWO_PI : a_width;
+        return 1;
+    }
+    if (a_width >= TWO_PI) {
+        *lo = b_lo;
+        *width = b_width;
+        return 1;
+    }
+    double d = floor_mod(b_lo - a_lo, TWO_PI), shifts[2] = {d, d - TWO_PI};
+    double first = HUGE_VAL, last = -HUGE_VAL;
+    int found = 0;
+    for (int k = 0; k < 2; k++) {
+        double start = shifts[k] > 0.0 ? shifts[k] : 0.0;
+        double stop = shifts[k] + b_width < a_width ? shifts[k] + b_width : a_width;
+        if (start <= stop) {
+            first = found ? lesser(first, start) : start;
+            last = found ? greater(last, stop) : stop;
+            found = 1;
+        }
+    }
+    if (!found) return 0;
+    *lo = a_lo + first;
+    *width = last - first;
+    return 1;
+}
+
+/* See _reduce.cos_range. */
+static void cos_range(double lo, double width, double *lowest, double *highest) {
+    if (width >= TWO_PI) {
+        *lowest = -1.0;
+        *highest = 1.0;
+        return;
+    }
+    double a = cos(lo), b = cos(lo + width);
+    *highest = floor_mod(-lo, TWO_PI) <= width ? 1.0 : greater(a, b);
+    *lowest = floor_mod(M_PI - lo, TWO_PI) <= width ? -1.0 : lesser(a, b);
+}
+
+/* See _convex.distance_to_boundary, for one point. */
+static double distance_to_boundary(const double *v, Py_ssize_t n, double x, double y) {
+    if (n == 1) return hypot(x - v[0], y - v[1]);
+    double best = HUGE_VAL;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
+        double rx = x - v[2 * i], ry = y - v[2 * i + 1];
+        double squared = ex * ex + ey * ey;
+        double t = squared > 0.0 ? (rx * ex + ry * ey) / squared : 0.0;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+        best = lesser(best, hypot(x - (v[2 * i] + t * ex), y - (v[2 * i + 1] + t * ey)));
+    }
+    return best;
+}
+
+/* See _convex.points_in_convex (its dense test), for one point. */
+static int point_in_convex(const double *v, Py_ssize_t n, int solid, double x, double y, double tolerance) {
+    if (!solid) return distance_to_boundary(v, n, x, y) <= tolerance;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
+        double signed_distance = (ex * (y - v[2 * i + 1]) - ey * (x - v[2 * i])) / hypot(ex, ey);
+        if (!(signed_distance >= -tolerance)) return 0;
+    }
+    return 1;
+}
+
+/* See _reduce.cap_inside; works in place. */
+static void cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssize_t max_vertices) {
+    Py_ssize_t floor_count = max_vertices > 3 ? max_vertices : 3;
+    int solid = prior_n >= 3 && polygon_area(prior, prior_n) > 0.0;
+    while (p->n > floor_count) {
+        Py_ssize_t n = p->n, best = 0;
+        double *v = p->v, best_cost = HUGE_VAL, best_x = 0.0, best_y = 0.0;
+        int any = 0;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
+            Py_ssize_t after = next + 1 < n ? next + 1 : 0;
+            double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
+            double ex = v[2 * next] - v[2 * i], ey = v[2 * next + 1] - v[2 * i + 1];
+            double fx = v[2 * after] - v[2 * next], fy = v[2 * after + 1] - v[2 * next + 1];
+            double denominator = px * fy - py * fx;
+            int removable = denominator > 1e-12 * hypot(px, py) * hypot(fx, fy);
+            double t = removable ? (ex * fy - ey * fx) / denominator : 0.0;
+            double x = v[2 * i] + t * px, y = v[2 * i + 1] + t * py;
+            removable = removable && point_in_convex(prior, prior_n, solid, x, y, TOLERANCE);
+            double cost = removable ? 0.5 * t * (px * ey - py * ex) : HUGE_VAL;
+            any |= removable;
+            /* np.argmin: the first of the cheapest. */
+            if (i == 0 || cost < best_cost) {
+                best = i;
+                best_cost = cost;
+                best_x = x;
+                best_y = y;
+            }
+        }
+        if (!any) break;
+        v[2 * best] = best_x;
+        v[2 * best + 1] = best_y;
+        Py_ssize_t gone = best + 1 < n ? best + 1 : 0;
+        memmove(v + 2 * gone, v + 2 * gone + 2, 2 * sizeof(double) * (size_t)(n - gone - 1));
+        p->n = n - 1;
+    }
+}
+
+/* The bearing-cone constraint of _reduce._cone_reduction on one polygon. */
+typedef struct {
+    double landmark_x, landmark_y, widen, cone_lo, cone_width, r_min, r_max, piece;
+} Cone;
+
+static int constrain(const Cone *cone, const double *v, Py_ssize_t n, Poly *out, Work *w) {
+    if (cone->cone_width >= TWO_PI && !isfinite(cone->r_max)) return copy_into(out, v, n);
+    return clip_to_sector(v, n, cone->landmark_x, cone->landmark_y, cone->cone_lo, cone->cone_width, cone->widen,
+                          cone->r_min, cone->r_max, cone->piece, out, w);
+}
+
+/* See _reduce._cone_reduction (with _sensor_constrained and _bearing_headings). Returns -1 on
+   error, else 0 with *reason -1 and the positions in *positions, or *reason a code. */
+static int cone_reduction(const double *prior, Py_ssize_t n, double heading_lo, double heading_width,
+                          double forward, double left, double bearing, double error, const Cone *cone, Work *w,
+                          int *reason, Poly **positions, double *arc_lo, double *arc_width) {
+    int has_arc = sensor_arc(forward, left, heading_lo, heading_width, &w->arc, w);
+    if (has_arc < 0) return -1;
+    Poly *sensors;
+    if (!has_arc) {
+        if (constrain(cone, prior, n, &w->sensors, w) < 0) return -1;
+        if (w->sensors.n == 0) {
+            *reason = NO_POSITION;
+            return 0;
+        }
+        *positions = sensors = &w->sensors;
+    } else {
+        if (minkowski_pair(prior, n, w->arc.v, w->arc.n, &w->sum, w) < 0) return -1;
+        if (constrain(cone, w->sum.v, w->sum.n, &w->sensors, w) < 0) return -1;
+        if (w->sensors.n == 0) {
+            *reason = NO_SENSOR_POSITION;
+            return 0;
+        }
+        /* p = s - R(h) o: an outer bound is the sensor region summed with the mirrored arc. */
+        if (reserve(&w->mirrored, w->arc.n) < 0) return -1;
+        for (Py_ssize_t i = 0; i < 2 * w->arc.n; i++) w->mirrored.v[i] = -w->arc.v[i];
+        w->mirrored.n = w->arc.n;
+        if (minkowski_pair(w->sensors.v, w->sensors.n, w->mirrored.v, w->mirrored.n, &w->sum, w) < 0) return -1;
+        if (clip_convex(prior, n, w->sum.v, w->sum.n, TOLERANCE, &w->positions, w) < 0) return -1;
+        if (w->positions.n == 0) {
+            *reason = NO_POSITION;
+            return 0;
+        }
+        *positions = &w->positions;
+        /* Sensors must also be reachable from the remaining positions. */
+        if (minkowski_pair(w->positions.v, w->positions.n, w->arc.v, w->arc.n, &w->sum, w) < 0) return -1;
+        if (clip_convex(w->sensors.v, w->sensors.n, w->sum.v, w->sum.n, TOLERANCE, &w->narrowed, w) < 0) return -1;
+        sensors = w->narrowed.n ? &w->narrowed : &w->sensors;
+    }
+    double seen_lo, seen_width;
+    subtended_arc(sensors->v, sensors->n, cone->landmark_x, cone->landmark_y, cone->widen, &seen_lo, &seen_width);
+    if (seen_width >= TWO_PI) {
+        seen_width = TWO_PI;
+    } else {
+        /* Directions from the sensors towards the landmark are those from it, turned by pi. */
+        double margin = error + TOLERANCE;
+        seen_lo = seen_lo + M_PI - bearing - margin;
+        seen_width = seen_width + 2.0 * margin;
+    }
+    if (!intersect_arcs(heading_lo, heading_width, seen_lo, seen_width, arc_lo, arc_width)) {
+        *reason = NO_BEARING_HEADING;
+        return 0;
+    }
+    *reason = -1;
+    return 0;
+}
+
+/* See _reduce.reduce_ground_line. */
+static int strip_reduction(const double *prior, Py_ssize_t n, double heading_lo, double heading_width,
+                           double forward, double left, double start_x, double start_y, double end_x, double end_y,
+                           double uncertainty, double offset, double offset_error, double angle, double angle_error,
+                           Poly *out, Work *w, int *reason, double *arc_lo, double *arc_width) {
+    double direction = atan2(end_y - start_y, end_x - start_x);
+    /* angle = direction - heading, so the heading is direction - angle. */
+    double margin = angle_error + TOLERANCE;
+    if (!intersect_arcs(heading_lo, heading_width, direction - angle - margin, 0.0 + 2.0 * margin, arc_lo,
+                        arc_width)) {
+        *reason = NO_LINE_HEADING;
+        return 0;
+    }
+    double nx = -sin(direction), ny = cos(direction);
+    double base = nx * start_x + ny * start_y;
+    double spread = offset_error + uncertainty;
+    double lo = base + offset - spread, hi = base + offset + spread;
+    double radius = hypot(forward, left);
+    if (radius > 0.0) {
+        /* normal . R(h) o = |o| cos(h + atan2(left, forward) - direction - pi/2). */
+        double shift = atan2(left, forward) - direction - M_PI / 2.0, lowest, highest;
+        cos_range(*arc_lo + shift, *arc_width, &lowest, &highest);
+        lo -= radius * highest;
+        hi -= radius * lowest;
+    }
+    double planes[6] = {nx, ny, hi + TOLERANCE, -nx, -ny, -lo + TOLERANCE};
+    if (clip_halfplanes(prior, n, planes, 2, out, w) < 0) return -1;
+    *reason = out->n ? -1 : NO_OFFSET_POSITION;
+    return 0;
+}
+
+/* --- argument parsing and results -------------------------------------------------- */
+
+static int parse_doubles(PyObject *const *args, Py_ssize_t count, const char *const *names, double *values) {
+    for (Py_ssize_t i = 0; i < count; i++) {
+        values[i] = PyFloat_AsDouble(args[i]);
+        if (values[i] == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_TypeError, "%s: expected a real number, got %.200s", names[i],
+                         Py_TYPE(args[i])->tp_name);
+            return -1;
+        }
+        /* Only the outer range may be unbounded (+inf: a Class I cone). */
+        int unbounded = strcmp(names[i], "range_max") == 0;
+        if (!isfinite(values[i]) && !(unbounded && values[i] == HUGE_VAL)) {
+            PyErr_Format(PyExc_ValueError, "%s: expected a finite number%s, got %R", names[i],
+                         unbounded ? " or inf" : "", args[i]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int parse_cap(PyObject *arg, Py_ssize_t *max_vertices) {
+    *max_vertices = PyNumber_AsSsize_t(arg, PyExc_OverflowError);
+    if (*max_vertices == -1 && PyErr_Occurred()) return -1;
+    if (*max_vertices < 3) {
+        PyErr_Format(PyExc_ValueError, "max_vertices: expected at least 3, got %zd", *max_vertices);
+        return -1;
+    }
+    return 0;
+}
+
+static int is_float64_format(const char *format) {
+    if (format == NULL) return 0; /* unsigned bytes */
+    if (*format == '@' || *format == '=' || (PY_LITTLE_ENDIAN && *format == '<') ||
+        (!PY_LITTLE_ENDIAN && (*format == '>' || *format == '!')))
+        format++;
+    return strcmp(format, "d") == 0;
+}
+
+/* Get the prior's vertices: a C-contiguous float64 buffer of n >= 1 (x, y) rows. */
+static int get_vertices(PyObject *object, Py_buffer *view, Py_ssize_t *n) {
+    static const char *expected = "vertices: expected a C-contiguous (n, 2) float64 buffer";
+    if (PyObject_GetBuffer(object, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0) {
+        PyErr_Clear();
+        if (PyObject_CheckBuffer(object))
+            PyErr_Format(PyExc_ValueError, "%s, got a non-contiguous %.200s", expected, Py_TYPE(object)->tp_name);
+        else
+            PyErr_Format(PyExc_TypeError, "%s, got %.200s", expected, Py_TYPE(object)->tp_name);
+        return -1;
+    }
+    const char *problem = NULL;
+    if (view->itemsize != (Py_ssize_t)sizeof(double) || !is_float64_format(view->format))
+        problem = "format";
+    else if (view->ndim > 2 || (view->ndim == 2 && view->shape[1] != 2))
+        problem = "shape";
+    else if (view->len < (Py_ssize_t)(2 * sizeof(double)) || view->len % (Py_ssize_t)(2 * sizeof(double)) != 0)
+        problem = "length";
+    if (problem == NULL) {
+        *n = view->len / (Py_ssize_t)(2 * sizeof(double));
+        return 0;
+    }
+    if (problem[0] == 'f')
+        PyErr_Format(PyExc_ValueError, "%s, got format '%s' with %zd-byte items", expected,
+                     view->format ? view->format : "B", view->itemsize);
+    else if (problem[0] == 's')
+        PyErr_Format(PyExc_ValueError, "%s, got %d dimensions with %zd in the last", expected, view->ndim,
+                     view->shape[view->ndim - 1]);
+    else
+        PyErr_Format(PyExc_ValueError, "%s, got %zd bytes", expected, view->len);
+    PyBuffer_Release(view);
+    return -1;
+}
+
+/* The tail of _reduce.reduce_map: the vertex cap, the centre update and both areas; returns
+   (vertex bytes, arc lo, arc width, centre x, centre y, area before, area after). */
+static PyObject *finish(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices,
+                        double center_x, double center_y, double arc_lo, double arc_width) {
+    if (positions->n > max_vertices) cap_inside(positions, prior, n, max_vertices);
+    double distance, x, y;
+    nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, &x, &y);
+    double values[6] = {arc_lo, arc_width, x, y, polygon_area(prior, n), polygon_area(positions->v, positions->n)};
+    PyObject *result = PyTuple_New(7);
+    if (!result) return NULL;
+    PyObject *raw = PyBytes_FromStringAndSize((const char *)positions->v,
+                                              (Py_ssize_t)(2 * sizeof(double) * (size_t)positions->n));
+    if (!raw) {
+        Py_DECREF(result);
+        return NULL;
+    }
+    PyTuple_SET_ITEM(result, 0, raw);
+    for (int k = 0; k < 6; k++) {
+        PyObject *value = PyFloat_FromDouble(values[k]);
+        if (!value) {
+            Py_DECREF(result);
+            return NULL;
+        }
+        PyTuple_SET_ITEM(result, k + 1, value);
+    }
+    return result;
+}
+
+/* Heading arc (lo, width) of a wedge: see _reduce.wedge_arc. */
+static void wedge_arc(double center, double cw, double ccw, double *lo, double *width) {
+    double sum = cw + ccw;
+    *lo = center - cw;
+    *width = TWO_PI < sum ? TWO_PI : sum;
+}
+
+static PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"center_x", "center_y",   "wedge_center", "wedge_cw", "wedge_ccw",
+                                        "forward",  "left",       "landmark_x",   "landmark_y", "widen",
+                                        "bearing",  "bearing_error", "range_min",  "range_max", "piece"};
+    enum { DOUBLES = sizeof(names) / sizeof(names[0]) };
+    double a[DOUBLES];
+    if (nargs != DOUBLES + 2) {
+        PyErr_Format(PyExc_TypeError, "reduce_cone: expected %d arguments, got %zd", DOUBLES + 2, nargs);
+        return NULL;
+    }
+    Py_ssize_t max_vertices, n;
+    if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 1], &max_vertices) < 0)
+        return NULL;
+    if (!(a[14] > 0.0)) {
+        PyErr_Format(PyExc_ValueError, "piece: expected a positive angle, got %R", args[15]);
+        return NULL;
+    }
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    const double *prior = (const double *)view.buf;
+    Work w;
+    memset(&w, 0, sizeof(w));
+    PyObject *result = NULL;
+    double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+    wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
+    /* The landmark is seen towards h + bearing, so the sensor lies from the landmark
+       towards h + bearing + pi, for some heading h of the wedge and bearing error. */
+    double margin = a[11] + TOLERANCE;
+    Cone cone = {a[7], a[8], a[9], heading_lo + a[10] + M_PI - margin, heading_width + 2.0 * margin,
+                 a[12], a[13], a[14]};
+    int reason = -1;
+    Poly *positions = NULL;
+    if (cone_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[10], a[11], &cone, &w, &reason,
+                       &positions, &arc_lo, &arc_width) < 0)
+        goto done;
+    if (reason >= 0)
+        result = PyLong_FromLong(reason);
+    else
+        result = finish(positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
+done:
+    work_free(&w);
+    PyBuffer_Release(&view);
+    return result;
+}
+
+static PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"center_x", "center_y", "wedge_center", "wedge_cw",    "wedge_ccw",
+                                        "forward",  "left",     "start_x",      "start_y",     "end_x",
+                                        "end_y",    "position_uncertainty", "offset", "offset_error", "angle",
+                                        "angle_error"};
+    enum { DOUBLES = sizeof(names) / sizeof(names[0]) };
+    double a[DOUBLES];
+    if (nargs != DOUBLES + 2) {
+        PyErr_Format(PyExc_TypeError, "reduce_strip: expected %d arguments, got %zd", DOUBLES + 2, nargs);
+        return NULL;
+    }
+    Py_ssize_t max_vertices, n;
+    if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 1], &max_vertices) < 0)
+        return NULL;
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    const double *prior = (const double *)view.buf;
+    Work w;
+    memset(&w, 0, sizeof(w));
+    PyObject *result = NULL;
+    double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+    wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
+    int reason = -1;
+    if (strip_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[7], a[8], a[9], a[10], a[11], a[12],
+                        a[13], a[14], a[15], &w.positions, &w, &reason, &arc_lo, &arc_width) < 0)
+        goto done;
+    if (reason >= 0)
+        result = PyLong_FromLong(reason);
+    else
+        result = finish(&w.positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
+done:
+    work_free(&w);
+    PyBuffer_Release(&view);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"grow_polygon", grow_polygon, METH_VARARGS,
      "grow_polygon(vertices, heading_lo, heading_hi, turn_min, turn_max, drift_max, chord_min, run_max, "
      "skitter_radius, max_vertices) -> bytes of (m, 2) float64 vertices"},
+    {"reduce_cone", (PyCFunction)(void (*)(void))reduce_cone, METH_FASTCALL,
+     "reduce_cone(vertices, center_x, center_y, wedge_center, wedge_cw, wedge_ccw, forward, left, landmark_x, "
+     "landmark_y, widen, bearing, bearing_error, range_min, range_max, piece, max_vertices) -> (vertex bytes, "
+     "arc_lo, arc_width, center_x, center_y, area_before, area_after), or an int reason code"},
+    {"reduce_strip", (PyCFunction)(void (*)(void))reduce_strip, METH_FASTCALL,
+     "reduce_strip(vertices, center_x, center_y, wedge_center, wedge_cw, wedge_ccw, forward, left, start_x, "
+     "start_y, end_x, end_y, position_uncertainty, offset, offset_error, angle, angle_error, max_vertices) -> "
+     "(vertex bytes, arc_lo, arc_width, center_x, center_y, area_before, area_after), or an int reason code"},
     {NULL, NULL, 0, NULL},
 };
 
-static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels",
-                                    "Compiled kernel of the growth step (see _convex.py for the reference).", -1,
-                                    methods};
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_kernels",
+    "Compiled kernels of the growth step and the landmark reductions (see _convex.py and _reduce.py for the "
+    "reference implementations).",
+    -1, methods, NULL, NULL, NULL, NULL};
 
 PyMODINIT_FUNC PyInit__kernels(void) { return PyModule_Create(&module); }

@@ -9,6 +9,10 @@ The sensor sits at ``p + R(h) o`` for a robot at ``p`` with heading ``h`` and a
 sensor offset ``o = (forward, left)``. With ``o != 0`` the Class I and II
 reductions first bound the sensor positions, constrain them, and map them back
 to robot positions through the arc ``R(W) o`` (replaced by an outer polygon).
+
+When the C extension ``aura_ums.geometry._kernels`` was built, :func:`reduce_map` runs
+each reduction's geometry in one compiled call that mirrors these functions operation
+for operation; the numpy functions here stay the reference and the fallback.
 """
 
 from __future__ import annotations
@@ -48,6 +52,27 @@ if TYPE_CHECKING:
     from aura_ums.uncertainty._map import SpatialUncertaintyMap
 
 Array = NDArray[np.float64]
+
+#: What a compiled reduction returns: (vertex bytes, arc lo, arc width, centre x, centre y,
+#: area before, area after), or the index in ``_REASONS`` of why it is empty.
+_KernelResult = tuple[bytes, float, float, float, float, float, float] | int
+_Kernel = Callable[..., _KernelResult]
+
+_compiled_reduce_cone: _Kernel | None
+_compiled_reduce_strip: _Kernel | None
+try:  # the compiled kernels, when the build had a C compiler
+    from aura_ums.geometry._kernels import reduce_cone as _compiled_reduce_cone
+    from aura_ums.geometry._kernels import reduce_strip as _compiled_reduce_strip
+except ImportError:  # pragma: no cover - exercised on machines without a compiler
+    _compiled_reduce_cone = _compiled_reduce_strip = None
+
+
+def compiled_kernels() -> tuple[_Kernel, _Kernel] | None:
+    """Return the compiled (cone, strip) reduction kernels, or None when the extension was not built."""
+    if _compiled_reduce_cone is None or _compiled_reduce_strip is None:
+        return None
+    return (_compiled_reduce_cone, _compiled_reduce_strip)
+
 
 #: Outward margin (m for positions, rad for angles) added to every bound of a reduction.
 TOLERANCE = 1e-9
@@ -130,7 +155,8 @@ def arc_wedge(arc: Arc, center: float) -> HeadingWedge:
     if offset > width:
         # Outside: clamp to whichever end is the shorter way round.
         offset = width if offset - width < TWO_PI - offset else 0.0
-    return HeadingWedge(lo + offset, offset, width - offset)
+    # 0 <= offset <= width, both finite: the checks of HeadingWedge() would all pass.
+    return HeadingWedge._trusted(lo + offset, offset, width - offset)
 
 
 def cos_range(arc: Arc) -> tuple[float, float]:
@@ -467,10 +493,112 @@ def check_pair(observation: object, landmark: object) -> None:
         raise InputError(f"landmark.id: expected {observed_id!r} (the observation's), got {landmark_id!r}")
 
 
+#: Why a compiled reduction is empty, by the code the kernel returns.
+_REASONS = (
+    "no position of the map is consistent with the observation",
+    "no sensor position of the map is consistent with the observation",
+    "no heading of the map is consistent with the observed bearing",
+    "no heading of the map is consistent with the observed line angle",
+    "no position of the map is at the observed offset from the line",
+)
+
+
 def reduce_map(
     prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
 ) -> Reduction:
     """Reduce a map by one observation of a landmark; see :meth:`SpatialUncertaintyMap.reduce`."""
+    check_pair(observation, landmark)
+    if max_vertices < 3:
+        raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
+    if _compiled_reduce_cone is not None and _compiled_reduce_strip is not None:
+        return _reduce_map_compiled(
+            _compiled_reduce_cone, _compiled_reduce_strip, prior, observation, landmark, max_vertices
+        )
+    return reduce_map_reference(prior, observation, landmark, max_vertices)
+
+
+def _reduce_map_compiled(
+    reduce_cone: _Kernel,
+    reduce_strip: _Kernel,
+    prior: SpatialUncertaintyMap,
+    observation: Observation,
+    landmark: Landmark,
+    max_vertices: int,
+) -> Reduction:
+    """:func:`reduce_map` with the geometry in one call of a compiled kernel (arguments checked)."""
+    vertices = np.ascontiguousarray(prior.polygon.vertices, dtype=np.float64)
+    wedge = prior.wedge
+    center_x, center_y = prior.center.tolist()
+    forward, left = observation.sensor_offset
+    found: _KernelResult
+    if isinstance(observation, GroundLineObservation) and isinstance(landmark, GroundLineLandmark):
+        start_x, start_y = landmark.start.tolist()
+        end_x, end_y = landmark.end.tolist()
+        found = reduce_strip(
+            vertices,
+            center_x,
+            center_y,
+            wedge.center,
+            wedge.cw,
+            wedge.ccw,
+            forward,
+            left,
+            start_x,
+            start_y,
+            end_x,
+            end_y,
+            landmark.position_uncertainty,
+            observation.offset,
+            observation.offset_error,
+            observation.angle,
+            observation.angle_error,
+            max_vertices,
+        )
+    elif isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
+        landmark, (VerticalLineLandmark, PointLandmark)
+    ):
+        if isinstance(observation, RangeBearingObservation):
+            r_min, r_max, piece = observation.range_min, observation.range_max, _SECTOR_PIECE
+        else:
+            r_min, r_max, piece = 0.0, math.inf, _CONE_PIECE
+        found = reduce_cone(
+            vertices,
+            center_x,
+            center_y,
+            wedge.center,
+            wedge.cw,
+            wedge.ccw,
+            forward,
+            left,
+            landmark.x,
+            landmark.y,
+            landmark.position_uncertainty,
+            observation.bearing,
+            observation.bearing_error,
+            r_min,
+            r_max,
+            piece,
+            max_vertices,
+        )
+    else:  # pragma: no cover - check_pair refused every other pairing
+        raise InputError(f"observation: expected a known pairing, got {type(observation).__name__}")
+    if isinstance(found, int):
+        area = prior.polygon.area
+        return Reduction(prior, False, area, area, wedge, wedge, _REASONS[found])
+    raw, lo, width, x, y, area_before, area_after = found
+    # Bytes are immutable, so the array is read-only as map values must be.
+    reduced_vertices = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
+    reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
+    reduced = type(prior)._trusted(
+        type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
+    )
+    return Reduction(reduced, True, area_before, area_after, wedge, reduced_wedge)
+
+
+def reduce_map_reference(
+    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+) -> Reduction:
+    """Pure-numpy :func:`reduce_map`: the reference the compiled kernels are tested against."""
     check_pair(observation, landmark)
     if max_vertices < 3:
         raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
