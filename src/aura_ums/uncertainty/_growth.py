@@ -149,8 +149,9 @@ def grow_polygon(
         The polygon ``P + skitter disk + hull(run endpoints)``, counter-clockwise.
     """
     if _compiled_grow_polygon is not None:
+        # Polygons hold C-contiguous float64 arrays already; converting costs a call.
         grown = _compiled_grow_polygon(
-            np.ascontiguousarray(vertices, dtype=np.float64),
+            vertices if vertices.flags.c_contiguous else np.ascontiguousarray(vertices, dtype=np.float64),
             heading_lo,
             heading_hi,
             bounds.turn_min,
