@@ -37,8 +37,12 @@ pytest: $(VENV)/.stamp-dev
 
 test: lint typecheck pytest
 
+# Speed against named baselines, measured in the same run (prints tables; asserts nothing).
 bench: $(VENV)/.stamp-dev
 	$(BIN)/python benchmarks/bench_growth.py
+	$(BIN)/python benchmarks/bench_reduce.py
+	$(BIN)/python benchmarks/bench_expecter.py
+	$(BIN)/python benchmarks/bench_perception.py
 
 clean:
 	rm -rf $(VENV) $(REPORT) build dist src/*.egg-info
