@@ -11,11 +11,14 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-$(VENV)/.stamp-install: pyproject.toml | $(BIN)/python
+# The install also compiles the C kernels: rebuild when their source changes.
+BUILD_INPUTS := pyproject.toml setup.py $(wildcard src/aura_ums/geometry/*.c)
+
+$(VENV)/.stamp-install: $(BUILD_INPUTS) | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e .
 	@touch $@
 
-$(VENV)/.stamp-dev: pyproject.toml | $(BIN)/python
+$(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[dev,opencv]"
 	@touch $@ $(VENV)/.stamp-install
 
@@ -26,8 +29,8 @@ figures: $(VENV)/.stamp-install
 	$(BIN)/aura-ums figures --out $(REPORT)/figures
 
 lint: $(VENV)/.stamp-dev
-	$(BIN)/ruff check src tests benchmarks
-	$(BIN)/ruff format --check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks setup.py
+	$(BIN)/ruff format --check src tests benchmarks setup.py
 
 typecheck: $(VENV)/.stamp-dev
 	$(BIN)/mypy
