@@ -1,0 +1,259 @@
+"""JSON encoding and strict decoding of the manager's state: maps, commands, observations.
+
+Floats are written by :func:`json.dumps`, which uses ``repr``: the shortest text that
+reads back as the very same double, so what is saved is restored bit for bit. Decoding
+refuses what it does not expect (a missing or unknown key, a wrong type, a non-finite
+number) with a :class:`~aura_ums.errors.FileFormatError` naming the source, the place
+(``"map.vertices[3]"``) and what was expected. No pickle, no eval.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any, NoReturn
+
+import numpy as np
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.uncertainty import (
+    BearingObservation,
+    GroundLineObservation,
+    Observation,
+    RangeBearingObservation,
+    SpatialUncertaintyMap,
+    TurnAndRun,
+)
+
+#: Version of the JSON documents written here; bump it when their layout changes.
+FORMAT_VERSION = 1
+
+_OBSERVATION_CLASSES: dict[str, type[Observation]] = {
+    cls.__name__: cls for cls in (BearingObservation, RangeBearingObservation, GroundLineObservation)
+}
+
+
+def dump_document(kind: str, body: Mapping[str, object]) -> str:
+    """Return a JSON document of ``kind`` holding ``body`` (floats written with ``repr``)."""
+    return json.dumps({"format": kind, "version": FORMAT_VERSION, **body}, indent=1, allow_nan=False)
+
+
+class Reader:
+    """Strict readers of decoded JSON values that fail naming ``source`` and the place.
+
+    Parameters
+    ----------
+    source : str
+        What is being read (a file name, or a description such as ``"<manager JSON>"``).
+    """
+
+    __slots__ = ("source",)
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, where: str, message: str) -> NoReturn:
+        """Raise the :class:`FileFormatError` for ``where``."""
+        raise FileFormatError(self.source, where, message)
+
+    def document(self, text: object, kind: str) -> dict[str, Any]:
+        """Parse ``text`` and check that it is a ``kind`` document of a known version."""
+        if not isinstance(text, str):
+            self.fail("", f"expected JSON text (str), got {type(text).__name__}")
+
+        def refuse_constant(name: str) -> NoReturn:
+            self.fail("", f"expected finite numbers, got {name}")
+
+        try:
+            data = json.loads(text, parse_constant=refuse_constant)
+        except json.JSONDecodeError as exc:
+            self.fail(f"line {exc.lineno} column {exc.colno}", f"expected valid JSON, got {exc.msg}")
+        top = self.mapping(data, "")
+        found = top.get("format")
+        if found != kind:
+            self.fail("format", f"expected {kind!r}, got {found!r}")
+        version = top.get("version")
+        if version != FORMAT_VERSION:
+            self.fail("version", f"expected {FORMAT_VERSION}, got {version!r}")
+        return top
+
+    def mapping(
+        self, value: object, where: str, keys: Iterable[str] = (), optional: Iterable[str] = ()
+    ) -> dict[str, Any]:
+        """Return ``value`` as a JSON object; with ``keys``, exactly those (plus ``optional``)."""
+        if not isinstance(value, dict):
+            self.fail(where, f"expected an object, got {_kind(value)}")
+        required = list(keys)
+        if required:
+            allowed = {*required, *optional}
+            for key in required:
+                if key not in value:
+                    self.fail(where, f"expected a key {key!r}, got none")
+            for key in value:
+                if key not in allowed:
+                    self.fail(where, f"expected only the keys {sorted(allowed)}, got {key!r}")
+        return value
+
+    def array(self, value: object, where: str) -> list[Any]:
+        """Return ``value`` as a JSON array."""
+        if not isinstance(value, list):
+            self.fail(where, f"expected an array, got {_kind(value)}")
+        return value
+
+    def number(self, value: object, where: str) -> float:
+        """Return ``value`` as a finite float (a JSON number, not a boolean)."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(where, f"expected a number, got {_kind(value)}")
+        result = float(value)
+        if not math.isfinite(result):
+            self.fail(where, f"expected a finite number, got {result!r}")
+        return result
+
+    def optional_number(self, value: object, where: str) -> float | None:
+        """Return ``value`` as a finite float, or None for JSON ``null``."""
+        return None if value is None else self.number(value, where)
+
+    def integer(self, value: object, where: str, minimum: int = 0) -> int:
+        """Return ``value`` as an integer >= ``minimum``."""
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(where, f"expected an integer, got {_kind(value)}")
+        if value < minimum:
+            self.fail(where, f"expected an integer >= {minimum}, got {value}")
+        return value
+
+    def string(self, value: object, where: str) -> str:
+        """Return ``value`` as a string."""
+        if not isinstance(value, str):
+            self.fail(where, f"expected a string, got {_kind(value)}")
+        return value
+
+    # --- values of aura-ums ------------------------------------------------------------
+
+    def command(self, value: object, where: str) -> TurnAndRun:
+        """Decode a :class:`TurnAndRun` written by :func:`encode_command`."""
+        data = self.mapping(value, where, ("turn", "run"))
+        turn = self.number(data["turn"], f"{where}.turn")
+        run = self.number(data["run"], f"{where}.run")
+        try:
+            return TurnAndRun(turn, run)
+        except InputError as exc:
+            self.fail(where, str(exc))
+
+    def observation(self, value: object, where: str) -> Observation:
+        """Decode an observation written by :func:`encode_observation` (its class is named)."""
+        data = self.mapping(value, where)
+        name = data.get("class")
+        cls = _OBSERVATION_CLASSES.get(name) if isinstance(name, str) else None
+        if cls is None:
+            self.fail(f"{where}.class", f"expected one of {sorted(_OBSERVATION_CLASSES)}, got {name!r}")
+        names = [field.name for field in dataclasses.fields(cls)]
+        self.mapping(data, where, ["class", *names])
+        kwargs: dict[str, object] = {}
+        for field_name in names:
+            item, place = data[field_name], f"{where}.{field_name}"
+            if field_name == "landmark_id":
+                kwargs[field_name] = self.string(item, place)
+            elif field_name == "sensor_offset":
+                pair = self.array(item, place)
+                if len(pair) != 2:
+                    self.fail(place, f"expected [forward, left], got {len(pair)} numbers")
+                kwargs[field_name] = (
+                    self.number(pair[0], f"{place}[0]"),
+                    self.number(pair[1], f"{place}[1]"),
+                )
+            else:
+                kwargs[field_name] = self.number(item, place)
+        try:
+            return cls(**kwargs)  # type: ignore[arg-type]
+        except InputError as exc:
+            self.fail(where, str(exc))
+
+    def uncertainty_map(self, value: object, where: str) -> SpatialUncertaintyMap:
+        """Decode a map written by :func:`encode_map`, bit for bit.
+
+        The values are validated by the public constructors; the exact saved numbers are
+        then kept even where a constructor would normalize them (re-wrapping a wedge
+        centre that is already in (-pi, pi] can move it by one unit in the last place).
+        """
+        data = self.mapping(value, where, ("vertices", "center", "wedge"))
+        rows = self.array(data["vertices"], f"{where}.vertices")
+        if not rows:
+            self.fail(f"{where}.vertices", "expected at least one vertex, got none")
+        points: list[tuple[float, float]] = []
+        for k, row in enumerate(rows):
+            place = f"{where}.vertices[{k}]"
+            pair = self.array(row, place)
+            if len(pair) != 2:
+                self.fail(place, f"expected [x, y], got {len(pair)} numbers")
+            points.append((self.number(pair[0], f"{place}[0]"), self.number(pair[1], f"{place}[1]")))
+        vertices = np.array(points, dtype=np.float64)
+        try:
+            polygon = ConvexPolygon(vertices)
+        except InputError as exc:
+            self.fail(f"{where}.vertices", str(exc))
+        if not np.array_equal(polygon.vertices, vertices):
+            exact = vertices.copy()
+            exact.setflags(write=False)
+            object.__setattr__(polygon, "vertices", exact)
+        center_list = self.array(data["center"], f"{where}.center")
+        if len(center_list) != 2:
+            self.fail(f"{where}.center", f"expected [x, y], got {len(center_list)} numbers")
+        center = (
+            self.number(center_list[0], f"{where}.center[0]"),
+            self.number(center_list[1], f"{where}.center[1]"),
+        )
+        wedge_data = self.mapping(data["wedge"], f"{where}.wedge", ("center", "cw", "ccw"))
+        heading = self.number(wedge_data["center"], f"{where}.wedge.center")
+        if not -math.pi < heading <= math.pi:
+            self.fail(f"{where}.wedge.center", f"expected a heading in (-pi, pi], got {heading!r}")
+        try:
+            wedge = HeadingWedge(
+                heading,
+                self.number(wedge_data["cw"], f"{where}.wedge.cw"),
+                self.number(wedge_data["ccw"], f"{where}.wedge.ccw"),
+            )
+        except InputError as exc:
+            self.fail(f"{where}.wedge", str(exc))
+        if wedge.center != heading:
+            object.__setattr__(wedge, "center", heading)
+        try:
+            return SpatialUncertaintyMap.from_polygon(polygon, center, wedge)
+        except InputError as exc:
+            self.fail(f"{where}.center", str(exc))
+
+
+def encode_command(command: TurnAndRun) -> dict[str, float]:
+    """Return a :class:`TurnAndRun` as a JSON object."""
+    return {"turn": command.turn, "run": command.run}
+
+
+def encode_observation(observation: Observation) -> dict[str, object]:
+    """Return an observation as a JSON object naming its class."""
+    data: dict[str, object] = {"class": type(observation).__name__}
+    for field in dataclasses.fields(observation):
+        value = getattr(observation, field.name)
+        data[field.name] = list(value) if field.name == "sensor_offset" else value
+    return data
+
+
+def encode_map(uncertainty_map: SpatialUncertaintyMap) -> dict[str, object]:
+    """Return a map as a JSON object: vertices, centre and wedge, every float exact."""
+    wedge = uncertainty_map.wedge
+    return {
+        "vertices": uncertainty_map.polygon.vertices.tolist(),
+        "center": uncertainty_map.center.tolist(),
+        "wedge": {"center": wedge.center, "cw": wedge.cw, "ccw": wedge.ccw},
+    }
+
+
+def _kind(value: object) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, (dict, list)):
+        return "an object" if isinstance(value, dict) else "an array"
+    return f"{type(value).__name__} {value!r}"

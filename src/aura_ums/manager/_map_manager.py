@@ -1,0 +1,602 @@
+"""The uncertainty map manager: the one writer of the spatial uncertainty map, and lost detection."""
+
+from __future__ import annotations
+
+import enum
+import types
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from aura_ums._validate import finite_float
+from aura_ums.errors import InputError, UnknownTerrainError
+from aura_ums.manager._blackboard import Blackboard, PositionReport
+from aura_ums.manager._codec import Reader, dump_document, encode_map
+from aura_ums.uncertainty import Observation, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+from aura_ums.world import RUN_TOLERANCE, MeadowMap, grow_through
+
+_KIND = "aura-ums/uncertainty-map-manager"
+
+#: Rejection reason: the observation is older than the map (the map was grown past its time).
+REJECT_STALE = "observation older than the map's time"
+#: Rejection reason: the meadow map has no landmark with the observation's id.
+REJECT_UNKNOWN_LANDMARK = "unknown landmark id"
+#: Rejection reason: the observation is not of the class of the landmark it names.
+REJECT_CLASS_MISMATCH = "observation class differs from the landmark's"
+
+
+class ManagerState(enum.Enum):
+    """Whether the robot knows where it is (:attr:`NOMINAL`) or has declared itself lost."""
+
+    #: Landmarks are being found and the map is small enough to be useful.
+    NOMINAL = "nominal"
+    #: The map grew too large, or predicted landmarks were missed too often: stop and look.
+    LOST = "lost"
+
+
+@dataclass(frozen=True, slots=True)
+class ObservationOutcome:
+    """What the manager did with one identified observation.
+
+    Attributes
+    ----------
+    observation : BearingObservation or RangeBearingObservation or GroundLineObservation
+        The observation taken from the identified landmark buffer.
+    accepted : bool
+        True when the map was reduced by it (a consistent reduction).
+    reason : str
+        Why it was rejected (a reduction's reason, or one of :data:`REJECT_STALE`,
+        :data:`REJECT_UNKNOWN_LANDMARK`, :data:`REJECT_CLASS_MISMATCH`); ``""`` when accepted.
+    area_before, area_after : float
+        Area of the map's polygon before and after, square metres (equal when rejected).
+    wedge_width_before, wedge_width_after : float
+        Width of the heading wedge before and after, radians (equal when rejected).
+    """
+
+    observation: Observation
+    accepted: bool
+    reason: str
+    area_before: float
+    area_after: float
+    wedge_width_before: float
+    wedge_width_after: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ManagerStep:
+    """The outcome of one :meth:`UncertaintyMapManager.update`.
+
+    Attributes
+    ----------
+    time : float
+        The ``now`` the update ran to, seconds.
+    map : SpatialUncertaintyMap
+        The map after the update (a snapshot: the manager never changes it in place).
+    state : ManagerState
+        The state after the update.
+    lost_reason : str
+        Why the robot is lost (``""`` when :attr:`ManagerState.NOMINAL`).
+    outcomes : tuple of ObservationOutcome
+        Every observation taken from the buffer, in time order.
+    grown_reports : int
+        Number of position reports the map was grown by in this update.
+    """
+
+    time: float
+    map: SpatialUncertaintyMap
+    state: ManagerState
+    lost_reason: str
+    outcomes: tuple[ObservationOutcome, ...]
+    grown_reports: int
+
+    @property
+    def accepted(self) -> tuple[ObservationOutcome, ...]:
+        """The outcomes of the observations that reduced the map."""
+        return tuple(o for o in self.outcomes if o.accepted)
+
+    @property
+    def rejected(self) -> tuple[ObservationOutcome, ...]:
+        """The outcomes of the observations that were rejected, with their reasons."""
+        return tuple(o for o in self.outcomes if not o.accepted)
+
+
+class UncertaintyMapManager:
+    """The uncertainty map manager: the only writer of the robot's spatial uncertainty map.
+
+    Each :meth:`update` takes the identified observations up to ``now`` from the
+    blackboard's buffer, in time order. Before each, it grows the map by the position
+    reports up to the observation's time stamp; then it reduces the map by the
+    observation, using the landmark's geometry from the meadow map. Finally it grows the
+    map by the remaining reports up to ``now``. Every report is grown by exactly once
+    (the manager keeps the index of the last report it consumed), with
+    :func:`~aura_ums.world.grow_through`: the run is split, from the map's most probable
+    pose, where it crosses meadows, and each piece grows with its meadow's terrain.
+
+    A report covers the motion since the previous one; an observation between two reports
+    is applied to the map grown to the earlier one, so reports should be at least as
+    frequent as camera frames (post one per frame). A run shorter than
+    :data:`~aura_ums.world.RUN_TOLERANCE` grows whole on the terrain of the meadow the
+    most probable pose is in (:func:`~aura_ums.world.split_run` cannot cut it).
+
+    Rejections (the map is kept and the reason counted): an observation older than the
+    map's time (the map was grown past it), an unknown landmark id, an observation of
+    another class than its landmark, and an inconsistent reduction (no pose of the map
+    agrees with it: most likely a misidentified landmark) -- never an emptied map.
+
+    Lost detection (the paper: "if no landmarks are recognized even though several have
+    been predicted, the robot would declare itself lost, stop, and then start searching
+    larger windows"): after an update the state is :attr:`ManagerState.LOST` when the
+    map's area exceeds ``area_limit``, or when ``missed_in_a_row`` (the schema manager's
+    :attr:`~aura_ums.schemas.SchemaManager.consecutive_missed`) reaches ``missed_limit`` and
+    no landmark was found in this update. LOST persists until a landmark is found again (a
+    consistent reduction), provided the map is then within ``area_limit``. While LOST,
+    :attr:`should_stop_and_look` is True (the simulator or vehicle stops and searches) and
+    :attr:`window_scale` is ``lost_window_scale`` (the caller widens the Expecter's image
+    windows by it about their centres); otherwise they are False and 1.0.
+
+    Parameters
+    ----------
+    initial_map : SpatialUncertaintyMap
+        Where the robot starts (bootstrapped or known from a previous leg).
+    meadow_map : MeadowMap
+        Long-term memory: the meadows' terrains and the landmarks' geometry.
+    table : TerrainTable
+        Statistics of the meadows' terrains.
+    sigmas : float
+        Standard deviations bounded by the growth, > 0.
+    area_limit : float or None
+        Map area (m^2, > 0) above which the robot is lost; None for no limit.
+    missed_limit : int
+        Frames in a row with predicted landmarks and none found that make the robot lost, >= 1.
+    lost_window_scale : float
+        :attr:`window_scale` while lost, >= 1.
+
+    Raises
+    ------
+    InputError
+        For an argument of the wrong type or out of range.
+
+    Examples
+    --------
+    >>> import math
+    >>> from aura_ums.uncertainty import BearingObservation, Pose, TerrainTable, TurnAndRun
+    >>> from aura_ums.world import make_grid_world
+    >>> world = make_grid_world(2, 3)                 # poles at (0, 0), (10, 0), (0, 10), (10, 10)
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.2, 0.05)
+    >>> manager = UncertaintyMapManager(start, world, TerrainTable.default(), area_limit=50.0)
+    >>> board = Blackboard()
+    >>> board.post_report(PositionReport(1.0, TurnAndRun(0.0, 2.0)))
+    >>> board.identified.post(BearingObservation("pole_0_2", 1.0, math.atan2(-2.5, 5.5), 0.01))
+    >>> board.identified.post(BearingObservation("pole_9_9", 1.0, 0.0, 0.01))     # not in the map
+    >>> step = manager.update(board, now=1.0)
+    >>> len(step.accepted), step.rejected[0].reason, step.state.value
+    (1, 'unknown landmark id', 'nominal')
+    >>> seen = step.accepted[0]                       # a small map: the heading narrows
+    >>> seen.wedge_width_after < seen.wedge_width_before, seen.area_after <= seen.area_before
+    (True, True)
+    >>> manager.update(board, now=2.0, missed_in_a_row=3).state    # predicted, not found: lost
+    <ManagerState.LOST: 'lost'>
+    >>> manager.should_stop_and_look, manager.window_scale
+    (True, 2.0)
+    """
+
+    __slots__ = (
+        "_accepted",
+        "_area_limit",
+        "_consumed",
+        "_grown",
+        "_lost_reason",
+        "_lost_window_scale",
+        "_map",
+        "_map_time",
+        "_meadow_map",
+        "_missed_limit",
+        "_rejected",
+        "_sigmas",
+        "_state",
+        "_table",
+    )
+
+    def __init__(
+        self,
+        initial_map: SpatialUncertaintyMap,
+        meadow_map: MeadowMap,
+        table: TerrainTable,
+        *,
+        sigmas: float = 3.0,
+        area_limit: float | None = None,
+        missed_limit: int = 3,
+        lost_window_scale: float = 2.0,
+    ) -> None:
+        if not isinstance(initial_map, SpatialUncertaintyMap):
+            raise InputError(
+                f"initial_map: expected a SpatialUncertaintyMap, got {type(initial_map).__name__}"
+            )
+        if not isinstance(meadow_map, MeadowMap):
+            raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+        if not isinstance(table, TerrainTable):
+            raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
+        self._meadow_map = meadow_map
+        self._table = table
+        self._sigmas = _positive(sigmas, "sigmas")
+        self._area_limit = None if area_limit is None else _positive(area_limit, "area_limit")
+        if isinstance(missed_limit, bool) or not isinstance(missed_limit, int) or missed_limit < 1:
+            raise InputError(f"missed_limit: expected an integer >= 1, got {missed_limit!r}")
+        self._missed_limit = missed_limit
+        scale = finite_float(lost_window_scale, "lost_window_scale")
+        if scale < 1.0:
+            raise InputError(f"lost_window_scale: expected a number >= 1, got {scale!r}")
+        self._lost_window_scale = scale
+        self._map = initial_map
+        self._map_time: float | None = None
+        self._consumed = 0
+        self._state = ManagerState.NOMINAL
+        self._lost_reason = ""
+        self._accepted = 0
+        self._rejected: dict[str, int] = {}
+        self._grown = 0
+
+    # --- what others read --------------------------------------------------------------
+
+    @property
+    def map(self) -> SpatialUncertaintyMap:
+        """The current map: an immutable snapshot, safe to hand to the Expecter and pilot."""
+        return self._map
+
+    @property
+    def state(self) -> ManagerState:
+        """NOMINAL, or LOST (see the class notes)."""
+        return self._state
+
+    @property
+    def lost_reason(self) -> str:
+        """Why the robot is lost; ``""`` when NOMINAL."""
+        return self._lost_reason
+
+    @property
+    def should_stop_and_look(self) -> bool:
+        """True while LOST: the robot should stop and search (wider windows, rotating if need be)."""
+        return self._state is ManagerState.LOST
+
+    @property
+    def window_scale(self) -> float:
+        """Factor by which to widen the Expecter's windows: ``lost_window_scale`` while LOST, else 1."""
+        return self._lost_window_scale if self._state is ManagerState.LOST else 1.0
+
+    @property
+    def map_time(self) -> float | None:
+        """Time of the last position report grown into the map, seconds; None before any."""
+        return self._map_time
+
+    @property
+    def consumed_reports(self) -> int:
+        """Number of the blackboard's position reports consumed (index of the next one)."""
+        return self._consumed
+
+    @property
+    def accepted_count(self) -> int:
+        """Observations that reduced the map, since construction."""
+        return self._accepted
+
+    @property
+    def rejected_counts(self) -> Mapping[str, int]:
+        """Observations rejected since construction, by reason (a read-only copy)."""
+        return types.MappingProxyType(dict(self._rejected))
+
+    @property
+    def rejected_count(self) -> int:
+        """Observations rejected since construction, all reasons together."""
+        return sum(self._rejected.values())
+
+    @property
+    def grown_reports(self) -> int:
+        """Position reports grown into the map since construction."""
+        return self._grown
+
+    @property
+    def sigmas(self) -> float:
+        """Standard deviations bounded by the growth."""
+        return self._sigmas
+
+    @property
+    def area_limit(self) -> float | None:
+        """Map area (m^2) above which the robot is lost; None for no limit."""
+        return self._area_limit
+
+    @property
+    def missed_limit(self) -> int:
+        """Missed frames in a row that make the robot lost."""
+        return self._missed_limit
+
+    # --- the update --------------------------------------------------------------------
+
+    def update(self, blackboard: Blackboard, *, now: float, missed_in_a_row: int = 0) -> ManagerStep:
+        """Bring the map up to ``now``: grow to each observation, reduce by it, grow to ``now``.
+
+        The identified observations with ``time <= now`` are drained from
+        ``blackboard.identified``; the position reports with ``time <= now`` not yet
+        consumed are grown into the map. The update is all or nothing: when it raises,
+        neither the manager nor the blackboard has changed.
+
+        Parameters
+        ----------
+        blackboard : Blackboard
+            Where the position reports and identified observations are (always the same one).
+        now : float
+            The time to bring the map to, seconds.
+        missed_in_a_row : int
+            The schema manager's count of frames in a row in which landmarks were
+            predicted and none found, >= 0.
+
+        Returns
+        -------
+        ManagerStep
+            The new map, state and what became of each observation.
+
+        Raises
+        ------
+        InputError
+            For a bad argument; for a blackboard that is not the one this manager has been
+            reading (fewer reports than consumed, or a different last consumed report); when
+            a run meets no meadow of the meadow map (from :func:`~aura_ums.world.grow_through`).
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import Pose, TerrainTable, TurnAndRun
+        >>> from aura_ums.world import make_grid_world
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+        >>> manager = UncertaintyMapManager(start, make_grid_world(1, 3), TerrainTable.default())
+        >>> board = Blackboard()
+        >>> manager.update(board, now=1.0).map is start      # nothing reported: nothing changes
+        True
+        >>> board.post_report(PositionReport(2.0, TurnAndRun(0.0, 8.0)))   # crosses two meadows
+        >>> step = manager.update(board, now=2.0)
+        >>> step.grown_reports, manager.consumed_reports, step.map.area > start.area
+        (1, 1, True)
+        """
+        if not isinstance(blackboard, Blackboard):
+            raise InputError(f"blackboard: expected a Blackboard, got {type(blackboard).__name__}")
+        time = finite_float(now, "now")
+        if isinstance(missed_in_a_row, bool) or not isinstance(missed_in_a_row, int) or missed_in_a_row < 0:
+            raise InputError(f"missed_in_a_row: expected a non-negative integer, got {missed_in_a_row!r}")
+        self._check_blackboard(blackboard)
+
+        current, index, map_time = self._map, self._consumed, self._map_time
+        outcomes: list[ObservationOutcome] = []
+        grown = 0
+        pending = blackboard.identified.peek(until=time)
+        for observation in pending:
+            reports = blackboard.reports_until(observation.time, start=index)
+            current, map_time = self._grow(current, reports, map_time)
+            index += len(reports)
+            grown += len(reports)
+            outcome, current = self._reduce(current, observation, map_time)
+            outcomes.append(outcome)
+        reports = blackboard.reports_until(time, start=index)
+        current, map_time = self._grow(current, reports, map_time)
+        index += len(reports)
+        grown += len(reports)
+
+        # Commit: nothing above changed the manager or the blackboard.
+        blackboard.identified.drain(until=time)  # exactly ``pending``: single-threaded by contract
+        self._map, self._consumed, self._map_time = current, index, map_time
+        self._grown += grown
+        for outcome in outcomes:
+            if outcome.accepted:
+                self._accepted += 1
+            else:
+                self._rejected[outcome.reason] = self._rejected.get(outcome.reason, 0) + 1
+        self._update_state(any(o.accepted for o in outcomes), missed_in_a_row)
+        return ManagerStep(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
+
+    def _check_blackboard(self, blackboard: Blackboard) -> None:
+        count = blackboard.report_count
+        if count < self._consumed:
+            raise InputError(
+                f"blackboard: expected the one this manager reads, with at least {self._consumed} "
+                f"position reports (consumed so far), got {count}"
+            )
+        if self._consumed:
+            last = blackboard._reports[self._consumed - 1].time  # one report, not a copy of all
+            if last != self._map_time:
+                raise InputError(
+                    f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
+                    f"is at t={self._map_time!r}, got t={last!r}"
+                )
+
+    def _grow(
+        self,
+        current: SpatialUncertaintyMap,
+        reports: tuple[PositionReport, ...],
+        map_time: float | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None]:
+        for report in reports:
+            current = self._grow_one(current, report.command)
+            map_time = report.time
+        return current, map_time
+
+    def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
+        if command.run <= RUN_TOLERANCE:
+            # split_run refuses a positive run shorter than its tolerance ("meets no meadow"):
+            # grow it whole on the terrain of the meadow it starts in, as it does a zero run.
+            pose = current.most_probable_pose()
+            meadow = self._meadow_map.meadow_at(pose.x, pose.y)
+            if meadow is not None:
+                return current.grow(command, self._table[meadow.terrain], sigmas=self._sigmas)
+        return grow_through(current, self._meadow_map, command, self._table, sigmas=self._sigmas)
+
+    def _reduce(
+        self, current: SpatialUncertaintyMap, observation: Observation, map_time: float | None
+    ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
+        area, width = current.area, current.wedge.width
+
+        def rejected(reason: str) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
+            return ObservationOutcome(observation, False, reason, area, area, width, width), current
+
+        if map_time is not None and observation.time < map_time:
+            return rejected(REJECT_STALE)
+        try:
+            landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+        except UnknownTerrainError:
+            return rejected(REJECT_UNKNOWN_LANDMARK)
+        if observation.landmark_class is not landmark.landmark_class:
+            return rejected(REJECT_CLASS_MISMATCH)
+        reduction = current.reduce(observation, landmark)
+        if not reduction.consistent:
+            return rejected(reduction.reason)
+        reduced = reduction.map
+        outcome = ObservationOutcome(
+            observation, True, "", reduction.area_before, reduction.area_after, width, reduced.wedge.width
+        )
+        return outcome, reduced
+
+    def _update_state(self, found: bool, missed_in_a_row: int) -> None:
+        reasons: list[str] = []
+        area = self._map.area
+        if self._area_limit is not None and area > self._area_limit:
+            reasons.append(f"map area {area:.6g} m^2 > area_limit {self._area_limit:g} m^2")
+        if not found and missed_in_a_row >= self._missed_limit:
+            reasons.append(
+                f"{missed_in_a_row} frames in a row with predicted landmarks not found "
+                f">= missed_limit {self._missed_limit}"
+            )
+        if reasons:
+            self._state, self._lost_reason = ManagerState.LOST, "; ".join(reasons)
+        elif found or self._state is ManagerState.NOMINAL:
+            self._state, self._lost_reason = ManagerState.NOMINAL, ""
+        # else: still LOST, for the reason recorded when it became so
+
+    # --- save and restore --------------------------------------------------------------
+
+    def to_json(self) -> str:
+        """Return the manager's whole state as JSON text.
+
+        The map (polygon vertices, centre, wedge) is written with ``repr`` precision, so
+        :meth:`from_json` restores it bit for bit; with it go the state, the counters, the
+        settings and the index and time of the last consumed position report. The meadow
+        map and terrain table are not saved: they are long-term memory, given again on
+        restore. Save the :class:`Blackboard` too (:meth:`Blackboard.to_json`).
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import Pose, TerrainTable
+        >>> from aura_ums.world import make_grid_world
+        >>> world, table = make_grid_world(1, 3), TerrainTable.default()
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.3), 0.1, 0.01)
+        >>> manager = UncertaintyMapManager(start, world, table, area_limit=40.0)
+        >>> again = UncertaintyMapManager.from_json(manager.to_json(), world, table)
+        >>> again.map.polygon.vertices.tobytes() == start.polygon.vertices.tobytes(), again.area_limit
+        (True, 40.0)
+        """
+        return dump_document(
+            _KIND,
+            {
+                "map": encode_map(self._map),
+                "map_time": self._map_time,
+                "consumed_reports": self._consumed,
+                "state": self._state.value,
+                "lost_reason": self._lost_reason,
+                "counters": {
+                    "accepted": self._accepted,
+                    "rejected": dict(self._rejected),
+                    "grown_reports": self._grown,
+                },
+                "settings": {
+                    "sigmas": self._sigmas,
+                    "area_limit": self._area_limit,
+                    "missed_limit": self._missed_limit,
+                    "lost_window_scale": self._lost_window_scale,
+                },
+            },
+        )
+
+    @classmethod
+    def from_json(
+        cls,
+        text: str,
+        meadow_map: MeadowMap,
+        table: TerrainTable,
+        *,
+        source: str = "<manager JSON>",
+    ) -> UncertaintyMapManager:
+        """Restore a manager saved by :meth:`to_json`, with its long-term memory.
+
+        Parameters
+        ----------
+        text : str
+            The JSON text.
+        meadow_map : MeadowMap
+            The meadow map (the same as when saved).
+        table : TerrainTable
+            The terrain table (the same as when saved).
+        source : str
+            Name used in error messages (e.g. the file it was read from).
+
+        Raises
+        ------
+        FileFormatError
+            When the text is not such a document, naming the place and what is wrong.
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import TerrainTable
+        >>> from aura_ums.world import make_grid_world
+        >>> UncertaintyMapManager.from_json("[1, 2]", make_grid_world(1, 1), TerrainTable.default())
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.FileFormatError: <manager JSON>: expected an object, got an array
+        """
+        if not isinstance(meadow_map, MeadowMap):
+            raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+        if not isinstance(table, TerrainTable):
+            raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
+        reader = Reader(source)
+        keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
+        data = reader.mapping(reader.document(text, _KIND), "", (*keys, "counters", "settings"))
+        settings = reader.mapping(
+            data["settings"], "settings", ("sigmas", "area_limit", "missed_limit", "lost_window_scale")
+        )
+        uncertainty_map = reader.uncertainty_map(data["map"], "map")
+        try:
+            manager = cls(
+                uncertainty_map,
+                meadow_map,
+                table,
+                sigmas=reader.number(settings["sigmas"], "settings.sigmas"),
+                area_limit=reader.optional_number(settings["area_limit"], "settings.area_limit"),
+                missed_limit=reader.integer(settings["missed_limit"], "settings.missed_limit", 1),
+                lost_window_scale=reader.number(settings["lost_window_scale"], "settings.lost_window_scale"),
+            )
+        except InputError as exc:
+            reader.fail("settings", str(exc))
+        manager._map_time = reader.optional_number(data["map_time"], "map_time")
+        manager._consumed = reader.integer(data["consumed_reports"], "consumed_reports")
+        if (manager._consumed == 0) != (manager._map_time is None):
+            reader.fail("map_time", "expected null exactly when consumed_reports is 0")
+        state = reader.string(data["state"], "state")
+        try:
+            manager._state = ManagerState(state)
+        except ValueError:
+            reader.fail("state", f"expected one of {[s.value for s in ManagerState]}, got {state!r}")
+        manager._lost_reason = reader.string(data["lost_reason"], "lost_reason")
+        counters = reader.mapping(data["counters"], "counters", ("accepted", "rejected", "grown_reports"))
+        manager._accepted = reader.integer(counters["accepted"], "counters.accepted")
+        manager._grown = reader.integer(counters["grown_reports"], "counters.grown_reports")
+        rejected = reader.mapping(counters["rejected"], "counters.rejected")
+        manager._rejected = {
+            reason: reader.integer(count, f"counters.rejected[{reason!r}]")
+            for reason, count in rejected.items()
+        }
+        return manager
+
+    def __repr__(self) -> str:
+        return (
+            f"UncertaintyMapManager({self._state.value}, area={self._map.area:.4g} m^2, "
+            f"reports consumed={self._consumed}, accepted={self._accepted}, rejected={self.rejected_count})"
+        )
+
+
+def _positive(value: object, name: str) -> float:
+    result = finite_float(value, name)
+    if not result > 0.0:
+        raise InputError(f"{name}: expected a positive number, got {result!r}")
+    return result

@@ -1,0 +1,647 @@
+"""The uncertainty map manager: growth to each observation, reduction, rejections, lost, save/restore."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.expecter import PerceptualStrategy
+from aura_ums.geometry import ConvexPolygon, wrap_angle
+from aura_ums.manager import (
+    REJECT_CLASS_MISMATCH,
+    REJECT_STALE,
+    REJECT_UNKNOWN_LANDMARK,
+    Blackboard,
+    ManagerState,
+    ManagerStep,
+    PositionReport,
+    UncertaintyMapManager,
+)
+from aura_ums.uncertainty import (
+    BearingObservation,
+    GroundLineLandmark,
+    GroundLineObservation,
+    Landmark,
+    Observation,
+    PointLandmark,
+    Pose,
+    RangeBearingObservation,
+    SpatialUncertaintyMap,
+    TerrainTable,
+    TurnAndRun,
+    VerticalLineLandmark,
+)
+from aura_ums.world import RUN_TOLERANCE, LandmarkRecord, Meadow, MeadowMap, grow_through
+
+TABLE = TerrainTable.default()
+POLE_NORTH = VerticalLineLandmark("pole_north", 8.0, 6.0, 0.0, 4.0)
+POLE_SOUTH = VerticalLineLandmark("pole_south", 14.0, -7.0, 0.0, 4.0)
+CORNER = PointLandmark("corner", 22.0, 3.0, 2.0)
+EDGE = GroundLineLandmark("edge", (0.0, -5.0), (20.0, -5.0))
+LANDMARKS: tuple[Landmark, ...] = (POLE_NORTH, POLE_SOUTH, CORNER, EDGE)
+START = Pose(2.0, 0.0, 0.0)
+STRIDE = TurnAndRun(0.0, 2.0)
+
+
+def box(x0: float, y0: float, x1: float, y1: float) -> ConvexPolygon:
+    return ConvexPolygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+
+
+def record(landmark: Landmark) -> LandmarkRecord:
+    return LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, 30.0, 0.5)
+
+
+def world_of(meadows: list[tuple[str, ConvexPolygon, str]], landmarks: tuple[Landmark, ...]) -> MeadowMap:
+    ids = [landmark.id for landmark in landmarks]
+    return MeadowMap(
+        [Meadow(name, polygon, terrain, tuple(ids)) for name, polygon, terrain in meadows],
+        [record(landmark) for landmark in landmarks],
+        terrain_table=TABLE,
+    )
+
+
+#: Two meadows side by side: concrete west of x = 10, gravel east of it.
+WORLD = world_of([("west", box(0, -5, 10, 5), "concrete"), ("east", box(10, -5, 20, 5), "gravel")], LANDMARKS)
+
+
+def start_map() -> SpatialUncertaintyMap:
+    return SpatialUncertaintyMap.from_pose(START, 0.2, 0.03)
+
+
+def manager_for(initial: SpatialUncertaintyMap | None = None, **settings: Any) -> UncertaintyMapManager:
+    return UncertaintyMapManager(initial or start_map(), WORLD, TABLE, **settings)
+
+
+# --- observations synthesised from a pose ------------------------------------------------
+
+
+def bearing_of(
+    pose: Pose, landmark: VerticalLineLandmark, time: float, error: float = 0.01
+) -> BearingObservation:
+    bearing = math.atan2(landmark.y - pose.y, landmark.x - pose.x) - pose.heading
+    return BearingObservation(landmark.id, time, bearing, error)
+
+
+def range_bearing_of(
+    pose: Pose, landmark: PointLandmark, time: float, error: float = 0.01, spread: float = 0.2
+) -> RangeBearingObservation:
+    distance = math.hypot(landmark.x - pose.x, landmark.y - pose.y)
+    bearing = math.atan2(landmark.y - pose.y, landmark.x - pose.x) - pose.heading
+    return RangeBearingObservation(
+        landmark.id, time, bearing, error, max(distance - spread, 0.0), distance + spread
+    )
+
+
+def line_of(
+    pose: Pose,
+    landmark: GroundLineLandmark,
+    time: float,
+    offset_error: float = 0.05,
+    angle_error: float = 0.01,
+) -> GroundLineObservation:
+    d = landmark.end - landmark.start
+    q = np.array([pose.x, pose.y]) - landmark.start
+    offset = float(d[0] * q[1] - d[1] * q[0]) / landmark.length
+    return GroundLineObservation(
+        landmark.id, time, offset, offset_error, landmark.direction - pose.heading, angle_error
+    )
+
+
+def assert_same_map(a: SpatialUncertaintyMap, b: SpatialUncertaintyMap) -> None:
+    """Bit-exact equality of two maps."""
+    assert a.polygon.vertices.shape == b.polygon.vertices.shape
+    assert a.polygon.vertices.tobytes() == b.polygon.vertices.tobytes()
+    assert a.center.tobytes() == b.center.tobytes()
+    assert (a.wedge.center, a.wedge.cw, a.wedge.ccw) == (b.wedge.center, b.wedge.cw, b.wedge.ccw)
+
+
+def board_with(*reports: tuple[float, TurnAndRun], observations: tuple[Observation, ...] = ()) -> Blackboard:
+    board = Blackboard()
+    board.post_reports(PositionReport(t, command) for t, command in reports)
+    for observation in observations:
+        board.identified.post(observation)
+    return board
+
+
+# --- growth to each observation, then reduction ------------------------------------------
+
+
+def by_hand() -> tuple[list[SpatialUncertaintyMap], BearingObservation, RangeBearingObservation]:
+    """Reports at t = 1, 2, 3, 4; a bearing at t = 2 and a range-bearing at t = 3.5, done by hand."""
+    m = start_map()
+    m = grow_through(m, WORLD, STRIDE, TABLE)
+    m = grow_through(m, WORLD, STRIDE, TABLE)
+    first = bearing_of(m.most_probable_pose(), POLE_NORTH, 2.0)
+    reduced_first = m.reduce(first, POLE_NORTH).map
+    m = grow_through(reduced_first, WORLD, STRIDE, TABLE)
+    second = range_bearing_of(m.most_probable_pose(), CORNER, 3.5)
+    reduced_second = m.reduce(second, CORNER).map
+    final = grow_through(reduced_second, WORLD, STRIDE, TABLE)
+    return [reduced_first, reduced_second, final], first, second
+
+
+def test_grows_to_each_observation_then_reduces_as_by_hand() -> None:
+    (after_first, after_second, final), first, second = by_hand()
+    board = board_with(*[(float(t), STRIDE) for t in (1, 2, 3, 4)], observations=(second, first))  # any order
+    manager = manager_for()
+    step = manager.update(board, now=4.0)
+    assert isinstance(step, ManagerStep)
+    assert_same_map(step.map, final)
+    assert step.map is manager.map
+    assert [o.observation for o in step.accepted] == [first, second]
+    assert step.rejected == ()
+    assert step.outcomes[0].area_after == pytest.approx(after_first.area)
+    assert step.outcomes[1].area_after == pytest.approx(after_second.area)
+    assert step.outcomes[1].area_after < step.outcomes[1].area_before
+    assert step.outcomes[0].wedge_width_after == after_first.wedge.width
+    assert step.outcomes[0].wedge_width_after <= step.outcomes[0].wedge_width_before
+    assert (step.time, step.grown_reports, step.state, step.lost_reason) == (4.0, 4, ManagerState.NOMINAL, "")
+    assert (manager.consumed_reports, manager.map_time, manager.grown_reports) == (4, 4.0, 4)
+    assert (manager.accepted_count, manager.rejected_count) == (2, 0)
+    assert not board.identified
+
+
+def test_split_updates_consume_each_report_once_and_give_the_same_map() -> None:
+    (_, _, final), first, second = by_hand()
+    board = board_with(*[(float(t), STRIDE) for t in (1, 2, 3, 4)], observations=(first, second))
+    manager = manager_for()
+    early = manager.update(board, now=2.5)  # reports 1, 2; the observation at t = 2
+    assert (early.grown_reports, len(early.outcomes), len(board.identified)) == (2, 1, 1)
+    again = manager.update(board, now=2.5)  # nothing new: nothing grown twice
+    assert (again.grown_reports, again.outcomes) == (0, ())
+    assert again.map is early.map
+    late = manager.update(board, now=10.0)
+    assert late.grown_reports == 2
+    assert_same_map(late.map, final)
+    assert manager.grown_reports == 4
+
+
+def test_reports_and_observations_after_now_wait() -> None:
+    board = board_with((1.0, STRIDE), (3.0, STRIDE))
+    board.identified.post(BearingObservation("pole_north", 2.5, 0.5, 0.01))
+    manager = manager_for()
+    step = manager.update(board, now=2.0)
+    assert (step.grown_reports, step.outcomes, len(board.identified)) == (1, (), 1)
+    assert manager.map_time == 1.0
+
+
+def test_each_piece_of_a_run_grows_with_its_meadows_terrain() -> None:
+    initial = SpatialUncertaintyMap.from_pose(Pose(7.0, 0.0, 0.0), 0.1, 0.02)
+    crossing = TurnAndRun(0.1, 7.0)  # concrete up to x = 10, gravel after
+    step = manager_for(initial).update(board_with((1.0, crossing)), now=1.0)
+    assert_same_map(step.map, grow_through(initial, WORLD, crossing, TABLE))
+    concrete_only = initial.grow(crossing, TABLE["concrete"])
+    assert step.map.area > concrete_only.area * 1.05  # gravel is rougher than concrete
+
+
+# --- rejections --------------------------------------------------------------------------
+
+
+def test_misidentified_landmark_is_rejected_and_counted_not_applied() -> None:
+    grown = grow_through(start_map(), WORLD, STRIDE, TABLE)
+    wrong = bearing_of(grown.most_probable_pose(), POLE_NORTH, 1.0)
+    wrong = BearingObservation(wrong.landmark_id, 1.0, wrong.bearing + math.pi, 0.01)  # seen behind
+    manager = manager_for()
+    step = manager.update(board_with((1.0, STRIDE), observations=(wrong,)), now=1.0)
+    (outcome,) = step.rejected
+    assert not outcome.accepted
+    assert outcome.reason.startswith("no ")
+    assert (outcome.area_before, outcome.wedge_width_before) == (
+        outcome.area_after,
+        outcome.wedge_width_after,
+    )
+    assert_same_map(step.map, grown)
+    assert step.map.area > 0.1  # kept whole, not emptied
+    assert dict(manager.rejected_counts) == {outcome.reason: 1}
+    assert manager.accepted_count == 0
+
+
+def test_unknown_id_wrong_class_and_stale_observations_are_rejected_with_reasons() -> None:
+    board = board_with((1.0, STRIDE), (2.0, STRIDE))
+    board.identified.post(BearingObservation("ghost_pole", 1.0, 0.3, 0.01))
+    board.identified.post(RangeBearingObservation("pole_north", 1.0, 0.3, 0.01, 5.0, 6.0))  # a Class I pole
+    manager = manager_for()
+    step = manager.update(board, now=2.0)
+    assert [o.reason for o in step.rejected] == [REJECT_UNKNOWN_LANDMARK, REJECT_CLASS_MISMATCH]
+    board.identified.post(
+        bearing_of(manager.map.most_probable_pose(), POLE_NORTH, 1.5)
+    )  # the map is at t = 2
+    late = manager.update(board, now=3.0)
+    assert [o.reason for o in late.rejected] == [REJECT_STALE]
+    assert manager.rejected_counts == {REJECT_UNKNOWN_LANDMARK: 1, REJECT_CLASS_MISMATCH: 1, REJECT_STALE: 1}
+    assert manager.rejected_count == 3
+    with pytest.raises(TypeError, match="does not support item assignment"):
+        manager.rejected_counts[REJECT_STALE] = 0  # type: ignore[index]
+
+
+def test_a_rejection_does_not_stop_later_observations() -> None:
+    grown = grow_through(start_map(), WORLD, STRIDE, TABLE)
+    good = line_of(grown.most_probable_pose(), EDGE, 1.0)
+    step = manager_for().update(
+        board_with((1.0, STRIDE), observations=(BearingObservation("ghost", 1.0, 0.0, 0.01), good)), now=1.0
+    )
+    assert [o.accepted for o in step.outcomes] == [False, True]
+    assert_same_map(step.map, grown.reduce(good, EDGE).map)
+
+
+# --- lost detection ----------------------------------------------------------------------
+
+
+def test_lost_by_area_then_found_again_by_a_consistent_reduction() -> None:
+    manager = manager_for(area_limit=2.0)
+    board = Blackboard()
+    states = []
+    for t in range(1, 6):  # the area passes 2 m^2 after the fifth stride (see below)
+        board.post_report(PositionReport(float(t), STRIDE))
+        states.append(manager.update(board, now=float(t)).state)
+    assert states[:4] == [ManagerState.NOMINAL] * 4
+    assert states[4] is ManagerState.LOST
+    assert manager.map.area > 2.0
+    assert manager.should_stop_and_look
+    assert manager.window_scale == 2.0
+    assert "area" in manager.lost_reason
+    # a misidentification is no landmark found: still lost
+    board.identified.post(BearingObservation("pole_north", 5.0, 3.0, 0.001))
+    assert manager.update(board, now=5.0).state is ManagerState.LOST
+    board.identified.post(range_bearing_of(manager.map.most_probable_pose(), CORNER, 5.0))
+    step = manager.update(board, now=5.0)
+    assert len(step.accepted) == 1
+    assert step.map.area < 2.0
+    assert (step.state, step.lost_reason) == (ManagerState.NOMINAL, "")
+    assert not manager.should_stop_and_look
+    assert manager.window_scale == 1.0
+
+
+def test_lost_while_the_area_stays_too_large_even_after_a_landmark() -> None:
+    manager = manager_for(area_limit=0.25)
+    board = board_with((1.0, STRIDE))
+    assert manager.update(board, now=1.0).state is ManagerState.LOST
+    board.identified.post(bearing_of(manager.map.most_probable_pose(), POLE_NORTH, 1.0, error=0.5))  # loose
+    step = manager.update(board, now=1.0)
+    assert len(step.accepted) == 1
+    assert step.state is ManagerState.LOST
+
+
+def test_lost_by_missed_predictions_persists_until_a_landmark_is_found() -> None:
+    manager = manager_for(missed_limit=3, lost_window_scale=3.0)
+    board = board_with((1.0, STRIDE))
+    assert manager.update(board, now=1.0, missed_in_a_row=2).state is ManagerState.NOMINAL
+    lost = manager.update(board, now=1.5, missed_in_a_row=3)
+    assert lost.state is ManagerState.LOST
+    assert "missed_limit 3" in lost.lost_reason
+    assert manager.window_scale == 3.0
+    # no evidence either way (the count is back to 0 but nothing was found): still lost
+    assert manager.update(board, now=1.6, missed_in_a_row=0).state is ManagerState.LOST
+    board.post_report(PositionReport(2.0, STRIDE))
+    board.identified.post(
+        bearing_of(grow_through(manager.map, WORLD, STRIDE, TABLE).most_probable_pose(), POLE_SOUTH, 2.0)
+    )
+    found = manager.update(board, now=2.0, missed_in_a_row=4)  # the count predates the identification
+    assert (found.state, len(found.accepted)) == (ManagerState.NOMINAL, 1)
+    assert manager.window_scale == 1.0
+
+
+# --- robustness --------------------------------------------------------------------------
+
+
+def test_an_update_that_fails_changes_nothing() -> None:
+    outside = SpatialUncertaintyMap.from_pose(Pose(50.0, 50.0, 0.0), 0.1, 0.01)
+    manager = manager_for(outside)
+    board = board_with(
+        (1.0, TurnAndRun(0.5, 0.0)), observations=(BearingObservation("pole_north", 1.0, 0.0, 0.1),)
+    )
+    with pytest.raises(InputError, match="expected a point inside a meadow"):
+        manager.update(board, now=1.0)
+    assert manager.map is outside
+    assert (manager.consumed_reports, manager.map_time, manager.grown_reports) == (0, None, 0)
+    assert len(board.identified) == 1
+
+
+def test_a_different_blackboard_is_refused() -> None:
+    manager = manager_for()
+    manager.update(board_with((1.0, STRIDE), (2.0, STRIDE)), now=2.0)
+    with pytest.raises(InputError, match=r"with at least 2 position reports \(consumed so far\), got 0"):
+        manager.update(Blackboard(), now=3.0)
+    with pytest.raises(InputError, match=r"whose report 1 is at t=2\.0, got t=5\.0"):
+        manager.update(board_with((1.0, STRIDE), (5.0, STRIDE)), now=6.0)
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"sigmas": 0.0}, "sigmas: expected a positive number, got 0.0"),
+        ({"area_limit": -1.0}, "area_limit: expected a positive number, got -1.0"),
+        ({"area_limit": math.inf}, "area_limit: expected a finite number, got inf"),
+        ({"missed_limit": 0}, "missed_limit: expected an integer >= 1, got 0"),
+        ({"missed_limit": True}, "missed_limit: expected an integer >= 1, got True"),
+        ({"lost_window_scale": 0.5}, "lost_window_scale: expected a number >= 1, got 0.5"),
+    ],
+)
+def test_bad_settings_are_refused(settings: dict[str, Any], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        manager_for(**settings)
+
+
+def test_bad_arguments_are_refused() -> None:
+    with pytest.raises(InputError, match="initial_map: expected a SpatialUncertaintyMap, got Pose"):
+        UncertaintyMapManager(START, WORLD, TABLE)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="meadow_map: expected a MeadowMap, got dict"):
+        UncertaintyMapManager(start_map(), {}, TABLE)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="table: expected a TerrainTable, got dict"):
+        UncertaintyMapManager(start_map(), WORLD, {})  # type: ignore[arg-type]
+    manager = manager_for()
+    with pytest.raises(InputError, match="blackboard: expected a Blackboard, got IdentifiedLandmarkBuffer"):
+        manager.update(Blackboard().identified, now=1.0)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="now: expected a finite number, got nan"):
+        manager.update(Blackboard(), now=math.nan)
+    with pytest.raises(InputError, match="missed_in_a_row: expected a non-negative integer, got -1"):
+        manager.update(Blackboard(), now=1.0, missed_in_a_row=-1)
+    assert "nominal" in repr(manager)
+
+
+# --- save and restore --------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """One step of a scripted run: what is posted, then the update."""
+
+    reports: tuple[PositionReport, ...]
+    observations: tuple[Observation, ...]
+    now: float
+    missed: int
+
+
+def scripted_run(seed: int, steps: int) -> list[Event]:
+    """A true trajectory east along the two meadows, with observations of it (and one wrong one)."""
+    rng = np.random.default_rng(seed)
+    truth = START
+    events = []
+    for k in range(1, steps + 1):
+        command = TurnAndRun(float(rng.uniform(-0.05, 0.05)), 1.4)
+        terrain = WORLD.meadow_at(truth.x, truth.y)
+        assert terrain is not None
+        truth = TABLE[terrain.terrain].sample_motion(truth, command, rng, truncate=3.0)
+        t = float(k)
+        observations: list[Observation] = []
+        if k % 3 == 0:
+            observations.append(bearing_of(truth, POLE_NORTH if k < 6 else POLE_SOUTH, t))
+        if k % 4 == 0:
+            observations.append(line_of(truth, EDGE, t))
+        if k == 5:
+            observations.append(BearingObservation("pole_north", t, -2.0, 0.01))  # misidentified
+        if k == 6:
+            observations.append(BearingObservation("ghost", t + 0.5, 0.0, 0.01))  # waits for the next update
+        events.append(Event((PositionReport(t, command),), tuple(observations), t, 3 if k in (7, 8) else 0))
+    return events
+
+
+def play(manager: UncertaintyMapManager, board: Blackboard, events: list[Event]) -> list[ManagerStep]:
+    steps = []
+    for event in events:
+        board.post_reports(event.reports)
+        for observation in event.observations:
+            board.identified.post(observation)
+        steps.append(manager.update(board, now=event.now, missed_in_a_row=event.missed))
+    return steps
+
+
+def test_save_half_way_restore_and_continue_gives_the_same_map_bit_for_bit() -> None:
+    events = scripted_run(seed=11, steps=10)
+    whole = manager_for(area_limit=3.0)
+    whole_board = Blackboard()
+    uninterrupted = play(whole, whole_board, events)
+    assert {s.state for s in uninterrupted} == {ManagerState.NOMINAL, ManagerState.LOST}  # a varied run
+    assert whole.accepted_count >= 3
+    assert whole.rejected_count >= 2
+
+    first = manager_for(area_limit=3.0)
+    first_board = Blackboard()
+    play(first, first_board, events[:6])
+    # something is pending: a future observation in the buffer, a report not yet consumed, commands
+    first_board.post_report(PositionReport(6.25, TurnAndRun(0.0, 0.0)))
+    first_board.push_command(TurnAndRun(0.0, 1.4))
+    saved_manager, saved_board = first.to_json(), first_board.to_json()
+    del first, first_board
+
+    manager = UncertaintyMapManager.from_json(saved_manager, WORLD, TABLE)
+    board = Blackboard.from_json(saved_board)
+    assert len(board.identified) == 1
+    assert board.pending_commands == (TurnAndRun(0.0, 1.4),)
+    resumed = play(manager, board, events[6:])
+
+    # the reference run had no extra zero-motion report: replay it that way too
+    reference = manager_for(area_limit=3.0)
+    reference_board = Blackboard()
+    play(reference, reference_board, events[:6])
+    reference_board.post_report(PositionReport(6.25, TurnAndRun(0.0, 0.0)))
+    expected = play(reference, reference_board, events[6:])
+
+    assert_same_map(resumed[-1].map, expected[-1].map)
+    assert [s.state for s in resumed] == [s.state for s in expected]
+    assert manager.to_json() == reference.to_json()
+    assert (manager.accepted_count, dict(manager.rejected_counts), manager.grown_reports) == (
+        reference.accepted_count,
+        dict(reference.rejected_counts),
+        reference.grown_reports,
+    )
+
+
+def test_restore_of_the_uninterrupted_script_matches_every_step() -> None:
+    events = scripted_run(seed=5, steps=9)
+    whole = manager_for(area_limit=3.0)
+    uninterrupted = play(whole, Blackboard(), events)
+    for cut in (0, 4, 8):
+        manager, board = manager_for(area_limit=3.0), Blackboard()
+        play(manager, board, events[:cut])
+        manager = UncertaintyMapManager.from_json(manager.to_json(), WORLD, TABLE)
+        board = Blackboard.from_json(board.to_json())
+        rest = play(manager, board, events[cut:])
+        for got, want in zip(rest, uninterrupted[cut:], strict=True):
+            assert_same_map(got.map, want.map)
+            assert got.state is want.state
+            assert [o.reason for o in got.outcomes] == [o.reason for o in want.outcomes]
+
+
+def test_round_trip_keeps_settings_state_and_counters() -> None:
+    manager = manager_for(sigmas=2.5, area_limit=0.2, missed_limit=4, lost_window_scale=1.5)
+    board = board_with((1.0, STRIDE), observations=(BearingObservation("ghost", 1.0, 0.0, 0.01),))
+    manager.update(board, now=1.0)
+    again = UncertaintyMapManager.from_json(manager.to_json(), WORLD, TABLE)
+    assert (again.sigmas, again.area_limit, again.missed_limit, again.window_scale) == (2.5, 0.2, 4, 1.5)
+    assert (again.state, again.lost_reason) == (ManagerState.LOST, manager.lost_reason)
+    assert (again.consumed_reports, again.map_time, again.grown_reports) == (1, 1.0, 1)
+    assert again.rejected_counts == {REJECT_UNKNOWN_LANDMARK: 1}
+    assert_same_map(again.map, manager.map)
+    assert again.to_json() == manager.to_json()
+    fresh = UncertaintyMapManager.from_json(manager_for().to_json(), WORLD, TABLE)
+    assert (fresh.area_limit, fresh.map_time, fresh.consumed_reports) == (None, None, 0)
+
+
+def test_a_wedge_centre_that_rewrapping_would_move_is_restored_exactly() -> None:
+    heading = next(h for h in np.linspace(0.01, 0.5, 1000).tolist() if wrap_angle(h) != h)
+    data = json.loads(manager_for().to_json())
+    data["map"]["wedge"]["center"] = heading
+    again = UncertaintyMapManager.from_json(json.dumps(data), WORLD, TABLE)
+    assert again.map.wedge.center == heading
+    assert json.loads(again.to_json())["map"]["wedge"]["center"] == heading
+
+
+def test_a_run_shorter_than_the_split_tolerance_grows_on_the_start_meadow() -> None:
+    for run in (0.0, 5e-324, 1e-12, RUN_TOLERANCE):
+        command = TurnAndRun(0.2, run)
+        step = manager_for().update(board_with((1.0, command)), now=1.0)
+        assert_same_map(step.map, start_map().grow(command, TABLE["concrete"]))
+    crossing = TurnAndRun(0.0, 2 * RUN_TOLERANCE)  # long enough for grow_through
+    step = manager_for().update(board_with((1.0, crossing)), now=1.0)
+    assert_same_map(step.map, grow_through(start_map(), WORLD, crossing, TABLE))
+
+
+def manager_document() -> dict[str, object]:
+    manager = manager_for(area_limit=5.0)
+    manager.update(
+        board_with((1.0, STRIDE), observations=(BearingObservation("ghost", 1.0, 0.0, 0.01),)), now=1.0
+    )
+    result: dict[str, object] = json.loads(manager.to_json())
+    return result
+
+
+def edited(path: str, value: object) -> str:
+    data = manager_document()
+    target: object = data
+    *keys, last = path.split("/")
+    for key in keys:
+        target = target[int(key)] if isinstance(target, list) else target[key]  # type: ignore[index]
+    if value is KeyError:
+        del target[last]  # type: ignore[attr-defined]
+    elif isinstance(target, list):
+        target[int(last)] = value
+    else:
+        target[last] = value  # type: ignore[index]
+    return json.dumps(data)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("not json", r"<manager JSON>: line 1 column 1: expected valid JSON"),
+        (
+            '{"format": "aura-ums/blackboard", "version": 1}',
+            r"format: expected 'aura-ums/uncertainty-map-manager'",
+        ),
+        (edited("map", KeyError), r"<manager JSON>: expected a key 'map', got none"),
+        (edited("map/vertices", []), r"map\.vertices: expected at least one vertex, got none"),
+        (edited("map/vertices/0", [1.0]), r"map\.vertices\[0\]: expected \[x, y\], got 1 numbers"),
+        (edited("map/vertices/2/1", "north"), r"map\.vertices\[2\]\[1\]: expected a number, got str 'north'"),
+        (
+            edited("map/vertices/0", [30.0, -30.0]),
+            r"map\.vertices: .*expected a convex counter-clockwise polygon",
+        ),
+        (edited("map/center", [40.0, 0.0]), r"map\.center: center: expected a point inside the polygon"),
+        (edited("map/wedge/cw", -0.1), r"map\.wedge: HeadingWedge\.cw: expected a non-negative number"),
+        (edited("map/wedge/center", 4.0), r"map\.wedge\.center: expected a heading in \(-pi, pi\], got 4\.0"),
+        (edited("map/wedge/spin", 0.0), r"map\.wedge: expected only the keys"),
+        (edited("state", "confused"), r"state: expected one of \['nominal', 'lost'\], got 'confused'"),
+        (edited("consumed_reports", -1), r"consumed_reports: expected an integer >= 0, got -1"),
+        (edited("consumed_reports", 1.5), r"consumed_reports: expected an integer, got float 1\.5"),
+        (edited("map_time", None), r"map_time: expected null exactly when consumed_reports is 0"),
+        (
+            edited("counters/rejected/unknown landmark id", "one"),
+            r"counters\.rejected\['unknown landmark id'\]",
+        ),
+        (edited("counters/accepted", None), r"counters\.accepted: expected an integer, got null"),
+        (edited("settings/sigmas", -3.0), r"settings: sigmas: expected a positive number, got -3\.0"),
+        (edited("settings/missed_limit", 0), r"settings\.missed_limit: expected an integer >= 1, got 0"),
+        (edited("settings/area_limit", "big"), r"settings\.area_limit: expected a number, got str"),
+        (edited("lost_reason", 3), r"lost_reason: expected a string, got int 3"),
+        (json.dumps(manager_document()).replace("5.0", "Infinity"), r"expected finite numbers, got Infinity"),
+    ],
+)
+def test_malformed_manager_json_names_what_is_wrong(text: str, message: str) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        UncertaintyMapManager.from_json(text, WORLD, TABLE)
+
+
+def test_restore_needs_the_long_term_memory() -> None:
+    text = manager_for().to_json()
+    with pytest.raises(InputError, match="meadow_map: expected a MeadowMap, got NoneType"):
+        UncertaintyMapManager.from_json(text, None, TABLE)  # type: ignore[arg-type]
+    with pytest.raises(FileFormatError, match=r"^saved\.json: version: expected 1, got 2$"):
+        UncertaintyMapManager.from_json(
+            text.replace('"version": 1', '"version": 2'), WORLD, TABLE, source="saved.json"
+        )
+
+
+# --- soundness over random runs ----------------------------------------------------------
+
+#: Landmarks of all three classes around the origin of one large meadow.
+FIELD_LANDMARKS: tuple[Landmark, ...] = (
+    VerticalLineLandmark("p1", 25.0, 20.0, 0.0, 4.0),
+    VerticalLineLandmark("p2", -20.0, 30.0, 0.0, 4.0),
+    VerticalLineLandmark("p3", 5.0, -35.0, 0.0, 4.0),
+    PointLandmark("c1", -30.0, -25.0, 2.5),
+    GroundLineLandmark("g1", (-60.0, 45.0), (60.0, 45.0)),
+    GroundLineLandmark("g2", (50.0, -60.0), (50.0, 60.0)),
+)
+FIELDS = {name: world_of([("field", box(-100, -100, 100, 100), name)], FIELD_LANDMARKS) for name in TABLE}
+
+
+def observe(pose: Pose, landmark: Landmark, time: float, rng: np.random.Generator) -> Observation:
+    """An observation of the true pose, noisy but within its stated bounds."""
+    u = float(rng.uniform(-0.99, 0.99))
+    if isinstance(landmark, VerticalLineLandmark):
+        exact = bearing_of(pose, landmark, time, error=0.02)
+        return BearingObservation(exact.landmark_id, time, exact.bearing + u * 0.02, 0.02)
+    if isinstance(landmark, PointLandmark):
+        exact_rb = range_bearing_of(pose, landmark, time, error=0.02, spread=0.5)
+        shift = float(rng.uniform(-0.4, 0.4))
+        return RangeBearingObservation(
+            landmark.id,
+            time,
+            exact_rb.bearing + u * 0.02,
+            0.02,
+            max(exact_rb.range_min + shift, 0.0),
+            exact_rb.range_max + shift,
+        )
+    exact_line = line_of(pose, landmark, time, offset_error=0.1, angle_error=0.02)
+    return GroundLineObservation(
+        landmark.id, time, exact_line.offset + u * 0.1, 0.1, exact_line.angle - u * 0.02, 0.02
+    )
+
+
+@settings(deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    terrain=st.sampled_from(sorted(TABLE)),
+    commands=st.lists(st.tuples(st.floats(-1.0, 1.0), st.floats(0.0, 3.0)), min_size=1, max_size=12),
+    seen=st.lists(st.integers(-1, len(FIELD_LANDMARKS) - 1), min_size=12, max_size=12),
+    stride=st.integers(1, 3),
+)
+def test_the_map_contains_the_true_pose_after_any_run(
+    seed: int, terrain: str, commands: list[tuple[float, float]], seen: list[int], stride: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    truth = Pose(float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)), float(rng.uniform(-math.pi, math.pi)))
+    guess = Pose(truth.x + 0.1, truth.y - 0.1, truth.heading + 0.02)
+    manager = UncertaintyMapManager(
+        SpatialUncertaintyMap.from_pose(guess, 0.3, 0.05), FIELDS[terrain], TABLE, sigmas=3.0
+    )
+    board = Blackboard()
+    for k, (turn, run) in enumerate(commands, start=1):
+        command = TurnAndRun(turn, run)
+        truth = TABLE[terrain].sample_motion(truth, command, rng, truncate=3.0)
+        board.post_report(PositionReport(float(k), command))
+        if seen[k - 1] >= 0:
+            board.identified.post(observe(truth, FIELD_LANDMARKS[seen[k - 1]], float(k), rng))
+        if k % stride == 0 or k == len(commands):
+            step = manager.update(board, now=float(k))
+            assert step.rejected == (), [o.reason for o in step.rejected]
+            assert step.map.contains(truth), (k, truth, step.map)
