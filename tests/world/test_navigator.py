@@ -278,3 +278,10 @@ def test_commands_for_needs_every_terrain_in_the_table(terrains: TerrainTable) -
         commands_for(world, Pose(1, 1, 0), 5.0, terrains)  # type: ignore[arg-type]
     with pytest.raises(InputError, match="uncertainty_map: expected a SpatialUncertaintyMap"):
         grow_through(None, world, TurnAndRun(0.0, 1.0), terrains)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("distance", [1e-12, 5e-324, 1e-9])
+def test_a_run_shorter_than_the_tolerance_is_one_piece_in_its_meadow(distance: float) -> None:
+    world = make_grid_world(1, 3, cell=5.0)
+    pieces = split_run(world, (2.5, 2.5), 0.0, distance)
+    assert [(piece.distance, piece.meadow_id) for piece in pieces] == [(distance, "cell_0_0")]

@@ -290,13 +290,15 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
     origin = _point(start, "start")
     angle = finite_float(heading, "heading")
     length = nonnegative_float(distance, "distance")
-    if length == 0.0:
+    if length <= RUN_TOLERANCE:
+        # Too short to cut by meadow boundaries: one piece on the start meadow's terrain.
         meadow = meadow_map.meadow_at(float(origin[0]), float(origin[1]))
-        if meadow is None:
+        if meadow is not None:
+            return [RunPiece(length, meadow.terrain, meadow.id)]
+        if length == 0.0:
             raise InputError(
                 f"start: expected a point inside a meadow for a zero-length run, got {_xy(origin)}"
             )
-        return [RunPiece(0.0, meadow.terrain, meadow.id)]
     direction = np.array([math.cos(angle), math.sin(angle)])
     line = shapely.LineString([origin, origin + length * direction])
     candidates = np.sort(meadow_map._tree.query(line, predicate="intersects"))
