@@ -1,0 +1,798 @@
+"""Scenario files: a TOML file naming a map, a terrain table, a camera, a start and a route.
+
+The format (paths are relative to the scenario file; angles in degrees where the key
+says ``_deg``, radians otherwise; every other unit SI)::
+
+    name = "paper_sidewalk"             # optional, default: the file's stem
+    description = "..."                 # optional
+    map = "sample:paper_sidewalk"       # a GeoJSON meadow map, or sample:<name>
+    terrain = "default"                 # a terrain table TOML file, or "default"
+    camera = "paper_camera.toml"        # a camera TOML file (aura_ums.camera.load_camera)
+    landmarks = ["lamppost_107"]        # optional: ids the robot uses (default: all)
+    frame_spacing = 1.0                 # optional: metres of commanded run between frames
+    # or: frame_rate = 2.0 (frames per second) with speed = 0.5 (m/s)
+
+    [start]                             # the believed start: centre and bounds
+    x = 0.0
+    y = 0.0
+    heading_deg = 0.0                   # or heading (radians)
+    position_radius = 0.3048            # metres, >= 0
+    heading_halfwidth_deg = 3.0         # or heading_halfwidth (radians), >= 0
+
+    [route]                             # exactly one of:
+    commands = [{turn_deg = 0.0, run = 3.048}]   # turn_deg or turn, run (m)
+    # waypoints = [[5.0, 0.0], [5.0, 4.0]]       # straight legs from the start
+    # goal = [20.0, 0.0]                         # legs planned with aura_ums.world.plan_route
+
+    [lost]                              # optional: when the manager declares the robot lost
+    area_limit = 25.0                   # m^2 of the position polygon, > 0
+    missed_limit = 3                    # landmarks expected but not found in a row, >= 1
+
+    [render]                            # optional: the synthetic camera and scene
+    noise = 2.0                         # gray levels (sd); clutter = 0 (ground strips);
+    clutter_lines = 0                   # per frame; pole_radius = 0.12; stripe_width = 0.1;
+    building_width = 15.0               # building_depth = 10.0; building_base = 0.0
+
+Frames are taken at the start, at the end of every command, and, with a frame spacing,
+every ``frame_spacing`` metres of commanded run along the route.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums._validate import finite_float, nonnegative_float, read_only
+from aura_ums.camera import Camera, load_camera
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.geometry import wrap_angle
+from aura_ums.sim._render import SyntheticCamera
+from aura_ums.sim._robot import SimulatedRobot
+from aura_ums.sim._scene import Scene
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+from aura_ums.world import LandmarkRecord, MeadowMap, plan_route, sample_world
+
+_TOP_KEYS = (
+    "name",
+    "description",
+    "map",
+    "terrain",
+    "camera",
+    "landmarks",
+    "frame_spacing",
+    "frame_rate",
+    "speed",
+    "start",
+    "route",
+    "lost",
+    "render",
+)
+_START_KEYS = (
+    "x",
+    "y",
+    "heading",
+    "heading_deg",
+    "position_radius",
+    "heading_halfwidth",
+    "heading_halfwidth_deg",
+)
+_RENDER_KEYS = (
+    "noise",
+    "clutter",
+    "clutter_lines",
+    "pole_radius",
+    "stripe_width",
+    "building_width",
+    "building_depth",
+    "building_base",
+)
+_SAMPLE_PREFIX = "sample:"
+_START_DRAWS = 100
+
+
+@dataclass(frozen=True, slots=True)
+class StartState:
+    """The believed start: most probable pose and the bounds of the uncertainty around it.
+
+    Parameters
+    ----------
+    pose : Pose
+        Most probable start pose.
+    position_radius : float
+        Metres, >= 0: the true position is within this distance.
+    heading_halfwidth : float
+        Radians, >= 0: the true heading is within this angle of ``pose.heading``.
+    """
+
+    pose: Pose
+    position_radius: float
+    heading_halfwidth: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.pose, Pose):
+            raise InputError(f"StartState.pose: expected a Pose, got {type(self.pose).__name__}")
+        object.__setattr__(
+            self, "position_radius", nonnegative_float(self.position_radius, "StartState.position_radius")
+        )
+        object.__setattr__(
+            self,
+            "heading_halfwidth",
+            nonnegative_float(self.heading_halfwidth, "StartState.heading_halfwidth"),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class LostLimits:
+    """When the map manager declares the robot lost.
+
+    Parameters
+    ----------
+    area_limit : float
+        Largest area of the position polygon, m^2, > 0 (``inf``: no limit).
+    missed_limit : int
+        Number of expected landmarks not found in a row, >= 1.
+    """
+
+    area_limit: float = math.inf
+    missed_limit: int = 3
+
+    def __post_init__(self) -> None:
+        area = float(self.area_limit) if isinstance(self.area_limit, (int, float)) else math.nan
+        if isinstance(self.area_limit, bool) or not area > 0.0:
+            raise InputError(f"LostLimits.area_limit: expected a positive number, got {self.area_limit!r}")
+        missed = self.missed_limit
+        if isinstance(missed, bool) or not isinstance(missed, int) or missed < 1:
+            raise InputError(f"LostLimits.missed_limit: expected an integer >= 1, got {missed!r}")
+        object.__setattr__(self, "area_limit", area)
+
+
+@dataclass(frozen=True, slots=True)
+class RenderSettings:
+    """Settings of the synthetic scene and camera (see :class:`Scene` and :class:`SyntheticCamera`).
+
+    Parameters
+    ----------
+    noise : float
+        Sensor noise, gray levels (standard deviation).
+    clutter : int
+        Random strips on the ground of the scene.
+    clutter_lines : int
+        Random line segments drawn over every image.
+    pole_radius, stripe_width : float
+        Metres: Class I poles' radius, Class III strips' width.
+    building_width, building_depth, building_base : float
+        Metres: size of the box drawn at each Class II landmark and the height of its floor.
+    """
+
+    noise: float = 2.0
+    clutter: int = 0
+    clutter_lines: int = 0
+    pole_radius: float = 0.12
+    stripe_width: float = 0.1
+    building_width: float = 15.0
+    building_depth: float = 10.0
+    building_base: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class SimulatedFrame:
+    """One frame of a simulated run.
+
+    Parameters
+    ----------
+    index : int
+        0 for the start, then 1, 2, ...
+    command : TurnAndRun or None
+        The command executed since the previous frame (None for the first frame).
+    pose : Pose
+        The robot's true pose when the image was taken.
+    image : ndarray of uint8, shape (height, width)
+        What the camera saw (read-only).
+    distance : float
+        Commanded run from the start to this frame, metres.
+    """
+
+    index: int
+    command: TurnAndRun | None
+    pose: Pose
+    image: NDArray[np.uint8]
+    distance: float
+
+
+class _Reader:
+    """Typed access to a parsed scenario document; every failure names the file and key."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, where: str, message: str) -> FileFormatError:
+        return FileFormatError(self.source, where, message)
+
+    def table(self, document: Mapping[str, object], name: str, *, required: bool) -> dict[str, object]:
+        value = document.get(name)
+        if value is None:
+            if required:
+                raise self.fail(f"[{name}]", "expected this table, got none")
+            return {}
+        if not isinstance(value, dict):
+            raise self.fail(f"[{name}]", f"expected a table, got {value!r}")
+        return value
+
+    def keys(self, table: Mapping[str, object], allowed: tuple[str, ...], where: str, sep: str = " ") -> None:
+        for key in table:
+            if key not in allowed:
+                raise self.fail(
+                    f"{where}{sep}{key}".strip(),
+                    f"expected one of {', '.join(allowed)}, got unknown key {key!r}",
+                )
+
+    def string(self, value: object, where: str) -> str:
+        if not isinstance(value, str) or not value:
+            raise self.fail(where, f"expected a non-empty string, got {value!r}")
+        return value
+
+    def number(self, value: object, where: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(where, f"expected a number, got {value!r}")
+        result = float(value)
+        if not math.isfinite(result):
+            raise self.fail(where, f"expected a finite number, got {value!r}")
+        return result
+
+    def positive(self, value: object, where: str) -> float:
+        result = self.number(value, where)
+        if result <= 0.0:
+            raise self.fail(where, f"expected a positive number, got {value!r}")
+        return result
+
+    def nonnegative(self, value: object, where: str) -> float:
+        result = self.number(value, where)
+        if result < 0.0:
+            raise self.fail(where, f"expected a non-negative number, got {value!r}")
+        return result
+
+    def integer(self, value: object, where: str, minimum: int) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            raise self.fail(where, f"expected an integer >= {minimum}, got {value!r}")
+        return value
+
+    def point(self, value: object, where: str) -> tuple[float, float]:
+        if not isinstance(value, list) or len(value) != 2:
+            raise self.fail(where, f"expected [x, y] in metres, got {value!r}")
+        return (self.number(value[0], f"{where}[0]"), self.number(value[1], f"{where}[1]"))
+
+    def angle(
+        self, table: Mapping[str, object], name: str, where: str, *, required: bool, sep: str = " "
+    ) -> float:
+        radians, degrees = table.get(name), table.get(f"{name}_deg")
+        if radians is not None and degrees is not None:
+            raise self.fail(f"{where}{sep}{name}_deg", f"expected {name} or {name}_deg, got both")
+        if degrees is not None:
+            return math.radians(self.number(degrees, f"{where}{sep}{name}_deg"))
+        if radians is not None:
+            return self.number(radians, f"{where}{sep}{name}")
+        if required:
+            raise self.fail(
+                f"{where}{sep}{name}_deg", f"expected {name}_deg (or {name} in radians), got none"
+            )
+        return 0.0
+
+    def path(self, value: object, where: str, base: Path) -> Path:
+        text = self.string(value, where)
+        path = Path(text)
+        return path if path.is_absolute() else base / path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Scenario:
+    r"""A simulation scenario: world, terrain statistics, camera, start, route and limits.
+
+    Read one with :meth:`from_toml` (format in this module's documentation); build the
+    true robot, the scene and the synthetic camera from it; or :meth:`simulate` the whole
+    route, frame by frame.
+
+    Parameters
+    ----------
+    name : str
+        Short name.
+    description : str
+        Free text.
+    meadow_map : MeadowMap
+        The world.
+    terrain : TerrainTable
+        Terrain statistics, holding every meadow's terrain.
+    camera : Camera
+        The robot's camera.
+    start : StartState
+        The believed start.
+    commands : tuple of TurnAndRun
+        The route as commands, in order.
+    landmark_ids : tuple of str
+        The landmarks the robot uses, in map order.
+    frame_spacing : float or None
+        Metres of commanded run between frames (None: frames at the start and at the end
+        of every command only).
+    lost : LostLimits
+        When to declare the robot lost.
+    render : RenderSettings
+        Settings of the synthetic scene and camera.
+    source : str
+        The file it was read from (``""`` when built in code).
+
+    Examples
+    --------
+    >>> import math, pathlib, tempfile
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "cam.toml").write_text(
+    ...     "[intrinsics]\nfx = 549\nfy = 549\ncx = 255.5\ncy = 239.5\nwidth = 512\nheight = 480\n"
+    ...     "[mount]\nheight = 1.2\ntilt_deg = 3\n")
+    >>> _ = (folder / "walk.toml").write_text(
+    ...     'map = "sample:paper_sidewalk"\ncamera = "cam.toml"\nframe_spacing = 2.0\n'
+    ...     "[start]\nx = 0.0\ny = 0.0\nheading_deg = 0.0\nposition_radius = 0.3\n"
+    ...     "heading_halfwidth_deg = 2.0\n[route]\ncommands = [{turn_deg = 0.0, run = 5.0}]\n")
+    >>> scenario = Scenario.from_toml(folder / "walk.toml")
+    >>> [command.run for command in scenario.legs()]       # a frame every 2 m, and at the stop
+    [2.0, 2.0, 1.0]
+    >>> frames = list(scenario.simulate(np.random.default_rng(0)))
+    >>> len(frames), frames[-1].image.shape, frames[-1].distance
+    (4, (480, 512), 5.0)
+    >>> _ = (folder / "bad.toml").write_text('map = "sample:moon"\ncamera = "cam.toml"\n')
+    >>> Scenario.from_toml(folder / "bad.toml")              # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...bad.toml: map: expected one of indoor_corridor, ..., got 'moon'
+    """
+
+    name: str
+    description: str
+    meadow_map: MeadowMap
+    terrain: TerrainTable
+    camera: Camera
+    start: StartState
+    commands: tuple[TurnAndRun, ...]
+    landmark_ids: tuple[str, ...]
+    frame_spacing: float | None = None
+    lost: LostLimits = LostLimits()
+    render: RenderSettings = RenderSettings()
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        for name, kind in (
+            ("meadow_map", MeadowMap),
+            ("terrain", TerrainTable),
+            ("camera", Camera),
+            ("start", StartState),
+            ("lost", LostLimits),
+            ("render", RenderSettings),
+        ):
+            value = getattr(self, name)
+            if not isinstance(value, kind):
+                raise InputError(f"Scenario.{name}: expected a {kind.__name__}, got {type(value).__name__}")
+        commands = tuple(self.commands)
+        for index, command in enumerate(commands):
+            if not isinstance(command, TurnAndRun):
+                raise InputError(f"Scenario.commands[{index}]: expected a TurnAndRun, got {command!r}")
+        object.__setattr__(self, "commands", commands)
+        ids = tuple(self.landmark_ids)
+        for index, ident in enumerate(ids):
+            self.meadow_map.landmark(ident)  # raises, naming the id, when unknown
+            if ident in ids[:index]:
+                raise InputError(
+                    f"Scenario.landmark_ids[{index}]: expected each id once, got {ident!r} again"
+                )
+        object.__setattr__(self, "landmark_ids", ids)
+        if self.frame_spacing is not None:
+            spacing = finite_float(self.frame_spacing, "Scenario.frame_spacing")
+            if spacing <= 0.0:
+                raise InputError(
+                    f"Scenario.frame_spacing: expected a positive number or None, got {spacing!r}"
+                )
+            object.__setattr__(self, "frame_spacing", spacing)
+
+    # --- reading ---------------------------------------------------------------------------
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scenario:
+        """Read a scenario file (format: this module's documentation).
+
+        Parameters
+        ----------
+        path : str or Path
+            The TOML file; the paths in it are relative to its folder.
+
+        Returns
+        -------
+        Scenario
+            The scenario, with its map, terrain table and camera loaded.
+
+        Raises
+        ------
+        FileFormatError
+            Naming the scenario file and the key (``map``, ``[start] x``,
+            ``[route] commands[2].run``, ...): unreadable file, malformed TOML, unknown or
+            missing keys, wrong types or values out of range, and files it names that do
+            not load (their own error is quoted).
+        """
+        source = str(path)
+        reader = _Reader(source)
+        try:
+            text = Path(path).read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise reader.fail("", "expected an existing scenario file, got no such file") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            reason = exc.strerror if isinstance(exc, OSError) else "bytes that are not UTF-8"
+            raise reader.fail("", f"expected a readable scenario file, got {reason}") from None
+        try:
+            document = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            line = re.search(r"line (\d+)", str(exc))
+            raise reader.fail(f"line {line.group(1)}" if line else "", f"expected TOML, got {exc}") from None
+        return cls._from_document(document, reader, Path(path).parent, Path(path).stem)
+
+    @classmethod
+    def _from_document(
+        cls, document: Mapping[str, object], reader: _Reader, base: Path, stem: str
+    ) -> Scenario:
+        reader.keys(document, _TOP_KEYS, "")
+        name = reader.string(document.get("name", stem), "name")
+        description = document.get("description", "")
+        if not isinstance(description, str):
+            raise reader.fail("description", f"expected a string, got {description!r}")
+        terrain = _load_terrain(document, reader, base)
+        meadow_map = _load_map(document, reader, base, terrain)
+        if "camera" not in document:
+            raise reader.fail("camera", "expected the path of a camera TOML file, got none")
+        camera_path = reader.path(document["camera"], "camera", base)
+        try:
+            camera = load_camera(camera_path)
+        except FileFormatError as exc:
+            raise reader.fail("camera", f"expected a camera file that loads, got: {exc}") from None
+        landmark_ids = _landmark_ids(document, reader, meadow_map)
+        start = _start(reader.table(document, "start", required=True), reader, meadow_map)
+        commands = _route(reader.table(document, "route", required=True), reader, meadow_map, start.pose)
+        spacing = _frame_spacing(document, reader)
+        lost = _lost(reader.table(document, "lost", required=False), reader)
+        render = _render(reader.table(document, "render", required=False), reader)
+        return cls(
+            name,
+            description,
+            meadow_map,
+            terrain,
+            camera,
+            start,
+            commands,
+            landmark_ids,
+            spacing,
+            lost,
+            render,
+            reader.source,
+        )
+
+    # --- using -----------------------------------------------------------------------------
+
+    @property
+    def landmarks(self) -> tuple[LandmarkRecord, ...]:
+        """The landmark records the robot uses (:attr:`landmark_ids`), in map order."""
+        return tuple(self.meadow_map.landmark(i) for i in self.landmark_ids)
+
+    def initial_map(self) -> SpatialUncertaintyMap:
+        """Return the spatial uncertainty map at the start (:meth:`SpatialUncertaintyMap.from_pose`)."""
+        s = self.start
+        return SpatialUncertaintyMap.from_pose(s.pose, s.position_radius, s.heading_halfwidth)
+
+    def legs(self) -> tuple[TurnAndRun, ...]:
+        """Return the commands cut where frames are taken: a frame follows each leg.
+
+        A command's turn stays with its first leg; the later legs of it only run.
+        """
+        if self.frame_spacing is None:
+            return self.commands
+        legs: list[TurnAndRun] = []
+        travelled = 0.0
+        tolerance = 1e-9 * max(1.0, self.frame_spacing)
+        for command in self.commands:
+            turn, remaining = command.turn, command.run
+            while True:
+                to_next = self.frame_spacing - math.fmod(travelled, self.frame_spacing)
+                if to_next >= remaining - tolerance:
+                    legs.append(TurnAndRun(turn, remaining))
+                    travelled += remaining
+                    break
+                legs.append(TurnAndRun(turn, to_next))
+                turn, remaining, travelled = 0.0, remaining - to_next, travelled + to_next
+        return tuple(legs)
+
+    def sample_true_start(self, rng: np.random.Generator) -> Pose:
+        """Draw a true start uniformly in the start disk and wedge (inside a meadow).
+
+        Draws again (up to 100 times) when the position falls outside every meadow, then
+        falls back on the believed start.
+        """
+        s = self.start
+        for _ in range(_START_DRAWS):
+            radius = s.position_radius * math.sqrt(rng.uniform())
+            angle = rng.uniform(-math.pi, math.pi)
+            heading = s.pose.heading + rng.uniform(-1.0, 1.0) * s.heading_halfwidth
+            x, y = s.pose.x + radius * math.cos(angle), s.pose.y + radius * math.sin(angle)
+            if self.meadow_map.meadow_at(x, y) is not None:
+                return Pose(x, y, heading)
+        return s.pose
+
+    def scene(self, rng: np.random.Generator) -> Scene:
+        """Build the scene of the map with :attr:`render`'s settings (texture, clutter from ``rng``)."""
+        r = self.render
+        return Scene.from_meadow_map(
+            self.meadow_map,
+            rng,
+            pole_radius=r.pole_radius,
+            stripe_width=r.stripe_width,
+            building_size=(r.building_width, r.building_depth),
+            building_base=r.building_base,
+            clutter=r.clutter,
+        )
+
+    def synthetic_camera(self, rng: np.random.Generator, *, scene: Scene | None = None) -> SyntheticCamera:
+        """Return a synthetic camera on this scenario's camera (scene from ``rng`` unless given)."""
+        r = self.render
+        the_scene = self.scene(rng) if scene is None else scene
+        return SyntheticCamera(self.camera, the_scene, rng, noise=r.noise, clutter_lines=r.clutter_lines)
+
+    def robot(self, pose: Pose, rng: np.random.Generator, *, truncate: float | None = None) -> SimulatedRobot:
+        """Return the true robot at ``pose`` in this scenario's world."""
+        return SimulatedRobot(self.meadow_map, self.terrain, pose, rng, truncate=truncate)
+
+    def simulate(
+        self, rng: np.random.Generator, *, exact_start: bool = False, truncate: float | None = None
+    ) -> Iterator[SimulatedFrame]:
+        """Drive the route and yield a frame at the start and after every leg (:meth:`legs`).
+
+        ``rng`` is split (``rng.spawn``) into the start's, the robot's and the camera's
+        generators, so a seed fixes the whole run.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            Source of randomness.
+        exact_start : bool
+            Start at the believed start pose instead of one drawn within its bounds.
+        truncate : float, optional
+            Clip the motion model's normals (see :class:`SimulatedRobot`).
+        """
+        start_rng, motion_rng, camera_rng = rng.spawn(3)
+        pose = self.start.pose if exact_start else self.sample_true_start(start_rng)
+        robot = self.robot(pose, motion_rng, truncate=truncate)
+        camera = self.synthetic_camera(camera_rng)
+        distance = 0.0
+
+        def shot() -> NDArray[np.uint8]:
+            image = camera.render(robot.pose)
+            image.setflags(write=False)
+            return image
+
+        yield SimulatedFrame(0, None, robot.pose, shot(), distance)
+        for index, leg in enumerate(self.legs(), start=1):
+            robot.execute(leg)
+            distance += leg.run
+            yield SimulatedFrame(index, leg, robot.pose, shot(), distance)
+
+    def __repr__(self) -> str:
+        return (
+            f"Scenario(name={self.name!r}, commands={len(self.commands)}, "
+            f"landmarks={len(self.landmark_ids)}, source={self.source!r})"
+        )
+
+
+# ------------------------------------------------------------------------------ parts
+
+
+def _load_terrain(document: Mapping[str, object], reader: _Reader, base: Path) -> TerrainTable:
+    value = document.get("terrain", "default")
+    if value == "default":
+        return TerrainTable.default()
+    path = reader.path(value, "terrain", base)
+    try:
+        return TerrainTable.from_toml(path)
+    except FileFormatError as exc:
+        raise reader.fail("terrain", f"expected a terrain table file that loads, got: {exc}") from None
+
+
+def _load_map(
+    document: Mapping[str, object], reader: _Reader, base: Path, terrain: TerrainTable
+) -> MeadowMap:
+    if "map" not in document:
+        raise reader.fail("map", "expected a GeoJSON meadow map path or sample:<name>, got none")
+    value = reader.string(document["map"], "map")
+    if value.startswith(_SAMPLE_PREFIX):
+        try:
+            meadow_map = sample_world(value[len(_SAMPLE_PREFIX) :])
+        except InputError as exc:
+            raise reader.fail("map", str(exc).split(": ", 1)[-1]) from None
+        for meadow in meadow_map.meadows:
+            if meadow.terrain not in terrain:
+                raise reader.fail(
+                    "terrain",
+                    f"expected a table with the terrain {meadow.terrain!r} of meadow {meadow.id!r}, "
+                    f"got terrains {', '.join(sorted(terrain))}",
+                )
+        return meadow_map
+    path = reader.path(value, "map", base)
+    try:
+        return MeadowMap.from_geojson(path, terrain_table=terrain)
+    except FileFormatError as exc:
+        raise reader.fail("map", f"expected a meadow map file that loads, got: {exc}") from None
+
+
+def _landmark_ids(document: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap) -> tuple[str, ...]:
+    if "landmarks" not in document:
+        return tuple(record.id for record in meadow_map.landmarks)
+    value = document["landmarks"]
+    if not isinstance(value, list):
+        raise reader.fail("landmarks", f"expected a list of landmark ids, got {value!r}")
+    known = {record.id for record in meadow_map.landmarks}
+    for index, item in enumerate(value):
+        where = f"landmarks[{index}]"
+        ident = reader.string(item, where)
+        if ident not in known:
+            raise reader.fail(where, f"expected the id of a landmark of the map, got {ident!r}")
+        if ident in value[:index]:
+            raise reader.fail(where, f"expected each id once, got {ident!r} again")
+    chosen = set(value)
+    return tuple(record.id for record in meadow_map.landmarks if record.id in chosen)
+
+
+def _start(table: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap) -> StartState:
+    reader.keys(table, _START_KEYS, "[start]")
+    values: dict[str, float] = {}
+    for key in ("x", "y", "position_radius"):
+        if key not in table:
+            raise reader.fail(f"[start] {key}", "expected this key, got none")
+    values["x"] = reader.number(table["x"], "[start] x")
+    values["y"] = reader.number(table["y"], "[start] y")
+    radius = reader.nonnegative(table["position_radius"], "[start] position_radius")
+    heading = reader.angle(table, "heading", "[start]", required=True)
+    halfwidth = reader.angle(table, "heading_halfwidth", "[start]", required=True)
+    if halfwidth < 0.0:
+        raise reader.fail(
+            "[start] heading_halfwidth_deg", f"expected a non-negative angle, got {halfwidth!r}"
+        )
+    if meadow_map.meadow_at(values["x"], values["y"]) is None:
+        raise reader.fail(
+            "[start] x", f"expected a start inside a meadow, got ({values['x']}, {values['y']})"
+        )
+    return StartState(Pose(values["x"], values["y"], heading), radius, halfwidth)
+
+
+def _commands_through(
+    points: NDArray[np.float64], pose: Pose, reader: _Reader, where: str
+) -> list[TurnAndRun]:
+    commands: list[TurnAndRun] = []
+    x, y, heading = pose.x, pose.y, pose.heading
+    for index, (px, py) in enumerate(points):
+        dx, dy = float(px) - x, float(py) - y
+        run = math.hypot(dx, dy)
+        if run == 0.0:
+            raise reader.fail(
+                f"{where}[{index}]", f"expected a point away from the previous one, got ({px}, {py})"
+            )
+        direction = math.atan2(dy, dx)
+        commands.append(TurnAndRun(wrap_angle(direction - heading), run))
+        x, y, heading = float(px), float(py), direction
+    return commands
+
+
+def _route(
+    table: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap, pose: Pose
+) -> tuple[TurnAndRun, ...]:
+    reader.keys(table, ("commands", "waypoints", "goal"), "[route]")
+    given = [key for key in ("commands", "waypoints", "goal") if key in table]
+    if len(given) != 1:
+        found = ", ".join(given) if given else "none"
+        raise reader.fail("[route]", f"expected exactly one of commands, waypoints, goal, got {found}")
+    key = given[0]
+    where = f"[route] {key}"
+    value = table[key]
+    if key == "goal":
+        goal = reader.point(value, where)
+        try:
+            route = plan_route(meadow_map, (pose.x, pose.y), goal)
+        except InputError as exc:
+            raise reader.fail(where, f"expected a goal reachable from the start, got: {exc}") from None
+        if len(route.waypoints) < 2:
+            raise reader.fail(where, f"expected a goal away from the start, got {list(goal)}")
+        return tuple(_commands_through(route.waypoints[1:], pose, reader, where))
+    if not isinstance(value, list) or not value:
+        raise reader.fail(where, f"expected a non-empty list, got {value!r}")
+    if key == "waypoints":
+        points = np.array([reader.point(item, f"{where}[{i}]") for i, item in enumerate(value)])
+        return tuple(_commands_through(points, pose, reader, where))
+    commands: list[TurnAndRun] = []
+    for index, item in enumerate(value):
+        place = f"{where}[{index}]"
+        if not isinstance(item, dict):
+            raise reader.fail(place, f"expected a table {{turn_deg = ..., run = ...}}, got {item!r}")
+        reader.keys(item, ("turn", "turn_deg", "run"), place, ".")
+        turn = reader.angle(item, "turn", place, required=False, sep=".")
+        if "run" not in item:
+            raise reader.fail(f"{place}.run", "expected the run in metres, got none")
+        commands.append(TurnAndRun(turn, reader.nonnegative(item["run"], f"{place}.run")))
+    return tuple(commands)
+
+
+def _frame_spacing(document: Mapping[str, object], reader: _Reader) -> float | None:
+    spacing, rate, speed = document.get("frame_spacing"), document.get("frame_rate"), document.get("speed")
+    if spacing is not None and rate is not None:
+        raise reader.fail("frame_rate", "expected frame_spacing or frame_rate, got both")
+    if spacing is not None:
+        if speed is not None:
+            raise reader.fail("speed", "expected speed only with frame_rate, got it with frame_spacing")
+        return reader.positive(spacing, "frame_spacing")
+    if rate is not None:
+        if speed is None:
+            raise reader.fail("speed", "expected the speed (m/s) that goes with frame_rate, got none")
+        return reader.positive(speed, "speed") / reader.positive(rate, "frame_rate")
+    if speed is not None:
+        raise reader.fail("speed", "expected speed only with frame_rate, got no frame_rate")
+    return None
+
+
+def _lost(table: Mapping[str, object], reader: _Reader) -> LostLimits:
+    reader.keys(table, ("area_limit", "missed_limit"), "[lost]")
+    area = reader.positive(table["area_limit"], "[lost] area_limit") if "area_limit" in table else math.inf
+    missed = reader.integer(table["missed_limit"], "[lost] missed_limit", 1) if "missed_limit" in table else 3
+    return LostLimits(area, missed)
+
+
+def _render(table: Mapping[str, object], reader: _Reader) -> RenderSettings:
+    reader.keys(table, _RENDER_KEYS, "[render]")
+    default = RenderSettings()
+    values: dict[str, float | int] = {}
+    for key in _RENDER_KEYS:
+        where = f"[render] {key}"
+        if key not in table:
+            values[key] = getattr(default, key)
+        elif key in ("clutter", "clutter_lines"):
+            values[key] = reader.integer(table[key], where, 0)
+        elif key in ("noise", "building_base"):
+            values[key] = reader.nonnegative(table[key], where)
+        else:
+            values[key] = reader.positive(table[key], where)
+    return RenderSettings(
+        noise=float(values["noise"]),
+        clutter=int(values["clutter"]),
+        clutter_lines=int(values["clutter_lines"]),
+        pole_radius=float(values["pole_radius"]),
+        stripe_width=float(values["stripe_width"]),
+        building_width=float(values["building_width"]),
+        building_depth=float(values["building_depth"]),
+        building_base=float(values["building_base"]),
+    )
+
+
+def waypoints_array(scenario: Scenario) -> NDArray[np.float64]:
+    """Return the commanded positions after each command, ``(n + 1, 2)`` from the start (read-only).
+
+    Examples
+    --------
+    >>> from aura_ums.camera import CameraIntrinsics, CameraMount
+    >>> from aura_ums.world import sample_world
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0))
+    >>> route = (TurnAndRun(0, 2.0), TurnAndRun(math.pi / 2, 0.5))
+    >>> s = Scenario("s", "", sample_world("paper_sidewalk"), TerrainTable.default(), camera,
+    ...              StartState(Pose(0, 0, 0), 0.3, 0.05), route, ())
+    >>> waypoints_array(s).round(6).tolist()
+    [[0.0, 0.0], [2.0, 0.0], [2.0, 0.5]]
+    """
+    x, y, heading = scenario.start.pose.x, scenario.start.pose.y, scenario.start.pose.heading
+    points = [(x, y)]
+    for command in scenario.commands:
+        heading += command.turn
+        x, y = x + command.run * math.cos(heading), y + command.run * math.sin(heading)
+        points.append((x, y))
+    return read_only(np.array(points))

@@ -1,0 +1,321 @@
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
+from aura_ums.sim import LostLimits, Scenario, StartState, waypoints_array
+from aura_ums.uncertainty import FOOT, LandmarkClass, TurnAndRun
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SCENARIO_FILES = sorted(p for p in SCENARIOS.glob("*.toml") if not p.name.endswith("camera.toml"))
+
+GOOD = """\
+map = "sample:paper_sidewalk"
+camera = "cam.toml"
+frame_spacing = 2.0
+
+[start]
+x = 0.0
+y = 0.0
+heading_deg = 0.0
+position_radius = 0.3
+heading_halfwidth_deg = 2.0
+
+[route]
+commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]
+
+[lost]
+area_limit = 20.0
+missed_limit = 2
+"""
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    shutil.copy(SCENARIOS / "paper_camera.toml", tmp_path / "cam.toml")
+    (tmp_path / "good.toml").write_text(GOOD)
+    return tmp_path
+
+
+def test_expected_scenario_files_exist() -> None:
+    names = {p.stem for p in SCENARIO_FILES}
+    assert {"paper_sidewalk", "paper_sidewalk_class2", "indoor_corridor", "four_terrains"} <= names
+
+
+@pytest.mark.parametrize("path", SCENARIO_FILES, ids=lambda p: p.stem)
+def test_each_scenario_file_loads_and_runs(path: Path) -> None:
+    scenario = Scenario.from_toml(path)
+    assert scenario.name == path.stem
+    assert scenario.commands
+    assert set(scenario.landmark_ids) <= {record.id for record in scenario.meadow_map.landmarks}
+    start = scenario.initial_map()
+    assert start.contains(scenario.start.pose.x, scenario.start.pose.y, scenario.start.pose.heading)
+    frames = list(scenario.simulate(np.random.default_rng(0)))
+    assert len(frames) == len(scenario.legs()) + 1
+    assert frames[-1].distance == pytest.approx(sum(c.run for c in scenario.commands))
+    intrinsics = scenario.camera.intrinsics
+    assert all(f.image.shape == (intrinsics.height, intrinsics.width) for f in frames)
+
+
+def test_paper_sidewalk_is_the_papers_experiment() -> None:
+    scenario = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")
+    assert scenario.start.position_radius == pytest.approx(FOOT)
+    assert scenario.frame_spacing is None
+    distances = [f.distance for f in scenario.simulate(np.random.default_rng(1), exact_start=True)]
+    assert distances == pytest.approx([0.0, 10 * FOOT, 20 * FOOT, 40 * FOOT])
+    k = scenario.camera.intrinsics
+    assert (k.width, k.height) == (512, 480)
+    assert math.degrees(2.0 * math.atan(k.width / 2.0 / k.fx)) == pytest.approx(50.0, abs=1.0)
+    assert scenario.camera.mount.height == pytest.approx(1.2)
+    classes = {record.symbol: record.landmark_class for record in scenario.landmarks}
+    assert classes == {
+        "telephone pole": LandmarkClass.VERTICAL_LINE,
+        "lamppost": LandmarkClass.VERTICAL_LINE,
+        "building corner": LandmarkClass.VERTICAL_LINE,
+    }
+    class2 = Scenario.from_toml(SCENARIOS / "paper_sidewalk_class2.toml")
+    assert {r.symbol: r.landmark_class for r in class2.landmarks}["building corner"] is LandmarkClass.POINT
+
+
+def test_four_terrains_crosses_every_terrain() -> None:
+    scenario = Scenario.from_toml(SCENARIOS / "four_terrains.toml")
+    assert scenario.frame_spacing == pytest.approx(2.0)  # frame_rate 1/s at 2 m/s
+    robot = scenario.robot(scenario.start.pose, np.random.default_rng(0))
+    seen: list[str] = []
+    for leg in scenario.legs():
+        robot.execute(leg)
+        seen.extend(terrain for _, terrain in robot.last_steps)
+    assert list(dict.fromkeys(seen)) == ["tile", "concrete", "grass", "gravel"]
+
+
+def test_frames_every_spacing_and_at_every_stop(folder: Path) -> None:
+    scenario = Scenario.from_toml(folder / "good.toml")
+    legs = scenario.legs()
+    assert [leg.run for leg in legs] == pytest.approx([2.0, 2.0, 1.0, 1.0])
+    assert [leg.turn for leg in legs] == pytest.approx([0.0, 0.0, 0.0, math.radians(10.0)])
+    assert scenario.lost.area_limit == 20.0
+    assert scenario.lost.missed_limit == 2
+    assert scenario.name == "good"
+    assert waypoints_array(scenario)[-1] == pytest.approx(
+        [5.0 + math.cos(0.17453292519943295), 0.17364817766693033]
+    )
+
+
+def test_simulation_is_deterministic_per_seed(folder: Path) -> None:
+    scenario = Scenario.from_toml(folder / "good.toml")
+    a = list(scenario.simulate(np.random.default_rng(3)))
+    b = list(scenario.simulate(np.random.default_rng(3)))
+    c = list(scenario.simulate(np.random.default_rng(4)))
+    assert [f.pose for f in a] == [f.pose for f in b]
+    assert all(np.array_equal(f.image, g.image) for f, g in zip(a, b, strict=True))
+    assert [f.pose for f in a] != [f.pose for f in c]
+    assert a[0].command is None
+    assert a[1].command == TurnAndRun(0.0, 2.0)
+
+
+def test_true_start_is_within_the_start_bounds(folder: Path) -> None:
+    scenario = Scenario.from_toml(folder / "good.toml")
+    start = scenario.initial_map()
+    rng = np.random.default_rng(0)
+    for _ in range(100):
+        pose = scenario.sample_true_start(rng)
+        assert math.hypot(pose.x, pose.y) <= 0.3
+        assert abs(pose.heading) <= math.radians(2.0) + 1e-12
+        assert start.contains(pose.x, pose.y, pose.heading)
+
+
+def test_route_from_waypoints_and_from_a_goal(folder: Path) -> None:
+    text = GOOD.replace(
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "waypoints = [[4.0, 0.0], [4.0, 0.5]]",
+    )
+    (folder / "w.toml").write_text(text)
+    commands = Scenario.from_toml(folder / "w.toml").commands
+    assert [value for c in commands for value in (c.turn, c.run)] == pytest.approx(
+        [0.0, 4.0, math.pi / 2, 0.5]
+    )
+    (folder / "g.toml").write_text(text.replace("waypoints = [[4.0, 0.0], [4.0, 0.5]]", "goal = [12.0, 0.0]"))
+    commands = Scenario.from_toml(folder / "g.toml").commands
+    assert sum(c.run for c in commands) == pytest.approx(12.0)
+    assert all(c.turn == pytest.approx(0.0) for c in commands)
+
+
+def test_relative_geojson_map_and_terrain_files(folder: Path) -> None:
+    shutil.copy(SCENARIOS / "four_terrains.geojson", folder / "sub_map.geojson")
+    (folder / "terrain.toml").write_text(
+        "".join(
+            f"[{name}]\n"
+            + "".join(
+                f"{key} = 0.01\n"
+                for key in (
+                    "translation_loss",
+                    "translation_inertial_loss",
+                    "translation_sd",
+                    "drift",
+                    "rotation_loss",
+                    "rotation_sd",
+                    "skitter",
+                    "skitter_sd",
+                )
+            )
+            for name in ("tile", "concrete", "grass", "gravel")
+        )
+    )
+    text = GOOD.replace('map = "sample:paper_sidewalk"', 'map = "sub_map.geojson"\nterrain = "terrain.toml"')
+    text = text.replace("x = 0.0\n", "x = 1.0\n")
+    (folder / "m.toml").write_text(text)
+    scenario = Scenario.from_toml(folder / "m.toml")
+    assert scenario.terrain["grass"].drift == 0.01
+    assert len(scenario.meadow_map.meadows) == 4
+
+
+MALFORMED = [
+    # (replace this, with that, key named in the message, what the message says)
+    ('map = "sample:paper_sidewalk"', 'map = "sample:moon"', "map", "expected one of"),
+    ('map = "sample:paper_sidewalk"', 'map = "nowhere.geojson"', "map", "nowhere.geojson.*No such file"),
+    ('map = "sample:paper_sidewalk"', "map = 3", "map", "expected a non-empty string"),
+    ('map = "sample:paper_sidewalk"\n', "", "map", "got none"),
+    ('camera = "cam.toml"', 'camera = "missing.toml"', "camera", "no such file"),
+    ('camera = "cam.toml"\n', "", "camera", "got none"),
+    (
+        'camera = "cam.toml"',
+        'camera = "cam.toml"\nterrain = "none.toml"',
+        "terrain",
+        "expected a terrain table",
+    ),
+    ("frame_spacing = 2.0", "frame_spacing = -1.0", "frame_spacing", "expected a positive number"),
+    ("frame_spacing = 2.0", "frame_spacing = 2.0\nframe_rate = 1.0", "frame_rate", "got both"),
+    ("frame_spacing = 2.0", "frame_rate = 1.0", "speed", "expected the speed"),
+    ("frame_spacing = 2.0", "frame_spacing = 2.0\ncolour = 1", "colour", "unknown key 'colour'"),
+    ("frame_spacing = 2.0", 'frame_spacing = 2.0\nlandmarks = ["nope"]', r"landmarks\[0\]", "got 'nope'"),
+    ("x = 0.0\n", "", r"\[start\] x", "expected this key"),
+    ("x = 0.0", 'x = "east"', r"\[start\] x", "expected a number"),
+    ("x = 0.0", "x = 100.0", r"\[start\] x", "expected a start inside a meadow"),
+    ("heading_deg = 0.0", "heading_deg = 0.0\nheading = 0.0", r"\[start\] heading_deg", "got both"),
+    ("heading_halfwidth_deg = 2.0\n", "", r"\[start\] heading_halfwidth_deg", "got none"),
+    ("position_radius = 0.3", "position_radius = -0.3", r"\[start\] position_radius", "non-negative"),
+    ("position_radius = 0.3", "position_radius = 0.3\nspeed = 3", r"\[start\] speed", "unknown key"),
+    ("run = 5.0 }", "run = -5.0 }", r"\[route\] commands\[0\]\.run", "non-negative"),
+    ("{ turn_deg = 10.0, run = 1.0 }", "{ turn_deg = 10.0 }", r"\[route\] commands\[1\]\.run", "got none"),
+    (
+        "{ turn_deg = 10.0, run = 1.0 }",
+        "{ turn = 1, turn_deg = 1, run = 1 }",
+        r"\[route\] commands\[1\]\.turn_deg",
+        "both",
+    ),
+    ("{ turn_deg = 10.0, run = 1.0 }", "{ spin = 1, run = 1 }", r"\[route\] commands\[1\]\.spin", "unknown"),
+    ("{ turn_deg = 10.0, run = 1.0 }", "3", r"\[route\] commands\[1\]", "expected a table"),
+    ("commands = [", "waypoints = [[1.0, 0.0]]\ncommands = [", r"\[route\]", "expected exactly one"),
+    (
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "commands = []",
+        r"\[route\] commands",
+        "non-empty list",
+    ),
+    (
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "waypoints = [[1.0]]",
+        r"\[route\] waypoints\[0\]",
+        r"expected \[x, y\]",
+    ),
+    (
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "waypoints = [[0.0, 0.0]]",
+        r"\[route\] waypoints\[0\]",
+        "away from the previous",
+    ),
+    (
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "goal = [500.0, 0.0]",
+        r"\[route\] goal",
+        "expected a goal reachable",
+    ),
+    ("area_limit = 20.0", "area_limit = 0", r"\[lost\] area_limit", "positive"),
+    ("missed_limit = 2", "missed_limit = 1.5", r"\[lost\] missed_limit", "integer >= 1"),
+    ("[lost]", "[render]\nnoise = -1\n[lost]", r"\[render\] noise", "non-negative"),
+    ("[lost]", "[render]\nclutter = 2.5\n[lost]", r"\[render\] clutter", "integer >= 0"),
+    ("[lost]", "[render]\nsparkle = 1\n[lost]", r"\[render\] sparkle", "unknown key"),
+    ("[lost]", "x = = 3\n[lost]", "line 15", "expected TOML"),
+    ("[start]", "[begin]", "begin", "unknown key 'begin'"),
+    (
+        "[route]\ncommands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]\n",
+        "",
+        r"\[route\]",
+        "expected this table, got none",
+    ),
+]
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key", "message"), MALFORMED, ids=[f"{m[2]}-{i}" for i, m in enumerate(MALFORMED)]
+)
+def test_malformed_scenario_names_file_and_key(
+    folder: Path, old: str, new: str, key: str, message: str
+) -> None:
+    assert old in GOOD
+    path = folder / "bad.toml"
+    path.write_text(GOOD.replace(old, new, 1))
+    with pytest.raises(FileFormatError, match=rf"bad\.toml: {key}.*{message}") as info:
+        Scenario.from_toml(path)
+    assert info.value.path == str(path)
+
+
+def test_missing_and_unreadable_scenario_files(tmp_path: Path) -> None:
+    with pytest.raises(FileFormatError, match=r"none\.toml: expected an existing scenario file"):
+        Scenario.from_toml(tmp_path / "none.toml")
+    (tmp_path / "bin.toml").write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(FileFormatError, match=r"bin\.toml: expected a readable scenario file, got bytes"):
+        Scenario.from_toml(tmp_path / "bin.toml")
+
+
+def test_sample_map_with_a_table_lacking_its_terrain(folder: Path) -> None:
+    (folder / "t.toml").write_text(
+        "[concrete]\n"
+        + "".join(
+            f"{key} = 0.0\n"
+            for key in (
+                "translation_loss",
+                "translation_inertial_loss",
+                "translation_sd",
+                "drift",
+                "rotation_loss",
+                "rotation_sd",
+                "skitter",
+                "skitter_sd",
+            )
+        )
+    )
+    (folder / "bad.toml").write_text(
+        GOOD.replace('camera = "cam.toml"', 'camera = "cam.toml"\nterrain = "t.toml"')
+    )
+    with pytest.raises(
+        FileFormatError, match=r"bad\.toml: terrain: expected a table with the terrain 'gravel'"
+    ):
+        Scenario.from_toml(folder / "bad.toml")
+
+
+def test_values_built_in_code_are_checked() -> None:
+    scenario = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")
+    with pytest.raises(InputError, match=r"StartState.position_radius: expected a non-negative number"):
+        StartState(scenario.start.pose, -1.0, 0.1)
+    with pytest.raises(InputError, match=r"LostLimits.missed_limit: expected an integer >= 1, got 0"):
+        LostLimits(10.0, 0)
+    with pytest.raises(InputError, match=r"LostLimits.area_limit: expected a positive number"):
+        LostLimits(0.0, 2)
+    with pytest.raises(UnknownTerrainError, match="got 'nope'"):
+        dataclasses.replace(scenario, landmark_ids=("nope",))
+    with pytest.raises(InputError, match=r"Scenario.frame_spacing: expected a positive number or None"):
+        dataclasses.replace(scenario, frame_spacing=0.0)
+
+
+def test_frames_are_read_only() -> None:
+    scenario = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")
+    frame = next(iter(scenario.simulate(np.random.default_rng(0))))
+    with pytest.raises(ValueError, match="read-only"):
+        frame.image[0, 0] = 0
