@@ -19,10 +19,10 @@ def test_paper_map_becomes_poles_a_building_patches_and_edges() -> None:
     # the Class I edge at the Class II corner is the building's corner, not a pole
     assert building.id == "east_engineering_corner"
     assert building.z_top == 7.0
-    assert [24.5, 6.0] in building.footprint.tolist()
+    assert [24.5, 5.0] in building.footprint.tolist()
     # the box extends away from the map's centre, so its corner faces the walk
     assert building.footprint[:, 0].min() == 24.5
-    assert building.footprint[:, 1].min() == 6.0
+    assert building.footprint[:, 1].min() == 5.0
     assert len(scene.patches) == len(world.meadows)
     assert [s.id for s in scene.stripes[:2]] == ["sidewalk_north_edge", "sidewalk_south_edge"]
     assert len(scene.stripes) == 2 + 5
