@@ -46,6 +46,8 @@ bench: $(VENV)/.stamp-dev
 	$(BIN)/python benchmarks/bench_reduce.py
 	$(BIN)/python benchmarks/bench_expecter.py
 	$(BIN)/python benchmarks/bench_perception.py
+	$(BIN)/python benchmarks/bench_sim.py
+	$(BIN)/python benchmarks/bench_loop.py
 
 clean:
 	rm -rf $(VENV) $(REPORT) build dist src/*.egg-info

@@ -1,7 +1,9 @@
-"""The ``aura-ums`` command: figures, demo and the tools built on the library."""
+"""The ``aura-ums`` command: figures, demo, simulate and the tools built on the library."""
 
 from __future__ import annotations
 
+import json
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -36,12 +38,76 @@ def figures(
 def demo(
     out: Annotated[Path, typer.Option("--out", help="Folder for the report.")] = Path("report"),
     seed: Annotated[int, typer.Option(help="Seed of every random draw in the report.")] = 0,
+    runs: Annotated[int, typer.Option(help="Monte Carlo runs per variant in the summary.")] = 40,
 ) -> None:
-    """Run the main job and write its report (figures and summary.md) into OUT."""
-    from aura_ums.plot import write_growth_report
+    """Run the paper's experiment and write its report (figures and summary.md) into OUT."""
+    from aura_ums.plot import write_experiment_report
 
-    summary = write_growth_report(out, seed=seed)
+    summary = write_experiment_report(out, seed=seed, runs=runs)
     _console.print(f"wrote {summary}")
+
+
+def _fail(message: str) -> typer.Exit:
+    _console.print(f"[red]error:[/red] {message}", highlight=False)
+    return typer.Exit(code=2)
+
+
+@app.command()
+def simulate(
+    scenario: Annotated[Path, typer.Argument(help="Scenario TOML file (see aura_ums.sim).")],
+    runs: Annotated[int, typer.Option("--runs", help="Monte Carlo runs, >= 1.")] = 100,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the whole Monte Carlo, >= 0.")] = 0,
+    metrics_json: Annotated[
+        Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
+    ] = None,
+    prune: Annotated[
+        bool,
+        typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
+    ] = True,
+) -> None:
+    """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics."""
+    import numpy as np
+    from rich.progress import Progress
+
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.sim import Scenario, run_scenario, summarize_runs
+
+    if runs < 1:
+        raise _fail(f"--runs: expected an integer >= 1, got {runs}")
+    if seed < 0:
+        raise _fail(f"--seed: expected an integer >= 0, got {seed}")
+    if not scenario.is_file():
+        raise _fail(f"{scenario}: expected a scenario TOML file, got no such file")
+    try:
+        loaded = Scenario.from_toml(scenario)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    generators = np.random.default_rng(seed).spawn(runs)
+    results = []
+    try:
+        with Progress(console=_console, transient=True) as progress:
+            task = progress.add_task(f"{loaded.name}", total=runs)
+            for rng in generators:
+                results.append(run_scenario(loaded, rng, prune=prune))
+                progress.advance(task)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    metrics: dict[str, object] = {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune}
+    metrics.update(summarize_runs(results))
+    for key, value in metrics.items():
+        _console.print(f"{key:28s} {value}", highlight=False)
+    if metrics_json is not None:
+        clean = {
+            k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()
+        }
+        try:
+            metrics_json.parent.mkdir(parents=True, exist_ok=True)
+            metrics_json.write_text(json.dumps(clean, indent=2) + "\n")
+        except OSError as exc:
+            raise _fail(
+                f"--metrics-json: expected a writable path, got {metrics_json}: {exc.strerror}"
+            ) from None
+        _console.print(f"wrote {metrics_json}")
 
 
 def main() -> None:

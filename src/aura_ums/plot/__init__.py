@@ -1,6 +1,7 @@
 """Matplotlib figures of maps, wedges, windows and sampled outcomes, and the demo report."""
 
 from aura_ums.plot._expecter import draw_expecter_figures
+from aura_ums.plot._experiment import experiment_table, write_experiment_report
 from aura_ums.plot._growth import draw_all_figures, draw_growth_figures, write_growth_report
 from aura_ums.plot._reduction import PathRunStep, draw_path_figure, run_down_path
 
@@ -10,6 +11,8 @@ __all__ = [
     "draw_expecter_figures",
     "draw_growth_figures",
     "draw_path_figure",
+    "experiment_table",
     "run_down_path",
+    "write_experiment_report",
     "write_growth_report",
 ]

@@ -25,7 +25,7 @@ pixels); a record's ``recognition_threshold`` is compared with them directly.
 """
 
 from aura_ums.schemas._frame import Frame
-from aura_ums.schemas._manager import SchemaManager, StepReport
+from aura_ums.schemas._manager import SchemaManager, SchemaManagerState, StepReport
 from aura_ums.schemas._perceive import DEFAULT_MIN_ASPECT
 from aura_ums.schemas._pilot import Pilot
 from aura_ums.schemas._schema import DEFAULT_LOST_FRAMES, TRACKING_MARGIN, FindLandmarkSchema
@@ -40,6 +40,7 @@ __all__ = [
     "Frame",
     "Pilot",
     "SchemaManager",
+    "SchemaManagerState",
     "SchemaReport",
     "SchemaState",
     "SchemaStatus",

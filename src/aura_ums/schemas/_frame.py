@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,11 @@ class Frame:
         thresholds). Kept as a read-only array (copied when the caller's is writable).
     map : SpatialUncertaintyMap
         The map snapshot for that time (read-only: the schemas never change it).
+    window_scale : float
+        Factor (>= 1) by which the schemas widen the Expecter's windows about their
+        centres (the map manager's :attr:`~aura_ums.manager.UncertaintyMapManager.window_scale`
+        while lost); ``inf`` searches the whole image, tracking included (the full-frame
+        baseline). Default 1: the Expecter's windows as they are.
 
     Notes
     -----
@@ -52,9 +58,15 @@ class Frame:
     time: float
     image: NDArray[np.generic]
     map: SpatialUncertaintyMap
+    window_scale: float
 
-    def __init__(self, time: float, image: ArrayLike, map: SpatialUncertaintyMap) -> None:
+    def __init__(
+        self, time: float, image: ArrayLike, map: SpatialUncertaintyMap, *, window_scale: float = 1.0
+    ) -> None:
         when = finite_float(time, "time")
+        scale = float(window_scale) if isinstance(window_scale, (int, float)) else math.nan
+        if isinstance(window_scale, bool) or not scale >= 1.0:
+            raise InputError(f"window_scale: expected a number >= 1 (or inf), got {window_scale!r}")
         try:
             array = np.asarray(image)
         except (TypeError, ValueError) as exc:  # pragma: no cover - numpy accepts nearly anything
@@ -74,6 +86,7 @@ class Frame:
         object.__setattr__(self, "time", when)
         object.__setattr__(self, "image", array)
         object.__setattr__(self, "map", map)
+        object.__setattr__(self, "window_scale", scale)
 
     @property
     def width(self) -> int:

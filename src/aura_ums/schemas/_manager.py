@@ -67,6 +67,25 @@ class StepReport:
         raise InputError(f"landmark_id: expected one of {known}, got {landmark_id!r}")
 
 
+@dataclass(frozen=True, slots=True)
+class SchemaManagerState:
+    """A schema manager's mutable state, for save and restore (:meth:`SchemaManager.export_state`).
+
+    Parameters
+    ----------
+    statuses : tuple of (str, SchemaStatus)
+        Each instantiation's status, in instantiation order.
+    last_time : float or None
+        Time of the last frame stepped.
+    counters : tuple of int
+        frames, predicted_total, missed_total, missed_frames, posted_total, consecutive_missed.
+    """
+
+    statuses: tuple[tuple[str, SchemaStatus], ...]
+    last_time: float | None
+    counters: tuple[int, int, int, int, int, int]
+
+
 class SchemaManager:
     """Holds the find-landmark schema instantiations of a leg and steps them on every frame.
 
@@ -289,6 +308,47 @@ class SchemaManager:
             self._missed_frames += 1
         suspects = tuple(r.landmark_id for r in reports if r.state is SchemaState.SUSPECT)
         return StepReport(frame.time, reports, tuple(posted), missed, suspects, self._consecutive_missed)
+
+    def export_state(self) -> SchemaManagerState:
+        """Return the instantiations' statuses and the counters (immutable values), for saving."""
+        return SchemaManagerState(
+            tuple((schema.landmark_id, self._status[schema.landmark_id]) for schema in self._schemas),
+            self._last_time,
+            (
+                self._frames,
+                self._predicted_total,
+                self._missed_total,
+                self._missed_frames,
+                self._posted_total,
+                self._consecutive_missed,
+            ),
+        )
+
+    def restore_state(self, state: SchemaManagerState) -> None:
+        """Restore what :meth:`export_state` returned, onto a manager with the same schemas.
+
+        Raises
+        ------
+        InputError
+            When the state is not a SchemaManagerState or names other landmarks.
+        """
+        if not isinstance(state, SchemaManagerState):
+            raise InputError(f"state: expected a SchemaManagerState, got {type(state).__name__}")
+        ids = [ident for ident, _ in state.statuses]
+        if ids != [schema.landmark_id for schema in self._schemas]:
+            raise InputError(
+                f"state: expected statuses for {[s.landmark_id for s in self._schemas]}, got {ids}"
+            )
+        self._status = dict(state.statuses)
+        self._last_time = state.last_time
+        (
+            self._frames,
+            self._predicted_total,
+            self._missed_total,
+            self._missed_frames,
+            self._posted_total,
+            self._consecutive_missed,
+        ) = state.counters
 
     def __len__(self) -> int:
         return len(self._schemas)

@@ -29,6 +29,26 @@ TRACKING_MARGIN = 16.0
 DEFAULT_LOST_FRAMES = 2
 
 
+def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWindow:
+    """Return ``window`` scaled by ``scale`` (>= 1) about its centre, clipped to the image.
+
+    ``inf`` gives the whole image.
+
+    Examples
+    --------
+    >>> widen(ImageWindow(10, 10, 30, 20), 2.0, 640, 480)
+    ImageWindow(u_min=0.0, v_min=5.0, u_max=40.0, v_max=25.0)
+    >>> widen(ImageWindow(10, 10, 30, 20), math.inf, 640, 480)
+    ImageWindow(u_min=-0.5, v_min=-0.5, u_max=639.5, v_max=479.5)
+    """
+    if math.isinf(scale):
+        return ImageWindow(-0.5, -0.5, width - 0.5, height - 0.5)
+    du = 0.5 * (scale - 1.0) * (window.u_max - window.u_min)
+    dv = 0.5 * (scale - 1.0) * (window.v_max - window.v_min)
+    wide = ImageWindow(window.u_min - du, window.v_min - dv, window.u_max + du, window.v_max + dv)
+    return wide.clipped(width, height) or window
+
+
 @dataclass(frozen=True, slots=True)
 class FindLandmarkSchema:
     """A find-landmark schema, slot-filled for one landmark by the pilot (the paper's schema).
@@ -46,11 +66,13 @@ class FindLandmarkSchema:
       the range.
     - **DISCOVERING**: the Expecter's window (None: the landmark cannot be in view
       this frame); the perceptual strategy runs on that window only and the evaluation
-      function scores what it found. A *hit* is a value >= the recognition threshold
-      with a detection that the camera can turn into a bounded observation. Discovery is
-      confirmed after ``confirm_frames`` consecutive hits; a miss, or a frame where the
-      landmark cannot be in view, resets the count; nothing is posted before the
-      confirming frame, so a match in fewer frames (a transient) is never posted.
+      function scores what it found (after a first hit, in the window that follows it,
+      as in tracking, so that the confirming hits are of one thing). A *hit* is a value
+      >= the recognition threshold with a detection that the camera can turn into a
+      bounded observation. Discovery is confirmed after ``confirm_frames`` consecutive
+      hits; a miss, or a frame where the landmark cannot be in view, resets the count;
+      nothing is posted before the confirming frame, so a match in fewer frames (a
+      transient) is never posted.
     - **TRACKING**: the window follows the last detection (see *Tracking window*); every
       hit gives an observation. After ``lost_frames`` consecutive misses the landmark is
       **SUSPECT** for that frame (the map may be partially invalid) and the schema
@@ -223,21 +245,30 @@ class FindLandmarkSchema:
         if not self.is_active(frame):
             return SchemaReport(ident, SchemaStatus(SchemaState.HIBERNATING), None, None, False, None, None)
         guaranteed = self.expecter.window(frame.map, self.record.landmark, margin=self.margin)
+        if guaranteed is not None and frame.window_scale != 1.0:
+            guaranteed = widen(guaranteed, frame.window_scale, k.width, k.height)
         if status.state is SchemaState.TRACKING and status.detection is not None:
             return self._track(frame, status, status.detection, guaranteed)
         if guaranteed is None:  # awake, but the landmark cannot be in view
             return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
-        value, detection, observation = self._look(frame, guaranteed)
+        search: ImageWindow | None = guaranteed
+        following = status.state is SchemaState.DISCOVERING and status.hits > 0
+        if following and status.detection is not None and not math.isinf(frame.window_scale):
+            # Confirming hits must be of one thing: follow the unconfirmed match as tracking does.
+            search = self.tracking_window(frame, status.detection, guaranteed)
+        if search is None:  # it would have left the view: discovery starts again
+            status, search = SchemaStatus(SchemaState.DISCOVERING), guaranteed
+        value, detection, observation = self._look(frame, search)
         if detection is None or observation is None:
             return SchemaReport(
-                ident, SchemaStatus(SchemaState.DISCOVERING), guaranteed, value, False, None, None
+                ident, SchemaStatus(SchemaState.DISCOVERING), search, value, False, None, None
             )
         hits = status.hits + 1 if status.state is SchemaState.DISCOVERING else 1
         if hits >= self.record.confirm_frames:
             confirmed = SchemaStatus(SchemaState.TRACKING, hits, 0, detection)
-            return SchemaReport(ident, confirmed, guaranteed, value, True, observation, detection)
+            return SchemaReport(ident, confirmed, search, value, True, observation, detection)
         pending = SchemaStatus(SchemaState.DISCOVERING, hits, 0, detection)
-        return SchemaReport(ident, pending, guaranteed, value, True, None, detection)
+        return SchemaReport(ident, pending, search, value, True, None, detection)
 
     # -- internals ---------------------------------------------------------------------
 
@@ -245,7 +276,10 @@ class FindLandmarkSchema:
         self, frame: Frame, status: SchemaStatus, last: Detection, guaranteed: ImageWindow | None
     ) -> SchemaReport:
         ident = self.record.id
-        window = None if guaranteed is None else self.tracking_window(frame, last, guaranteed)
+        if guaranteed is not None and math.isinf(frame.window_scale):
+            window: ImageWindow | None = guaranteed  # the full-frame baseline: no tracking window
+        else:
+            window = None if guaranteed is None else self.tracking_window(frame, last, guaranteed)
         if guaranteed is None or window is None:  # left the view: discover again, not suspect
             return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
         value, detection, observation = self._look(frame, window)

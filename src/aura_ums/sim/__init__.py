@@ -3,9 +3,23 @@
 :class:`SimulatedRobot` moves as the terrain model of the meadows it crosses says;
 :class:`SyntheticCamera` renders grayscale images of a :class:`Scene` (built from a
 meadow map's landmarks) from the robot's true pose; :class:`Scenario` reads a TOML file
-naming a map, a terrain table, a camera, a start and a route.
+naming a map, a terrain table, a camera, a start and a route; :func:`run_scenario` drives a
+scenario through the closed loop (pilot, schemas, Expecter, perception, buffer, manager)
+and returns a :class:`RunResult`.
 """
 
+from aura_ums.sim._loop import (
+    FRAME_PERIOD,
+    LOOK_TURN,
+    MAX_LOOK_FRAMES,
+    FrameRecord,
+    LoopState,
+    PerceptionMode,
+    RunResult,
+    check_render_consistency,
+    run_scenario,
+    summarize_runs,
+)
 from aura_ums.sim._render import CLIP_NEAR, TEXTURE_FADE, SyntheticCamera, fill_polygon
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scenario import (
@@ -34,23 +48,33 @@ __all__ = [
     "CLIP_NEAR",
     "CORNER_MATCH_DISTANCE",
     "DEFAULT_GROUND_SHADE",
+    "FRAME_PERIOD",
+    "LOOK_TURN",
+    "MAX_LOOK_FRAMES",
     "TERRAIN_SHADES",
     "TEXTURE_FADE",
     "Building",
+    "FrameRecord",
     "GroundPatch",
     "GroundStripe",
+    "LoopState",
     "LostLimits",
+    "PerceptionMode",
     "Pole",
     "RenderSettings",
+    "RunResult",
     "Scenario",
     "Scene",
     "SimulatedFrame",
     "SimulatedRobot",
     "StartState",
     "SyntheticCamera",
+    "check_render_consistency",
     "fill_polygon",
     "ground_texture",
     "landmark_points",
     "random_clutter",
+    "run_scenario",
+    "summarize_runs",
     "waypoints_array",
 ]

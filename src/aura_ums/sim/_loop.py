@@ -1,0 +1,608 @@
+"""The closed loop, frame by frame: pilot -> schemas -> Expecter -> perception -> buffer -> manager.
+
+Each frame of :func:`run_scenario`:
+
+1. the true robot executes its command (the next leg of the route, or, while the map
+   manager says the robot is lost, a turn in place to look around) and the command is
+   posted to the blackboard as a time-stamped :class:`~aura_ums.manager.PositionReport`;
+2. the synthetic camera renders the image from the true pose;
+3. the manager grows the map to the frame's time; the pilot's find-landmark schemas step
+   on the image with that map snapshot (the Expecter's windows, widened by the manager's
+   ``window_scale`` while lost; the whole image in :attr:`PerceptionMode.FULL_FRAME`),
+   posting their identifications to the identified landmark buffer;
+4. the manager reduces the map by them (``prune=False``: they are dropped; growth only).
+
+Consistency of the synthetic world with the map (:func:`check_render_consistency`): the
+camera renders Class I poles with a radius and Class III strips with a width, and the
+line finder finds their *edges*, not their axes; a bearing from an edge is off the mapped
+axis by up to the radius. The reductions stay sound only when every used landmark's
+``position_uncertainty`` is at least the rendered pole radius (Class I poles; a Class I
+edge at a building's corner has none) or half the strip width (Class III).
+"""
+
+from __future__ import annotations
+
+import bisect
+import enum
+import math
+import statistics
+import time as _time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.errors import InputError
+from aura_ums.expecter import ImageWindow
+from aura_ums.manager import Blackboard, ManagerState, PositionReport, UncertaintyMapManager
+from aura_ums.schemas import Frame, Pilot, SchemaManager, SchemaManagerState
+from aura_ums.sim._scenario import Scenario, waypoints_array
+from aura_ums.sim._scene import CORNER_MATCH_DISTANCE
+from aura_ums.uncertainty import (
+    GroundLineLandmark,
+    PointLandmark,
+    Pose,
+    SpatialUncertaintyMap,
+    TurnAndRun,
+    VerticalLineLandmark,
+)
+from aura_ums.world import MeadowMap, ShortTermMemory
+
+#: Seconds between frames (the loop's clock).
+FRAME_PERIOD = 1.0
+#: Radians of each look-around turn while lost (the turns go +a, -2a, +a: back to the start).
+LOOK_TURN = math.radians(15.0)
+#: Frames in a row spent looking around while lost before the run gives up.
+MAX_LOOK_FRAMES = 12
+_LOOK_PATTERN = (1.0, -2.0, 1.0)
+
+
+class PerceptionMode(enum.Enum):
+    """Where perception runs: in the Expecter's windows, or on the whole image (the baseline)."""
+
+    WINDOWS = "windows"
+    FULL_FRAME = "full_frame"
+
+
+@dataclass(frozen=True, slots=True)
+class FrameRecord:
+    """What happened in one frame of the closed loop.
+
+    Parameters
+    ----------
+    index : int
+        0 for the start frame, then 1, 2, ...
+    time : float
+        Seconds.
+    command : TurnAndRun or None
+        The command executed before the frame (None for the start frame).
+    moved : bool
+        False when the robot stood still and turned to look around (lost).
+    true_pose : Pose
+        The true pose at the frame.
+    inside : bool
+        Whether the true pose is inside the map after the frame.
+    map_before, map_after : SpatialUncertaintyMap
+        The map grown to the frame's time (the snapshot the schemas used), and after reductions.
+    windows : tuple of (str, ImageWindow)
+        The windows searched, per landmark id.
+    found : tuple of str
+        Ids of the landmarks that matched.
+    posted : tuple of str
+        Ids of the identifications posted to the buffer.
+    accepted : int
+        Observations that reduced the map.
+    rejected : tuple of str
+        Reasons of the rejected observations.
+    state : ManagerState
+        The manager's state after the frame.
+    frame_ms : float
+        Milliseconds of the loop (schemas, perception and manager; not the rendering).
+    """
+
+    index: int
+    time: float
+    command: TurnAndRun | None
+    moved: bool
+    true_pose: Pose
+    inside: bool
+    map_before: SpatialUncertaintyMap
+    map_after: SpatialUncertaintyMap
+    windows: tuple[tuple[str, ImageWindow], ...]
+    found: tuple[str, ...]
+    posted: tuple[str, ...]
+    accepted: int
+    rejected: tuple[str, ...]
+    state: ManagerState
+    frame_ms: float
+
+    @property
+    def area_before(self) -> float:
+        """Area of the map before the frame's reductions, m^2."""
+        return self.map_before.area
+
+    @property
+    def area(self) -> float:
+        """Area of the map after the frame, m^2."""
+        return self.map_after.area
+
+    @property
+    def wedge_width_before(self) -> float:
+        """Width of the heading wedge before the frame's reductions, radians."""
+        return self.map_before.wedge.width
+
+    @property
+    def wedge_width(self) -> float:
+        """Width of the heading wedge after the frame, radians."""
+        return self.map_after.wedge.width
+
+
+@dataclass(frozen=True, slots=True)
+class LoopState:
+    """Everything needed to resume a run (:func:`run_scenario` ``stop_after`` / ``resume_from``).
+
+    The manager and blackboard are their exact JSON (:meth:`UncertaintyMapManager.to_json`,
+    :meth:`Blackboard.to_json`); the schema manager's statuses and counters are immutable
+    values; the random generators are their ``bit_generator.state``.
+    """
+
+    scenario: str
+    prune: bool
+    perception: PerceptionMode
+    next_index: int
+    leg: int
+    instantiated: int
+    look_frames: int
+    true_pose: Pose
+    manager_json: str
+    blackboard_json: str
+    schemas: SchemaManagerState
+    motion_rng: dict[str, Any]
+    camera_rng: dict[str, Any]
+    scene_rng: dict[str, Any]
+    records: tuple[FrameRecord, ...]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RunResult:
+    """The outcome of :func:`run_scenario`: per-frame records and aggregates.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    records : tuple of FrameRecord
+        Every frame, in order (those before a resume included).
+    final_map : SpatialUncertaintyMap
+        The map after the last frame.
+    completed : bool
+        Whether the route was driven to its end (False when stopped early or given up lost).
+    saved : LoopState or None
+        The state to resume from, when stopped by ``stop_after``.
+    predictions, hits : int
+        Landmark windows searched, and matches in them, over the run.
+    images : tuple of ndarray
+        The images of the frames, when asked for (``keep_images``); else empty.
+    """
+
+    scenario: str
+    records: tuple[FrameRecord, ...]
+    final_map: SpatialUncertaintyMap
+    completed: bool
+    saved: LoopState | None
+    predictions: int
+    hits: int
+    images: tuple[NDArray[np.uint8], ...] = field(default=(), repr=False)
+
+    @property
+    def containment_rate(self) -> float:
+        """Fraction of frames whose true pose is inside the map after the frame."""
+        return sum(r.inside for r in self.records) / max(1, len(self.records))
+
+    @property
+    def detection_rate(self) -> float:
+        """Matches per searched window (nan when nothing was predicted)."""
+        return self.hits / self.predictions if self.predictions else math.nan
+
+    @property
+    def median_area(self) -> float:
+        """Median map area after each frame, m^2."""
+        return statistics.median(r.area for r in self.records)
+
+    @property
+    def median_wedge_width(self) -> float:
+        """Median wedge width after each frame, radians."""
+        return statistics.median(r.wedge_width for r in self.records)
+
+    @property
+    def median_frame_ms(self) -> float:
+        """Median milliseconds per frame of the loop."""
+        return statistics.median(r.frame_ms for r in self.records)
+
+    @property
+    def rejected(self) -> int:
+        """Observations rejected by the manager (inconsistent or otherwise) over the run."""
+        return sum(len(r.rejected) for r in self.records)
+
+    @property
+    def accepted(self) -> int:
+        """Observations that reduced the map over the run."""
+        return sum(r.accepted for r in self.records)
+
+    @property
+    def lost_frames(self) -> int:
+        """Frames after which the manager's state was LOST."""
+        return sum(r.state is ManagerState.LOST for r in self.records)
+
+    @property
+    def ever_lost(self) -> bool:
+        """Whether the robot declared itself lost at some frame."""
+        return self.lost_frames > 0
+
+
+def check_render_consistency(scenario: Scenario, world: MeadowMap | None = None) -> None:
+    """Check that the rendered landmarks are within the map's position uncertainty.
+
+    Rule: a used Class I landmark drawn as a pole needs ``position_uncertainty >=
+    render.pole_radius``; a used Class III landmark needs ``position_uncertainty >=
+    render.stripe_width / 2`` (the line finder finds edges, not axes).
+
+    Raises
+    ------
+    InputError
+        Naming the landmark and both numbers.
+
+    Examples
+    --------
+    >>> import dataclasses, pathlib
+    >>> scenario = Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml"))
+    >>> check_render_consistency(scenario)
+    >>> thick = dataclasses.replace(scenario, render=dataclasses.replace(scenario.render, pole_radius=0.5))
+    >>> check_render_consistency(thick)           # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: telephone_pole_12: expected position_uncertainty >= ... got 0.15
+    """
+    drawn = scenario.meadow_map if world is None else world
+    corners = [r.landmark for r in drawn.landmarks if isinstance(r.landmark, PointLandmark)]
+    radius, half = scenario.render.pole_radius, scenario.render.stripe_width / 2.0
+    for record in scenario.landmarks:
+        landmark = record.landmark
+        if isinstance(landmark, VerticalLineLandmark):
+            edge = any(
+                math.hypot(c.x - landmark.x, c.y - landmark.y) <= CORNER_MATCH_DISTANCE for c in corners
+            )
+            if not edge and landmark.position_uncertainty < radius:
+                raise InputError(
+                    f"{record.id}: expected position_uncertainty >= the rendered pole radius "
+                    f"{radius:g} m, got {landmark.position_uncertainty:g}"
+                )
+        elif isinstance(landmark, GroundLineLandmark) and landmark.position_uncertainty < half:
+            raise InputError(
+                f"{record.id}: expected position_uncertainty >= half the rendered strip width "
+                f"{half:g} m, got {landmark.position_uncertainty:g}"
+            )
+
+
+def _generator(state: dict[str, Any]) -> np.random.Generator:
+    bit_generator = getattr(np.random, str(state["bit_generator"]))()
+    bit_generator.state = state
+    return np.random.Generator(bit_generator)
+
+
+def _route_indices(scenario: Scenario, legs: tuple[TurnAndRun, ...]) -> list[int]:
+    """Index of the route command each leg belongs to."""
+    ends: list[float] = []
+    total = 0.0
+    for command in scenario.commands:
+        total += command.run
+        ends.append(total)
+    indices: list[int] = []
+    travelled = 0.0
+    for leg in legs:
+        travelled += leg.run
+        tolerance = 1e-9 * max(1.0, travelled)
+        index = bisect.bisect_left(ends, travelled - tolerance)
+        indices.append(min(index, len(ends) - 1))
+    return indices
+
+
+class _Loop:
+    """The running loop: the robot, camera, pilot, schema manager, blackboard and map manager."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        rng: np.random.Generator,
+        *,
+        prune: bool,
+        perception: PerceptionMode,
+        world: MeadowMap | None,
+        resume_from: LoopState | None,
+    ) -> None:
+        self.scenario = scenario
+        self.prune = prune
+        self.perception = perception
+        self.legs = scenario.legs()
+        self.route_of_leg = _route_indices(scenario, self.legs)
+        self.waypoints = waypoints_array(scenario)
+        self.used = set(scenario.landmark_ids)
+        self.pilot = Pilot(scenario.camera)
+        drawn = scenario if world is None else _with_map(scenario, world)
+        s = scenario
+        limit = s.lost.area_limit if math.isfinite(s.lost.area_limit) else None
+        if resume_from is None:
+            start_rng, motion_rng, camera_rng = rng.spawn(3)
+            self.scene_state = camera_rng.bit_generator.state
+            true_start = s.sample_true_start(start_rng)
+            self.robot = s.robot(true_start, motion_rng)
+            self.motion_rng = motion_rng
+            self.camera = drawn.synthetic_camera(camera_rng)
+            self.camera_rng = camera_rng
+            self.manager = UncertaintyMapManager(
+                s.initial_map(), s.meadow_map, s.terrain, area_limit=limit, missed_limit=s.lost.missed_limit
+            )
+            self.board = Blackboard()
+            self.schemas = SchemaManager(buffer=self.board.identified)
+            self.instantiated = 0
+            self.next_index, self.leg, self.look_frames = 0, 0, 0
+            self.records: list[FrameRecord] = []
+            self._instantiate_through(self.route_of_leg[0] if self.legs else 0)
+        else:
+            if resume_from.scenario != s.name:
+                raise InputError(f"resume_from: expected a state of {s.name!r}, got {resume_from.scenario!r}")
+            self.scene_state = resume_from.scene_rng
+            self.camera_rng = _generator(resume_from.scene_rng)
+            self.camera = drawn.synthetic_camera(self.camera_rng)
+            self.camera_rng.bit_generator.state = resume_from.camera_rng
+            self.motion_rng = _generator(resume_from.motion_rng)
+            self.robot = s.robot(resume_from.true_pose, self.motion_rng)
+            self.manager = UncertaintyMapManager.from_json(resume_from.manager_json, s.meadow_map, s.terrain)
+            self.board = Blackboard.from_json(resume_from.blackboard_json)
+            self.schemas = SchemaManager(buffer=self.board.identified)
+            self.instantiated = 0
+            self._instantiate_through(resume_from.instantiated - 1)
+            self.schemas.restore_state(resume_from.schemas)
+            self.next_index, self.leg = resume_from.next_index, resume_from.leg
+            self.look_frames = resume_from.look_frames
+            self.records = list(resume_from.records)
+        self.predictions = sum(len(r.windows) for r in self.records)
+        self.hits = sum(len(r.found) for r in self.records)
+
+    def _instantiate_through(self, route_index: int) -> None:
+        if not self.scenario.commands:
+            return
+        while self.instantiated <= min(route_index, len(self.scenario.commands) - 1):
+            j = self.instantiated
+            stm = ShortTermMemory.for_leg(self.scenario.meadow_map, self.waypoints[j], self.waypoints[j + 1])
+            have = set(self.schemas.states)
+            new = [
+                schema
+                for schema in self.pilot.schemas_for_leg(stm)
+                if schema.landmark_id in self.used and schema.landmark_id not in have
+            ]
+            self.schemas.instantiate(new)
+            self.instantiated += 1
+
+    @property
+    def done(self) -> bool:
+        return self.next_index > 0 and (self.leg >= len(self.legs) or self.look_frames >= MAX_LOOK_FRAMES)
+
+    def step(self, keep: list[NDArray[np.uint8]] | None) -> None:
+        index = self.next_index
+        now = index * FRAME_PERIOD
+        command: TurnAndRun | None = None
+        moved = True
+        looking = self.prune and self.manager.should_stop_and_look
+        if index > 0:
+            if looking:
+                command = TurnAndRun(LOOK_TURN * _LOOK_PATTERN[self.look_frames % len(_LOOK_PATTERN)], 0.0)
+                self.look_frames += 1
+                moved = False
+            else:
+                command = self.legs[self.leg]
+                self._instantiate_through(self.route_of_leg[self.leg])
+                self.leg += 1
+                self.look_frames = 0
+            self.robot.execute(command)
+            self.board.post_report(PositionReport(now, command))
+        true_pose = self.robot.pose
+        image = self.camera.render(true_pose)
+        image.setflags(write=False)
+        if keep is not None:
+            keep.append(image)
+        started = _time.perf_counter()
+        grown = self.manager.update(self.board, now=now, missed_in_a_row=self.schemas.consecutive_missed)
+        if self.perception is PerceptionMode.FULL_FRAME:
+            scale = math.inf
+        else:
+            scale = self.manager.window_scale if self.prune else 1.0
+        report = self.schemas.step(Frame(now, image, grown.map, window_scale=scale))
+        if not self.prune:
+            self.board.identified.drain(until=now)
+        after = self.manager.update(self.board, now=now, missed_in_a_row=report.consecutive_missed)
+        elapsed = 1000.0 * (_time.perf_counter() - started)
+        windows = tuple((r.landmark_id, r.window) for r in report.schemas if r.window is not None)
+        self.predictions += len(windows)
+        self.hits += len(report.found)
+        self.records.append(
+            FrameRecord(
+                index=index,
+                time=now,
+                command=command,
+                moved=moved,
+                true_pose=true_pose,
+                inside=after.map.contains(true_pose),
+                map_before=grown.map,
+                map_after=after.map,
+                windows=windows,
+                found=report.found,
+                posted=tuple(o.landmark_id for o in report.posted),
+                accepted=len(after.accepted),
+                rejected=tuple(o.reason for o in after.rejected),
+                state=after.state,
+                frame_ms=elapsed,
+            )
+        )
+        self.next_index += 1
+
+    def save(self) -> LoopState:
+        return LoopState(
+            scenario=self.scenario.name,
+            prune=self.prune,
+            perception=self.perception,
+            next_index=self.next_index,
+            leg=self.leg,
+            instantiated=self.instantiated,
+            look_frames=self.look_frames,
+            true_pose=self.robot.pose,
+            manager_json=self.manager.to_json(),
+            blackboard_json=self.board.to_json(),
+            schemas=self.schemas.export_state(),
+            motion_rng=dict(self.motion_rng.bit_generator.state),
+            camera_rng=dict(self.camera_rng.bit_generator.state),
+            scene_rng=dict(self.scene_state),
+            records=tuple(self.records),
+        )
+
+
+def _with_map(scenario: Scenario, world: MeadowMap) -> Scenario:
+    import dataclasses
+
+    return dataclasses.replace(scenario, meadow_map=world, landmark_ids=())
+
+
+def run_scenario(
+    scenario: Scenario,
+    rng: np.random.Generator,
+    *,
+    prune: bool = True,
+    perception: PerceptionMode = PerceptionMode.WINDOWS,
+    stop_after: int | None = None,
+    resume_from: LoopState | None = None,
+    world: MeadowMap | None = None,
+    keep_images: bool = False,
+) -> RunResult:
+    """Drive a scenario's route through the closed loop, frame by frame (see the module notes).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario: its meadow map is the robot's long-term memory.
+    rng : numpy.random.Generator
+        Source of every random draw (split into the start's, the robot's and the camera's);
+        unused when resuming.
+    prune : bool
+        Reduce the map by the identified landmarks (False: growth only, no lost response).
+    perception : PerceptionMode
+        Run perception in the Expecter's windows, or on the full frame (the baseline).
+    stop_after : int or None
+        Stop after this many frames in all (the start frame included) and return the
+        state to resume from in :attr:`RunResult.saved`.
+    resume_from : LoopState or None
+        Continue a run stopped by ``stop_after``.
+    world : MeadowMap or None
+        The world the camera sees, when it differs from the map (moved landmarks).
+    keep_images : bool
+        Keep the frames' images in :attr:`RunResult.images` (frames of this call only).
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    InputError
+        For bad arguments, or a scenario whose rendering breaks the consistency rule
+        (:func:`check_render_consistency`).
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> scenario = Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml"))
+    >>> result = run_scenario(scenario, np.random.default_rng(1))
+    >>> len(result.records), result.completed, result.containment_rate
+    (4, True, 1.0)
+    >>> half = run_scenario(scenario, np.random.default_rng(1), stop_after=2)
+    >>> rest = run_scenario(scenario, np.random.default_rng(99), resume_from=half.saved)
+    >>> rest.final_map.polygon.vertices.tobytes() == result.final_map.polygon.vertices.tobytes()
+    True
+    """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    if not isinstance(rng, np.random.Generator):
+        raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+    if not isinstance(perception, PerceptionMode):
+        raise InputError(f"perception: expected a PerceptionMode, got {perception!r}")
+    if stop_after is not None and (
+        isinstance(stop_after, bool) or not isinstance(stop_after, int) or stop_after < 1
+    ):
+        raise InputError(f"stop_after: expected an integer >= 1 or None, got {stop_after!r}")
+    if resume_from is not None:
+        if not isinstance(resume_from, LoopState):
+            raise InputError(f"resume_from: expected a LoopState, got {type(resume_from).__name__}")
+        prune, perception = resume_from.prune, resume_from.perception
+    check_render_consistency(scenario, world)
+    loop = _Loop(scenario, rng, prune=prune, perception=perception, world=world, resume_from=resume_from)
+    images: list[NDArray[np.uint8]] | None = [] if keep_images else None
+    while not loop.done:
+        if stop_after is not None and loop.next_index >= stop_after:
+            return RunResult(
+                scenario.name,
+                tuple(loop.records),
+                loop.manager.map,
+                False,
+                loop.save(),
+                loop.predictions,
+                loop.hits,
+                tuple(images or ()),
+            )
+        loop.step(images)
+    completed = loop.leg >= len(loop.legs)
+    return RunResult(
+        scenario.name,
+        tuple(loop.records),
+        loop.manager.map,
+        completed,
+        None,
+        loop.predictions,
+        loop.hits,
+        tuple(images or ()),
+    )
+
+
+def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> dict[str, float | int]:
+    """Return the Monte Carlo metrics of several runs, over all their frames.
+
+    Keys: ``containment_rate`` (fraction of frames with the true pose inside the map),
+    ``median_area_m2``, ``median_wedge_width_rad``, ``landmark_detection_rate`` (matches
+    per searched window), ``inconsistent_observations`` (observations the manager
+    rejected), ``accepted_observations``, ``median_frame_ms``, ``frames``,
+    ``runs_lost`` (runs that declared themselves lost), ``runs_completed``.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> scenario = Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml"))
+    >>> metrics = summarize_runs([run_scenario(scenario, np.random.default_rng(s)) for s in (1, 2)])
+    >>> metrics["frames"], metrics["containment_rate"]
+    (8, 1.0)
+    """
+    records = [r for result in results for r in result.records]
+    if not records:
+        raise InputError("results: expected at least one run with frames, got none")
+    predictions = sum(result.predictions for result in results)
+    hits = sum(result.hits for result in results)
+    return {
+        "containment_rate": sum(r.inside for r in records) / len(records),
+        "median_area_m2": statistics.median(r.area for r in records),
+        "median_wedge_width_rad": statistics.median(r.wedge_width for r in records),
+        "landmark_detection_rate": hits / predictions if predictions else math.nan,
+        "inconsistent_observations": sum(len(r.rejected) for r in records),
+        "accepted_observations": sum(r.accepted for r in records),
+        "median_frame_ms": statistics.median(r.frame_ms for r in records),
+        "frames": len(records),
+        "runs_lost": sum(result.ever_lost for result in results),
+        "runs_completed": sum(result.completed for result in results),
+    }
