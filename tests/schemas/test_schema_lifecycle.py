@@ -104,6 +104,28 @@ def test_discovery_of_a_class_ii_corner(rng: np.random.Generator) -> None:
     assert math.dist(detection.point, truth_pixel) <= 3.0
 
 
+def test_a_corner_with_a_second_strong_corner_in_its_window_is_not_identified(
+    rng: np.random.Generator,
+) -> None:
+    corner = PointLandmark("corner", 12.0, 2.0, 3.0, symbol="building corner", position_uncertainty=0.1)
+    record = LandmarkRecord(
+        corner, PerceptualStrategy.INTEREST_OPERATOR, {"window": 5.0, "min_interest": 150.0}, 30.0, 1000.0, 1
+    )
+    schema = FindLandmarkSchema(record, EXPECTER, pixel_error=1.0)
+    snapshot = map_around(TRUTH)
+    u_c, v_c = CAMERA.project(TRUTH, [(corner.x, corner.y, corner.z)])[0]
+    images = []
+    for _ in range(3):
+        image = corner_image(rng, TRUTH, corner).astype(np.float64)
+        # A dark notch in the bright face just below the corner's row: its corners are as
+        # strong, and taking one for the landmark would prune the true pose away.
+        image[int(v_c) + 1 : int(v_c) + 7, int(u_c) - 14 : int(u_c) - 9] = 90.0
+        images.append(image.astype(np.uint8))
+    reports = run(schema, images, [snapshot] * 3, [TRUTH] * 3)
+    assert all(r.observation is None for r in reports)
+    assert all(r.state is SchemaState.DISCOVERING for r in reports)
+
+
 def test_discovery_of_a_class_iii_path_edge(rng: np.random.Generator) -> None:
     edge = GroundLineLandmark(
         "edge", (-5.0, -1.0), (30.0, -1.0), symbol="sidewalk edge", position_uncertainty=0.05

@@ -150,3 +150,25 @@ def test_manager_rejects_bad_input(rng: np.random.Generator) -> None:
         manager.step(Frame(0.5, pole_image(rng, TRUTH, []), snapshot))
     with pytest.raises(InputError, match=r"frame\.image: expected the camera's 640x480 image, got 320x240"):
         manager.step(Frame(2.0, np.zeros((240, 320), dtype=np.uint8), snapshot))
+
+
+# identifications another landmark of the same kind could explain ------------------------
+
+
+def test_a_detection_inside_another_landmarks_bounds_is_withheld(rng: np.random.Generator) -> None:
+    # Two poles 0.3 m apart at 10 m: from some pose of the map each could appear where the
+    # other is seen, so neither identification may prune the map.
+    near = VerticalLineLandmark("near_pole", 10.0, 2.0, 0.0, 4.0, position_uncertainty=0.1)
+    twin = VerticalLineLandmark("twin_pole", 10.0, 2.3, 0.0, 4.0, position_uncertainty=0.1)
+    manager = manager_for(near, twin, confirm=1)
+    snapshot = map_around(TRUTH)
+    step = manager.step(Frame(1.0, pole_image(rng, TRUTH, [near, twin]), snapshot))
+    assert step.posted == ()
+    assert set(step.ambiguous) == {"near_pole", "twin_pole"}
+    assert manager.ambiguous_total == 2
+    assert len(manager.buffer) == 0
+    # Far apart, the same two kinds of landmark are told apart and posted.
+    apart = manager_for(LEFT, RIGHT, confirm=1)
+    step = apart.step(Frame(1.0, pole_image(rng, TRUTH, [LEFT, RIGHT]), snapshot))
+    assert {o.landmark_id for o in step.posted} == {"left_pole", "right_pole"}
+    assert step.ambiguous == ()

@@ -6,7 +6,10 @@ import types
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
 from aura_ums.errors import InputError
+from aura_ums.geometry import ImageWindow
 from aura_ums.manager import IdentifiedLandmarkBuffer
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._schema import FindLandmarkSchema
@@ -33,6 +36,9 @@ class StepReport:
         Ids of the tracked landmarks that became suspect this frame.
     consecutive_missed : int
         Frames in a row, up to this one, in which landmarks were predicted and none was found.
+    ambiguous : tuple of str
+        Ids whose identification was withheld: it lay where another mapped landmark of the
+        same kind may appear (see :meth:`SchemaManager.step`).
     """
 
     time: float
@@ -41,6 +47,7 @@ class StepReport:
     missed: tuple[str, ...]
     suspects: tuple[str, ...]
     consecutive_missed: int
+    ambiguous: tuple[str, ...] = ()
 
     @property
     def predicted(self) -> tuple[str, ...]:
@@ -78,12 +85,13 @@ class SchemaManagerState:
     last_time : float or None
         Time of the last frame stepped.
     counters : tuple of int
-        frames, predicted_total, missed_total, missed_frames, posted_total, consecutive_missed.
+        frames, predicted_total, missed_total, missed_frames, posted_total, consecutive_missed,
+        ambiguous_total.
     """
 
     statuses: tuple[tuple[str, SchemaStatus], ...]
     last_time: float | None
-    counters: tuple[int, int, int, int, int, int]
+    counters: tuple[int, int, int, int, int, int, int]
 
 
 class SchemaManager:
@@ -147,6 +155,7 @@ class SchemaManager:
     """
 
     __slots__ = (
+        "_ambiguous_total",
         "_buffer",
         "_consecutive_missed",
         "_frames",
@@ -178,6 +187,7 @@ class SchemaManager:
         self._missed_frames = 0
         self._posted_total = 0
         self._consecutive_missed = 0
+        self._ambiguous_total = 0
         self.instantiate(schemas)
 
     def instantiate(self, schemas: Iterable[FindLandmarkSchema]) -> None:
@@ -265,6 +275,11 @@ class SchemaManager:
     def step(self, frame: Frame) -> StepReport:
         """Step every schema on one frame; post identifications; update the lost-detection counts.
 
+        An identification is withheld (listed in :attr:`StepReport.ambiguous`, not posted)
+        when it lies inside the Expecter's bounds of another landmark of the same class and
+        perceptual strategy: from some pose of the map that other landmark could appear
+        there, and a wrong identification would prune the true pose away.
+
         Parameters
         ----------
         frame : Frame
@@ -288,10 +303,11 @@ class SchemaManager:
                 f"got {frame.time!r}"
             )
         reports = tuple(schema.step(frame, self._status[schema.landmark_id]) for schema in self._schemas)
+        ambiguous = self._ambiguous(frame, reports)
         posted: list[Observation] = []
         for report in reports:
             self._status[report.landmark_id] = report.status
-            if report.observation is not None:
+            if report.observation is not None and report.landmark_id not in ambiguous:
                 self._buffer.post(report.observation)
                 posted.append(report.observation)
         self._last_time = frame.time
@@ -307,7 +323,55 @@ class SchemaManager:
             self._consecutive_missed += 1
             self._missed_frames += 1
         suspects = tuple(r.landmark_id for r in reports if r.state is SchemaState.SUSPECT)
-        return StepReport(frame.time, reports, tuple(posted), missed, suspects, self._consecutive_missed)
+        self._ambiguous_total += len(ambiguous)
+        return StepReport(
+            frame.time,
+            reports,
+            tuple(posted),
+            missed,
+            suspects,
+            self._consecutive_missed,
+            tuple(r.landmark_id for r in reports if r.landmark_id in ambiguous),
+        )
+
+    def _ambiguous(self, frame: Frame, reports: tuple[SchemaReport, ...]) -> set[str]:
+        """Ids whose identification lies where another mapped landmark of the same kind may appear.
+
+        The Expecter's bounds hold a landmark's projection from every pose of the map. A
+        detection inside another landmark's bounds, by the same perceptual strategy and of
+        the same class, may be that other landmark: no pose of the map tells them apart,
+        and posting it could prune the true pose away. Such an identification is withheld
+        (the schema keeps its state; nothing is posted this frame).
+        """
+        result: set[str] = set()
+        bounds: dict[str, ImageWindow | None] = {}
+        for report in reports:
+            if report.observation is None or report.detection is None:
+                continue
+            schema = self._by_id(report.landmark_id)
+            point = np.array([report.detection.point], dtype=np.float64)
+            for other in self._schemas:
+                if (
+                    other is schema
+                    or other.record.landmark_class is not schema.record.landmark_class
+                    or other.record.strategy is not schema.record.strategy
+                ):
+                    continue
+                if other.landmark_id not in bounds:
+                    bounds[other.landmark_id] = other.expecter.bounds(frame.map, other.record.landmark)
+                window = bounds[other.landmark_id]
+                if window is not None and bool(window.contains(point)[0]):
+                    result.add(report.landmark_id)
+                    break
+        return result
+
+    @property
+    def ambiguous_total(self) -> int:
+        """Identifications withheld so far because another landmark of the same kind may be there."""
+        return self._ambiguous_total
+
+    def _by_id(self, landmark_id: str) -> FindLandmarkSchema:
+        return next(schema for schema in self._schemas if schema.landmark_id == landmark_id)
 
     def export_state(self) -> SchemaManagerState:
         """Return the instantiations' statuses and the counters (immutable values), for saving."""
@@ -321,6 +385,7 @@ class SchemaManager:
                 self._missed_frames,
                 self._posted_total,
                 self._consecutive_missed,
+                self._ambiguous_total,
             ),
         )
 
@@ -348,6 +413,7 @@ class SchemaManager:
             self._missed_frames,
             self._posted_total,
             self._consecutive_missed,
+            self._ambiguous_total,
         ) = state.counters
 
     def __len__(self) -> int:

@@ -9,7 +9,9 @@ Supported (landmark class, perceptual strategy) pairs, with the record's ``param
   the tallest region at least ``min_aspect`` (default 3) times taller than wide; value:
   its height in pixels; location: its centroid (on the line's axis).
 - Class II, ``INTEREST_OPERATOR``: :class:`MoravecOperator` (``window`` -> size,
-  ``min_interest`` -> threshold, ``suppression``); :func:`evaluate_corner`.
+  ``min_interest`` -> threshold, ``suppression``); :func:`evaluate_corner`. Two or more
+  interest points at or above the recognition threshold in the window make the corner
+  ambiguous: no hit.
 - Class III, ``LINE_FINDER``: :class:`FastLineFinder` as for Class I; without an
   ``orientation`` it is tuned, frame by frame, to the image direction of the ground line
   seen from the map's most probable pose; :func:`evaluate_path_edge`.
@@ -206,7 +208,12 @@ def detect(
         box = _box(np.array([[seg[0], seg[1]], [seg[2], seg[3]]]))
         return evidence.value, Detection(time, evidence.value, evidence.point, box, seg, pose)
     if isinstance(detector, MoravecOperator):
-        corner = evaluate_corner(detector.find(image, window))
+        points = detector.find(image, window)
+        if int(np.count_nonzero(points[:, 2] >= record.recognition_threshold)) >= 2:
+            # Several corners strong enough to be the landmark: which one is the mapped
+            # corner cannot be told, and a wrong one would prune the true pose away.
+            return 0.0, None
+        corner = evaluate_corner(points)
         if corner.point is None:
             return corner.value, None
         box = _box(np.array([corner.point]))
