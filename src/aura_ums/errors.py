@@ -13,6 +13,7 @@ __all__ = [
     "FileFormatError",
     "InputError",
     "MissingDependencyError",
+    "OutsideMapError",
     "UnknownTerrainError",
 ]
 
@@ -23,6 +24,10 @@ class AuraUmsError(Exception):
 
 class InputError(AuraUmsError, ValueError):
     """An argument or a value given to aura-ums is not what it expects."""
+
+
+class OutsideMapError(InputError):
+    """A position or a run lies outside every meadow of the meadow map."""
 
 
 class MissingDependencyError(AuraUmsError, ImportError):

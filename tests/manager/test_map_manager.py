@@ -645,3 +645,16 @@ def test_the_map_contains_the_true_pose_after_any_run(
             step = manager.update(board, now=float(k))
             assert step.rejected == (), [o.reason for o in step.rejected]
             assert step.map.contains(truth), (k, truth, step.map)
+
+
+def test_a_run_from_an_estimate_outside_every_meadow_grows_on_the_nearest_terrain() -> None:
+    # The estimate grazes the edge of mapped free space and its run leaves the map: the
+    # manager grows on the nearest meadow's terrain instead of giving up on the report.
+    outside = SpatialUncertaintyMap.from_pose(Pose(2.0, 10.5, math.pi / 2), 0.1, 0.01)
+    manager = UncertaintyMapManager(outside, WORLD, TABLE)
+    board = Blackboard()
+    board.post_report(PositionReport(1.0, TurnAndRun(0.0, 2.0)))
+    step = manager.update(board, now=1.0)
+    expected = outside.grow(TurnAndRun(0.0, 2.0), TABLE["concrete"])  # "west" is the nearest meadow
+    assert np.array_equal(step.map.polygon.vertices, expected.polygon.vertices)
+    assert manager.grown_reports == 1

@@ -7,12 +7,14 @@ import types
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import shapely
+
 from aura_ums._validate import finite_float
-from aura_ums.errors import InputError, UnknownTerrainError
+from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
-from aura_ums.uncertainty import Observation, SpatialUncertaintyMap, TerrainTable, TurnAndRun
-from aura_ums.world import RUN_TOLERANCE, MeadowMap, grow_through
+from aura_ums.uncertainty import Observation, Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
 
@@ -415,14 +417,24 @@ class UncertaintyMapManager:
         return current, map_time
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
+        pose = current.most_probable_pose()
         if command.run <= RUN_TOLERANCE:
-            # split_run refuses a positive run shorter than its tolerance ("meets no meadow"):
-            # grow it whole on the terrain of the meadow it starts in, as it does a zero run.
-            pose = current.most_probable_pose()
+            # A run too short to cut by meadows: whole, on the start meadow's terrain.
             meadow = self._meadow_map.meadow_at(pose.x, pose.y)
             if meadow is not None:
                 return current.grow(command, self._table[meadow.terrain], sigmas=self._sigmas)
-        return grow_through(current, self._meadow_map, command, self._table, sigmas=self._sigmas)
+        try:
+            return grow_through(current, self._meadow_map, command, self._table, sigmas=self._sigmas)
+        except OutsideMapError:
+            pass
+        # The estimate's run leaves every meadow (it grazes the edge of mapped free space,
+        # the map knows no walls): grow on the nearest meadow's terrain, not give up.
+        terrain = self._table[self._nearest_meadow(pose).terrain]
+        return current.grow(command, terrain, sigmas=self._sigmas)
+
+    def _nearest_meadow(self, pose: Pose) -> Meadow:
+        point = shapely.Point(pose.x, pose.y)
+        return min(self._meadow_map.meadows, key=lambda meadow: meadow.polygon.to_shapely().distance(point))
 
     def _reduce(
         self, current: SpatialUncertaintyMap, observation: Observation, map_time: float | None

@@ -19,7 +19,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
-from aura_ums.errors import InputError
+from aura_ums.errors import InputError, OutsideMapError
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
 from aura_ums.world._ltm import MeadowMap
 
@@ -315,7 +315,7 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
             if hi - lo > RUN_TOLERANCE:
                 spans.append((lo, hi, int(index)))
     if not spans:
-        raise InputError(
+        raise OutsideMapError(
             f"start, heading, distance: expected a run that meets a meadow, got one from "
             f"{_xy(origin)} of {length!r} m at heading {angle!r} outside every meadow"
         )
