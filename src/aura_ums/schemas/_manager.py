@@ -344,7 +344,10 @@ class SchemaManager:
         (the schema keeps its state; nothing is posted this frame).
         """
         result: set[str] = set()
-        bounds: dict[str, ImageWindow | None] = {}
+        # Awake schemas computed their bounds this frame; only hibernating ones did not.
+        bounds: dict[str, ImageWindow | None] = {
+            r.landmark_id: r.bounds for r in reports if r.state is not SchemaState.HIBERNATING
+        }
         for report in reports:
             if report.observation is None or report.detection is None:
                 continue

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -244,7 +245,16 @@ class FindLandmarkSchema:
         ident = self.record.id
         if not self.is_active(frame):
             return SchemaReport(ident, SchemaStatus(SchemaState.HIBERNATING), None, None, False, None, None)
-        guaranteed = self.expecter.window(frame.map, self.record.landmark, margin=self.margin)
+        # The guaranteed bounds go into the report too, so that the manager's ambiguity
+        # check reuses them instead of asking the Expecter again.
+        bounds = self.expecter.bounds(frame.map, self.record.landmark)
+        report = self._step_awake(frame, status, bounds)
+        return report if bounds is None else dataclasses.replace(report, bounds=bounds)
+
+    def _step_awake(self, frame: Frame, status: SchemaStatus, bounds: ImageWindow | None) -> SchemaReport:
+        k = self.expecter.camera.intrinsics
+        ident = self.record.id
+        guaranteed = None if bounds is None else bounds.expanded(self.margin).clipped(k.width, k.height)
         if guaranteed is not None and frame.window_scale != 1.0:
             guaranteed = widen(guaranteed, frame.window_scale, k.width, k.height)
         if status.state is SchemaState.TRACKING and status.detection is not None:

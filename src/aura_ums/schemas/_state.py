@@ -108,6 +108,10 @@ class SchemaReport:
         confirms a discovery and on every tracking frame with a hit; None otherwise.
     detection : Detection or None
         This frame's match, when it was a hit.
+    bounds : ImageWindow or None
+        The Expecter's guaranteed bounds of the landmark's projection this frame (before
+        margin and clipping); None when the schema hibernates or the landmark cannot be
+        in view.
     """
 
     landmark_id: str
@@ -117,6 +121,7 @@ class SchemaReport:
     hit: bool
     observation: Observation | None
     detection: Detection | None
+    bounds: ImageWindow | None = None
 
     @property
     def state(self) -> SchemaState:
