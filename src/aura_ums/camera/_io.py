@@ -178,15 +178,7 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
     _check_keys(table, ("height", "forward", "left", "pan", "pan_deg", "tilt", "tilt_deg"), source, "[mount]")
     if "height" not in table:
         raise FileFormatError(source, "[mount]", "expected key height, got none for it")
-    mount_values: dict[str, float] = {
-        key: _number(table[key], source, f"[mount] {key}")
-        for key in ("height", "forward", "left")
-        if key in table
-    }
-    for name in _ANGLES:
-        angle = _angle(table, name, source, "[mount]")
-        if angle is not None:
-            mount_values[name] = angle
+    mount_values = _lengths_and_angles(table, ("height", "forward", "left"), source, "[mount]")
     try:
         mount = CameraMount(**mount_values)
     except InputError as exc:
@@ -199,20 +191,26 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         source,
         "[calibration_bounds]",
     )
-    bound_values: dict[str, float] = {
-        key: _number(table[key], source, f"[calibration_bounds] {key}")
-        for key in ("fx", "fy", "cx", "cy", "height")
-        if key in table
-    }
-    for name in _ANGLES:
-        angle = _angle(table, name, source, "[calibration_bounds]")
-        if angle is not None:
-            bound_values[name] = angle
+    bound_values = _lengths_and_angles(
+        table, ("fx", "fy", "cx", "cy", "height"), source, "[calibration_bounds]"
+    )
     try:
         bounds = CalibrationBounds(**bound_values)
     except InputError as exc:
         raise _reraise(source, "[calibration_bounds]", exc) from None
     return Camera(intrinsics, mount), bounds
+
+
+def _lengths_and_angles(
+    table: Mapping[str, object], keys: tuple[str, ...], source: str, where: str
+) -> dict[str, float]:
+    """Read the plain numbers ``keys`` and the angles (pan, tilt; radians or ``*_deg``) of a table."""
+    values = {key: _number(table[key], source, f"{where} {key}") for key in keys if key in table}
+    for name in _ANGLES:
+        angle = _angle(table, name, source, where)
+        if angle is not None:
+            values[name] = angle
+    return values
 
 
 def load_camera(path: str | Path) -> Camera:
