@@ -134,6 +134,38 @@ def _grid(hull: Array, count: int) -> Array:
     )
 
 
+def _widened(attained: Array, x_low: Array, x_high: Array, y_low: Array, y_high: Array) -> Array:
+    """Return the attained (x lo, x hi, y lo, y hi) widened by newly attained values."""
+    return np.array(
+        [
+            min(attained[0], x_low.min()),
+            max(attained[1], x_high.max()),
+            min(attained[2], y_low.min()),
+            max(attained[3], y_high.max()),
+        ]
+    )
+
+
+def _round_outcome(bounds: Array, attained: Array) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Combine one refinement round: its bound, the bound's gaps to the attained values, live cells.
+
+    A cell stays live while it may hold an extreme (its bound reaches past an attained value).
+    """
+    relevant = np.column_stack(
+        [
+            bounds[:, 0] <= attained[0],
+            bounds[:, 1] >= attained[1],
+            bounds[:, 2] <= attained[2],
+            bounds[:, 3] >= attained[3],
+        ]
+    )
+    result = _combine(bounds, relevant)
+    gaps = np.array(
+        [attained[0] - result[0], result[1] - attained[1], attained[2] - result[2], result[3] - attained[3]]
+    )
+    return result, gaps, np.asarray(np.any(relevant, axis=1))
+
+
 def _boundary_range(hull: Array, c: Coefficients, tolerance: float) -> tuple[Array, Array]:
     """Bound x_d and y_d over the hull's boundary (its vertices and edges).
 
@@ -155,32 +187,8 @@ def _boundary_range(hull: Array, c: Coefficients, tolerance: float) -> tuple[Arr
     attained = np.array([np.inf, -np.inf, np.inf, -np.inf])
     for round_index in range(_MAX_ROUNDS + 1):
         bounds, ends = _piece_bounds(pieces, c)  # (m, 4) bounds; (m, 4) end values (min/max)
-        attained = np.array(
-            [
-                min(attained[0], ends[:, 0].min()),
-                max(attained[1], ends[:, 1].max()),
-                min(attained[2], ends[:, 2].min()),
-                max(attained[3], ends[:, 3].max()),
-            ]
-        )
-        relevant = np.column_stack(
-            [
-                bounds[:, 0] <= attained[0],
-                bounds[:, 1] >= attained[1],
-                bounds[:, 2] <= attained[2],
-                bounds[:, 3] >= attained[3],
-            ]
-        )
-        result = _combine(bounds, relevant)
-        gaps = np.array(
-            [
-                attained[0] - result[0],
-                result[1] - attained[1],
-                attained[2] - result[2],
-                result[3] - attained[3],
-            ]
-        )
-        keep = np.any(relevant, axis=1)
+        attained = _widened(attained, ends[:, 0], ends[:, 1], ends[:, 2], ends[:, 3])
+        result, gaps, keep = _round_outcome(bounds, attained)
         if round_index == _MAX_ROUNDS or bool(np.all(gaps <= tolerance)) or 2 * int(keep.sum()) > _MAX_CELLS:
             return np.array([result[0], result[2]]), np.array([result[1], result[3]])
         kept = pieces[keep]
@@ -267,32 +275,8 @@ def _box_range(hull: Array, coefficients: Coefficients, tolerance: float) -> tup
         inside = _inside(np.column_stack([centres_x, centres_y]), hull)
         if np.any(inside):
             cx, cy = distort(centres_x[inside], centres_y[inside], coefficients)
-            attained = np.array(
-                [
-                    min(attained[0], cx.min()),
-                    max(attained[1], cx.max()),
-                    min(attained[2], cy.min()),
-                    max(attained[3], cy.max()),
-                ]
-            )
-        relevant = np.column_stack(
-            [
-                bounds[:, 0] <= attained[0],
-                bounds[:, 1] >= attained[1],
-                bounds[:, 2] <= attained[2],
-                bounds[:, 3] >= attained[3],
-            ]
-        )
-        result = _combine(bounds, relevant)
-        gaps = np.array(
-            [
-                attained[0] - result[0],
-                result[1] - attained[1],
-                attained[2] - result[2],
-                result[3] - attained[3],
-            ]
-        )
-        keep = np.any(relevant, axis=1)
+            attained = _widened(attained, cx, cx, cy, cy)
+        result, gaps, keep = _round_outcome(bounds, attained)
         if round_index == _MAX_ROUNDS or bool(np.all(gaps <= tolerance)) or 4 * int(keep.sum()) > _MAX_CELLS:
             return np.array([result[0], result[2]]), np.array([result[1], result[3]])
         cells = _split(cells[keep])
