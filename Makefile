@@ -19,7 +19,7 @@ $(VENV)/.stamp-install: $(BUILD_INPUTS) | $(BIN)/python
 	@touch $@
 
 $(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[dev,opencv]"
+	$(BIN)/python -m pip install --quiet -e ".[dev,opencv,foxglove,ros]"
 	@touch $@ $(VENV)/.stamp-install
 
 demo: $(VENV)/.stamp-install
