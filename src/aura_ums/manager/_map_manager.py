@@ -193,6 +193,7 @@ class UncertaintyMapManager:
         "_meadow_map",
         "_missed_limit",
         "_rejected",
+        "_relocalizations",
         "_sigmas",
         "_state",
         "_table",
@@ -236,6 +237,7 @@ class UncertaintyMapManager:
         self._accepted = 0
         self._rejected: dict[str, int] = {}
         self._grown = 0
+        self._relocalizations = 0
 
     # --- what others read --------------------------------------------------------------
 
@@ -288,6 +290,11 @@ class UncertaintyMapManager:
     def rejected_count(self) -> int:
         """Observations rejected since construction, all reasons together."""
         return sum(self._rejected.values())
+
+    @property
+    def relocalizations(self) -> int:
+        """Times the map was replaced by :meth:`relocalize`, since construction."""
+        return self._relocalizations
 
     @property
     def grown_reports(self) -> int:
@@ -390,6 +397,41 @@ class UncertaintyMapManager:
         self._update_state(any(o.accepted for o in outcomes), missed_in_a_row)
         return ManagerStep(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
 
+    def relocalize(self, new_map: SpatialUncertaintyMap) -> None:
+        """Replace the map by one re-derived elsewhere (re-localization), keeping the clock.
+
+        The map's time and the consumed position reports stay: ``new_map`` must describe
+        the robot at :attr:`map_time`. The state returns to :attr:`ManagerState.NOMINAL`
+        (the new map is the response to being lost) and :attr:`relocalizations` counts it.
+        Used by :class:`~aura_ums.logs.EnvelopeLocalizer`, whose envelope map, kept under
+        worst-case bounds, re-seeds a working map that outliers have led astray.
+
+        Raises
+        ------
+        InputError
+            When ``new_map`` is not a :class:`SpatialUncertaintyMap`.
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import Pose, TerrainTable
+        >>> from aura_ums.world import make_grid_world
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+        >>> manager = UncertaintyMapManager(start, make_grid_world(1, 1), TerrainTable.default())
+        >>> wider = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 1.0, 0.5)
+        >>> manager.relocalize(wider)
+        >>> manager.map is wider, manager.relocalizations
+        (True, 1)
+        >>> manager.relocalize("here")
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: new_map: expected a SpatialUncertaintyMap, got str
+        """
+        if not isinstance(new_map, SpatialUncertaintyMap):
+            raise InputError(f"new_map: expected a SpatialUncertaintyMap, got {type(new_map).__name__}")
+        self._map = new_map
+        self._relocalizations += 1
+        self._state, self._lost_reason = ManagerState.NOMINAL, ""
+
     def _check_blackboard(self, blackboard: Blackboard) -> None:
         count = blackboard.report_count
         if count < self._consumed:
@@ -417,6 +459,11 @@ class UncertaintyMapManager:
         return current, map_time
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
+        meadows = self._meadow_map.meadows
+        if len(meadows) == 1:
+            # One meadow, one terrain: there is nothing to split the run by (and a run that
+            # leaves it would fall back to this terrain anyway).
+            return current.grow(command, self._table[meadows[0].terrain], sigmas=self._sigmas)
         pose = current.most_probable_pose()
         if command.run <= RUN_TOLERANCE:
             # A run too short to cut by meadows: whole, on the start meadow's terrain.
@@ -511,6 +558,7 @@ class UncertaintyMapManager:
                     "accepted": self._accepted,
                     "rejected": dict(self._rejected),
                     "grown_reports": self._grown,
+                    "relocalizations": self._relocalizations,
                 },
                 "settings": {
                     "sigmas": self._sigmas,
@@ -590,7 +638,10 @@ class UncertaintyMapManager:
         except ValueError:
             reader.fail("state", f"expected one of {[s.value for s in ManagerState]}, got {state!r}")
         manager._lost_reason = reader.string(data["lost_reason"], "lost_reason")
-        counters = reader.mapping(data["counters"], "counters", ("accepted", "rejected", "grown_reports"))
+        counters = reader.mapping(
+            data["counters"], "counters", ("accepted", "rejected", "grown_reports", "relocalizations")
+        )
+        manager._relocalizations = reader.integer(counters["relocalizations"], "counters.relocalizations")
         manager._accepted = reader.integer(counters["accepted"], "counters.accepted")
         manager._grown = reader.integer(counters["grown_reports"], "counters.grown_reports")
         rejected = reader.mapping(counters["rejected"], "counters.rejected")
