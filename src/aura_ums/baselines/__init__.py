@@ -1,0 +1,43 @@
+"""Baseline estimators to compare the spatial uncertainty map with: an EKF and a particle filter.
+
+Both consume exactly what :class:`~aura_ums.uncertainty.SpatialUncertaintyMap` consumes:
+:class:`~aura_ums.uncertainty.TurnAndRun` commands with
+:class:`~aura_ums.uncertainty.TerrainStats` to predict, and
+:class:`~aura_ums.uncertainty.BearingObservation` /
+:class:`~aura_ums.uncertainty.RangeBearingObservation` with the landmark's (x, y) to
+update, and describe their belief by a :class:`ConfidenceRegion` (a convex polygon and a
+heading interval) for side-by-side figures.
+
+This package imports only geometry, uncertainty, validation and errors.
+"""
+
+from aura_ums.baselines._ekf import MIN_LANDMARK_DISTANCE, ExtendedKalmanFilter
+from aura_ums.baselines._moments import MotionMoments, clipped_normal_moments, motion_moments
+from aura_ums.baselines._particle import DEFAULT_PARTICLES, ParticleFilter, systematic_resample
+from aura_ums.baselines._protocol import Estimator
+from aura_ums.baselines._region import (
+    ELLIPSE_SIDES,
+    ConfidenceRegion,
+    chi2_quantile,
+    ellipse_polygon,
+    mahalanobis_core,
+    shortest_arc,
+)
+
+__all__ = [
+    "DEFAULT_PARTICLES",
+    "ELLIPSE_SIDES",
+    "MIN_LANDMARK_DISTANCE",
+    "ConfidenceRegion",
+    "Estimator",
+    "ExtendedKalmanFilter",
+    "MotionMoments",
+    "ParticleFilter",
+    "chi2_quantile",
+    "clipped_normal_moments",
+    "ellipse_polygon",
+    "mahalanobis_core",
+    "motion_moments",
+    "shortest_arc",
+    "systematic_resample",
+]

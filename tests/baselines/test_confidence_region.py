@@ -1,0 +1,218 @@
+"""ConfidenceRegion, the ellipse polygon, the particle core and the shortest heading arc."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from numpy.typing import NDArray
+
+from aura_ums.baselines import (
+    ConfidenceRegion,
+    ExtendedKalmanFilter,
+    chi2_quantile,
+    ellipse_polygon,
+    mahalanobis_core,
+    shortest_arc,
+)
+from aura_ums.baselines._region import convex_hull_polygon
+from aura_ums.errors import InputError
+from aura_ums.geometry import ConvexPolygon
+from aura_ums.uncertainty import Pose, TerrainTable, TurnAndRun
+
+SQUARE = ConvexPolygon([(-1, -1), (1, -1), (1, 1), (-1, 1)])
+
+
+def test_contains_wraps_around_pi() -> None:
+    region = ConfidenceRegion(SQUARE, math.pi, 0.1, 0.99)
+    assert region.contains(0.0, 0.0, -math.pi + 0.09) is True
+    assert region.contains(0.0, 0.0, math.pi - 0.09) is True
+    assert region.contains(0.0, 0.0, 3 * math.pi + 0.05) is True  # any representative of the angle
+    assert region.contains(0.0, 0.0, math.pi - 0.11) is False
+    assert region.contains(0.0, 0.0, 0.0) is False
+    assert region.contains(1.5, 0.0, math.pi) is False  # heading fine, position outside
+    headings = np.array([[math.pi, -math.pi + 0.05], [0.0, math.pi - 0.2]])
+    inside = region.contains(np.zeros((2, 2)), np.zeros((2, 2)), headings)
+    assert isinstance(inside, np.ndarray)
+    assert inside.shape == (2, 2)
+    assert inside.tolist() == [[True, True], [False, False]]
+
+
+def test_centre_is_wrapped_and_wide_interval_is_the_full_circle() -> None:
+    region = ConfidenceRegion(SQUARE, -math.pi, 5.0, 0.5)
+    assert region.heading_center == math.pi
+    assert region.heading_halfwidth == math.pi
+    assert region.heading_width == 2 * math.pi
+    assert region.wedge.is_full_circle
+    assert np.all(region.contains(np.zeros(7), np.zeros(7), np.linspace(-math.pi, math.pi, 7)))
+
+
+def test_degenerate_polygon_region() -> None:
+    region = ConfidenceRegion(ConvexPolygon.point(2.0, 3.0), 0.0, 0.0, 0.9)
+    assert region.area == 0.0
+    assert region.center == (2.0, 3.0)
+    assert region.contains(2.0, 3.0, 0.0) is True
+    assert region.contains(2.0, 3.0 + 1e-6, 0.0) is False
+    assert region.contains(2.0, 3.0, 1e-6) is False
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"polygon": [(0, 0)]}, "polygon: expected a ConvexPolygon"),
+        ({"heading_center": math.nan}, "heading_center: expected a finite number"),
+        ({"heading_halfwidth": -0.1}, "heading_halfwidth: expected a non-negative number"),
+        ({"probability": 1.0}, r"probability: expected a probability in \(0, 1\)"),
+        ({"probability": 0.0}, r"probability: expected a probability in \(0, 1\)"),
+    ],
+)
+def test_bad_region_arguments(kwargs: dict[str, object], match: str) -> None:
+    args: dict[str, object] = {
+        "polygon": SQUARE,
+        "heading_center": 0.0,
+        "heading_halfwidth": 0.1,
+        "probability": 0.99,
+    }
+    args.update(kwargs)
+    with pytest.raises(InputError, match=match):
+        ConfidenceRegion(**args)  # type: ignore[arg-type]
+
+
+def test_contains_rejects_mismatched_shapes() -> None:
+    region = ConfidenceRegion(SQUARE, 0.0, 0.1, 0.99)
+    with pytest.raises(InputError, match="contains: expected x, y and heading of one shape"):
+        region.contains(np.zeros(2), np.zeros(3), np.zeros(2))
+
+
+def test_chi2_quantiles_match_scipy() -> None:
+    from scipy.stats import chi2
+
+    for p in (0.5, 0.9, 0.99, 0.999):
+        assert chi2_quantile(p, 1) == pytest.approx(chi2.ppf(p, 1), rel=1e-9)
+        assert chi2_quantile(p, 2) == pytest.approx(chi2.ppf(p, 2), rel=1e-9)
+
+
+def test_ellipse_polygon_circumscribes_the_ellipse() -> None:
+    covariance = (2.0, 0.8, 0.5)
+    scale = 9.21
+    vertices = ellipse_polygon((3.0, -1.0), covariance, scale)
+    polygon = ConvexPolygon(vertices)  # validates: convex and counter-clockwise
+    assert polygon.vertex_count == 64
+    matrix = np.array([[2.0, 0.8], [0.8, 0.5]])
+    root = np.linalg.cholesky(matrix * scale)
+    t = np.linspace(0.0, 2 * math.pi, 2000)
+    boundary = np.array([3.0, -1.0]) + (root @ np.vstack([np.cos(t), np.sin(t)])).T
+    assert np.all(polygon.contains(boundary))
+    ellipse_area = math.pi * scale * math.sqrt(np.linalg.det(matrix))
+    assert 1.0 < polygon.area / ellipse_area < 1.0 + 2.5e-3
+
+
+def _ekf_with_covariance(correlated: bool) -> ExtendedKalmanFilter:
+    ekf = ExtendedKalmanFilter(
+        Pose(1.0, -2.0, 3.0), position_sd=0.3, heading_sd=0.05, bearing_sd=0.01, range_sd=0.1
+    )
+    if correlated:  # a long run correlates the lateral position with the heading
+        ekf.predict(TurnAndRun(0.3, 15.0), TerrainTable.default()["grass"])
+    return ekf
+
+
+@pytest.mark.parametrize("correlated", [False, True])
+def test_ekf_region_is_calibrated_on_gaussian_draws(correlated: bool) -> None:
+    """Containment of Gaussian draws: ~p uncorrelated, >= p correlated (Gaussian correlation inequality)."""
+    ekf = _ekf_with_covariance(correlated)
+    mean, covariance = ekf.mean, ekf.covariance
+    rng = np.random.default_rng(7)
+    n = 200_000
+    draws = rng.multivariate_normal([mean.x, mean.y, mean.heading], covariance, n)
+    p = 0.99
+    region = ekf.region(p)
+    rate = float(np.mean(region.contains(draws[:, 0], draws[:, 1], draws[:, 2])))
+    tolerance = 4.0 * math.sqrt(p * (1 - p) / n)
+    if correlated:
+        assert abs(covariance[0, 2]) > 0.1 * math.sqrt(covariance[0, 0] * covariance[2, 2])
+        assert rate >= p - tolerance
+    else:
+        assert rate == pytest.approx(p, abs=tolerance)
+    # Each factor holds sqrt(p) of its marginal.
+    q = math.sqrt(p)
+    in_position = float(np.mean(region.polygon.contains(draws[:, :2])))
+    offset = np.abs(np.remainder(draws[:, 2] - region.heading_center + math.pi, 2 * math.pi) - math.pi)
+    in_heading = float(np.mean(offset <= region.heading_halfwidth))
+    assert in_position == pytest.approx(q, abs=4.0 * math.sqrt(q * (1 - q) / n))
+    assert in_heading == pytest.approx(q, abs=4.0 * math.sqrt(q * (1 - q) / n))
+
+
+def test_shortest_arc_across_the_seam_and_degenerate() -> None:
+    headings = np.array([math.pi - 0.05, -math.pi + 0.05, 0.0])
+    center, halfwidth = shortest_arc(headings, np.array([0.45, 0.45, 0.1]), 0.9)
+    assert abs(math.remainder(center - math.pi, 2 * math.pi)) < 1e-12
+    assert halfwidth == pytest.approx(0.05)
+    assert shortest_arc(np.full(5, -1.0), np.full(5, 0.2), 0.99) == (-1.0, 0.0)
+    assert shortest_arc(np.array([2.0]), np.array([1.0]), 0.5) == (2.0, 0.0)
+
+
+def test_shortest_arc_of_uniform_circle() -> None:
+    headings = np.linspace(-math.pi, math.pi, 360, endpoint=False)
+    _, halfwidth = shortest_arc(headings, np.full(360, 1 / 360), 0.5)
+    assert halfwidth == pytest.approx(math.pi / 2, abs=2 * math.pi / 360)
+
+
+def _brute_force_arc(headings: NDArray[np.float64], weights: NDArray[np.float64], p: float) -> float:
+    best = 2 * math.pi
+    for start in headings:
+        offsets = np.remainder(headings - start, 2 * math.pi)
+        order = np.argsort(offsets)
+        held = np.cumsum(weights[order])
+        k = int(np.searchsorted(held, p * (1 - 1e-12)))
+        best = min(best, float(offsets[order][min(k, len(held) - 1)]))
+    return best
+
+
+@given(
+    st.lists(st.floats(-math.pi, math.pi), min_size=1, max_size=12),
+    st.integers(0, 2**32 - 1),
+    st.floats(0.05, 0.999),
+)
+def test_shortest_arc_holds_the_weight_and_is_shortest(headings: list[float], seed: int, p: float) -> None:
+    h = np.array(headings)
+    weights = np.random.default_rng(seed).uniform(0.1, 1.0, len(h))
+    weights /= weights.sum()
+    center, halfwidth = shortest_arc(h, weights, p)
+    offset = np.abs(np.remainder(h - center + math.pi, 2 * math.pi) - math.pi)
+    assert float(weights[offset <= halfwidth + 1e-9].sum()) >= p * (1 - 1e-9)
+    assert 2 * halfwidth == pytest.approx(_brute_force_arc(h, weights, p), abs=1e-9)
+
+
+@given(st.integers(1, 40), st.integers(0, 2**32 - 1), st.floats(0.05, 0.999), st.booleans())
+def test_mahalanobis_core_holds_the_weight(n: int, seed: int, p: float, collinear: bool) -> None:
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 2)) * [3.0, 0.5]
+    if collinear:
+        points[:, 1] = 2.0 * points[:, 0]
+    weights = rng.uniform(0.0, 1.0, n) + 1e-3
+    weights /= weights.sum()
+    core = mahalanobis_core(points, weights, p)
+    hull = ConvexPolygon.from_points(core)
+    assert float(weights[hull.contains(points, tolerance=1e-9)].sum()) >= p * (1 - 1e-9)
+    # The fewest: without its last (farthest) point the core holds less than p.
+    rows = [int(np.flatnonzero(np.all(points == row, axis=1))[0]) for row in core]
+    assert len(set(rows)) == len(rows)
+    assert float(weights[rows[:-1]].sum()) < p
+
+
+@given(st.integers(1, 300), st.integers(0, 2**32 - 1), st.sampled_from(["cloud", "collinear", "repeated"]))
+def test_prefiltered_hull_is_the_hull(n: int, seed: int, kind: str) -> None:
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 2)) * [5.0, 0.1] + [100.0, -40.0]
+    if kind == "collinear":
+        points[:, 1] = -0.5 * points[:, 0]
+    elif kind == "repeated":
+        points = points[rng.integers(0, min(n, 3), n)]
+    hull = convex_hull_polygon(points)
+    reference = ConvexPolygon.from_points(points)
+    assert hull.vertex_count == reference.vertex_count
+    assert hull.area == pytest.approx(reference.area, rel=1e-12, abs=1e-12)
+    assert np.all(hull.contains(points, tolerance=1e-9))
