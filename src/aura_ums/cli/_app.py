@@ -10,6 +10,10 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
+from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
+from aura_ums.cli._logs import import_app
+from aura_ums.cli._replay import calibrate, compare, replay
+
 app = typer.Typer(
     name="aura-ums",
     help="Guaranteed spatial uncertainty management for a mobile robot (after Arkin's AuRA).",
@@ -64,6 +68,7 @@ def simulate(
         bool,
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
+    mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
 ) -> None:
     """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics."""
     import numpy as np
@@ -108,6 +113,16 @@ def simulate(
                 f"--metrics-json: expected a writable path, got {metrics_json}: {exc.strerror}"
             ) from None
         _console.print(f"wrote {metrics_json}")
+    if mcap is not None:
+        write_simulation_mcap_option(mcap, loaded, seed, prune=prune)
+
+
+# Commands on recorded logs, and the dataset importers (``aura-ums import ...``).
+import_app.command("rosbag")(rosbag_command)
+app.add_typer(import_app, name="import")
+app.command()(calibrate)
+app.command()(replay)
+app.command()(compare)
 
 
 def main() -> None:

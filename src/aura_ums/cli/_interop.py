@@ -1,0 +1,160 @@
+"""Interoperability commands: ``aura-ums import rosbag`` (a ROS bag to a log folder) and ``--mcap``.
+
+The command functions are plain typer callbacks that the application registers
+(``import_app.command("rosbag")(rosbag_command)``); the ``--mcap`` helpers are called by
+the commands that run a scenario or replay a log.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+if TYPE_CHECKING:
+    from aura_ums.export._types import ReplayLike
+    from aura_ums.sim import Scenario
+
+_console = Console(soft_wrap=True)
+
+
+def _fail(message: str) -> typer.Exit:
+    _console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
+    return typer.Exit(code=2)
+
+
+def _span(first: float, last: float) -> str:
+    if not (math.isfinite(first) and math.isfinite(last)):
+        return "none"
+    return f"{first:.3f} .. {last:.3f} s ({last - first:.1f} s)"
+
+
+def rosbag_command(
+    bag: Annotated[
+        Path, typer.Argument(help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.")
+    ],
+    out_dir: Annotated[Path, typer.Argument(help="Log folder to write.")],
+    odom: Annotated[
+        str,
+        typer.Option(
+            "--odom", help="Motion topic: nav_msgs/msg/Odometry, geometry_msgs/msg/TwistStamped or Twist."
+        ),
+    ],
+    observations: Annotated[
+        str,
+        typer.Option(
+            "--observations",
+            help="Observation topic: geometry_msgs/msg/PointStamped, frame_id = landmark id, "
+            "x = range m (0: bearing only), y = bearing rad, z = bearing error rad (0: default).",
+        ),
+    ],
+    landmarks: Annotated[
+        Path, typer.Option("--landmarks", help="landmarks.csv in the log format (id, x, y, ...; SI units).")
+    ],
+    groundtruth: Annotated[
+        str | None,
+        typer.Option(
+            "--groundtruth",
+            help="Ground-truth topic: nav_msgs/msg/Odometry, geometry_msgs/msg/PoseStamped or "
+            "PoseWithCovarianceStamped.",
+        ),
+    ] = None,
+    name: Annotated[str | None, typer.Option("--name", help="Log name (default: the bag's name).")] = None,
+    overwrite: Annotated[
+        bool, typer.Option("--overwrite", help="Replace an existing log in OUT_DIR.")
+    ] = False,
+) -> None:
+    """Import the ROS bag BAG as a log folder OUT_DIR (topics and conventions: docs/interop.md).
+
+    Sensor bounds are the log defaults (meta.toml): edit them, or calibrate, before replaying.
+    """
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import LogMeta
+    from aura_ums.logs._rosbag import import_rosbag
+
+    try:
+        meta = None if name is None else LogMeta(name, source=f"ROS bag {bag.name}")
+        log = import_rosbag(
+            bag,
+            out_dir,
+            odom_topic=odom,
+            observations_topic=observations,
+            landmarks=landmarks,
+            meta=meta,
+            groundtruth_topic=groundtruth,
+            overwrite=overwrite,
+        )
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    kinds = Counter(observation.kind.value for observation in log.observations)
+    seen = len({observation.landmark_id for observation in log.observations})
+    times = [observation.time for observation in log.observations]
+    _console.print(f"wrote {log.path}", highlight=False, markup=False)
+    rows = [
+        ("log", log.meta.name),
+        ("source", log.meta.source),
+        ("landmarks", f"{len(log.landmarks)} ({seen} observed)"),
+        (
+            "observations",
+            f"{len(log.observations)} ("
+            + ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items()))
+            + ")",
+        ),
+        ("observation span", _span(min(times, default=math.nan), max(times, default=math.nan))),
+        ("odometry rows", str(len(log.odometry) if log.odometry is not None else 0)),
+        ("odometry span", _span(*log.motion_span)),
+    ]
+    if log.groundtruth is not None:
+        truth = log.groundtruth
+        rows.append(("ground truth rows", str(len(truth))))
+        rows.append(("ground truth span", _span(float(truth.time[0]), float(truth.time[-1]))))
+    for key, value in rows:
+        _console.print(f"{key:18s} {value}", highlight=False, markup=False)
+
+
+# --- MCAP export, for the commands that run or replay (``--mcap``) ---------------------------
+
+MCAP_HELP = "Also write an MCAP file to open in Foxglove (needs aura-ums[foxglove]; topics: docs/interop.md)."
+
+
+def write_simulation_mcap_option(path: Path, scenario: Scenario, seed: int, *, prune: bool) -> Path:
+    """Run the first Monte Carlo run of ``seed`` again, with its images, and write it as MCAP.
+
+    The run is the one ``simulate --seed SEED`` runs first (the first child of
+    ``default_rng(seed).spawn(...)``). Prints where it wrote; on an aura-ums error prints
+    ``error: ...`` and exits with code 2.
+    """
+    import numpy as np
+
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.export import write_simulation_mcap
+    from aura_ums.sim import run_scenario
+
+    (rng,) = np.random.default_rng(seed).spawn(1)
+    try:
+        result = run_scenario(scenario, rng, prune=prune, keep_images=True)
+        written = write_simulation_mcap(path, scenario, result)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    _console.print(
+        f"wrote {written} (run 1 of seed {seed}; open it in Foxglove)", highlight=False, markup=False
+    )
+    return written
+
+
+def write_replay_mcap_option(path: Path, replay: ReplayLike) -> Path:
+    """Write a replay as MCAP; prints where, or ``error: ...`` and exits with code 2."""
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.export import write_replay_mcap
+
+    try:
+        written = write_replay_mcap(path, replay)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    _console.print(f"wrote {written} (open it in Foxglove)", highlight=False, markup=False)
+    return written

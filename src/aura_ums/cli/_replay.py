@@ -1,0 +1,263 @@
+"""``aura-ums calibrate``, ``replay`` and ``compare``: the map on recorded logs."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+if TYPE_CHECKING:
+    from aura_ums.logs import ReplayOptions
+
+_console = Console(soft_wrap=True)
+
+
+def _fail(message: str) -> typer.Exit:
+    _console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
+    return typer.Exit(code=2)
+
+
+_CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
+
+
+def _options(classes: str, sigmas: float, sensors: Path | None, robust: bool) -> ReplayOptions:
+    from aura_ums.logs import ReplayOptions, load_sensors
+    from aura_ums.uncertainty import LandmarkClass
+
+    if classes not in _CLASSES:
+        raise _fail(f"--classes: expected I or II, got {classes!r}")
+    landmark_class = LandmarkClass[_CLASSES[classes]]
+    if sensors is None:
+        return ReplayOptions(sigmas=sigmas, landmark_class=landmark_class, robust=robust)
+    motion, working, envelope = load_sensors(sensors)
+    return ReplayOptions(
+        sigmas=sigmas,
+        landmark_class=landmark_class,
+        robust=robust,
+        working=working,
+        envelope=envelope,
+        motion=motion,
+    )
+
+
+def calibrate(
+    log_dirs: Annotated[list[Path], typer.Argument(help="Log folders with groundtruth.csv, one terrain.")],
+    out: Annotated[Path, typer.Option("--out", help="Terrain table TOML to write.")],
+    sensors_out: Annotated[
+        Path | None,
+        typer.Option(
+            "--sensors-out", help="Motion and sensor bounds TOML (default: OUT with .sensors.toml)."
+        ),
+    ] = None,
+    quantile: Annotated[float, typer.Option(help="Quantile the motion and working bounds cover.")] = 0.99,
+    horizon: Annotated[float, typer.Option(help="Seconds per motion window of the fit.")] = 1.0,
+) -> None:
+    """Estimate terrain statistics and sensor bounds from logs with ground truth."""
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import calibrate_logs, load_log
+
+    try:
+        logs = [load_log(folder) for folder in log_dirs]
+        calibration = calibrate_logs(logs, quantile=quantile, horizon=horizon)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    sensors = sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    sensors.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(calibration.terrain_table().to_toml())
+    sensors.write_text(calibration.sensors_toml())
+    motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
+    _console.print(
+        f"motion: delay {motion.delay_s:.2f} s, run scale {motion.run_scale:.3f}, "
+        f"turn scale {motion.turn_scale:.3f} ({calibration.motion_windows} windows)"
+    )
+    for name, bounds in (("working", working), ("envelope", envelope)):
+        _console.print(
+            f"{name}: bearing +-{bounds.bearing_error:.4f} rad, range "
+            f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
+            f"({calibration.observations} observations)"
+        )
+    _console.print(f"wrote {out} and {sensors}")
+
+
+def replay(
+    log_dir: Annotated[Path, typer.Argument(help="Log folder (docs/log-format.md).")],
+    terrain: Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")],
+    sensors: Annotated[
+        Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
+    ] = None,
+    sigmas: Annotated[
+        float, typer.Option("--sigmas", help="Standard deviations bounded by the growth.")
+    ] = 3.0,
+    classes: Annotated[str, typer.Option("--classes", help="I: bearings only; II: range and bearing.")] = "I",
+    robust: Annotated[
+        bool, typer.Option("--robust/--gate-only", help="Re-localize from an envelope map (default).")
+    ] = True,
+    metrics_json: Annotated[
+        Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
+    ] = None,
+    steps_csv: Annotated[
+        Path | None, typer.Option("--steps-csv", help="Write one row per time step to this CSV file.")
+    ] = None,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Folder for a figure of the replay.")] = None,
+    mcap: Annotated[
+        Path | None, typer.Option("--mcap", help="Write the replay as MCAP for Foxglove.")
+    ] = None,
+) -> None:
+    """Run the map manager over a log and report containment, area, wedge width and speed."""
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import load_log, replay_log
+    from aura_ums.uncertainty import TerrainTable
+
+    try:
+        log = load_log(log_dir)
+        table = TerrainTable.from_toml(terrain)
+        options = _options(classes, sigmas, sensors, robust)
+        result = replay_log(log, table, options)
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    metrics = result.metrics()
+    for key, value in metrics.items():
+        shown = f"{value:.6g}" if isinstance(value, float) else str(value)
+        _console.print(f"{key}: {escape(shown)}", highlight=False)
+    if metrics_json is not None:
+        metrics_json.parent.mkdir(parents=True, exist_ok=True)
+        metrics_json.write_text(json.dumps(metrics, indent=2, allow_nan=True) + "\n")
+        _console.print(f"wrote {metrics_json}")
+    if steps_csv is not None:
+        steps_csv.parent.mkdir(parents=True, exist_ok=True)
+        lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
+        for s in result.steps:
+            inside = "" if s.inside is None else str(int(s.inside))
+            lines.append(
+                f"{s.time!r},{inside},{s.map.area!r},{s.map.wedge.width!r},{s.accepted},{s.rejected},"
+                f"{s.update_us:.3f},{s.state.value},{int(s.relocalized)}"
+            )
+        steps_csv.write_text("\n".join(lines) + "\n")
+        _console.print(f"wrote {steps_csv}")
+    if plot is not None:
+        from aura_ums.plot import draw_replay
+
+        _console.print(f"wrote {draw_replay(result, plot)}")
+    if mcap is not None:
+        from aura_ums.cli._interop import write_replay_mcap_option
+
+        write_replay_mcap_option(mcap, result)
+
+
+def compare(
+    log_dir: Annotated[Path, typer.Argument(help="Log folder with groundtruth.csv.")],
+    terrain: Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")],
+    sensors: Annotated[
+        Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
+    ] = None,
+    calibration_logs: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--noise-from", help="Logs whose observation errors give the filters' noise (default LOG_DIR)."
+        ),
+    ] = None,
+    classes: Annotated[
+        str, typer.Option("--classes", help="I: bearings only; II: range and bearing.")
+    ] = "II",
+    particles: Annotated[int, typer.Option("--particles", help="Particles of the particle filter.")] = 1000,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
+    metrics_json: Annotated[
+        Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
+    ] = None,
+) -> None:
+    """Print our map next to an EKF and a particle filter on the same log (99% regions)."""
+    import numpy as np
+
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import compare_on_log, load_log, observation_errors
+    from aura_ums.uncertainty import TerrainTable
+
+    if particles < 1:
+        raise _fail(f"--particles: expected an integer >= 1, got {particles}")
+    try:
+        log = load_log(log_dir)
+        table = TerrainTable.from_toml(terrain)
+        options = _options(classes, 3.0, sensors, True)
+        noise_logs = [load_log(p) for p in calibration_logs] if calibration_logs else [log]
+        bearing, ranges = observation_errors(noise_logs)
+        if bearing.size < 2:
+            raise _fail("--noise-from: expected logs with observations inside their ground truth, got none")
+        bearing_sd = float(np.std(bearing))
+        range_sd = float(np.std(ranges)) if ranges.size > 1 else 0.05
+        rows = compare_on_log(
+            log,
+            table,
+            options,
+            bearing_sd=bearing_sd,
+            range_sd_fraction=max(range_sd, 1e-3),
+            rng=np.random.default_rng(seed),
+            particles=particles,
+        )
+    except AuraUmsError as exc:
+        raise _fail(str(exc)) from None
+    grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters")
+    for column in (
+        "method",
+        "truth inside",
+        "median area m^2",
+        "median heading width rad",
+        "RMSE m",
+        "us/step",
+        "rejected",
+    ):
+        grid.add_column(column, justify="right")
+    for row in rows:
+        grid.add_row(
+            row.method,
+            f"{row.containment_rate:.4f}",
+            f"{row.median_area_m2:.4g}",
+            f"{row.median_heading_width_rad:.3f}",
+            f"{row.position_rmse_m:.3f}",
+            f"{row.median_update_us:.1f}",
+            str(row.rejected),
+        )
+    _console.print(grid)
+    if metrics_json is not None:
+        metrics_json.parent.mkdir(parents=True, exist_ok=True)
+        payload = {
+            "log": log.meta.name,
+            "landmark_class": classes,
+            "bearing_sd": bearing_sd,
+            "range_sd_fraction": range_sd,
+            "methods": [
+                {
+                    k: (None if isinstance(v, float) and math.isnan(v) else v)
+                    for k, v in zip(
+                        (
+                            "method",
+                            "containment_rate",
+                            "median_area_m2",
+                            "median_heading_width_rad",
+                            "position_rmse_m",
+                            "median_update_us",
+                            "rejected",
+                        ),
+                        (
+                            r.method,
+                            r.containment_rate,
+                            r.median_area_m2,
+                            r.median_heading_width_rad,
+                            r.position_rmse_m,
+                            r.median_update_us,
+                            r.rejected,
+                        ),
+                        strict=True,
+                    )
+                }
+                for r in rows
+            ],
+        }
+        metrics_json.write_text(json.dumps(payload, indent=2) + "\n")
+        _console.print(f"wrote {metrics_json}")

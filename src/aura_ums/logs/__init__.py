@@ -1,0 +1,93 @@
+"""Robot logs: the log folder format, dataset readers, and odometry to turn-and-run reports.
+
+A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
+
+- :func:`load_log` reads and validates one into a :class:`RobotLog` (SI units), and
+  :func:`write_log` writes one back exactly;
+- :class:`RobotLog` holds :class:`LogMeta`, :class:`LogLandmark` s, :class:`LogObservation` s,
+  the motion as :class:`Odometry` (velocities) or recorded position reports, and an optional
+  :class:`GroundTruth`; :meth:`RobotLog.position_reports` turns the motion into the
+  time-stamped :class:`~aura_ums.manager.PositionReport` s the map manager grows by
+  (:func:`odometry_to_commands`);
+- :func:`read_mrclam` and :func:`import_mrclam` read the UTIAS MRCLAM dataset
+  (Leung et al., IJRR 2011).
+"""
+
+# Replay, calibration and robust localization are the lead's (_calibrate, _replay, _robust,
+# _synthetic); the formats and readers are helper-logs' (_io, _log, _mrclam, _odometry).
+# One sorted import block (ruff's isort), so the two are interleaved below.
+from aura_ums.logs._calibrate import (
+    Calibration,
+    MotionCalibration,
+    SensorBounds,
+    calibrate_logs,
+    load_sensors,
+    observation_errors,
+)
+from aura_ums.logs._compare import MethodSummary, compare_on_log
+from aura_ums.logs._io import LOG_FILES, load_log, write_log
+from aura_ums.logs._log import (
+    GroundTruth,
+    LogLandmark,
+    LogMeta,
+    LogObservation,
+    ObservationKind,
+    Odometry,
+    RobotLog,
+)
+from aura_ums.logs._mrclam import import_mrclam, read_mrclam
+from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
+from aura_ums.logs._replay import (
+    ReplayOptions,
+    ReplayResult,
+    ReplayStep,
+    log_meadow_map,
+    meta_bounds,
+    observation_for,
+    position_reports_for,
+    replay_log,
+    replay_start,
+)
+from aura_ums.logs._robust import EnvelopeLocalizer, EnvelopeStep
+from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+from aura_ums.logs._synthetic import SYNTHETIC_LANDMARKS, synthetic_log
+
+__all__ = [
+    "LOG_FILES",
+    "SYNTHETIC_LANDMARKS",
+    "Calibration",
+    "EnvelopeLocalizer",
+    "EnvelopeStep",
+    "GroundTruth",
+    "LogLandmark",
+    "LogMeta",
+    "LogObservation",
+    "MethodSummary",
+    "MotionCalibration",
+    "ObservationKind",
+    "Odometry",
+    "ReplayOptions",
+    "ReplayResult",
+    "ReplayStep",
+    "ReverseMotion",
+    "RobotLog",
+    "SensorBounds",
+    "calibrate_logs",
+    "compare_on_log",
+    "import_mrclam",
+    "import_rosbag",
+    "load_log",
+    "load_sensors",
+    "log_meadow_map",
+    "meta_bounds",
+    "observation_errors",
+    "observation_for",
+    "odometry_to_commands",
+    "position_reports_for",
+    "read_mrclam",
+    "read_rosbag",
+    "replay_log",
+    "replay_start",
+    "synthetic_log",
+    "write_log",
+]

@@ -1,0 +1,222 @@
+"""The spatial uncertainty map next to an EKF and a particle filter, on the same log."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+
+from aura_ums._validate import finite_float
+from aura_ums.baselines import ExtendedKalmanFilter, ParticleFilter
+from aura_ums.errors import InputError
+from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._replay import (
+    ReplayOptions,
+    ReplayResult,
+    meta_bounds,
+    observation_for,
+    position_reports_for,
+    replay_log,
+    replay_start,
+)
+from aura_ums.uncertainty import BearingObservation, RangeBearingObservation, TerrainTable
+
+
+@dataclass(frozen=True, slots=True)
+class MethodSummary:
+    """One row of :func:`compare_on_log`'s table.
+
+    Attributes
+    ----------
+    method : str
+        ``"aura-ums"``, ``"EKF"`` or ``"PF (n)"``.
+    containment_rate : float
+        Fraction of the steps whose ground truth is inside the method's region (our map;
+        the filters' 99% regions).
+    median_area_m2 : float
+        Median area of the position region, m^2.
+    median_heading_width_rad : float
+        Median width of the heading region, radians.
+    position_rmse_m : float
+        Root mean square distance from the region's centre (our map) or the mean (the
+        filters) to the true position, metres.
+    median_update_us : float
+        Median microseconds per step (growth or prediction since the previous step, and
+        the step's observations).
+    rejected : int
+        Observations rejected (our gate; the filters' Mahalanobis gates).
+    """
+
+    method: str
+    containment_rate: float
+    median_area_m2: float
+    median_heading_width_rad: float
+    position_rmse_m: float
+    median_update_us: float
+    rejected: int
+
+
+def _frames(log: RobotLog, start: float) -> dict[float, list[LogObservation]]:
+    frames: dict[float, list[LogObservation]] = {}
+    for row in log.observations:
+        if row.time > start:
+            frames.setdefault(row.time, []).append(row)
+    return frames
+
+
+def _ours(result: ReplayResult) -> MethodSummary:
+    errors = [
+        math.hypot(s.map.center[0] - s.truth.x, s.map.center[1] - s.truth.y)
+        for s in result.steps
+        if s.truth is not None
+    ]
+    return MethodSummary(
+        "aura-ums",
+        result.containment_rate,
+        result.median_area_m2,
+        result.median_wedge_width_rad,
+        float(np.sqrt(np.mean(np.square(errors)))) if errors else math.nan,
+        result.median_update_us,
+        result.inconsistent_observations,
+    )
+
+
+def compare_on_log(
+    log: RobotLog,
+    table: TerrainTable,
+    options: ReplayOptions | None = None,
+    *,
+    bearing_sd: float,
+    range_sd_fraction: float,
+    rng: np.random.Generator,
+    particles: int = 1000,
+    probability: float = 0.99,
+) -> tuple[MethodSummary, ...]:
+    """Run our map, an EKF and a particle filter over the same log and judge each against ground truth.
+
+    All three see the same position reports (:func:`position_reports_for`), the same
+    terrain statistics and the same observations, step by step. The filters start from
+    the same pose with standard deviations of a third of our start bounds, use
+    ``bearing_sd`` (rad) and ``range_sd_fraction`` (of the range) as their measurement
+    noise, and gate at 99.9%; their region is the ``probability`` confidence region.
+
+    Parameters
+    ----------
+    log : RobotLog
+        A log with ground truth.
+    table : TerrainTable
+        Must hold the log's terrain.
+    options : ReplayOptions or None
+        Our replay's options (landmark class, bounds, motion calibration).
+    bearing_sd : float
+        Radians, > 0.
+    range_sd_fraction : float
+        Fraction of the range, > 0.
+    rng : numpy.random.Generator
+        The particle filter's randomness.
+    particles : int
+        Particles, >= 1.
+    probability : float
+        Probability of the filters' confidence regions, in (0, 1).
+
+    Returns
+    -------
+    tuple of MethodSummary
+        Ours, the EKF's and the particle filter's.
+
+    Raises
+    ------
+    InputError
+        For a bad argument or a log without ground truth.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(3), duration=20.0)
+    >>> rows = compare_on_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}),
+    ...                       bearing_sd=0.006, range_sd_fraction=0.012,
+    ...                       rng=np.random.default_rng(0), particles=200)
+    >>> [row.method for row in rows], rows[0].containment_rate
+    (['aura-ums', 'EKF', 'PF (200)'], 1.0)
+    """
+    if not isinstance(log, RobotLog):
+        raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
+    if log.groundtruth is None:
+        raise InputError(f"log {log.meta.name!r}: expected ground truth to compare against, got none")
+    opts = ReplayOptions() if options is None else options
+    b_sd = finite_float(bearing_sd, "bearing_sd")
+    r_sd = finite_float(range_sd_fraction, "range_sd_fraction")
+    if not b_sd > 0.0 or not r_sd > 0.0:
+        raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
+    ours = replay_log(log, table, opts)
+    if opts.motion is not None:
+        motion = opts.motion
+        meta = dataclasses.replace(
+            log.meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
+        )
+        log = dataclasses.replace(log, meta=meta)
+    terrain = table[log.meta.terrain]
+    start_time, start_pose = replay_start(log)
+    reports = position_reports_for(log, opts)
+    frames = _frames(log, start_time)
+    bounds = opts.working if opts.working is not None else meta_bounds(log)
+    common = {
+        "position_sd": max(log.meta.start_radius / 3.0, 1e-3),
+        "heading_sd": max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
+        "bearing_sd": b_sd,
+        "range_sd": 0.01,
+        "range_sd_fraction": r_sd,
+    }
+    filters: list[tuple[str, ExtendedKalmanFilter | ParticleFilter]] = [
+        ("EKF", ExtendedKalmanFilter(start_pose, gate_probability=0.999, **common)),
+        (
+            f"PF ({particles})",
+            ParticleFilter(start_pose, rng, particles=particles, gate_probability=0.999, **common),
+        ),
+    ]
+    landmarks = {lm.id: (lm.x, lm.y) for lm in log.landmarks}
+    truth = log.groundtruth
+    if truth is None:  # replaced above by the motion calibration, never dropped
+        raise InputError(f"log {log.meta.name!r}: expected ground truth to compare against, got none")
+    summaries = [_ours(ours)]
+    for name, estimator in filters:
+        inside: list[bool] = []
+        areas: list[float] = []
+        widths: list[float] = []
+        errors: list[float] = []
+        micros: list[float] = []
+        next_report = 0
+        for frame_time in sorted(frames):
+            began = _time.perf_counter()
+            while next_report < len(reports) and reports[next_report].time <= frame_time:
+                estimator.predict(reports[next_report].command, terrain)
+                next_report += 1
+            for row in frames[frame_time]:
+                seen = observation_for(row, opts.landmark_class, bounds)
+                if isinstance(seen, (BearingObservation, RangeBearingObservation)):
+                    estimator.update(seen, landmarks[row.landmark_id])
+            micros.append((_time.perf_counter() - began) * 1e6)
+            region = estimator.region(probability)
+            x, y, heading = truth.at([frame_time])[0]
+            areas.append(region.area)
+            widths.append(region.heading_width)
+            if math.isnan(x):
+                continue
+            inside.append(bool(region.contains(x, y, heading)))
+            mean = estimator.mean
+            errors.append(math.hypot(mean.x - x, mean.y - y))
+        summaries.append(
+            MethodSummary(
+                name,
+                float(np.mean(inside)) if inside else math.nan,
+                float(np.median(areas)) if areas else math.nan,
+                float(np.median(widths)) if widths else math.nan,
+                float(np.sqrt(np.mean(np.square(errors)))) if errors else math.nan,
+                float(np.median(micros)) if micros else math.nan,
+                estimator.rejected_count,
+            )
+        )
+    return tuple(summaries)

@@ -1,0 +1,675 @@
+"""The log folder format: ``meta.toml`` and CSV files (see ``docs/log-format.md``).
+
+Reading validates every file once and fails with a :class:`FileFormatError` that names
+the file and the line (or the TOML key). Writing uses SI units and ``repr`` floats, so a
+written log reads back equal.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import tomllib
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import NoReturn
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.manager import PositionReport
+from aura_ums.uncertainty import Pose, TurnAndRun
+
+META = "meta.toml"
+ODOMETRY = "odometry.csv"
+COMMANDS = "commands.csv"
+OBSERVATIONS = "observations.csv"
+LANDMARKS = "landmarks.csv"
+GROUNDTRUTH = "groundtruth.csv"
+#: Every file of a log folder, in the order they are described.
+LOG_FILES = (META, ODOMETRY, COMMANDS, OBSERVATIONS, LANDMARKS, GROUNDTRUTH)
+
+#: Factors from each unit a ``[units]`` table may name to SI.
+LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048}
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+# The unit of every number in the files: "length", "angle", "time", a ratio of two, or "" (none).
+_ODOMETRY_COLUMNS = {"time": "time", "v": "length/time", "omega": "angle/time"}
+_COMMAND_COLUMNS = {"time": "time", "turn": "angle", "run": "length"}
+_OBSERVATION_COLUMNS = {
+    "time": "time",
+    "landmark_id": "text",
+    "bearing": "angle",
+    "range": "length",
+    "bearing_error": "angle",
+    "range_error": "length",
+}
+_LANDMARK_COLUMNS = {
+    "id": "text",
+    "x": "length",
+    "y": "length",
+    "position_uncertainty": "length",
+    "z_bottom": "length",
+    "z_top": "length",
+    "symbol": "text",
+}
+_GROUNDTRUTH_COLUMNS = {"time": "time", "x": "length", "y": "length", "heading": "angle"}
+
+# meta.toml: table -> key -> (LogMeta field, unit). The top-level table is "".
+_META_KEYS: dict[str, dict[str, tuple[str, str]]] = {
+    "": {"name": ("name", "text"), "terrain": ("terrain", "text"), "source": ("source", "text")},
+    "sensor": {
+        "bearing_error": ("bearing_error", "angle"),
+        "range_error": ("range_error", "length"),
+        "range_error_fraction": ("range_error_fraction", ""),
+    },
+    "motion": {"delay_s": ("delay_s", ""), "run_scale": ("run_scale", ""), "turn_scale": ("turn_scale", "")},
+    "start": {
+        "x": ("start.x", "length"),
+        "y": ("start.y", "length"),
+        "heading": ("start.heading", "angle"),
+        "radius": ("start_radius", "length"),
+        "heading_halfwidth": ("start_heading_halfwidth", "angle"),
+    },
+    "landmarks": {"z_bottom": ("landmark_z_bottom", "length"), "z_top": ("landmark_z_top", "length")},
+}
+_TABLES = ("units", *(table for table in _META_KEYS if table))
+_FIELD_PLACES = {
+    target: (f"[{table}] {key}" if table else key)
+    for table, keys in _META_KEYS.items()
+    for key, (target, _) in keys.items()
+}
+_FIELD_PLACES["start"] = "[start]"
+
+#: Line of the first data row in the CSV files :func:`write_log` writes (a comment, then the header).
+FIRST_ROW_LINE = 3
+
+
+@dataclass(frozen=True, slots=True)
+class Units:
+    """Factors from a log's file units to SI.
+
+    Parameters
+    ----------
+    length, angle, time : float
+        Metres per length unit, radians per angle unit, seconds per time unit.
+    """
+
+    length: float = 1.0
+    angle: float = 1.0
+    time: float = 1.0
+
+    def factor(self, unit: str) -> float:
+        """Return the factor of a unit expression: "", "length", "angle/time", ..."""
+        if unit in ("", "text"):
+            return 1.0
+        numerator, _, denominator = unit.partition("/")
+        value: float = getattr(self, numerator)
+        return value / getattr(self, denominator) if denominator else value
+
+
+# --- reading -----------------------------------------------------------------------------------
+
+
+class _CsvFile:
+    """One CSV file: its path for messages, its columns of stripped cells and their line numbers."""
+
+    def __init__(self, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> None:
+        self.source = str(path)
+        self.units = columns
+        if not path.is_file():
+            self.fail("", "expected a CSV file, got no such file")
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            self.fail("", f"expected a readable UTF-8 CSV file, got {exc}")
+        numbers: list[int] = []
+        lines: list[str] = []
+        for number, line in enumerate(text.splitlines(), start=1):
+            stripped = line.strip()
+            if stripped and not stripped.startswith("#"):
+                numbers.append(number)
+                lines.append(line)
+        if not lines:
+            self.fail("", f"expected a header row naming the columns {', '.join(required)}, got none")
+        reader = csv.reader(lines, strict=True)
+        try:
+            parsed = list(reader)
+        except csv.Error as exc:
+            self.fail(f"line {numbers[min(reader.line_num, len(numbers)) - 1]}", f"expected CSV, got {exc}")
+        if len(parsed) != len(lines):  # a quoted cell spanning lines
+            self.fail("", "expected one row per line, got a quoted cell spanning lines")
+        header = [name.strip() for name in parsed[0]]
+        where = f"line {numbers[0]}"
+        for index, name in enumerate(header):
+            if name not in columns:
+                self.fail(where, f"expected columns from {', '.join(columns)}, got unknown column {name!r}")
+            if name in header[:index]:
+                self.fail(where, f"expected each column once, got {name!r} twice")
+        for name in required:
+            if name not in header:
+                self.fail(where, f"expected a column {name!r}, got columns {', '.join(header)}")
+        body = parsed[1:]
+        self.lines = numbers[1:]
+        for number, cells in zip(self.lines, body, strict=True):
+            if len(cells) != len(header):
+                self.fail(f"line {number}", f"expected {len(header)} cells, got {len(cells)}")
+        transposed = list(zip(*body, strict=True)) if body else [() for _ in header]
+        self.cells = {
+            name: [cell.strip() for cell in column] for name, column in zip(header, transposed, strict=True)
+        }
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+    def fail(self, where: str, message: str) -> NoReturn:
+        raise FileFormatError(self.source, where, message)
+
+    def fail_at(self, row: int, message: str) -> NoReturn:
+        self.fail(f"line {self.lines[row]}", message)
+
+    def numbers(self, column: str, units: Units, *, optional: bool = False) -> NDArray[np.float64]:
+        """Return a column as finite floats in SI; with ``optional``, NaN where absent or empty."""
+        factor = units.factor(self.units[column])
+        if column not in self.cells:
+            return np.full(len(self), np.nan)
+        cells = self.cells[column]
+        try:
+            values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
+        except ValueError:
+            for row, cell in enumerate(cells):
+                try:
+                    float(cell)
+                except ValueError:
+                    self.fail_at(row, f"expected a number in column {column!r}, got {cell!r}")
+            raise  # pragma: no cover - the loop above finds the cell
+        values = values.reshape(-1)
+        bad = ~np.isfinite(values)
+        if optional:
+            bad &= np.array([cell != "" for cell in cells], dtype=bool)
+        if np.any(bad):
+            row = int(np.argmax(bad))
+            self.fail_at(row, f"expected a finite number in column {column!r}, got {cells[row]!r}")
+        result: NDArray[np.float64] = values * factor
+        return result
+
+    def texts(self, column: str) -> list[str]:
+        """Return a column of non-empty strings."""
+        cells = self.cells[column]
+        for row, cell in enumerate(cells):
+            if not cell:
+                self.fail_at(row, f"expected a non-empty {column} in column {column!r}, got ''")
+        return cells
+
+    def at_least(self, column: str, values: NDArray[np.float64], *, positive: bool = False) -> None:
+        """Check a column (NaN for not given) is >= 0, or > 0 with ``positive``."""
+        bad = values <= 0.0 if positive else values < 0.0
+        if np.any(bad):
+            row = int(np.argmax(bad))
+            expected = f"a positive {column}" if positive else f"a {column} >= 0"
+            self.fail_at(row, f"expected {expected}, got {self.cells[column][row]!r}")
+
+    def times(self, units: Units, *, strict: bool) -> NDArray[np.float64]:
+        """Return the ``time`` column in seconds, checked increasing (strictly or not)."""
+        time = self.numbers("time", units)
+        steps = np.diff(time)
+        bad = steps <= 0.0 if strict else steps < 0.0
+        if np.any(bad):
+            row = int(np.argmax(bad)) + 1
+            cells = self.cells["time"]
+            order = "strictly increasing" if strict else "non-decreasing"
+            self.fail_at(
+                row,
+                f"expected {order} times, got {cells[row]!r} after {cells[row - 1]!r} "
+                f"(line {self.lines[row - 1]})",
+            )
+        return time
+
+    def need_rows(self) -> None:
+        if not self.lines:
+            self.fail("", "expected at least one data row, got none")
+
+
+def _given(values: NDArray[np.float64]) -> list[float | None]:
+    return [None if math.isnan(value) else value for value in values.tolist()]
+
+
+def _kind(value: object) -> str:
+    return repr(value) if isinstance(value, (str, int, float, bool)) else type(value).__name__
+
+
+class _MetaReader:
+    def __init__(self, path: Path) -> None:
+        self.source = str(path)
+        if not path.is_file():
+            self.fail("", "expected the log's TOML metadata file, got no such file")
+        try:
+            self.document = tomllib.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError) as exc:
+            self.fail("", f"expected a readable UTF-8 TOML file, got {exc}")
+        except tomllib.TOMLDecodeError as exc:
+            self.fail("", f"expected valid TOML, got {exc}")
+
+    def fail(self, where: str, message: str) -> NoReturn:
+        raise FileFormatError(self.source, where, message)
+
+    def units(self) -> Units:
+        table = self.document.get("units", {})
+        if not isinstance(table, Mapping):
+            self.fail("[units]", f"expected a table, got {_kind(table)}")
+        choices = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS, "time": TIME_UNITS}
+        factors: dict[str, float] = {}
+        for key, value in table.items():
+            if key not in choices:
+                self.fail(
+                    f"[units] {key}", f"expected one of the keys length, angle, time, got unknown {key!r}"
+                )
+            if value not in choices[key]:
+                self.fail(
+                    f"[units] {key}",
+                    f"expected one of {', '.join(map(repr, choices[key]))}, got {_kind(value)}",
+                )
+            factors[key] = choices[key][value]
+        return Units(**factors)
+
+    def read(self, default_name: str) -> tuple[LogMeta, Units]:
+        units = self.units()
+        values: dict[str, object] = {}
+        for key, value in self.document.items():
+            if key in _TABLES:
+                if not isinstance(value, Mapping):
+                    self.fail(f"[{key}]", f"expected a table, got {_kind(value)}")
+                if key != "units":
+                    for inner, item in value.items():
+                        self.value(key, inner, item, units, values)
+            elif key in _META_KEYS[""]:
+                self.value("", key, value, units, values)
+            else:
+                known = ", ".join([*_META_KEYS[""], *(f"[{table}]" for table in _TABLES)])
+                self.fail(key, f"expected one of {known}, got unknown key {key!r}")
+        pose = {
+            axis: values.pop(f"start.{axis}") for axis in ("x", "y", "heading") if f"start.{axis}" in values
+        }
+        if pose and len(pose) != 3:
+            given = " and ".join(pose)
+            self.fail("[start]", f"expected x, y and heading together (or none of them), got only {given}")
+        if pose:
+            values["start"] = Pose(pose["x"], pose["y"], pose["heading"])  # type: ignore[arg-type]
+        values.setdefault("name", default_name)
+        try:
+            meta = LogMeta(**values)  # type: ignore[arg-type]
+        except InputError as exc:
+            name, _, message = str(exc).partition(": ")
+            field = name.removeprefix("LogMeta.")
+            self.fail(_FIELD_PLACES.get(field, field), message)
+        return meta, units
+
+    def value(self, table: str, key: str, value: object, units: Units, values: dict[str, object]) -> None:
+        where = f"[{table}] {key}" if table else key
+        keys = _META_KEYS[table]
+        if key not in keys:
+            self.fail(where, f"expected one of the keys {', '.join(keys)}, got unknown {key!r}")
+        target, unit = keys[key]
+        if unit == "text":
+            if not isinstance(value, str):
+                self.fail(where, f"expected a string, got {_kind(value)}")
+            values[target] = value
+            return
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(where, f"expected a number, got {_kind(value)}")
+        if not math.isfinite(value):
+            self.fail(where, f"expected a finite number, got {value!r}")
+        values[target] = float(value) * units.factor(unit)
+
+
+def load_log(folder: str | os.PathLike[str]) -> RobotLog:
+    r"""Read a log folder (see ``docs/log-format.md``), validating every file.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The folder holding ``meta.toml``, ``observations.csv``, ``landmarks.csv``, exactly
+        one of ``odometry.csv`` and ``commands.csv``, and optionally ``groundtruth.csv``.
+
+    Returns
+    -------
+    RobotLog
+        The log in SI units, its ``path`` set to ``folder``.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line (or TOML key) and saying what was expected and what
+        was found: missing files or columns, unknown columns or keys, cells that are not
+        finite numbers, unsorted times, unknown or duplicate landmark ids, negative runs,
+        both odometry and commands, values out of range.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "meta.toml").write_text('name = "demo"\n[units]\nangle = "deg"\n')
+    >>> _ = (folder / "landmarks.csv").write_text("id,x,y\npole,3.0,0.0\n")
+    >>> _ = (folder / "observations.csv").write_text("time,landmark_id,bearing\n0.5,pole,90\n")
+    >>> _ = (folder / "commands.csv").write_text("time,turn,run\n1.0,0.0,0.5\n")
+    >>> log = load_log(folder)
+    >>> log.observations[0].bearing == math.pi / 2, log.commands[0].command.run
+    (True, 0.5)
+    >>> _ = (folder / "observations.csv").write_text("time,landmark_id,bearing\n0.5,post,90\n")
+    >>> load_log(folder)      # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: .../observations.csv: line 2: expected a landmark id ..., got 'post'
+    """
+    base = Path(folder)
+    if not base.is_dir():
+        raise FileFormatError(str(base), "", "expected a log folder, got no such folder")
+    meta, units = _MetaReader(base / META).read(base.name)
+    landmarks = _read_landmarks(base / LANDMARKS, units)
+    observations = _read_observations(base / OBSERVATIONS, units, {item.id for item in landmarks})
+    has_odometry, has_commands = (base / ODOMETRY).exists(), (base / COMMANDS).exists()
+    if has_odometry == has_commands:
+        got = "both" if has_odometry else "neither"
+        raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
+    odometry = _read_odometry(base / ODOMETRY, units) if has_odometry else None
+    commands = None if has_odometry else _read_commands(base / COMMANDS, units)
+    groundtruth = _read_groundtruth(base / GROUNDTRUTH, units) if (base / GROUNDTRUTH).exists() else None
+    return RobotLog(meta, landmarks, observations, odometry, commands, groundtruth, base)
+
+
+def _read_landmarks(path: Path, units: Units) -> tuple[LogLandmark, ...]:
+    table = _CsvFile(path, _LANDMARK_COLUMNS, ("id", "x", "y"))
+    ids = table.texts("id")
+    first: dict[str, int] = {}
+    for row, ident in enumerate(ids):
+        if ident in first:
+            table.fail_at(
+                row, f"expected a unique id, got {ident!r} again (first at line {table.lines[first[ident]]})"
+            )
+        first[ident] = row
+    x, y = table.numbers("x", units), table.numbers("y", units)
+    uncertainty = table.numbers("position_uncertainty", units, optional=True)
+    table.at_least("position_uncertainty", uncertainty)
+    bottom = table.numbers("z_bottom", units, optional=True)
+    top = table.numbers("z_top", units, optional=True)
+    upside_down = top < bottom
+    if np.any(upside_down):
+        row = int(np.argmax(upside_down))
+        table.fail_at(
+            row,
+            f"expected z_top >= z_bottom ({table.cells['z_bottom'][row]}), got {table.cells['z_top'][row]!r}",
+        )
+    symbols = table.cells.get("symbol", [""] * len(table))
+    result = []
+    for row, (ident, u, zb, zt) in enumerate(
+        zip(ids, _given(uncertainty), _given(bottom), _given(top), strict=True)
+    ):
+        try:
+            result.append(
+                LogLandmark(ident, float(x[row]), float(y[row]), u or 0.0, zb, zt, symbols[row] or "landmark")
+            )
+        except InputError as exc:
+            table.fail_at(row, str(exc).partition(": ")[2])
+    return tuple(result)
+
+
+def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogObservation, ...]:
+    table = _CsvFile(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"))
+    times = table.times(units, strict=False)
+    ids = table.texts("landmark_id")
+    for row, ident in enumerate(ids):
+        if ident not in known:
+            table.fail_at(row, f"expected a landmark id listed in {LANDMARKS}, got {ident!r}")
+    bearing = table.numbers("bearing", units)
+    measured = table.numbers("range", units, optional=True)
+    bearing_error = table.numbers("bearing_error", units, optional=True)
+    range_error = table.numbers("range_error", units, optional=True)
+    table.at_least("range", measured)
+    table.at_least("bearing_error", bearing_error, positive=True)
+    table.at_least("range_error", range_error)
+    try:
+        return tuple(
+            LogObservation(*values)
+            for values in zip(
+                times.tolist(),
+                ids,
+                bearing.tolist(),
+                _given(measured),
+                _given(bearing_error),
+                _given(range_error),
+                table.lines,
+                strict=True,
+            )
+        )
+    except InputError as exc:  # pragma: no cover - every value was checked above
+        table.fail("", str(exc))
+
+
+def _read_odometry(path: Path, units: Units) -> Odometry:
+    table = _CsvFile(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"))
+    table.need_rows()
+    time = table.times(units, strict=True)
+    return Odometry(time, table.numbers("v", units), table.numbers("omega", units))
+
+
+def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
+    table = _CsvFile(path, _COMMAND_COLUMNS, ("time", "turn", "run"))
+    times = table.times(units, strict=True)
+    turn, run = table.numbers("turn", units), table.numbers("run", units)
+    table.at_least("run", run)
+    return tuple(
+        PositionReport(when, TurnAndRun(angle, distance))
+        for when, angle, distance in zip(times.tolist(), turn.tolist(), run.tolist(), strict=True)
+    )
+
+
+def _read_groundtruth(path: Path, units: Units) -> GroundTruth:
+    table = _CsvFile(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"))
+    table.need_rows()
+    time = table.times(units, strict=True)
+    return GroundTruth(
+        time, table.numbers("x", units), table.numbers("y", units), table.numbers("heading", units)
+    )
+
+
+# --- writing -----------------------------------------------------------------------------------
+
+
+def _toml_string(text: str) -> str:
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
+
+
+def _meta_toml(meta: LogMeta) -> str:
+    lines = [
+        "# aura-ums log metadata (docs/log-format.md)",
+        f"name = {_toml_string(meta.name)}",
+        f"terrain = {_toml_string(meta.terrain)}",
+        f"source = {_toml_string(meta.source)}",
+        "",
+        "[units]",
+        'length = "m"',
+        'angle = "rad"',
+        'time = "s"',
+        "",
+        "[sensor]",
+        f"bearing_error = {meta.bearing_error!r}",
+        f"range_error = {meta.range_error!r}",
+        f"range_error_fraction = {meta.range_error_fraction!r}",
+        "",
+        "[motion]",
+        f"delay_s = {meta.delay_s!r}",
+        f"run_scale = {meta.run_scale!r}",
+        f"turn_scale = {meta.turn_scale!r}",
+        "",
+        "[start]",
+    ]
+    if meta.start is not None:
+        lines += [f"x = {meta.start.x!r}", f"y = {meta.start.y!r}", f"heading = {meta.start.heading!r}"]
+    lines += [
+        f"radius = {meta.start_radius!r}",
+        f"heading_halfwidth = {meta.start_heading_halfwidth!r}",
+        "",
+        "[landmarks]",
+        f"z_bottom = {meta.landmark_z_bottom!r}",
+        f"z_top = {meta.landmark_z_top!r}",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _cell(value: object) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def _csv_text(title: str, header: Sequence[str], rows: Iterator[Sequence[object]]) -> str:
+    buffer = io.StringIO()
+    buffer.write(f"# {title}\n")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    for row in rows:
+        writer.writerow([_cell(value) for value in row])
+    lines = buffer.getvalue().split("\n")
+    for index in range(2, len(lines)):
+        if lines[index].startswith("#"):  # an id starting with '#' is not a comment: quote it
+            first, comma, rest = lines[index].partition(",")
+            lines[index] = f'"{first}"{comma}{rest}'
+    return "\n".join(lines)
+
+
+def _floats(array: np.ndarray) -> list[float]:
+    return [float(value) for value in array]
+
+
+def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+    """Write ``log`` as a log folder (SI units, ``repr`` floats) that :func:`load_log` reads back equal.
+
+    Parameters
+    ----------
+    log : RobotLog
+        The log to write.
+    folder : str or path-like
+        Created if needed (with its parents).
+    overwrite : bool
+        Replace the log files of a folder that already has some. The log files this log
+        does not have (e.g. ``groundtruth.csv``) are then removed. Other files are left alone.
+
+    Returns
+    -------
+    Path
+        The folder.
+
+    Raises
+    ------
+    InputError
+        When the folder already holds log files and ``overwrite`` is False, or ``folder``
+        is not a folder.
+    FileFormatError
+        When a file cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> log = RobotLog(LogMeta("demo"), (), (), commands=(PositionReport(1.0, TurnAndRun(0.1, 0.5)),))
+    >>> folder = write_log(log, Path(tempfile.mkdtemp()) / "demo")
+    >>> sorted(path.name for path in folder.iterdir())
+    ['commands.csv', 'landmarks.csv', 'meta.toml', 'observations.csv']
+    >>> load_log(folder).commands == log.commands
+    True
+    >>> write_log(log, folder)        # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: folder: expected a folder without a log, got .../demo holding ...
+    """
+    if not isinstance(log, RobotLog):
+        raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
+    base = Path(folder)
+    if base.exists() and not base.is_dir():
+        raise InputError(f"folder: expected a folder, got the file {base}")
+    existing = [name for name in LOG_FILES if (base / name).exists()]
+    if existing and not overwrite:
+        raise InputError(
+            f"folder: expected a folder without a log, got {base} holding {', '.join(existing)} "
+            "(pass overwrite=True)"
+        )
+    files: dict[str, str] = {META: _meta_toml(log.meta)}
+    files[LANDMARKS] = _landmarks_csv(log.landmarks)
+    files[OBSERVATIONS] = _observations_csv(log.observations)
+    if log.odometry is not None:
+        odometry = log.odometry
+        files[ODOMETRY] = _csv_text(
+            "odometry: time [s], v [m/s], omega [rad/s]; each row holds until the next",
+            ("time", "v", "omega"),
+            zip(_floats(odometry.time), _floats(odometry.v), _floats(odometry.omega), strict=True),
+        )
+    else:
+        assert log.commands is not None
+        files[COMMANDS] = _csv_text(
+            "commands: time [s] when the motion ended, turn [rad], run [m]",
+            ("time", "turn", "run"),
+            ((report.time, report.command.turn, report.command.run) for report in log.commands),
+        )
+    if log.groundtruth is not None:
+        truth = log.groundtruth
+        files[GROUNDTRUTH] = _csv_text(
+            "ground truth: time [s], x [m], y [m], heading [rad]",
+            ("time", "x", "y", "heading"),
+            zip(_floats(truth.time), _floats(truth.x), _floats(truth.y), _floats(truth.heading), strict=True),
+        )
+    try:
+        base.mkdir(parents=True, exist_ok=True)
+        for name in existing:
+            if name not in files:
+                (base / name).unlink()
+        for name, text in files.items():
+            (base / name).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise FileFormatError(str(base), "", f"expected a writable folder, got {exc}") from exc
+    return base
+
+
+def _landmarks_csv(landmarks: Sequence[LogLandmark]) -> str:
+    heights = any(item.z_bottom is not None or item.z_top is not None for item in landmarks)
+    header = ["id", "x", "y", "position_uncertainty", *(("z_bottom", "z_top") if heights else ()), "symbol"]
+
+    def rows() -> Iterator[list[object]]:
+        for item in landmarks:
+            cells: list[object] = [item.id, item.x, item.y, item.position_uncertainty]
+            if heights:
+                cells += [item.z_bottom, item.z_top]
+            yield [*cells, item.symbol]
+
+    return _csv_text("landmarks: id, x [m], y [m], position_uncertainty [m], heights [m]", header, rows())
+
+
+def _observations_csv(observations: Sequence[LogObservation]) -> str:
+    optional = [
+        name
+        for name in ("range", "bearing_error", "range_error")
+        if any(getattr(item, name) is not None for item in observations)
+    ]
+    header = ["time", "landmark_id", "bearing", *optional]
+    rows = (
+        [item.time, item.landmark_id, item.bearing, *(getattr(item, n) for n in optional)]
+        for item in observations
+    )
+    return _csv_text(
+        "observations: time [s], landmark_id, bearing [rad], range [m], bearing_error [rad], range_error [m]",
+        header,
+        rows,
+    )
+
+
+def renumbered(observations: Sequence[LogObservation]) -> tuple[LogObservation, ...]:
+    """Return the observations with the ``line`` numbers :func:`write_log` gives them."""
+    return tuple(replace(item, line=FIRST_ROW_LINE + index) for index, item in enumerate(observations))

@@ -1,0 +1,252 @@
+"""Reader of the UTIAS Multi-Robot Cooperative Localization and Mapping (MRCLAM) dataset.
+
+K. Y. K. Leung, Y. Halpern, T. D. Barfoot, H. H. T. Liu, "The UTIAS Multi-Robot
+Cooperative Localization and Mapping Dataset", IJRR 30(8), 2011. Each dataset folder
+holds whitespace-separated ``.dat`` files with ``#`` header lines: ``Barcodes.dat``
+(subject, barcode), ``Landmark_Groundtruth.dat`` (subject, x, y, x sd, y sd) and, per
+robot N, ``RobotN_Odometry.dat`` (time, v, omega), ``RobotN_Measurement.dat`` (time,
+barcode, range, bearing) and ``RobotN_Groundtruth.dat`` (time, x, y, heading); SI units.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import replace
+from pathlib import Path
+from typing import NoReturn
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs._io import renumbered, write_log
+from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+
+#: Subjects 1-5 are the robots; 6-20 the landmarks.
+ROBOT_SUBJECTS = range(1, 6)
+CITATION = "Leung et al., IJRR 2011"
+LANDMARK_SYMBOL = "cylinder"
+
+
+class _DatFile:
+    """A whitespace-separated ``.dat`` file of numbers, rows kept with their line numbers."""
+
+    def __init__(self, path: Path, columns: tuple[str, ...]) -> None:
+        self.source = str(path)
+        if not path.is_file():
+            self.fail("", f"expected an MRCLAM data file ({', '.join(columns)}), got no such file")
+        try:
+            text = path.read_text(encoding="utf-8", errors="replace")
+        except OSError as exc:
+            self.fail("", f"expected a readable file, got {exc.strerror}")
+        lines: list[int] = []
+        rows: list[list[float]] = []
+        for number, line in enumerate(text.splitlines(), start=1):
+            cells = line.split()
+            if not cells or cells[0].startswith("#"):
+                continue
+            if len(cells) != len(columns):
+                self.fail(
+                    f"line {number}",
+                    f"expected {len(columns)} numbers ({', '.join(columns)}), got {len(cells)}",
+                )
+            try:
+                values = [float(cell) for cell in cells]
+            except ValueError:
+                self.fail(f"line {number}", f"expected numbers ({', '.join(columns)}), got {line.strip()!r}")
+            if not all(math.isfinite(value) for value in values):
+                self.fail(f"line {number}", f"expected finite numbers, got {line.strip()!r}")
+            lines.append(number)
+            rows.append(values)
+        self.lines = np.array(lines, dtype=np.int64)
+        self.data: NDArray[np.float64] = np.array(rows, dtype=np.float64).reshape(-1, len(columns))
+
+    def fail(self, where: str, message: str) -> NoReturn:
+        raise FileFormatError(self.source, where, message)
+
+    def increasing(self) -> tuple[NDArray[np.float64], int]:
+        """Rows with strictly increasing times: an exact repeat of a time keeps the last row.
+
+        Returns the rows and how many repeats were dropped; a time going back is an error.
+        """
+        if len(self.data) == 0:
+            self.fail("", "expected at least one data row, got none")
+        time = self.data[:, 0]
+        steps = np.diff(time)
+        if np.any(steps < 0.0):
+            row = int(np.argmax(steps < 0.0)) + 1
+            self.fail(
+                f"line {self.lines[row]}",
+                f"expected non-decreasing times, got {float(time[row])!r} after {float(time[row - 1])!r}",
+            )
+        keep = np.concatenate((steps > 0.0, [True]))
+        return self.data[keep], int(np.count_nonzero(~keep))
+
+
+def _dataset_label(folder: Path) -> str:
+    match = re.search(r"(\d+)$", folder.name)
+    return f"UTIAS MRCLAM Dataset{match.group(1)}" if match else f"UTIAS MRCLAM dataset {folder.name!r}"
+
+
+def _plural(count: int, word: str) -> str:
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
+def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
+    """Read one robot's run from a UTIAS MRCLAM dataset folder (any of its datasets).
+
+    Measurements of barcodes that belong to robots (subjects 1-5) or to no subject are
+    dropped, and so are landmark subjects missing from ``Landmark_Groundtruth.dat``; the
+    counts are in ``meta.source``. Landmark ids are the subject numbers as strings ("6"
+    to "20"); their ``position_uncertainty`` is 3 times the larger of the x and y
+    standard deviations. Exact repeats of an odometry (or ground-truth) time keep the last
+    row, and are counted in ``meta.source`` too. Measurements outside the ground truth's
+    time span are kept. The meta has terrain ``"floor"`` and :class:`LogMeta`'s default
+    bounds (placeholders for calibration). Each observation's ``line`` is its line in
+    ``RobotN_Measurement.dat``.
+
+    Parameters
+    ----------
+    dataset_dir : str or path-like
+        The folder with ``Barcodes.dat``, ``Landmark_Groundtruth.dat`` and ``RobotN_*.dat``.
+    robot : int
+        Robot number, 1 to 5.
+
+    Returns
+    -------
+    RobotLog
+        Range-and-bearing observations, odometry (the recorded commanded velocities) and
+        ground truth, in SI units; ``path`` is None.
+
+    Raises
+    ------
+    InputError
+        For a robot number outside 1-5.
+    FileFormatError
+        For a missing folder or file (naming it) or a malformed line (naming file and line).
+
+    Examples
+    --------
+    >>> read_mrclam("/no/such/folder", 1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: /no/such/folder: expected a UTIAS MRCLAM dataset folder, got no such ...
+    """
+    if (
+        isinstance(robot, bool)
+        or not isinstance(robot, (int, np.integer))
+        or int(robot) not in ROBOT_SUBJECTS
+    ):
+        raise InputError(f"robot: expected a robot number from 1 to 5, got {robot!r}")
+    robot = int(robot)
+    folder = Path(dataset_dir)
+    if not folder.is_dir():
+        raise FileFormatError(str(folder), "", "expected a UTIAS MRCLAM dataset folder, got no such folder")
+    prefix = f"Robot{robot}_"
+    if not (folder / f"{prefix}Measurement.dat").is_file():
+        present = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})
+        raise FileFormatError(
+            str(folder / f"{prefix}Measurement.dat"),
+            "",
+            f"expected robot {robot}'s measurements, got no such file "
+            f"(robots in this folder: {', '.join(present) or 'none'})",
+        )
+
+    barcodes = _DatFile(folder / "Barcodes.dat", ("subject", "barcode"))
+    subject_of = {int(barcode): int(subject) for subject, barcode in barcodes.data}
+    landmark_file = _DatFile(folder / "Landmark_Groundtruth.dat", ("subject", "x", "y", "x_sd", "y_sd"))
+    landmarks: list[LogLandmark] = []
+    for number, (subject, x, y, x_sd, y_sd) in zip(
+        landmark_file.lines.tolist(), landmark_file.data.tolist(), strict=True
+    ):
+        try:
+            landmarks.append(
+                LogLandmark(str(int(subject)), x, y, 3.0 * max(abs(x_sd), abs(y_sd)), symbol=LANDMARK_SYMBOL)
+            )
+        except InputError as exc:
+            landmark_file.fail(f"line {number}", str(exc).partition(": ")[2])
+    known = {landmark.id for landmark in landmarks}
+
+    measurements = _DatFile(folder / f"{prefix}Measurement.dat", ("time", "barcode", "range", "bearing"))
+    observations: list[LogObservation] = []
+    robots = unknown = 0
+    for number, (time, barcode, distance, bearing) in zip(
+        measurements.lines.tolist(), measurements.data.tolist(), strict=True
+    ):
+        subject = subject_of.get(int(barcode))
+        if subject in ROBOT_SUBJECTS:
+            robots += 1
+        elif subject is None or str(subject) not in known:
+            unknown += 1
+        elif distance < 0.0:
+            measurements.fail(f"line {number}", f"expected a range >= 0, got {distance!r}")
+        else:
+            observations.append(LogObservation(time, str(subject), bearing, range=distance, line=int(number)))
+    observations.sort(key=lambda item: item.time)  # stable: frames keep their order
+
+    odometry_rows, odometry_repeats = _DatFile(
+        folder / f"{prefix}Odometry.dat", ("time", "v", "omega")
+    ).increasing()
+    truth_rows, truth_repeats = _DatFile(
+        folder / f"{prefix}Groundtruth.dat", ("time", "x", "y", "heading")
+    ).increasing()
+
+    notes = [f"dropped {robots} robot and {unknown} unknown-barcode measurements"]
+    if odometry_repeats:
+        notes.append(f"dropped {_plural(odometry_repeats, 'repeated odometry time')} (kept the last row)")
+    if truth_repeats:
+        notes.append(f"dropped {_plural(truth_repeats, 'repeated ground-truth time')} (kept the last row)")
+    source = f"{_dataset_label(folder)} robot {robot} ({CITATION}); {'; '.join(notes)}"
+    meta = LogMeta(name=f"{folder.name}-robot{robot}", terrain="floor", source=source)
+    return RobotLog(
+        meta,
+        tuple(landmarks),
+        tuple(observations),
+        odometry=Odometry(odometry_rows[:, 0], odometry_rows[:, 1], odometry_rows[:, 2]),
+        groundtruth=GroundTruth(truth_rows[:, 0], truth_rows[:, 1], truth_rows[:, 2], truth_rows[:, 3]),
+    )
+
+
+def import_mrclam(
+    dataset_dir: str | os.PathLike[str],
+    robot: int,
+    out_dir: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+) -> RobotLog:
+    """Read one robot's run with :func:`read_mrclam` and write it as a log folder.
+
+    Parameters
+    ----------
+    dataset_dir : str or path-like
+        The MRCLAM dataset folder.
+    robot : int
+        Robot number, 1 to 5.
+    out_dir : str or path-like
+        The log folder to write (see :func:`write_log`).
+    overwrite : bool
+        Replace an existing log in ``out_dir``.
+
+    Returns
+    -------
+    RobotLog
+        The log as :func:`load_log` would read it back: ``path`` is ``out_dir`` and each
+        observation's ``line`` is its line in the written ``observations.csv``.
+
+    Raises
+    ------
+    InputError, FileFormatError
+        As :func:`read_mrclam` and :func:`write_log`.
+
+    Examples
+    --------
+    >>> import_mrclam("/no/such/folder", 1, "/tmp/never-written")   # nothing is written
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: /no/such/folder: expected a UTIAS MRCLAM dataset folder, got no such ...
+    """
+    log = read_mrclam(dataset_dir, robot)
+    folder = write_log(log, out_dir, overwrite=overwrite)
+    return replace(log, observations=renumbered(log.observations), path=folder)

@@ -1,0 +1,267 @@
+"""Recorded velocities to turn-and-run position reports: integration under a zero-order hold."""
+
+from __future__ import annotations
+
+import enum
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from aura_ums._validate import finite_float, float_array
+from aura_ums.errors import InputError
+from aura_ums.manager import PositionReport
+from aura_ums.uncertainty import TurnAndRun
+
+#: More reports than this from one call is a mistake (a max_interval far too small).
+MAX_REPORTS = 10_000_000
+
+
+class ReverseMotion(enum.Enum):
+    """What :func:`odometry_to_commands` does with negative forward velocities.
+
+    The turn-and-run model has no reverse gear.
+
+    - ``ERROR``: refuse, naming the first negative row (the default).
+    - ``FLIP``: cut the motion where the sign of ``v`` changes; report a reversing piece
+      that turns by ``t`` and backs up by ``d`` as ``TurnAndRun(t + pi, d)`` followed, at the
+      same time, by ``TurnAndRun(-pi, 0)``: turn round, run forward, turn back. The end
+      pose is the same (up to the turn-then-run approximation that forward pieces make
+      too), and growth through the two half turns is sound, if wide.
+
+    Examples
+    --------
+    >>> ReverseMotion("flip")
+    <ReverseMotion.FLIP: 'flip'>
+    """
+
+    ERROR = "error"
+    FLIP = "flip"
+
+
+def cumulative_integral(
+    time: NDArray[np.float64], values: NDArray[np.float64], query: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Integrate a zero-order-hold signal from ``time[0]`` to each query time.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Row times, seconds, strictly increasing, n >= 1.
+    values : ndarray, shape (n,)
+        Row ``i`` holds on ``[time[i], time[i + 1])``; the last row only ends the record.
+    query : ndarray, shape (k,)
+        Seconds, any order.
+
+    Returns
+    -------
+    ndarray, shape (k,)
+        The integral of the signal from ``time[0]`` to each query time (value unit times
+        seconds); 0 before ``time[0]``, constant after ``time[-1]``.
+
+    Examples
+    --------
+    >>> time, values = np.array([0.0, 1.0, 3.0]), np.array([2.0, 1.0, 5.0])
+    >>> cumulative_integral(time, values, np.array([-1.0, 0.5, 2.0, 9.0]))
+    array([0., 1., 3., 4.])
+    """
+    steps = values[:-1] * np.diff(time)
+    at_rows = np.concatenate(([0.0], np.cumsum(steps)))
+    clipped = np.clip(query, time[0], time[-1])
+    row = np.clip(np.searchsorted(time, clipped, side="right") - 1, 0, len(time) - 1)
+    partial = np.where(row < len(time) - 1, values[row] * (clipped - time[row]), 0.0)
+    result: NDArray[np.float64] = at_rows[row] + partial
+    return result
+
+
+def report_times(
+    boundaries: NDArray[np.float64], start: float, end: float, max_interval: float
+) -> NDArray[np.float64]:
+    """Return the end times of the reports, cut at the boundaries and at most ``max_interval`` apart.
+
+    The times are the boundaries in ``(start, end]``, ``end``, and more evenly spaced
+    between them wherever two are more than ``max_interval`` apart.
+
+    Parameters
+    ----------
+    boundaries : ndarray, shape (k,)
+        Seconds at which a report must end, any order; those outside ``(start, end]`` are ignored.
+    start, end : float
+        Seconds, ``start <= end``.
+    max_interval : float
+        Seconds, > 0 (inf: no subdivision).
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        Strictly increasing seconds in ``(start, end]``, ending with ``end``; empty when
+        ``start == end``.
+
+    Examples
+    --------
+    >>> report_times(np.array([0.3, 5.0]), 0.0, 1.0, 0.4).round(6).tolist()
+    [0.3, 0.65, 1.0]
+    """
+    if end <= start:
+        return np.empty(0)
+    inside = boundaries[(boundaries > start) & (boundaries < end)]
+    anchors = np.unique(np.concatenate(([start], inside, [end])))
+    if not math.isfinite(max_interval):
+        return anchors[1:]
+    gaps = np.diff(anchors)
+    pieces = np.maximum(np.ceil(gaps / max_interval), 1.0)
+    total = float(pieces.sum())
+    if total > MAX_REPORTS:
+        raise InputError(
+            f"max_interval: expected at most {MAX_REPORTS} reports, got {total:.0f} "
+            f"(max_interval {max_interval!r} s over {end - start!r} s)"
+        )
+    counts = pieces.astype(np.int64)
+    gap_index = np.repeat(np.arange(len(gaps)), counts)
+    step = np.arange(len(gap_index)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    times = anchors[gap_index] + gaps[gap_index] * (step / counts[gap_index])
+    times[np.cumsum(counts) - 1] = anchors[1:]  # the anchors themselves, exactly
+    keep = np.concatenate((np.diff(times) > 0.0, [True]))
+    result: NDArray[np.float64] = times[keep]
+    return result
+
+
+def odometry_to_commands(
+    time: ArrayLike,
+    v: ArrayLike,
+    omega: ArrayLike,
+    cut_times: ArrayLike = (),
+    *,
+    max_interval: float = 0.25,
+    delay_s: float = 0.0,
+    run_scale: float = 1.0,
+    turn_scale: float = 1.0,
+    start: float | None = None,
+    end: float | None = None,
+    reverse: ReverseMotion = ReverseMotion.ERROR,
+) -> tuple[PositionReport, ...]:
+    """Integrate recorded velocities into turn-and-run position reports.
+
+    Row ``i`` holds from ``time[i]`` until ``time[i + 1]`` (zero-order hold); the last row
+    only ends the record, and there is no motion outside it. Every time is first delayed by
+    ``delay_s``. The motion from ``start`` to ``end`` is cut at each of ``cut_times`` in
+    ``(start, end]``, at ``end``, and evenly in between wherever two cuts are more than
+    ``max_interval`` apart. The piece ending at each cut ``T`` becomes
+    ``PositionReport(T, TurnAndRun(turn_scale * integral(omega), run_scale * integral(|v|)))``.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Seconds, strictly increasing, n >= 1.
+    v : array_like, shape (n,)
+        Forward velocity, m/s.
+    omega : array_like, shape (n,)
+        Angular velocity, rad/s, counter-clockwise positive.
+    cut_times : array_like, shape (k,)
+        Seconds (after the delay, like ``start`` and ``end``) at which a report must end.
+    max_interval : float
+        Longest time, seconds, a report may cover; > 0, ``math.inf`` for none.
+    delay_s : float
+        Seconds, >= 0: the motion recorded at ``t`` happens at ``t + delay_s``.
+    run_scale, turn_scale : float
+        Factors, > 0, applied to the integrated run and turn.
+    start, end : float or None
+        Seconds, ``start <= end``; default the first and the last delayed row time (but
+        never past the other bound when only one is given: the span is then empty).
+    reverse : ReverseMotion
+        ``ERROR`` (default) refuses negative ``v``; ``FLIP`` reports reversing pieces as a
+        turn round, a forward run and a turn back (two reports with the same time).
+
+    Returns
+    -------
+    tuple of PositionReport
+        Runs >= 0; times strictly increasing (except the ``FLIP`` pairs); empty when
+        ``start == end``. The runs sum to ``run_scale`` times the integral of ``|v|`` and
+        the turns to ``turn_scale`` times the integral of ``omega`` (plus 0 net for flips).
+
+    Raises
+    ------
+    InputError
+        For non-finite or mismatched arrays, unsorted times, bad scales, ``end < start``,
+        or negative ``v`` with ``ReverseMotion.ERROR``.
+
+    Examples
+    --------
+    >>> reports = odometry_to_commands([0.0, 2.0], [0.5, 0.0], [0.1, 0.0], [0.5], max_interval=1.0)
+    >>> [(r.time, round(r.command.turn, 3), r.command.run) for r in reports]
+    [(0.5, 0.05, 0.25), (1.25, 0.075, 0.375), (2.0, 0.075, 0.375)]
+    >>> odometry_to_commands([0.0, 1.0], [1.0, 1.0], [0.0, 0.0], start=1.0)   # nothing to cover
+    ()
+    """
+    t = float_array(time, "time").reshape(-1)
+    forward = float_array(v, "v").reshape(-1)
+    angular = float_array(omega, "omega").reshape(-1)
+    if not len(t) == len(forward) == len(angular):
+        raise InputError(
+            f"time, v, omega: expected equal lengths, got {len(t)}, {len(forward)}, {len(angular)}"
+        )
+    if len(t) == 0:
+        raise InputError("time: expected at least one row, got none")
+    steps = np.diff(t)
+    if np.any(steps <= 0.0):
+        row = int(np.argmax(steps <= 0.0)) + 1
+        raise InputError(
+            f"time: expected strictly increasing times, got {float(t[row])!r} after {float(t[row - 1])!r}"
+        )
+    cuts = float_array(cut_times, "cut_times").reshape(-1)
+    if not isinstance(reverse, ReverseMotion):
+        raise InputError(f"reverse: expected a ReverseMotion, got {reverse!r}")
+    if isinstance(max_interval, bool) or not isinstance(max_interval, (int, float)) or not max_interval > 0:
+        raise InputError(
+            f"max_interval: expected a positive number of seconds (or inf), got {max_interval!r}"
+        )
+    delay = finite_float(delay_s, "delay_s")
+    if delay < 0.0:
+        raise InputError(f"delay_s: expected a non-negative number, got {delay!r}")
+    for name, scale in (("run_scale", run_scale), ("turn_scale", turn_scale)):
+        if finite_float(scale, name) <= 0.0:
+            raise InputError(f"{name}: expected a positive number, got {scale!r}")
+    reversing = forward < 0.0
+    if reverse is ReverseMotion.ERROR and np.any(reversing):
+        row = int(np.argmax(reversing))
+        raise InputError(
+            f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
+            f"pass reverse=ReverseMotion.FLIP), got {float(forward[row])!r} at row {row}"
+        )
+
+    t = t + delay
+    low = None if start is None else finite_float(start, "start")
+    high = None if end is None else finite_float(end, "end")
+    # A default never conflicts with a given bound: the span is then empty.
+    if low is None:
+        low = float(t[0]) if high is None else min(float(t[0]), high)
+    if high is None:
+        high = max(float(t[-1]), low)
+    if high < low:
+        raise InputError(f"end: expected a time >= start ({low!r}), got {high!r}")
+    boundaries = cuts
+    if np.any(reversing):
+        changes = np.flatnonzero(np.diff(reversing.astype(np.int8)) != 0) + 1
+        boundaries = np.concatenate((cuts, t[changes]))
+    times = report_times(boundaries, low, high, float(max_interval))
+    if len(times) == 0:
+        return ()
+    edges = np.concatenate(([low], times))
+    turn = np.diff(cumulative_integral(t, angular, edges)) * turn_scale
+    ahead = np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale
+    back = np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale
+    reports: list[PositionReport] = []
+    for when, piece_turn, piece_ahead, piece_back in zip(
+        times.tolist(),
+        turn.tolist(),
+        np.maximum(ahead, 0.0).tolist(),
+        np.maximum(back, 0.0).tolist(),
+        strict=True,
+    ):
+        if piece_back > 0.0:
+            # Cut at every sign change, so a piece backing up runs no distance forward.
+            reports.append(PositionReport(when, TurnAndRun(piece_turn + math.pi, piece_back)))
+            reports.append(PositionReport(when, TurnAndRun(-math.pi, 0.0)))
+        else:
+            reports.append(PositionReport(when, TurnAndRun(piece_turn, piece_ahead)))
+    return tuple(reports)

@@ -1,0 +1,374 @@
+"""Read ROS bags into robot logs, with the pure-Python ``rosbags`` package (extra ``ros``).
+
+A bag (a rosbag2 folder, sqlite3 or MCAP storage; ROS 1 ``.bag`` files are read by the
+same reader) gives a :class:`~aura_ums.logs.RobotLog` from three topics:
+
+**Motion** (``odom_topic``), as velocities held from each message to the next
+(:class:`~aura_ums.logs.Odometry`):
+
+- ``nav_msgs/msg/Odometry``: ``v = twist.twist.linear.x`` (m/s, forward in the robot
+  frame), ``omega = twist.twist.angular.z`` (rad/s, counter-clockwise), at ``header.stamp``;
+- ``geometry_msgs/msg/TwistStamped``: ``twist.linear.x`` and ``twist.angular.z`` at
+  ``header.stamp`` (velocity commands);
+- ``geometry_msgs/msg/Twist``: the same, at the bag's receive time (it has no stamp).
+
+**Observations** (``observations_topic``): ROS has no standard landmark message, so the
+convention is a ``geometry_msgs/msg/PointStamped`` per observation, needing no custom
+message definitions:
+
+- ``header.frame_id``: the landmark's id (as in the landmark list);
+- ``header.stamp``: the time of the observation;
+- ``point.x``: range, metres, horizontal, >= 0; ``0`` or ``NaN`` for a bearing-only one;
+- ``point.y``: bearing, radians from the robot's heading to the landmark, counter-clockwise
+  positive (any angle; wrapped to (-pi, pi]);
+- ``point.z``: bound on the bearing error, radians, > 0; ``0`` or ``NaN`` takes the log's
+  :attr:`~aura_ums.logs.LogMeta.bearing_error`. The range error bound always comes from
+  the log's meta (:meth:`~aura_ums.logs.LogMeta.range_bound`).
+
+**Ground truth** (optional ``groundtruth_topic``): ``nav_msgs/msg/Odometry``
+(``pose.pose``), ``geometry_msgs/msg/PoseStamped`` (``pose``) or
+``geometry_msgs/msg/PoseWithCovarianceStamped`` (``pose.pose``): ``position.x``, ``.y``
+(m, world frame) and the yaw of ``orientation`` (rad).
+
+Times are seconds: the header stamp (``sec + nanosec * 1e-9``); a stamp of exactly zero
+(unset) takes the bag's receive time. Each topic's messages are sorted by time;
+odometry and ground truth need distinct times. Every error names the bag, the topic and,
+for a bad message, its index in the topic (0 for the first).
+"""
+
+from __future__ import annotations
+
+import importlib
+import itertools
+import math
+import os
+from collections.abc import Iterator, Sequence
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
+from aura_ums.logs._io import Units, _read_landmarks, renumbered, write_log
+from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+
+#: Message types read as motion (velocities).
+MOTION_TYPES = ("nav_msgs/msg/Odometry", "geometry_msgs/msg/TwistStamped", "geometry_msgs/msg/Twist")
+#: The message type of observations (see the convention in :mod:`aura_ums.logs._rosbag`).
+OBSERVATION_TYPE = "geometry_msgs/msg/PointStamped"
+#: Message types read as ground truth (poses).
+GROUNDTRUTH_TYPES = (
+    "nav_msgs/msg/Odometry",
+    "geometry_msgs/msg/PoseStamped",
+    "geometry_msgs/msg/PoseWithCovarianceStamped",
+)
+
+
+def _require_rosbags() -> None:
+    try:
+        importlib.import_module("rosbags.highlevel")
+        importlib.import_module("rosbags.typesys")
+    except ImportError as exc:
+        raise MissingDependencyError(
+            f"reading ROS bags needs the optional package 'rosbags' (import failed: {exc}); "
+            "install aura-ums[ros]"
+        ) from exc
+
+
+def _topic(value: object, name: str) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise InputError(f"{name}: expected a topic name such as '/odom', got {value!r}")
+    return value
+
+
+def _landmarks(value: object) -> tuple[LogLandmark, ...]:
+    if isinstance(value, (str, os.PathLike)):
+        path = Path(value)
+        if not path.is_file():
+            raise FileFormatError(str(path), "", "expected a landmarks CSV file, got no such file")
+        return _read_landmarks(path, Units())
+    if not isinstance(value, Sequence):
+        raise InputError(
+            "landmarks: expected a sequence of LogLandmark or a landmarks.csv path, "
+            f"got {type(value).__name__}"
+        )
+    for index, item in enumerate(value):
+        if not isinstance(item, LogLandmark):
+            raise InputError(f"landmarks[{index}]: expected a LogLandmark, got {type(item).__name__}")
+    return tuple(value)
+
+
+def _yaw(q: Any) -> float:
+    """Heading (rad) of a quaternion ``(x, y, z, w)``: the rotation about +z."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class _Bag:
+    """An open bag: its topics, and each topic's messages with their times."""
+
+    def __init__(self, reader: Any, path: Path, error: type[Exception]) -> None:
+        self.reader = reader
+        self.path = path
+        self.error = error
+        self.topics: dict[str, str | None] = {name: info.msgtype for name, info in reader.topics.items()}
+        self.counts: dict[str, int] = {name: info.msgcount for name, info in reader.topics.items()}
+
+    def fail(self, where: str, message: str) -> FileFormatError:
+        return FileFormatError(str(self.path), where, message)
+
+    def check(self, topic: str, allowed: Sequence[str], role: str) -> str:
+        """Return the topic's message type after checking it is present, of a type read, not empty."""
+        if topic not in self.topics:
+            present = ", ".join(f"{name} ({kind})" for name, kind in sorted(self.topics.items())) or "none"
+            raise self.fail(
+                f"topic {topic}",
+                f"expected the {role} topic in the bag, got no such topic; topics: {present}",
+            )
+        kind = self.topics[topic]
+        if kind is None or kind not in allowed:
+            raise self.fail(
+                f"topic {topic}",
+                f"expected {role} messages of type {' or '.join(allowed)}, got {kind or 'several types'}",
+            )
+        if self.counts[topic] == 0:
+            raise self.fail(f"topic {topic}", f"expected at least one {role} message, got none")
+        return kind
+
+    def messages(self, topic: str) -> Iterator[tuple[int, int, Any]]:
+        """(index in the topic, receive time ns, message) in receive order."""
+        connections = [c for c in self.reader.connections if c.topic == topic]
+        for index, (connection, received, raw) in enumerate(self.reader.messages(connections=connections)):
+            try:
+                message = self.reader.deserialize(raw, connection.msgtype)
+            except self.error as exc:  # corrupt data, or a definition that does not match it
+                raise self.fail(
+                    f"topic {topic}, message {index}", f"expected a {connection.msgtype}, got {exc}"
+                ) from exc
+            yield index, received, message
+
+
+def _time(header: Any, received: int) -> float:
+    stamp = header.stamp
+    if stamp.sec == 0 and stamp.nanosec == 0:
+        return received * 1e-9
+    return float(stamp.sec) + float(stamp.nanosec) * 1e-9
+
+
+def _sorted_rows(
+    bag: _Bag, topic: str, rows: list[tuple[float, int, tuple[float, ...]]], role: str
+) -> np.ndarray[Any, np.dtype[np.float64]]:
+    """Rows (time, values...) sorted by time, after checking times are distinct and finite."""
+    rows.sort(key=lambda row: (row[0], row[1]))
+    for (t0, i0, _), (t1, i1, _) in itertools.pairwise(rows):
+        if t1 == t0:
+            raise bag.fail(
+                f"topic {topic}, message {i1}",
+                f"expected {role} messages at distinct times, got time {t1!r} s again (message {i0})",
+            )
+    return np.array([(t, *values) for t, _, values in rows], dtype=np.float64)
+
+
+def _motion(bag: _Bag, topic: str, kind: str) -> Odometry:
+    rows: list[tuple[float, int, tuple[float, ...]]] = []
+    for index, received, message in bag.messages(topic):
+        if kind == "nav_msgs/msg/Odometry":
+            time, twist = _time(message.header, received), message.twist.twist
+        elif kind == "geometry_msgs/msg/TwistStamped":
+            time, twist = _time(message.header, received), message.twist
+        else:
+            time, twist = received * 1e-9, message
+        v, omega = float(twist.linear.x), float(twist.angular.z)
+        if not (math.isfinite(v) and math.isfinite(omega)):
+            raise bag.fail(
+                f"topic {topic}, message {index}",
+                f"expected finite velocities, got linear.x {v!r} and angular.z {omega!r}",
+            )
+        rows.append((time, index, (v, omega)))
+    table = _sorted_rows(bag, topic, rows, "motion")
+    return Odometry(table[:, 0], table[:, 1], table[:, 2])
+
+
+def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
+    rows: list[tuple[float, int, tuple[float, ...]]] = []
+    for index, received, message in bag.messages(topic):
+        pose = message.pose if kind == "geometry_msgs/msg/PoseStamped" else message.pose.pose
+        x, y = float(pose.position.x), float(pose.position.y)
+        heading = _yaw(pose.orientation)
+        if not all(math.isfinite(value) for value in (x, y, heading)):
+            raise bag.fail(
+                f"topic {topic}, message {index}",
+                f"expected a finite pose, got x {x!r}, y {y!r}, heading {heading!r}",
+            )
+        rows.append((_time(message.header, received), index, (x, y, heading)))
+    table = _sorted_rows(bag, topic, rows, "ground truth")
+    return GroundTruth(table[:, 0], table[:, 1], table[:, 2], table[:, 3])
+
+
+def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple[LogObservation, ...]:
+    found: list[tuple[float, int, LogObservation]] = []
+    listed = ", ".join(list(known)[:20]) + (", ..." if len(known) > 20 else "")
+    for index, received, message in bag.messages(topic):
+        where = f"topic {topic}, message {index}"
+        ident = message.header.frame_id
+        if ident not in known:
+            raise bag.fail(where, f"expected header.frame_id to be a landmark id ({listed}), got {ident!r}")
+        x, y, z = float(message.point.x), float(message.point.y), float(message.point.z)
+        if not math.isfinite(y):
+            raise bag.fail(where, f"expected point.y to be a finite bearing (rad), got {y!r}")
+        if x < 0.0 or math.isinf(x):
+            raise bag.fail(
+                where, f"expected point.x to be a range >= 0 m (0 or NaN: bearing only), got {x!r}"
+            )
+        if z < 0.0 or math.isinf(z):
+            raise bag.fail(
+                where,
+                f"expected point.z to be a bearing error bound > 0 rad (0 or NaN: the log's), got {z!r}",
+            )
+        time = _time(message.header, received)
+        observation = LogObservation(
+            time,
+            ident,
+            y,
+            range=x if x > 0.0 else None,
+            bearing_error=z if z > 0.0 else None,
+            line=index,
+        )
+        found.append((time, index, observation))
+    found.sort(key=lambda item: (item[0], item[1]))
+    return tuple(observation for _, _, observation in found)
+
+
+def read_rosbag(
+    bag_path: str | os.PathLike[str],
+    *,
+    odom_topic: str,
+    observations_topic: str,
+    landmarks: Sequence[LogLandmark] | str | os.PathLike[str],
+    meta: LogMeta | None = None,
+    groundtruth_topic: str | None = None,
+) -> RobotLog:
+    """Read a ROS bag into a robot log (topics and the observation convention: module notes).
+
+    Parameters
+    ----------
+    bag_path : str or path-like
+        A rosbag2 folder (with ``metadata.yaml``; sqlite3 or MCAP storage), or a ROS 1
+        ``.bag`` file.
+    odom_topic : str
+        Motion: ``nav_msgs/msg/Odometry``, ``geometry_msgs/msg/TwistStamped`` or
+        ``geometry_msgs/msg/Twist``.
+    observations_topic : str
+        Observations: ``geometry_msgs/msg/PointStamped`` (frame_id = landmark id,
+        x = range m, y = bearing rad, z = bearing error bound rad).
+    landmarks : sequence of LogLandmark, or path
+        The landmark list, or a ``landmarks.csv`` file in the log format (SI units).
+    meta : LogMeta or None
+        The log's metadata; None: ``LogMeta(<bag name>)`` with its default bounds, and a
+        ``source`` naming the bag and topics.
+    groundtruth_topic : str or None
+        True poses: ``nav_msgs/msg/Odometry``, ``geometry_msgs/msg/PoseStamped`` or
+        ``geometry_msgs/msg/PoseWithCovarianceStamped``.
+
+    Returns
+    -------
+    RobotLog
+        Motion as :class:`Odometry`; each observation's ``line`` is its message index in
+        the topic; ``path`` is None.
+
+    Raises
+    ------
+    MissingDependencyError
+        When ``rosbags`` is not installed (``pip install aura-ums[ros]``).
+    InputError
+        For arguments of the wrong type.
+    FileFormatError
+        Naming the bag and topic: a missing bag, a missing topic (listing those present),
+        a topic of another message type, an empty topic, a bad message (with its index:
+        unknown landmark id, negative range, non-finite values, repeated times).
+
+    Examples
+    --------
+    >>> read_rosbag("no_such_bag", odom_topic="/odom", observations_topic="/landmarks",
+    ...             landmarks=())                                    # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: no_such_bag: expected a ROS bag (...), got no such file or folder
+    """
+    odom = _topic(odom_topic, "odom_topic")
+    observed = _topic(observations_topic, "observations_topic")
+    truth = None if groundtruth_topic is None else _topic(groundtruth_topic, "groundtruth_topic")
+    if meta is not None and not isinstance(meta, LogMeta):
+        raise InputError(f"meta: expected a LogMeta or None, got {type(meta).__name__}")
+    if not isinstance(bag_path, (str, os.PathLike)):
+        raise InputError(f"bag_path: expected a path, got {type(bag_path).__name__}")
+    path = Path(bag_path)
+    if not path.exists():
+        raise FileFormatError(
+            str(path),
+            "",
+            "expected a ROS bag (a rosbag2 folder or a ROS 1 .bag file), got no such file or folder",
+        )
+    listed = _landmarks(landmarks)
+    _require_rosbags()
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    try:
+        with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as reader:
+            bag = _Bag(reader, path, AnyReaderError)
+            kinds = {odom: bag.check(odom, MOTION_TYPES, "motion")}
+            kinds[observed] = bag.check(observed, (OBSERVATION_TYPE,), "observation")
+            if truth is not None:
+                kinds[truth] = bag.check(truth, GROUNDTRUTH_TYPES, "ground truth")
+            odometry = _motion(bag, odom, kinds[odom])
+            observations = _observations(bag, observed, {item.id: item for item in listed})
+            groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
+    except (AnyReaderError, OSError) as exc:  # no metadata.yaml, unreadable storage, bad definitions
+        raise FileFormatError(str(path), "", f"expected a readable ROS bag, got {exc}") from exc
+    if meta is None:
+        topics = f"motion {odom}, observations {observed}" + (f", ground truth {truth}" if truth else "")
+        meta = LogMeta(path.stem or path.name, source=f"ROS bag {path.name} ({topics})")
+    try:
+        return RobotLog(meta, listed, observations, odometry=odometry, groundtruth=groundtruth)
+    except InputError as exc:  # e.g. duplicate landmark ids in the list
+        raise InputError(f"{path}: {exc}") from exc
+
+
+def import_rosbag(
+    bag_path: str | os.PathLike[str],
+    out_dir: str | os.PathLike[str],
+    *,
+    odom_topic: str,
+    observations_topic: str,
+    landmarks: Sequence[LogLandmark] | str | os.PathLike[str],
+    meta: LogMeta | None = None,
+    groundtruth_topic: str | None = None,
+    overwrite: bool = False,
+) -> RobotLog:
+    """Read a ROS bag with :func:`read_rosbag` and write it as a log folder (:func:`write_log`).
+
+    Parameters are those of :func:`read_rosbag`, plus ``out_dir`` (the log folder to write)
+    and ``overwrite`` (replace an existing log there).
+
+    Returns
+    -------
+    RobotLog
+        The log as :func:`load_log` reads it back: ``path`` is ``out_dir`` and each
+        observation's ``line`` is its line in the written ``observations.csv``.
+
+    Raises
+    ------
+    MissingDependencyError, InputError, FileFormatError
+        As :func:`read_rosbag` and :func:`write_log`.
+    """
+    log = read_rosbag(
+        bag_path,
+        odom_topic=odom_topic,
+        observations_topic=observations_topic,
+        landmarks=landmarks,
+        meta=meta,
+        groundtruth_topic=groundtruth_topic,
+    )
+    folder = write_log(log, out_dir, overwrite=overwrite)
+    return replace(log, observations=renumbered(log.observations), path=folder)

@@ -1,0 +1,156 @@
+"""``aura-ums import rosbag`` and the ``--mcap`` helpers, on a local typer app registered as the CLI does."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import pytest
+import typer
+from rosbags.rosbag2 import Writer
+from rosbags.typesys import Stores, get_typestore
+from typer.testing import CliRunner
+
+from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
+from aura_ums.export import mcap_channels
+from aura_ums.logs import load_log
+from aura_ums.sim import Scenario
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def make_app() -> typer.Typer:
+    app = typer.Typer()
+    import_app = typer.Typer()
+    import_app.command("rosbag")(rosbag_command)
+    app.add_typer(import_app, name="import")
+
+    @app.command()
+    def simulate(
+        scenario: Path,
+        mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+        seed: int = 0,
+    ) -> None:
+        if mcap is not None:
+            write_simulation_mcap_option(mcap, Scenario.from_toml(scenario), seed, prune=True)
+
+    return app
+
+
+@pytest.fixture(scope="module")
+def bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    t = store.types
+
+    def header(seconds: float, frame: str = "") -> Any:
+        sec = math.floor(seconds)
+        stamp = t["builtin_interfaces/msg/Time"](sec=sec, nanosec=round((seconds - sec) * 1e9))
+        return t["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
+
+    def vector(kind: str, x: float, y: float, z: float) -> Any:
+        return t[f"geometry_msgs/msg/{kind}"](x=x, y=y, z=z)
+
+    path = tmp_path_factory.mktemp("bags") / "walk"
+    with Writer(path, version=9) as writer:
+        motion = writer.add_connection("/cmd", "geometry_msgs/msg/TwistStamped", typestore=store)
+        seen = writer.add_connection("/seen", "geometry_msgs/msg/PointStamped", typestore=store)
+        truth = writer.add_connection("/truth", "geometry_msgs/msg/PoseStamped", typestore=store)
+        for i in range(4):
+            time = 5.0 + i
+            twist = t["geometry_msgs/msg/Twist"](
+                linear=vector("Vector3", 0.5, 0, 0), angular=vector("Vector3", 0, 0, 0)
+            )
+            command = t["geometry_msgs/msg/TwistStamped"](header=header(time), twist=twist)
+            writer.write(motion, round(time * 1e9), store.serialize_cdr(command, command.__msgtype__))
+            point = t["geometry_msgs/msg/PointStamped"](
+                header=header(time + 0.5, "pole"),
+                point=vector("Point", 0.0 if i % 2 else 3.0 - i * 0.5, 0.1, 0),
+            )
+            writer.write(seen, round((time + 0.5) * 1e9), store.serialize_cdr(point, point.__msgtype__))
+            orientation = t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
+            pose = t["geometry_msgs/msg/Pose"](
+                position=vector("Point", 0.5 * i, 0, 0), orientation=orientation
+            )
+            stamped = t["geometry_msgs/msg/PoseStamped"](header=header(time, "map"), pose=pose)
+            writer.write(truth, round(time * 1e9), store.serialize_cdr(stamped, stamped.__msgtype__))
+    return path
+
+
+@pytest.fixture
+def landmarks(tmp_path: Path) -> Path:
+    path = tmp_path / "landmarks.csv"
+    path.write_text("id,x,y,position_uncertainty\npole,3.0,0.3,0.05\ntree,0.0,5.0,0.2\n")
+    return path
+
+
+def invoke(*args: str) -> Any:
+    return CliRunner().invoke(make_app(), list(args))
+
+
+def test_import_rosbag_writes_the_log_and_a_summary(bag: Path, landmarks: Path, tmp_path: Path) -> None:
+    out = tmp_path / "log"
+    args = ["import", "rosbag", str(bag), str(out), "--odom", "/cmd", "--observations", "/seen"]
+    result = invoke(*args, "--landmarks", str(landmarks), "--groundtruth", "/truth", "--name", "hall")
+    assert result.exit_code == 0, result.output
+    assert f"wrote {out}" in result.output
+    assert "observations       4 (2 bearing, 2 range_bearing)" in result.output
+    assert "landmarks          2 (1 observed)" in result.output
+    assert "ground truth rows  4" in result.output
+    log = load_log(out)
+    assert log.meta.name == "hall"
+    assert [o.range for o in log.observations] == [3.0, None, 2.0, None]
+    assert log.odometry is not None
+    assert log.odometry.time.tolist() == [5.0, 6.0, 7.0, 8.0]
+    # again without --overwrite: a clean error; with it: replaced
+    again = invoke(*args, "--landmarks", str(landmarks))
+    assert again.exit_code == 2
+    assert "error: folder: expected a folder without a log" in again.output
+    assert invoke(*args, "--landmarks", str(landmarks), "--overwrite").exit_code == 0
+    assert load_log(out).meta.name == "walk"
+    assert load_log(out).groundtruth is None
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            ("--odom", "/odom"),
+            "topic /odom: expected the motion topic in the bag, got no such topic; topics: /cmd",
+        ),
+        (("--odom", "/seen"), "topic /seen: expected motion messages of type nav_msgs/msg/Odometry"),
+        (("--groundtruth", "/cmd"), "topic /cmd: expected ground truth messages of type"),
+    ],
+)
+def test_bad_topics_are_clean_errors(
+    bag: Path, landmarks: Path, tmp_path: Path, change: tuple[str, str], message: str
+) -> None:
+    options = {"--odom": "/cmd", "--observations": "/seen", "--landmarks": str(landmarks)}
+    options[change[0]] = change[1]
+    args = [item for pair in options.items() for item in pair]
+    result = invoke("import", "rosbag", str(bag), str(tmp_path / "log"), *args)
+    assert result.exit_code == 2
+    assert result.output.startswith("error: ")
+    assert message in " ".join(result.output.split())
+    assert not (tmp_path / "log").exists()
+
+
+def test_missing_landmarks_file(bag: Path, tmp_path: Path) -> None:
+    args = ["--odom", "/cmd", "--observations", "/seen", "--landmarks", str(tmp_path / "none.csv")]
+    result = invoke("import", "rosbag", str(bag), str(tmp_path / "log"), *args)
+    assert result.exit_code == 2
+    assert "expected a landmarks CSV file, got no such file" in result.output
+
+
+def test_simulate_mcap_option(tmp_path: Path) -> None:
+    out = tmp_path / "run.mcap"
+    result = invoke("simulate", str(SCENARIOS / "paper_sidewalk.toml"), "--mcap", str(out), "--seed", "2")
+    assert result.exit_code == 0, result.output
+    assert "wrote" in result.output
+    assert mcap_channels(out)["/camera/image"] == "foxglove.RawImage"
+    (tmp_path / "file").write_text("")
+    bad = invoke(
+        "simulate", str(SCENARIOS / "paper_sidewalk.toml"), "--mcap", str(tmp_path / "file" / "x.mcap")
+    )
+    assert bad.exit_code == 2
+    assert "expected a writable file" in bad.output

@@ -1,0 +1,110 @@
+"""Builders and comparisons shared by the tests of aura_ums.logs."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from aura_ums.logs import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.manager import PositionReport
+from aura_ums.uncertainty import Pose, TurnAndRun
+
+#: Where the published datasets live (never copied into the repository).
+MRCLAM6 = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "mrclam6"
+
+#: A valid log folder, file by file; tests of bad logs replace one file.
+VALID_FILES: dict[str, str] = {
+    "meta.toml": 'name = "tiny"\nterrain = "tile"\n\n[sensor]\nbearing_error = 0.02\n',
+    "landmarks.csv": "id,x,y\n# two poles\nA,3.0,0.0\nB,0.0,4.0\n",
+    "observations.csv": "time,landmark_id,bearing,range\n0.5,A,0.1,3.0\n0.5,B,1.5,\n1.0,A,0.2,2.5\n",
+    "odometry.csv": "time,v,omega\n0.0,0.5,0.0\n1.0,0.5,0.1\n2.0,0.0,0.0\n",
+    "groundtruth.csv": "time,x,y,heading\n0.0,0.0,0.0,0.0\n2.0,1.0,0.0,0.1\n",
+}
+
+
+def write_files(folder: Path, files: Mapping[str, str | None]) -> Path:
+    """Write ``files`` into ``folder`` (None: leave that file out) and return the folder."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        if text is not None:
+            (folder / name).write_text(text, encoding="utf-8")
+    return folder
+
+
+def small_log(*, commands: bool = False, groundtruth: bool = True, start: bool = True) -> RobotLog:
+    """A small log exercising every optional field."""
+    meta = LogMeta(
+        "small log",
+        terrain="concrete",
+        bearing_error=0.03,
+        range_error=0.07,
+        range_error_fraction=0.02,
+        delay_s=0.125,
+        run_scale=1.1,
+        turn_scale=1.05,
+        start=Pose(0.1, -0.2, 3.0) if start else None,
+        start_radius=0.3,
+        start_heading_halfwidth=0.04,
+        landmark_z_bottom=0.2,
+        landmark_z_top=2.5,
+        source='made up "for tests", with commas',
+    )
+    landmarks = (
+        LogLandmark("a", 1.0 / 3.0, 2.0, 0.01, 0.0, 3.0, "lamppost"),
+        LogLandmark("#7", -1e-9, 1e9, symbol="sign, red"),
+        LogLandmark('b"q', 0.5, 0.25),
+    )
+    observations = (
+        LogObservation(0.1, "a", 0.7, range=2.0),
+        LogObservation(0.1, "#7", -3.0),
+        LogObservation(0.3, 'b"q', 0.1, range=1.5, bearing_error=0.01, range_error=0.2),
+    )
+    truth = GroundTruth([0.0, 0.25, 0.5], [0.0, 0.1, 0.2], [0.0, 0.0, 0.1], [3.1, -3.1, -2.9])
+    if commands:
+        reports = (PositionReport(0.2, TurnAndRun(0.1, 0.2)), PositionReport(0.4, TurnAndRun(-0.3, 0.0)))
+        return RobotLog(
+            meta, landmarks, observations, commands=reports, groundtruth=truth if groundtruth else None
+        )
+    odometry = Odometry([0.0, 0.1, 0.35], [0.2, 0.3, 0.0], [0.0, -0.5, 0.0])
+    return RobotLog(
+        meta, landmarks, observations, odometry=odometry, groundtruth=truth if groundtruth else None
+    )
+
+
+def assert_same_log(actual: RobotLog, expected: RobotLog, *, lines: bool = False) -> None:
+    """Every field equal (floats exactly); observation line numbers only when ``lines``."""
+    assert actual.meta == expected.meta
+    assert actual.landmarks == expected.landmarks
+    assert len(actual.observations) == len(expected.observations)
+    for got, want in zip(actual.observations, expected.observations, strict=True):
+        if lines:
+            assert got == want
+        else:
+            assert (
+                got.time,
+                got.landmark_id,
+                got.bearing,
+                got.range,
+                got.bearing_error,
+                got.range_error,
+            ) == (
+                want.time,
+                want.landmark_id,
+                want.bearing,
+                want.range,
+                want.bearing_error,
+                want.range_error,
+            )
+    assert actual.commands == expected.commands
+    assert (actual.odometry is None) == (expected.odometry is None)
+    if actual.odometry is not None and expected.odometry is not None:
+        for name in ("time", "v", "omega"):
+            np.testing.assert_array_equal(getattr(actual.odometry, name), getattr(expected.odometry, name))
+    assert (actual.groundtruth is None) == (expected.groundtruth is None)
+    if actual.groundtruth is not None and expected.groundtruth is not None:
+        for name in ("time", "x", "y", "heading"):
+            np.testing.assert_array_equal(
+                getattr(actual.groundtruth, name), getattr(expected.groundtruth, name)
+            )

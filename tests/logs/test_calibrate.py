@@ -1,0 +1,117 @@
+"""Calibration of terrain statistics, motion and sensor bounds from logs with ground truth."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+from log_helpers import MRCLAM6
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs import (
+    SensorBounds,
+    calibrate_logs,
+    load_sensors,
+    observation_errors,
+    read_mrclam,
+    synthetic_log,
+)
+from aura_ums.uncertainty import TerrainTable
+
+MRCLAM = MRCLAM6
+
+
+def test_calibration_recovers_the_synthetic_sensor_bounds() -> None:
+    log = synthetic_log(np.random.default_rng(0), duration=120.0, bearing_noise=0.02, range_noise=0.05)
+    calibration = calibrate_logs([log], quantile=0.99)
+    bearing, ranges = observation_errors([log])
+    assert np.abs(bearing).max() <= 0.02 + 1e-9
+    assert 0.015 < calibration.working.bearing_error <= 0.02
+    assert calibration.envelope.bearing_error >= calibration.working.bearing_error
+    assert 0.03 < calibration.working.range_fraction_low < 0.06
+    assert 0.03 < calibration.working.range_fraction_high < 0.06
+    assert calibration.motion.delay_s == 0.0  # the synthetic commands are not delayed
+    assert ranges.size == bearing.size
+
+
+def test_sensor_file_round_trips(tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    calibration = calibrate_logs([log])
+    path = tmp_path / "sensors.toml"
+    path.write_text(calibration.sensors_toml())
+    motion, working, envelope = load_sensors(path)
+    assert (motion, working, envelope) == (calibration.motion, calibration.working, calibration.envelope)
+    table = TerrainTable.from_toml(_write(tmp_path / "terrain.toml", calibration.terrain_table().to_toml()))
+    assert table["floor"] == calibration.stats
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('format = "aura-ums/sensor-calibration"\n', "expected keys"),
+        ("format = [", "expected TOML"),
+        (
+            'format = "x"\n[motion]\n[working]\n[envelope]\n',
+            "format: expected 'aura-ums/sensor-calibration'",
+        ),
+    ],
+)
+def test_bad_sensor_files_name_the_file(tmp_path: Path, text: str, match: str) -> None:
+    path = _write(tmp_path / "bad.toml", text)
+    with pytest.raises(FileFormatError, match=match):
+        load_sensors(path)
+
+
+def test_missing_sensor_file_is_named(tmp_path: Path) -> None:
+    with pytest.raises(FileFormatError, match=r"nothere.toml: expected a sensor calibration TOML file"):
+        load_sensors(tmp_path / "nothere.toml")
+
+
+def test_out_of_range_sensor_value_is_named(tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    text = (
+        calibrate_logs([log])
+        .sensors_toml()
+        .replace("[working]\nbearing_error = ", "[working]\nbearing_error = -")
+    )
+    with pytest.raises(FileFormatError, match=r"SensorBounds.bearing_error: expected a positive number"):
+        load_sensors(_write(tmp_path / "neg.toml", text))
+
+
+def test_calibration_input_errors() -> None:
+    log = synthetic_log(np.random.default_rng(1), duration=30.0)
+    with pytest.raises(InputError, match="expected at least one log"):
+        calibrate_logs([])
+    with pytest.raises(InputError, match="expected logs with ground truth"):
+        calibrate_logs([dataclasses.replace(log, groundtruth=None)])
+    with pytest.raises(InputError, match="quantile: expected a number in"):
+        calibrate_logs([log], quantile=1.0)
+    other = dataclasses.replace(log, meta=dataclasses.replace(log.meta, terrain="grass"))
+    with pytest.raises(InputError, match="expected logs on one terrain"):
+        calibrate_logs([log, other])
+
+
+def test_sensor_bounds_range_interval_is_sound_for_relative_errors() -> None:
+    bounds = SensorBounds(0.01, 0.0, 0.1, 0.05)
+    rng = np.random.default_rng(3)
+    true = rng.uniform(0.5, 10.0, 1000)
+    error = rng.uniform(-0.1, 0.05, 1000)  # (measured - true) / measured in [-low, high]
+    measured = true / (1.0 - error)
+    for m, t in zip(measured, true, strict=True):
+        low, high = bounds.range_interval(float(m))
+        assert low - 1e-9 <= t <= high + 1e-9
+
+
+@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
+def test_mrclam_calibration_finds_the_command_delay_and_heavy_tails() -> None:
+    calibration = calibrate_logs([read_mrclam(MRCLAM, 1)])
+    assert 0.1 <= calibration.motion.delay_s <= 0.3  # commanded velocities lead the robot
+    assert calibration.motion.run_scale > 1.0  # the robot sometimes outruns its command
+    assert calibration.envelope.bearing_error > 1.5 * calibration.working.bearing_error

@@ -1,0 +1,126 @@
+"""Replay of logs through the map manager: synthetic logs with known truth, and the MRCLAM data."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from log_helpers import MRCLAM6
+
+from aura_ums.errors import InputError
+from aura_ums.logs import (
+    MotionCalibration,
+    ReplayOptions,
+    RobotLog,
+    SensorBounds,
+    calibrate_logs,
+    observation_for,
+    read_mrclam,
+    replay_log,
+    synthetic_log,
+)
+from aura_ums.uncertainty import (
+    BearingObservation,
+    LandmarkClass,
+    RangeBearingObservation,
+    TerrainTable,
+)
+
+MRCLAM = MRCLAM6
+FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
+
+
+@pytest.fixture(scope="module")
+def clean_log() -> RobotLog:
+    return synthetic_log(np.random.default_rng(5), duration=60.0)
+
+
+@pytest.mark.parametrize("landmark_class", [LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT])
+def test_clean_synthetic_log_keeps_the_truth_at_every_step(
+    clean_log: RobotLog, landmark_class: LandmarkClass
+) -> None:
+    result = replay_log(clean_log, FLOOR, ReplayOptions(landmark_class=landmark_class))
+    assert len(result.steps) > 100
+    assert all(step.inside for step in result.steps)
+    assert all(step.envelope_inside for step in result.steps)
+    assert result.inconsistent_observations == 0
+    assert result.relocalizations == 0
+    # Landmarks do shrink the map: it stays far below the growth-only area.
+    grown_only = replay_log(
+        dataclasses.replace(clean_log, observations=()), FLOOR, ReplayOptions(landmark_class=landmark_class)
+    )
+    assert grown_only.steps == ()
+    assert result.median_area_m2 < 2.0
+    metrics = result.metrics()
+    for key in (
+        "containment_rate",
+        "median_area_m2",
+        "median_wedge_width_rad",
+        "inconsistent_observations",
+        "median_update_us",
+    ):
+        assert key in metrics
+    assert metrics["containment_rate"] == 1.0
+
+
+def test_class_two_is_tighter_than_class_one(clean_log: RobotLog) -> None:
+    one = replay_log(clean_log, FLOOR, ReplayOptions(landmark_class=LandmarkClass.VERTICAL_LINE))
+    two = replay_log(clean_log, FLOOR, ReplayOptions(landmark_class=LandmarkClass.POINT))
+    assert two.median_area_m2 < one.median_area_m2
+
+
+def test_observation_for_uses_row_bounds_first() -> None:
+    from aura_ums.logs import LogObservation
+
+    bounds = SensorBounds(0.05, 0.0, 0.1, 0.05)
+    row = LogObservation(1.0, "a", 0.2, range=4.0)
+    seen = observation_for(row, LandmarkClass.POINT, bounds)
+    assert isinstance(seen, RangeBearingObservation)
+    assert (seen.range_min, seen.range_max, seen.bearing_error) == pytest.approx((3.8, 4.4, 0.05))
+    own = observation_for(
+        LogObservation(1.0, "a", 0.2, range=4.0, bearing_error=0.01, range_error=0.2),
+        LandmarkClass.POINT,
+        bounds,
+    )
+    assert isinstance(own, RangeBearingObservation)
+    assert (own.range_min, own.range_max, own.bearing_error) == pytest.approx((3.8, 4.2, 0.01))
+    bearing_only = observation_for(LogObservation(1.0, "a", 0.2), LandmarkClass.POINT, bounds)
+    assert isinstance(bearing_only, BearingObservation)
+
+
+def test_replay_rejects_bad_arguments(clean_log: RobotLog) -> None:
+    with pytest.raises(InputError, match="expected a terrain 'floor' \\(the log's\\)"):
+        replay_log(clean_log, TerrainTable.default())
+    with pytest.raises(InputError, match="log: expected a RobotLog"):
+        replay_log("log", FLOOR)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"ReplayOptions.sigmas: expected a positive number"):
+        ReplayOptions(sigmas=0.0)
+    no_start = dataclasses.replace(clean_log, groundtruth=None)
+    with pytest.raises(InputError, match=r"expected a \[start\] pose in meta.toml or a groundtruth.csv"):
+        replay_log(no_start, FLOOR)
+
+
+def test_zero_length_log_gives_no_steps() -> None:
+    log = synthetic_log(np.random.default_rng(2), duration=0.1)
+    result = replay_log(dataclasses.replace(log, observations=()), FLOOR)
+    assert result.steps == ()
+    assert np.isnan(result.containment_rate)
+
+
+@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
+def test_mrclam_range_bearing_replay_keeps_the_truth_on_both_robots() -> None:
+    # Calibrated on robot 1, replayed on robot 1 and on robot 2 (the acceptance figure).
+    robot1, robot2 = read_mrclam(MRCLAM, 1), read_mrclam(MRCLAM, 2)
+    calibration = calibrate_logs([robot1])
+    assert isinstance(calibration.motion, MotionCalibration)
+    options = ReplayOptions(
+        landmark_class=LandmarkClass.POINT,
+        working=calibration.working,
+        envelope=calibration.envelope,
+        motion=calibration.motion,
+    )
+    for log in (robot1, robot2):
+        result = replay_log(log, calibration.terrain_table(), options)
+        assert result.containment_rate >= 0.99, log.meta.name
+        assert result.median_area_m2 < 2.0

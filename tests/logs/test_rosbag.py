@@ -1,0 +1,394 @@
+"""ROS bags to robot logs: a synthetic run written with ``rosbags`` and read back exactly."""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys.store import Typestore
+
+from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
+from aura_ums.logs import LogLandmark, LogMeta, load_log
+from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+
+T0 = 1_700_000_000  # epoch seconds of the first stamp
+LANDMARKS = (
+    LogLandmark("pole", 4.0, 2.0, 0.05, 0.0, 3.0, "lamppost"),
+    LogLandmark("corner", 1.0, -3.0, 0.1),
+    LogLandmark("door", -2.0, 1.5),
+)
+
+
+@dataclass
+class Run:
+    """A synthetic trajectory: velocities at 10 Hz, true poses, and observations of the landmarks."""
+
+    time: np.ndarray[Any, np.dtype[np.float64]]
+    v: np.ndarray[Any, np.dtype[np.float64]]
+    omega: np.ndarray[Any, np.dtype[np.float64]]
+    x: np.ndarray[Any, np.dtype[np.float64]]
+    y: np.ndarray[Any, np.dtype[np.float64]]
+    heading: np.ndarray[Any, np.dtype[np.float64]]
+    # (time, landmark id, bearing (any angle), range or None, bearing error or None)
+    observations: list[tuple[float, str, float, float | None, float | None]] = field(default_factory=list)
+
+
+def synthetic_run() -> Run:
+    rng = np.random.default_rng(11)
+    n = 30
+    time = T0 + 0.1 * np.arange(n, dtype=np.float64) + 0.0123
+    v = 0.5 + 0.2 * np.sin(np.arange(n) / 5.0)
+    omega = 0.3 * np.cos(np.arange(n) / 7.0)
+    heading = np.concatenate(([0.4], 0.4 + np.cumsum(omega[:-1] * 0.1)))
+    x = np.concatenate(([0.0], np.cumsum(v[:-1] * np.cos(heading[:-1]) * 0.1)))
+    y = np.concatenate(([0.0], np.cumsum(v[:-1] * np.sin(heading[:-1]) * 0.1)))
+    run = Run(time, v, omega, x, y, heading)
+    for i in range(0, n, 3):
+        for j, landmark in enumerate(LANDMARKS):
+            dx, dy = landmark.x - x[i], landmark.y - y[i]
+            bearing = math.atan2(dy, dx) - heading[i] + (2 * math.pi if j == 2 else 0.0)  # one unwrapped
+            distance = math.hypot(dx, dy) if (i + j) % 2 else None
+            error = float(rng.uniform(0.01, 0.05)) if j == 1 else None
+            run.observations.append((float(time[i]) + 0.001 * j, landmark.id, bearing, distance, error))
+    return run
+
+
+def stamp(store: Typestore, seconds: float) -> Any:
+    sec = math.floor(seconds)
+    return store.types["builtin_interfaces/msg/Time"](sec=sec, nanosec=round((seconds - sec) * 1e9))
+
+
+def header(store: Typestore, seconds: float, frame: str = "") -> Any:
+    return store.types["std_msgs/msg/Header"](stamp=stamp(store, seconds), frame_id=frame)
+
+
+def vector(store: Typestore, x: float = 0.0, y: float = 0.0, z: float = 0.0, kind: str = "Vector3") -> Any:
+    return store.types[f"geometry_msgs/msg/{kind}"](x=x, y=y, z=z)
+
+
+def pose(store: Typestore, x: float, y: float, heading: float) -> Any:
+    q = store.types["geometry_msgs/msg/Quaternion"](
+        x=0.0, y=0.0, z=math.sin(heading / 2), w=math.cos(heading / 2)
+    )
+    return store.types["geometry_msgs/msg/Pose"](position=vector(store, x, y, kind="Point"), orientation=q)
+
+
+def twist(store: Typestore, v: float, omega: float) -> Any:
+    return store.types["geometry_msgs/msg/Twist"](linear=vector(store, v), angular=vector(store, z=omega))
+
+
+def odometry_message(store: Typestore, run: Run, i: int) -> Any:
+    t = store.types
+    return t["nav_msgs/msg/Odometry"](
+        header=header(store, float(run.time[i]), "odom"),
+        child_frame_id="base_link",
+        pose=t["geometry_msgs/msg/PoseWithCovariance"](
+            pose=pose(store, float(run.x[i]), float(run.y[i]), float(run.heading[i])), covariance=np.zeros(36)
+        ),
+        twist=t["geometry_msgs/msg/TwistWithCovariance"](
+            twist=twist(store, float(run.v[i]), float(run.omega[i])), covariance=np.zeros(36)
+        ),
+    )
+
+
+def observation_message(store: Typestore, obs: tuple[float, str, float, float | None, float | None]) -> Any:
+    time, ident, bearing, distance, error = obs
+    x = math.nan if distance is None else distance
+    return store.types["geometry_msgs/msg/PointStamped"](
+        header=header(store, time, ident), point=vector(store, x, bearing, error or 0.0, kind="Point")
+    )
+
+
+Message = tuple[int, Any]  # receive time ns, message
+
+
+def write_bag(
+    path: Path, topics: dict[str, tuple[str, Sequence[Message]]], storage: StoragePlugin = StoragePlugin.MCAP
+) -> Path:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    with Writer(path, version=9, storage_plugin=storage) as writer:
+        for topic, (msgtype, messages) in topics.items():
+            connection = writer.add_connection(topic, msgtype, typestore=store)
+            for received, message in messages:
+                writer.write(connection, received, store.serialize_cdr(message, msgtype))
+    return path
+
+
+def ns(seconds: float) -> int:
+    return round(seconds * 1e9)
+
+
+def standard_topics(run: Run, store: Typestore) -> dict[str, tuple[str, Sequence[Message]]]:
+    odometry = [(ns(float(t)) + 5_000_000, odometry_message(store, run, i)) for i, t in enumerate(run.time)]
+    observations = [(ns(o[0]) + 7_000_000, observation_message(store, o)) for o in run.observations]
+    truth = [
+        (
+            ns(float(t)),
+            store.types["geometry_msgs/msg/PoseStamped"](
+                header=header(store, float(t), "map"),
+                pose=pose(store, float(run.x[i]), float(run.y[i]), float(run.heading[i])),
+            ),
+        )
+        for i, t in enumerate(run.time)
+    ]
+    return {
+        "/odom": ("nav_msgs/msg/Odometry", odometry),
+        "/landmarks": ("geometry_msgs/msg/PointStamped", observations),
+        "/truth": ("geometry_msgs/msg/PoseStamped", truth),
+    }
+
+
+@pytest.fixture(scope="module")
+def run() -> Run:
+    return synthetic_run()
+
+
+@pytest.fixture(scope="module")
+def bag(run: Run, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    return write_bag(tmp_path_factory.mktemp("bags") / "walk", standard_topics(run, store))
+
+
+def read(bag: Path, **overrides: Any) -> Any:
+    arguments: dict[str, Any] = {
+        "odom_topic": "/odom",
+        "observations_topic": "/landmarks",
+        "landmarks": LANDMARKS,
+        "groundtruth_topic": "/truth",
+    }
+    arguments.update(overrides)
+    return read_rosbag(bag, **arguments)
+
+
+def wrapped(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+# --- the round trip -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("storage", [StoragePlugin.MCAP, StoragePlugin.SQLITE3], ids=["mcap", "sqlite3"])
+def test_the_bag_is_read_as_written(run: Run, tmp_path: Path, storage: StoragePlugin) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    log = read(write_bag(tmp_path / "bag", standard_topics(run, store), storage))
+    assert log.odometry is not None
+    np.testing.assert_allclose(log.odometry.time, run.time, rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(log.odometry.v, run.v)
+    np.testing.assert_array_equal(log.odometry.omega, run.omega)
+    assert log.groundtruth is not None
+    np.testing.assert_allclose(log.groundtruth.time, run.time, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(log.groundtruth.x, run.x, atol=1e-12)
+    np.testing.assert_allclose(log.groundtruth.y, run.y, atol=1e-12)
+    np.testing.assert_allclose(log.groundtruth.heading, [wrapped(h) for h in run.heading], atol=1e-12)
+    assert len(log.observations) == len(run.observations)
+    for got, (time, ident, bearing, distance, error) in zip(log.observations, run.observations, strict=True):
+        assert got.landmark_id == ident
+        assert math.isclose(got.time, time, abs_tol=1e-6)
+        assert math.isclose(got.bearing, wrapped(bearing), abs_tol=1e-12)
+        assert got.range == distance
+        assert got.bearing_error == error
+        assert got.range_error is None
+    assert log.landmarks == LANDMARKS
+    assert log.meta.name == "bag"
+    assert "/odom" in log.meta.source
+    assert "/truth" in log.meta.source
+
+
+def test_import_writes_a_log_that_loads_back_equal(bag: Path, tmp_path: Path) -> None:
+    meta = LogMeta("walk", terrain="concrete", bearing_error=0.02)
+    log = import_rosbag(
+        bag,
+        tmp_path / "log",
+        odom_topic="/odom",
+        observations_topic="/landmarks",
+        landmarks=LANDMARKS,
+        meta=meta,
+        groundtruth_topic="/truth",
+    )
+    loaded = load_log(tmp_path / "log")
+    assert log.path == loaded.path == tmp_path / "log"
+    assert loaded.meta == meta
+    assert loaded.landmarks == log.landmarks
+    assert loaded.observations == log.observations
+    for name in ("time", "v", "omega"):
+        np.testing.assert_array_equal(getattr(loaded.odometry, name), getattr(log.odometry, name))
+    for name in ("time", "x", "y", "heading"):
+        np.testing.assert_array_equal(getattr(loaded.groundtruth, name), getattr(log.groundtruth, name))
+    with pytest.raises(InputError, match=r"folder: expected a folder without a log"):
+        import_rosbag(
+            bag, tmp_path / "log", odom_topic="/odom", observations_topic="/landmarks", landmarks=LANDMARKS
+        )
+
+
+def test_landmarks_from_a_csv_file(bag: Path, tmp_path: Path) -> None:
+    csv = tmp_path / "landmarks.csv"
+    csv.write_text(
+        "id,x,y,position_uncertainty,symbol\npole,4,2,0.05,lamppost\ncorner,1,-3,0.1,x\ndoor,-2,1.5,0,x\n"
+    )
+    log = read(bag, landmarks=csv, groundtruth_topic=None)
+    assert [item.id for item in log.landmarks] == ["pole", "corner", "door"]
+    assert log.groundtruth is None
+    csv.write_text("id,x,y\npole,4,2\n")
+    with pytest.raises(
+        FileFormatError, match=r"message \d+: expected header\.frame_id to be a landmark id \(pole\)"
+    ):
+        read(bag, landmarks=csv)
+    with pytest.raises(FileFormatError, match=r"none\.csv: expected a landmarks CSV file, got no such file"):
+        read(bag, landmarks=tmp_path / "none.csv")
+
+
+def test_twist_commands_take_the_receive_time(run: Run, tmp_path: Path) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    received = [ns(float(t)) for t in run.time]
+    commands = [
+        (r, twist(store, float(v), float(w))) for r, v, w in zip(received, run.v, run.omega, strict=True)
+    ]
+    # stamped commands arrive out of order; an unset (zero) stamp takes the receive time
+    stamped_type = store.types["geometry_msgs/msg/TwistStamped"]
+    stamped = [
+        (received[i], stamped_type(header=header(store, float(run.time[i])), twist=commands[i][1]))
+        for i in (2, 0, 1)
+    ]
+    unset = stamped_type(header=header(store, 0.0), twist=twist(store, 0.25, 0.0))
+    topics = standard_topics(run, store)
+    path = write_bag(
+        tmp_path / "bag",
+        {
+            "/cmd_vel": ("geometry_msgs/msg/Twist", commands),
+            "/cmd_stamped": ("geometry_msgs/msg/TwistStamped", [*stamped, (received[5], unset)]),
+            "/landmarks": topics["/landmarks"],
+        },
+    )
+    log = read(path, odom_topic="/cmd_vel", groundtruth_topic=None)
+    np.testing.assert_allclose(log.odometry.time, run.time, rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(log.odometry.v, run.v)
+    log = read(path, odom_topic="/cmd_stamped", groundtruth_topic=None)
+    np.testing.assert_allclose(log.odometry.time, [*run.time[:3], run.time[5]], rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(log.odometry.v, [*run.v[:3], 0.25])
+
+
+def test_a_ros1_bag_is_read_too(tmp_path: Path) -> None:
+    from rosbags.rosbag1 import Writer as Writer1
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    t = store.types
+
+    def header1(seconds: float, frame: str = "") -> Any:
+        return t["std_msgs/msg/Header"](seq=0, stamp=stamp(store, seconds), frame_id=frame)
+
+    times = [10.0, 10.5, 11.25]
+    with Writer1(tmp_path / "old.bag") as writer:
+        motion = writer.add_connection("/cmd", "geometry_msgs/msg/TwistStamped", typestore=store)
+        seen = writer.add_connection("/seen", "geometry_msgs/msg/PointStamped", typestore=store)
+        for i, time in enumerate(times):
+            command = t["geometry_msgs/msg/TwistStamped"](
+                header=header1(time), twist=twist(store, 0.1 * i, -0.2)
+            )
+            writer.write(motion, ns(time), store.serialize_ros1(command, "geometry_msgs/msg/TwistStamped"))
+            point = vector(store, 2.0 + i, 0.3, 0.0, kind="Point")
+            observation = t["geometry_msgs/msg/PointStamped"](header=header1(time + 0.1, "pole"), point=point)
+            writer.write(
+                seen, ns(time + 0.1), store.serialize_ros1(observation, "geometry_msgs/msg/PointStamped")
+            )
+    log = read(tmp_path / "old.bag", odom_topic="/cmd", observations_topic="/seen", groundtruth_topic=None)
+    assert log.odometry is not None
+    np.testing.assert_allclose(log.odometry.time, times)
+    np.testing.assert_allclose(log.odometry.v, [0.0, 0.1, 0.2])
+    np.testing.assert_array_equal(log.odometry.omega, [-0.2, -0.2, -0.2])
+    assert [o.range for o in log.observations] == [2.0, 3.0, 4.0]
+    assert log.meta.name == "old"
+
+
+# --- errors -----------------------------------------------------------------------------------
+
+
+def test_missing_wrong_and_empty_topics(bag: Path, run: Run, tmp_path: Path) -> None:
+    with pytest.raises(
+        FileFormatError, match=r"walk: topic /scan: expected the motion topic in the bag, got no such "
+    ):
+        read(bag, odom_topic="/scan")
+    with pytest.raises(
+        FileFormatError, match=r"topics: /landmarks \(geometry_msgs/msg/PointStamped\), /odom \("
+    ):
+        read(bag, odom_topic="/scan")
+    with pytest.raises(
+        FileFormatError,
+        match=r"topic /odom: expected observation messages of type geometry_msgs/msg/PointStamped, "
+        r"got nav_msgs/msg/Odometry",
+    ):
+        read(bag, observations_topic="/odom")
+    with pytest.raises(
+        FileFormatError, match=r"topic /landmarks: expected motion messages of type nav_msgs/msg/Od"
+    ):
+        read(bag, odom_topic="/landmarks")
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    topics = standard_topics(run, store)
+    empty = write_bag(
+        tmp_path / "empty", {"/odom": topics["/odom"], "/landmarks": ("geometry_msgs/msg/PointStamped", [])}
+    )
+    with pytest.raises(
+        FileFormatError, match=r"empty: topic /landmarks: expected at least one observation message"
+    ):
+        read(empty, groundtruth_topic=None)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda m: setattr(m.point, "x", -1.0), r"message 0: expected point\.x to be a range >= 0 m"),
+        (lambda m: setattr(m.point, "y", math.nan), r"message 0: expected point\.y to be a finite bearing"),
+        (lambda m: setattr(m.point, "z", -0.1), r"message 0: expected point\.z to be a bearing error bound"),
+        (
+            lambda m: setattr(m.header, "frame_id", "tree"),
+            r"message 0: expected header\.frame_id .*got 'tree'",
+        ),
+    ],
+)
+def test_bad_observations_name_the_message(
+    run: Run, tmp_path: Path, change: Callable[[Any], None], match: str
+) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    topics = standard_topics(run, store)
+    _, observations = topics["/landmarks"]
+    change(observations[0][1])
+    path = write_bag(tmp_path / "bad", topics)
+    with pytest.raises(FileFormatError, match=rf"bad: topic /landmarks, {match}"):
+        read(path)
+
+
+def test_repeated_odometry_stamps(run: Run, tmp_path: Path) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    topics = standard_topics(run, store)
+    kind, odometry = topics["/odom"]
+    topics["/odom"] = (kind, [*odometry, (odometry[-1][0] + 1, odometry_message(store, run, 4))])
+    path = write_bag(tmp_path / "again", topics)
+    with pytest.raises(
+        FileFormatError, match=r"topic /odom, message 30: expected motion messages at distinct times"
+    ):
+        read(path)
+
+
+def test_bad_arguments(bag: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    with pytest.raises(FileFormatError, match=r"nothing: expected a ROS bag .* got no such file or folder"):
+        read(tmp_path / "nothing")
+    (tmp_path / "folder").mkdir()
+    with pytest.raises(FileFormatError, match=r"folder: expected a readable ROS bag, got .*metadata"):
+        read(tmp_path / "folder")
+    with pytest.raises(InputError, match=r"odom_topic: expected a topic name such as '/odom', got ''"):
+        read(bag, odom_topic="")
+    with pytest.raises(InputError, match=r"meta: expected a LogMeta or None, got str"):
+        read(bag, meta="walk")
+    with pytest.raises(InputError, match=r"landmarks\[0\]: expected a LogLandmark, got tuple"):
+        read(bag, landmarks=[("pole", 4.0, 2.0)])
+    for name in [m for m in sys.modules if m == "rosbags" or m.startswith("rosbags.")]:
+        monkeypatch.setitem(sys.modules, name, None)
+    with pytest.raises(MissingDependencyError, match=r"install aura-ums\[ros\]"):
+        read(bag)
