@@ -238,6 +238,10 @@ def replay_start(log: RobotLog) -> tuple[float, Pose]:
         When the log has neither a start pose in its meta nor ground truth.
     """
     first_motion = log.motion_span[0] + log.meta.delay_s
+    if log.commands:
+        # A command is the motion *ending* at its time: the first one starts a period earlier.
+        period = log.commands[1].time - log.commands[0].time if len(log.commands) > 1 else 1e-6
+        first_motion -= period
     if log.meta.start is not None:
         return first_motion, log.meta.start
     if log.groundtruth is None:
