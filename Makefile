@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 REPORT ?= report
 
-.PHONY: demo test lint typecheck pytest bench figures clean
+.PHONY: demo test lint typecheck pytest bench figures docs clean
 
 $(BIN)/python:
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "aura-ums needs Python >= 3.11, got " + sys.version.split()[0])'
@@ -20,6 +20,10 @@ $(VENV)/.stamp-install: $(BUILD_INPUTS) | $(BIN)/python
 
 $(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[dev,opencv,foxglove,ros]"
+	@touch $@ $(VENV)/.stamp-install
+
+$(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
 	@touch $@ $(VENV)/.stamp-install
 
 demo: $(VENV)/.stamp-install
@@ -48,6 +52,11 @@ bench: $(VENV)/.stamp-dev
 	$(BIN)/python benchmarks/bench_perception.py
 	$(BIN)/python benchmarks/bench_sim.py
 	$(BIN)/python benchmarks/bench_loop.py
+
+# The documentation site (docs/): every warning, unresolved references included, is an error.
+docs: $(VENV)/.stamp-docs
+	MPLBACKEND=Agg $(BIN)/sphinx-build -E -W --keep-going -n -q -b html docs docs/_build/html
+	@echo "docs: open docs/_build/html/index.html"
 
 clean:
 	rm -rf $(VENV) $(REPORT) build dist src/*.egg-info
