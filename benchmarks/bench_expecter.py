@@ -3,7 +3,8 @@
 Run: ``.venv/bin/python benchmarks/bench_expecter.py``. Prints three tables:
 
 1. median microseconds per ``Expecter.window`` call, per landmark class, for 16- and
-   64-vertex maps, with an ideal and a distorted camera;
+   64-vertex maps, with an ideal and a distorted camera: the compiled kernel (when built)
+   against the numpy reference, measured in the same run;
 2. the Figure 4 scenario: window area of the polygonal map over the disk model's
    (target <= 0.5), and over an EKF's 3-sigma box whose covariance matches the polygon's
    second moments (and the wedge's, as a uniform heading);
@@ -23,6 +24,7 @@ from numpy.typing import NDArray
 
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.expecter import Expecter, disk_model_map, gaussian_box_map
+from aura_ums.expecter import _expecter as expecter_module
 from aura_ums.expecter._scenario import figure4_scenario
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
@@ -37,14 +39,23 @@ REPEATS = 300
 RANDOM_MAPS = 40
 
 
-def median_microseconds(expecter: Expecter, the_map: SpatialUncertaintyMap, landmark: Landmark) -> float:
-    for _ in range(10):
-        expecter.window(the_map, landmark)
-    times = []
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        expecter.window(the_map, landmark)
-        times.append(time.perf_counter() - start)
+def median_microseconds(
+    expecter: Expecter, the_map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool = True
+) -> float:
+    """Median microseconds of ``Expecter.window``; ``compiled=False`` runs the numpy reference."""
+    saved = expecter_module._compiled_expecter_points
+    if not compiled:
+        expecter_module._compiled_expecter_points = None
+    try:
+        for _ in range(10):
+            expecter.window(the_map, landmark)
+        times = []
+        for _ in range(REPEATS):
+            start = time.perf_counter()
+            expecter.window(the_map, landmark)
+            times.append(time.perf_counter() - start)
+    finally:
+        expecter_module._compiled_expecter_points = saved
     return 1e6 * statistics.median(times)
 
 
@@ -99,16 +110,22 @@ def timing_table() -> None:
         "II (point)": PointLandmark("corner", 12.0, -1.5, 2.5, position_uncertainty=0.1),
         "III (ground line)": GroundLineLandmark("edge", (4.0, -2.0), (16.0, -2.5), position_uncertainty=0.1),
     }
-    print("Median time per Expecter.window call (microseconds)")
-    print(f"{'class':<20} {'camera':<10} {'16 vertices':>12} {'64 vertices':>12}")
+    built = expecter_module._compiled_expecter_points is not None
+    print("Median time per Expecter.window call (microseconds); baseline: the numpy reference")
+    if not built:
+        print("(the C extension is not built: both columns run the numpy reference)")
+    print(f"{'class':<20} {'camera':<10} {'vertices':>8} {'compiled':>9} {'numpy':>9} {'speed-up':>9}")
     for class_name, landmark in landmarks.items():
         for camera_name, camera in cameras.items():
             expecter = Expecter(camera)
-            row = [
-                median_microseconds(expecter, elongated_map(n, 2.0, 0.4, 0.3, math.radians(4.0)), landmark)
-                for n in (16, 64)
-            ]
-            print(f"{class_name:<20} {camera_name:<10} {row[0]:>12.0f} {row[1]:>12.0f}")
+            for n in (16, 64):
+                the_map = elongated_map(n, 2.0, 0.4, 0.3, math.radians(4.0))
+                fast = median_microseconds(expecter, the_map, landmark)
+                reference = median_microseconds(expecter, the_map, landmark, compiled=False)
+                print(
+                    f"{class_name:<20} {camera_name:<10} {n:>8} {fast:>9.0f} {reference:>9.0f} "
+                    f"{reference / fast:>8.1f}x"
+                )
 
 
 def figure4_table() -> None:

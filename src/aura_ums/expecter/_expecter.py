@@ -33,12 +33,18 @@ The result is exact up to the outer polygons (relative excess below 1/cos(pi/128
 the extremes of a projection over a convex set are attained at its extreme points, and
 those are actual poses (a vertex of the map with an end of the wedge, or a point of the
 landmark's own set).
+
+Speed: when the C extension ``aura_ums.geometry._kernels`` was built, one call of its
+``expecter_points`` runs every step from the map's vertices to the normalized points and
+their box (the three Minkowski operands merged in one pass); the numpy functions below
+stay the reference implementation and the fallback.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,6 +63,13 @@ from aura_ums.uncertainty import (
 )
 
 Array = NDArray[np.float64]
+
+_CompiledPoints = Callable[..., tuple[bytes, float, float, float, float] | None]
+_compiled_expecter_points: _CompiledPoints | None
+try:  # the compiled kernel, when the build had a C compiler
+    from aura_ums.geometry._kernels import expecter_points as _compiled_expecter_points
+except ImportError:  # pragma: no cover - exercised on machines without a compiler
+    _compiled_expecter_points = None
 
 #: Angular step (rad) of the outer polygons of swept arcs: 0.03 % outside the arc.
 _ARC_STEP = math.pi / 64
@@ -101,10 +114,13 @@ class Expecter:
     """
 
     camera: Camera
+    _rotation: tuple[float, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.camera, Camera):
             raise InputError(f"camera: expected a Camera, got {type(self.camera).__name__}")
+        rotation = tuple(float(value) for value in self.camera.mount.rotation().ravel())
+        object.__setattr__(self, "_rotation", rotation)
 
     def bounds(self, map: SpatialUncertaintyMap, landmark: Landmark) -> ImageWindow | None:
         """Return the guaranteed window, before any margin and before clipping to the image.
@@ -135,25 +151,7 @@ class Expecter:
         InputError
             When ``map`` or ``landmark`` is of the wrong type.
         """
-        _check_map(map)
-        ground, levels = _landmark_geometry(landmark)
-        relative = _relative_ground(map, ground)
-        camera_points = _clip_to_front(self.camera, relative, levels)
-        if camera_points is None:
-            return None
-        normalized = camera_points[:, :2] / camera_points[:, 2:3]
-        k = self.camera.intrinsics
-        if k.distortion is None:
-            lower, upper = normalized.min(axis=0), normalized.max(axis=0)
-        else:
-            tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
-            lower, upper = distorted_range(normalized, k.distortion, tolerance)
-        with np.errstate(over="ignore", invalid="ignore"):
-            u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
-            v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
-        return ImageWindow(
-            _outward(u[0], -1.0), _outward(v[0], -1.0), _outward(u[1], 1.0), _outward(v[1], 1.0)
-        )
+        return _bounds(self, map, landmark, compiled=_compiled_expecter_points is not None)
 
     def window(
         self,
@@ -192,6 +190,108 @@ class Expecter:
             return None
         k = self.camera.intrinsics
         return guaranteed.expanded(pixels).clipped(k.width, k.height)
+
+
+def _bounds(
+    expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool
+) -> ImageWindow | None:
+    """:meth:`Expecter.bounds` by the compiled kernel or by the numpy reference."""
+    _check_map(map)
+    camera = expecter.camera
+    k = camera.intrinsics
+    normalized: Array | None = None
+    if compiled:
+        result = _compiled_points(expecter, map, landmark)
+        if result is None:
+            return None
+        raw, x_lo, y_lo, x_hi, y_hi = result
+        if k.distortion is None:
+            return _pixel_window(k.fx, k.fy, k.cx, k.cy, x_lo, y_lo, x_hi, y_hi)
+        normalized = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
+    else:
+        ground, levels = _landmark_geometry(landmark)
+        relative = _relative_ground(map, ground)
+        camera_points = _clip_to_front(camera, relative, levels)
+        if camera_points is None:
+            return None
+        normalized = camera_points[:, :2] / camera_points[:, 2:3]
+        if k.distortion is None:
+            lower, upper = normalized.min(axis=0), normalized.max(axis=0)
+            return _pixel_window(
+                k.fx, k.fy, k.cx, k.cy, float(lower[0]), float(lower[1]), float(upper[0]), float(upper[1])
+            )
+    tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
+    lower, upper = distorted_range(normalized, k.distortion, tolerance)
+    with np.errstate(over="ignore", invalid="ignore"):
+        u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
+        v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
+    return ImageWindow(
+        _outward(float(u[0]), -1.0),
+        _outward(float(v[0]), -1.0),
+        _outward(float(u[1]), 1.0),
+        _outward(float(v[1]), 1.0),
+    )
+
+
+def _pixel_window(
+    fx: float, fy: float, cx: float, cy: float, x_lo: float, y_lo: float, x_hi: float, y_hi: float
+) -> ImageWindow:
+    """Pixels of a box of normalized coordinates (fx, fy > 0: monotone), pushed outward."""
+    return ImageWindow(
+        _outward(fx * x_lo + cx, -1.0),
+        _outward(fy * y_lo + cy, -1.0),
+        _outward(fx * x_hi + cx, 1.0),
+        _outward(fy * y_hi + cy, 1.0),
+    )
+
+
+def _compiled_points(
+    expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark
+) -> tuple[bytes, float, float, float, float] | None:
+    """Run the compiled kernel: (bytes of the normalized points, their box), or None when behind."""
+    assert _compiled_expecter_points is not None  # the caller checked
+    if isinstance(landmark, VerticalLineLandmark):
+        count, ax, ay = 1, landmark.x, landmark.y
+        bx, by = ax, ay
+        bottom, top = landmark.z_bottom, landmark.z_top
+        levels = 1 if top == bottom else 2
+    elif isinstance(landmark, PointLandmark):
+        count, ax, ay = 1, landmark.x, landmark.y
+        bx, by = ax, ay
+        bottom = top = landmark.z
+        levels = 1
+    elif isinstance(landmark, GroundLineLandmark):
+        count = 2
+        (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
+        bottom = top = 0.0
+        levels = 1
+    else:
+        _landmark_geometry(landmark)  # raises the InputError naming the type
+        raise AssertionError("unreachable")  # pragma: no cover
+    mount = expecter.camera.mount
+    wedge = map.wedge
+    full = wedge.is_full_circle
+    return _compiled_expecter_points(
+        map.polygon.vertices,
+        count,
+        _DISK_SIDES,
+        1 if full else 0,
+        levels,
+        ax,
+        ay,
+        bx,
+        by,
+        landmark.position_uncertainty,
+        0.0 if full else wedge.center - wedge.cw,
+        0.0 if full else wedge.width,
+        _ARC_STEP,
+        *expecter._rotation,
+        mount.forward,
+        mount.left,
+        bottom - mount.height,
+        top - mount.height,
+        _CUT_PLANE,
+    )
 
 
 def _check_map(map: object) -> None:
