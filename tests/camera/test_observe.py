@@ -14,6 +14,7 @@ from aura_ums.camera import (
     Camera,
     CameraIntrinsics,
     CameraMount,
+    _observe,
     observe_ground_line,
     observe_point,
     observe_vertical_line,
@@ -393,6 +394,53 @@ def test_landmark_above_the_camera() -> None:
     assert obs.range_min <= 9.6 <= obs.range_max
     with pytest.raises(InputError, match=r"expected a pixel above the horizon for a landmark at height 3\.0"):
         observe_point(FLAT, lamp, (320.0, 400.0), time=0.0)
+
+
+# ------------------------------------------------------------------ the one-pixel float path
+
+
+def test_one_pixel_float_path_agrees_with_the_array_path(rng: np.random.Generator) -> None:
+    # Class I and II observe one pixel with plain floats; the arrays of _rays are the reference.
+    compared = 0
+    while compared < 600:
+        scene = random_scene(rng)
+        camera = scene.nominal
+        if compared % 2:
+            camera = Camera(replace(camera.intrinsics, distortion=None), camera.mount)
+        u, v = random_image_pixel(rng).tolist()
+        try:
+            rays = _observe._rays(camera, scene.bounds, np.array([[u, v]]), scene.pixel_error)
+        except InputError:
+            with pytest.raises(InputError, match="pixel: expected"):
+                _observe._pixel_ray(camera, scene.bounds, u, v, scene.pixel_error)
+            continue
+        ray = _observe._pixel_ray(camera, scene.bounds, u, v, scene.pixel_error)
+        expected = [rays.w.lo[0, 0], rays.w.hi[0, 0], rays.psi.lo[0, 0], rays.psi.hi[0, 0]]
+        assert list(ray[:4]) == pytest.approx(expected, rel=1e-12, abs=1e-15)
+        assert [ray.w0, ray.psi0] == pytest.approx([rays.w0[0], rays.psi0[0]], rel=1e-12, abs=1e-15)
+        bearing, error = _observe._pixel_bearing(camera, scene.bounds, ray)
+        reference, reference_error = _observe._bearing_bound(camera, scene.bounds, rays)
+        assert wrap_angle(bearing - reference) == pytest.approx(0.0, abs=1e-12)
+        assert error == pytest.approx(reference_error, rel=1e-9, abs=1e-15)
+        compared += 1
+
+
+def test_float_sine_and_cosine_ranges_agree_with_the_interval_ones(rng: np.random.Generator) -> None:
+    lo = rng.uniform(-10.0, 10.0, 3000)
+    hi = lo + np.where(rng.random(3000) < 0.1, 0.0, rng.uniform(0.0, 7.0, 3000))
+    sine, cosine = _observe._isin(_observe._Interval(lo, hi)), _observe._icos(_observe._Interval(lo, hi))
+    for k in range(len(lo)):
+        assert _observe._sin_range(lo[k], hi[k]) == pytest.approx((sine.lo[k], sine.hi[k]), abs=1e-15)
+        assert _observe._cos_range(lo[k], hi[k]) == pytest.approx((cosine.lo[k], cosine.hi[k]), abs=1e-15)
+
+
+def test_pixel_given_as_floats_arrays_or_numpy_scalars_gives_the_same_observation() -> None:
+    pixel = FLAT.project(Pose(0, 0, 0), [(9.0, 1.0, 0.0)])[0]
+    observations = [
+        observe_point(FLAT, replace(CORNER, x=9.0, y=1.0), form, time=0.0, pixel_error=0.5)
+        for form in (tuple(pixel.tolist()), pixel, (pixel[0], pixel[1]), [pixel.tolist()])
+    ]
+    assert all(o == observations[0] for o in observations)
 
 
 # ------------------------------------------------------------------ input errors

@@ -48,6 +48,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -406,6 +407,10 @@ class CalibrationBounds:
         return ("fx", "fy", "cx", "cy", "pan", "tilt", "height")
 
 
+#: The bounds of an exact calibration (what ``bounds=None`` means).
+_EXACT = CalibrationBounds()
+
+
 # --------------------------------------------------------------------------- the rays
 
 
@@ -413,7 +418,7 @@ def _check_camera(camera: object, bounds: object) -> tuple[Camera, CalibrationBo
     if not isinstance(camera, Camera):
         raise InputError(f"camera: expected Camera, got {type(camera).__name__}")
     if bounds is None:
-        bounds = CalibrationBounds()
+        bounds = _EXACT
     if not isinstance(bounds, CalibrationBounds):
         raise InputError(f"bounds: expected CalibrationBounds, got {type(bounds).__name__}")
     k = camera.intrinsics
@@ -491,6 +496,132 @@ def _rays(
         raise InputError("pixel: expected a pixel the distortion model can invert, got one beyond its fold")
     x0, y0 = nominal_xy[:, 0], nominal_xy[:, 1]
     return _Rays(w, psi, x0 / np.sqrt(1.0 + y0 * y0), mount.tilt + np.arctan(y0))
+
+
+# ------------------------------------------------------- one pixel, plain floats
+#
+# Class I and II observe one pixel over one calibration box. The functions below are the
+# same interval arithmetic as _Interval, _rays and _bearing_bound, operation for
+# operation, on plain floats: numpy's per-call overhead dominates arrays of one element.
+
+
+class _PixelRay(NamedTuple):
+    """Enclosures [lo, hi] of ``w`` and ``psi`` of one pixel's ray, and their nominal values."""
+
+    w_lo: float
+    w_hi: float
+    psi_lo: float
+    psi_hi: float
+    w0: float
+    psi0: float
+
+
+def _mul(a_lo: float, a_hi: float, b_lo: float, b_hi: float) -> tuple[float, float]:
+    """Interval product, as ``_Interval.__mul__``."""
+    p1, p2, p3, p4 = a_lo * b_lo, a_lo * b_hi, a_hi * b_lo, a_hi * b_hi
+    return min(p1, p2, p3, p4), max(p1, p2, p3, p4)
+
+
+def _sqr(lo: float, hi: float) -> tuple[float, float]:
+    """Interval square, as ``_Interval.sqr``."""
+    a, b = lo * lo, hi * hi
+    return (0.0 if lo <= 0.0 <= hi else min(a, b)), max(a, b)
+
+
+def _param_scalar(nominal: float, bound: float) -> tuple[float, float]:
+    """One sub-box of a parameter, as ``_param(nominal, bound, 1)``."""
+    low = nominal - bound
+    return low + 0.0, low + 2.0 * bound
+
+
+def _normalized_interval(
+    pixel: float, error: float, centre: tuple[float, float], focal: tuple[float, float]
+) -> tuple[float, float]:
+    """``(pixel +- error - centre) / focal`` as in ``_rays``: a difference, then a product."""
+    lo, hi = (pixel - error) + (-centre[1]), (pixel + error) + (-centre[0])
+    return _mul(lo, hi, 1.0 / focal[1], 1.0 / focal[0])
+
+
+def _pixel_ray(
+    camera: Camera, bounds: CalibrationBounds, u: float, v: float, pixel_error: float
+) -> _PixelRay:
+    """Enclose (w, psi) of one pixel over the calibration box (``_rays`` with one sub-box)."""
+    k, mount = camera.intrinsics, camera.mount
+    if k.distortion is not None:  # the interval Newton enclosure runs on arrays
+        rays = _rays(camera, bounds, np.array([[u, v]]), pixel_error)
+        return _PixelRay(
+            float(rays.w.lo.ravel()[0]),
+            float(rays.w.hi.ravel()[0]),
+            float(rays.psi.lo.ravel()[0]),
+            float(rays.psi.hi.ravel()[0]),
+            float(rays.w0[0]),
+            float(rays.psi0[0]),
+        )
+    fx = _param_scalar(k.fx, bounds.fx)
+    fy = _param_scalar(k.fy, bounds.fy)
+    cx = _param_scalar(k.cx, bounds.cx)
+    cy = _param_scalar(k.cy, bounds.cy)
+    tilt = _param_scalar(mount.tilt, bounds.tilt)
+    x_lo, x_hi = _normalized_interval(u, pixel_error, cx, fx)
+    y_lo, y_hi = _normalized_interval(v, pixel_error, cy, fy)
+    s_lo, s_hi = _sqr(y_lo, y_hi)
+    w_lo, w_hi = _mul(x_lo, x_hi, 1.0 / math.sqrt(s_hi + 1.0), 1.0 / math.sqrt(s_lo + 1.0))
+    psi_lo, psi_hi = tilt[0] + math.atan(y_lo), tilt[1] + math.atan(y_hi)
+    x0, y0 = (u - k.cx) / k.fx, (v - k.cy) / k.fy
+    return _PixelRay(w_lo, w_hi, psi_lo, psi_hi, x0 / math.sqrt(1.0 + y0 * y0), mount.tilt + math.atan(y0))
+
+
+def _sin_range(lo: float, hi: float) -> tuple[float, float]:
+    """Exact range of sin over [lo, hi], as ``_isin``."""
+    s_lo, s_hi = math.sin(lo), math.sin(hi)
+    peak = math.pi / 2 + 2 * math.pi * math.ceil((lo - math.pi / 2) / (2 * math.pi))
+    trough = -math.pi / 2 + 2 * math.pi * math.ceil((lo + math.pi / 2) / (2 * math.pi))
+    return (-1.0 if trough <= hi else min(s_lo, s_hi)), (1.0 if peak <= hi else max(s_lo, s_hi))
+
+
+def _cos_range(lo: float, hi: float) -> tuple[float, float]:
+    """Exact range of cos over [lo, hi], as ``_icos``."""
+    c_lo, c_hi = math.cos(lo), math.cos(hi)
+    peak = 2 * math.pi * math.ceil(lo / (2 * math.pi))
+    trough = math.pi + 2 * math.pi * math.ceil((lo - math.pi) / (2 * math.pi))
+    return (-1.0 if trough <= hi else min(c_lo, c_hi)), (1.0 if peak <= hi else max(c_lo, c_hi))
+
+
+def _pixel_bearing(camera: Camera, bounds: CalibrationBounds, ray: _PixelRay) -> tuple[float, float]:
+    """(bearing, bearing_error) of one pixel's ray over the box, as ``_bearing_bound``."""
+    y_lo, y_hi = -ray.w_hi, -ray.w_lo
+    x_lo, x_hi = _cos_range(ray.psi_lo, ray.psi_hi)
+    nominal = wrap_angle(camera.mount.pan + math.atan2(-ray.w0, math.cos(ray.psi0)))
+    if y_lo <= 0.0 <= y_hi and x_lo <= 0.0 <= x_hi:
+        return nominal, math.pi
+    # A box that excludes the origin spans less than half a turn: extremes at its corners.
+    reference = math.atan2(0.5 * (y_lo + y_hi), 0.5 * (x_lo + x_hi))
+    relative = [
+        wrap_angle(math.atan2(yy, xx) - reference)
+        for yy, xx in ((y_lo, x_lo), (y_lo, x_hi), (y_hi, x_lo), (y_hi, x_hi))
+    ]
+    lo = reference + min(relative) - bounds.pan
+    hi = reference + max(relative) + bounds.pan
+    error = _widen(0.5 * (hi - lo))
+    if error >= math.pi:
+        return nominal, math.pi
+    return wrap_angle(camera.mount.pan + 0.5 * (lo + hi)), error
+
+
+def _one_pixel(camera: Camera, pixel: ArrayLike) -> tuple[float, float]:
+    """Check one pixel, as ``_check_pixels(camera, pixel, "pixel", 1)``; a fast path for two floats."""
+    if isinstance(pixel, tuple) and len(pixel) == 2 and all(isinstance(c, float) for c in pixel):
+        u, v = pixel
+        k = camera.intrinsics
+        if (
+            math.isfinite(u)
+            and math.isfinite(v)
+            and -0.5 <= u <= k.width - 0.5
+            and -0.5 <= v <= k.height - 0.5
+        ):
+            return float(u), float(v)
+    uv = _check_pixels(camera, pixel, "pixel", 1)
+    return float(uv[0, 0]), float(uv[0, 1])
 
 
 def _widen(error: float) -> float:
@@ -580,8 +711,8 @@ def observe_vertical_line(
     if not isinstance(landmark, VerticalLineLandmark):
         raise InputError(f"landmark: expected VerticalLineLandmark, got {type(landmark).__name__}")
     error, when = _common_inputs(pixel_error, time)
-    uv = _check_pixels(camera, pixel, "pixel", 1)
-    bearing, bearing_error = _bearing_bound(camera, checked, _rays(camera, checked, uv, error))
+    u, v = _one_pixel(camera, pixel)
+    bearing, bearing_error = _pixel_bearing(camera, checked, _pixel_ray(camera, checked, u, v, error))
     return BearingObservation(landmark.id, when, bearing, bearing_error, camera.mount.sensor_offset)
 
 
@@ -660,41 +791,38 @@ height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that pl
         cap = finite_float(max_range, "max_range")
         if cap <= 0.0:
             raise InputError(f"max_range: expected a positive number, got {cap}")
-    uv = _check_pixels(camera, pixel, "pixel", 1)
+    u, v = _one_pixel(camera, pixel)
     height = camera.mount.height
-    drop = _Interval.around(height - landmark.z, checked.height)
-    if bool(drop.contains_zero()):
+    drop_lo, drop_hi = (height - landmark.z) - checked.height, (height - landmark.z) + checked.height
+    if drop_lo <= 0.0 <= drop_hi:
         raise InputError(
             f"bounds.height: expected the camera height {height} +- {checked.height} m to exclude the "
             f"landmark's height {landmark.z} m, got an interval that reaches it"
         )
-    sign = 1.0 if drop.lo > 0.0 else -1.0
-    rays = _rays(camera, checked, uv, error)
-    if sign * math.sin(float(rays.psi0[0])) <= 0.0:
+    sign = 1.0 if drop_lo > 0.0 else -1.0
+    ray = _pixel_ray(camera, checked, u, v, error)
+    if sign * math.sin(ray.psi0) <= 0.0:
         raise InputError(
             f"pixel: expected a pixel {'below' if sign > 0 else 'above'} the horizon for a landmark at "
-            f"height {landmark.z} m (camera at {height} m), got ({uv[0, 0]}, {uv[0, 1]}) whose ray "
+            f"height {landmark.z} m (camera at {height} m), got ({u}, {v}) whose ray "
             "never meets that plane"
         )
-    bearing, bearing_error = _bearing_bound(camera, checked, rays)
-    sine = _isin(rays.psi) * sign  # positive where the ray meets the plane
-    s_max = float(sine.hi.ravel()[0])
-    s_min = float(sine.lo.ravel()[0])
-    w2 = rays.w.sqr()
-    d_abs = drop.abs()
-    w2_lo, w2_hi = float(w2.lo.ravel()[0]), float(w2.hi.ravel()[0])
-    low = float(d_abs.lo) * math.sqrt(max((1.0 + w2_lo) / (s_max * s_max) - 1.0, 0.0))
-    if s_min > 0.0:
-        high = float(d_abs.hi) * math.sqrt(max((1.0 + w2_hi) / (s_min * s_min) - 1.0, 0.0))
-    else:
-        high = math.inf
+    bearing, bearing_error = _pixel_bearing(camera, checked, ray)
+    sine_lo, sine_hi = _sin_range(ray.psi_lo, ray.psi_hi)
+    s_min, s_max = min(sine_lo * sign, sine_hi * sign), max(sine_lo * sign, sine_hi * sign)
+    w2_lo, w2_hi = _sqr(ray.w_lo, ray.w_hi)
+    d_abs_lo = 0.0 if drop_lo <= 0.0 <= drop_hi else min(abs(drop_lo), abs(drop_hi))
+    d_abs_hi = max(abs(drop_lo), abs(drop_hi))
+    low = d_abs_lo * math.sqrt(max((1.0 + w2_lo) / (s_max * s_max) - 1.0, 0.0))
+    # s_min <= 0: the error bounds reach the horizon, the range is unbounded above
+    high = d_abs_hi * math.sqrt(max((1.0 + w2_hi) / (s_min * s_min) - 1.0, 0.0)) if s_min > 0.0 else math.inf
     margin = _widen(0.5 * (high - low)) - 0.5 * (high - low) if math.isfinite(high) else 0.0
     range_min = max(0.0, low - margin - _PAD * low)
     range_max = high + margin + _PAD * high
     if math.isinf(range_max) and math.isinf(cap):
         raise InputError(
             f"max_range: expected a bound on the range, because the error bounds of pixel "
-            f"({uv[0, 0]}, {uv[0, 1]}) reach the horizon (unbounded range), got None"
+            f"({u}, {v}) reach the horizon (unbounded range), got None"
         )
     if range_min > cap:
         raise InputError(f"max_range: expected at least the smallest possible range {range_min} m, got {cap}")

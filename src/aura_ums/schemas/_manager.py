@@ -6,8 +6,6 @@ import types
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-import numpy as np
-
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.manager import IdentifiedLandmarkBuffer
@@ -352,7 +350,7 @@ class SchemaManager:
             if report.observation is None or report.detection is None:
                 continue
             schema = self._by_id(report.landmark_id)
-            point = np.array([report.detection.point], dtype=np.float64)
+            u, v = report.detection.point
             for other in self._schemas:
                 if (
                     other is schema
@@ -363,7 +361,8 @@ class SchemaManager:
                 if other.landmark_id not in bounds:
                     bounds[other.landmark_id] = other.expecter.bounds(frame.map, other.record.landmark)
                 window = bounds[other.landmark_id]
-                if window is not None and bool(window.contains(point)[0]):
+                inside = window is not None and window.u_min <= u <= window.u_max
+                if inside and window is not None and window.v_min <= v <= window.v_max:
                     result.add(report.landmark_id)
                     break
         return result

@@ -20,19 +20,22 @@ Supported (landmark class, perceptual strategy) pairs, with the record's ``param
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import shapely
 from numpy.typing import NDArray
 
 from aura_ums.camera import (
+    NEAR_PLANE,
     CalibrationBounds,
     Camera,
     observe_ground_line,
     observe_point,
     observe_vertical_line,
+    robot_from_camera_rotation,
     undistort_points,
 )
 from aura_ums.errors import InputError
@@ -57,6 +60,12 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord
+
+_polygon_distance: Callable[..., float] | None
+try:  # the compiled kernel, when the build had a C compiler
+    from aura_ums.geometry._kernels import polygon_distance as _polygon_distance
+except ImportError:  # pragma: no cover - exercised on machines without a compiler
+    _polygon_distance = None
 
 #: A perceptual strategy, parameterized.
 Detector = FastLineFinder | MoravecOperator | RegionSegmenter
@@ -137,13 +146,28 @@ def build_detector(record: LandmarkRecord) -> Detector:
 
 def may_be_within(map: SpatialUncertaintyMap, landmark: Landmark, reach: float) -> bool:
     """Whether some position of the map is within ``reach`` metres of where the landmark may be."""
+    return (
+        map_gap(map, landmark, compiled=_polygon_distance is not None) - landmark.position_uncertainty
+        <= reach
+    )
+
+
+def map_gap(map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool) -> float:
+    """Distance (m) from the map's polygon (edges included) to the landmark's point or segment.
+
+    ``compiled`` picks the C kernel (when built); otherwise shapely, the reference.
+    """
+    if compiled and _polygon_distance is not None:
+        if isinstance(landmark, GroundLineLandmark):
+            (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
+            return _polygon_distance(map.polygon.vertices, ax, ay, bx, by)
+        return _polygon_distance(map.polygon.vertices, landmark.x, landmark.y, landmark.x, landmark.y)
     geometry: shapely.Geometry
     if isinstance(landmark, GroundLineLandmark):
         geometry = shapely.LineString([landmark.start, landmark.end])
     else:
         geometry = shapely.Point(landmark.x, landmark.y)
-    gap = float(shapely.distance(map.polygon.to_shapely(), geometry))
-    return gap - landmark.position_uncertainty <= reach
+    return float(shapely.distance(map.polygon.to_shapely(), geometry))
 
 
 def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: Pose) -> float | None:
@@ -165,9 +189,8 @@ def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: 
     return math.atan2(dv, du) % math.pi
 
 
-def _box(points: NDArray[np.float64]) -> ImageWindow:
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    return ImageWindow(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+def _box(u1: float, v1: float, u2: float, v2: float) -> ImageWindow:
+    return ImageWindow(min(u1, u2), min(v1, v2), max(u1, u2), max(v1, v2))
 
 
 def detect(
@@ -204,9 +227,10 @@ def detect(
             evidence = evaluate_vertical_line(lines, orientation=orientation, tolerance=detector.tolerance)
         if evidence.segment is None or evidence.point is None:
             return evidence.value, None
-        seg = evidence.segment
-        box = _box(np.array([[seg[0], seg[1]], [seg[2], seg[3]]]))
-        return evidence.value, Detection(time, evidence.value, evidence.point, box, seg, pose)
+        u1, v1, u2, v2 = (float(c) for c in evidence.segment)
+        point = (float(evidence.point[0]), float(evidence.point[1]))
+        detection = Detection(time, evidence.value, point, _box(u1, v1, u2, v2), (u1, v1, u2, v2), pose)
+        return evidence.value, detection
     if isinstance(detector, MoravecOperator):
         points = detector.find(image, window)
         if int(np.count_nonzero(points[:, 2] >= record.recognition_threshold)) >= 2:
@@ -216,8 +240,8 @@ def detect(
         corner = evaluate_corner(points)
         if corner.point is None:
             return corner.value, None
-        box = _box(np.array([corner.point]))
-        return corner.value, Detection(time, corner.value, corner.point, box, None, pose)
+        u, v = float(corner.point[0]), float(corner.point[1])
+        return corner.value, Detection(time, corner.value, (u, v), _box(u, v, u, v), None, pose)
     aspect = record.parameters.get("min_aspect", DEFAULT_MIN_ASPECT)
     best: tuple[float, tuple[float, float], ImageWindow] | None = None
     for region in detector.find(image, window):
@@ -284,20 +308,27 @@ def predicted_shift(
     the camera; Class III: the ground plane); that point is projected from ``pose``. None
     when it is then behind the camera (the landmark has left the view).
     """
-    ray = undistort_points(camera.intrinsics, [detection.point])[0]
+    k = camera.intrinsics
+    if k.distortion is None:
+        u, v = detection.point
+        rx, ry = (u - k.cx) / k.fx, (v - k.cy) / k.fy
+    else:
+        ray = undistort_points(k, [detection.point])[0]
+        if not np.isfinite(ray).all():
+            return (0.0, 0.0)
+        rx, ry = float(ray[0]), float(ray[1])
     then = detection.pose
-    if not np.isfinite(ray).all():
-        return (0.0, 0.0)
     mount = camera.mount
-    d = mount.rotation() @ np.array([ray[0], ray[1], 1.0])
+    r = _rotation(mount.pan, mount.tilt)
+    d0 = r[0] * rx + r[1] * ry + r[2]
+    d1 = r[3] * rx + r[4] * ry + r[5]
+    d2 = r[6] * rx + r[7] * ry + r[8]
     c, s = math.cos(then.heading), math.sin(then.heading)
-    direction = np.array([c * d[0] - s * d[1], s * d[0] + c * d[1], d[2]])
-    centre = np.array(
-        [
-            then.x + c * mount.forward - s * mount.left,
-            then.y + s * mount.forward + c * mount.left,
-            mount.height,
-        ]
+    direction = (c * d0 - s * d1, s * d0 + c * d1, d2)
+    centre = (
+        then.x + c * mount.forward - s * mount.left,
+        then.y + s * mount.forward + c * mount.left,
+        mount.height,
     )
     if isinstance(landmark, GroundLineLandmark):
         if direction[2] >= -1e-9:
@@ -309,12 +340,47 @@ def predicted_shift(
         if horizontal < 1e-9 or reach < 1e-9:
             return (0.0, 0.0)
         t = reach / horizontal
-    point = (centre + t * direction).reshape(1, 3)
-    before = camera.project(then, point)[0]
-    after = camera.project(pose, point)[0]
-    if not (np.isfinite(before).all() and np.isfinite(after).all()):
+    point = (centre[0] + t * direction[0], centre[1] + t * direction[1], centre[2] + t * direction[2])
+    before = _project(camera, r, then, point)
+    after = _project(camera, r, pose, point)
+    if before is None or after is None:
         return None
-    return (float(after[0] - before[0]), float(after[1] - before[1]))
+    return (after[0] - before[0], after[1] - before[1])
+
+
+@functools.lru_cache(maxsize=64)
+def _rotation(pan: float, tilt: float) -> tuple[float, ...]:
+    """:meth:`CameraMount.rotation` as 9 floats, row by row (camera to robot axes)."""
+    return tuple(float(value) for value in robot_from_camera_rotation(pan, tilt).ravel())
+
+
+def _project(
+    camera: Camera, r: tuple[float, ...], pose: Pose, point: tuple[float, float, float]
+) -> tuple[float, float] | None:
+    """:meth:`Camera.project` of one world point (m) from one pose, on floats; None behind the camera."""
+    mount, k = camera.mount, camera.intrinsics
+    c, s = math.cos(pose.heading), math.sin(pose.heading)
+    dx, dy = point[0] - pose.x, point[1] - pose.y
+    bx = c * dx + s * dy - mount.forward
+    by = -s * dx + c * dy - mount.left
+    bz = point[2] - mount.height
+    z = bx * r[2] + by * r[5] + bz * r[8]
+    if not z > NEAR_PLANE:
+        return None
+    x = (bx * r[0] + by * r[3] + bz * r[6]) / z
+    y = (bx * r[1] + by * r[4] + bz * r[7]) / z
+    if k.distortion is not None:  # camera.distort's polynomial, on floats
+        k1, k2, p1, p2, k3 = k.distortion
+        r2 = x * x + y * y
+        radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+        x, y = (
+            x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+            y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
+        )
+    u, v = k.fx * x + k.cx, k.fy * y + k.cy
+    if not (math.isfinite(u) and math.isfinite(v)):
+        return None
+    return (u, v)
 
 
 def intersection(a: ImageWindow, b: ImageWindow) -> ImageWindow | None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -15,7 +14,6 @@ from aura_ums.schemas._perceive import (
     Detector,
     build_detector,
     detect,
-    intersection,
     may_be_within,
     observe,
     predicted_shift,
@@ -28,6 +26,15 @@ from aura_ums.world import LandmarkRecord
 TRACKING_MARGIN = 16.0
 #: Consecutive tracking frames without a match after which a tracked landmark becomes suspect.
 DEFAULT_LOST_FRAMES = 2
+
+
+def _grown_clipped(window: ImageWindow, margin: float, width: int, height: int) -> ImageWindow | None:
+    """``window.expanded(margin).clipped(width, height)``, building one window instead of two."""
+    u0, v0 = max(window.u_min - margin, -0.5), max(window.v_min - margin, -0.5)
+    u1, v1 = min(window.u_max + margin, width - 0.5), min(window.v_max + margin, height - 0.5)
+    if u0 > u1 or v0 > v1:
+        return None
+    return ImageWindow(u0, v0, u1, v1)
 
 
 def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWindow:
@@ -249,12 +256,23 @@ class FindLandmarkSchema:
         # check reuses them instead of asking the Expecter again.
         bounds = self.expecter.bounds(frame.map, self.record.landmark)
         report = self._step_awake(frame, status, bounds)
-        return report if bounds is None else dataclasses.replace(report, bounds=bounds)
+        if bounds is None:
+            return report
+        return SchemaReport(
+            report.landmark_id,
+            report.status,
+            report.window,
+            report.value,
+            report.hit,
+            report.observation,
+            report.detection,
+            bounds,
+        )
 
     def _step_awake(self, frame: Frame, status: SchemaStatus, bounds: ImageWindow | None) -> SchemaReport:
         k = self.expecter.camera.intrinsics
         ident = self.record.id
-        guaranteed = None if bounds is None else bounds.expanded(self.margin).clipped(k.width, k.height)
+        guaranteed = None if bounds is None else _grown_clipped(bounds, self.margin, k.width, k.height)
         if guaranteed is not None and frame.window_scale != 1.0:
             guaranteed = widen(guaranteed, frame.window_scale, k.width, k.height)
         if status.state is SchemaState.TRACKING and status.detection is not None:
@@ -314,14 +332,18 @@ class FindLandmarkSchema:
         if shift is None:
             return None
         du, dv = shift
-        box = last.box
-        moved = ImageWindow(box.u_min + du, box.v_min + dv, box.u_max + du, box.v_max + dv)
-        k = camera.intrinsics
-        around = moved.expanded(self.tracking_margin).clipped(k.width, k.height)
-        if around is None:
+        box, m, k = last.box, self.tracking_margin, camera.intrinsics
+        # The moved box grown by the margin, clipped to the image (None: off the image), then
+        # cut to the guaranteed window (all of it when they do not overlap): one window built.
+        u0, v0 = max(box.u_min + du - m, -0.5), max(box.v_min + dv - m, -0.5)
+        u1, v1 = min(box.u_max + du + m, k.width - 0.5), min(box.v_max + dv + m, k.height - 0.5)
+        if u0 > u1 or v0 > v1:
             return None
-        overlap = intersection(around, guaranteed)
-        return guaranteed if overlap is None else overlap
+        u0, v0 = max(u0, guaranteed.u_min), max(v0, guaranteed.v_min)
+        u1, v1 = min(u1, guaranteed.u_max), min(v1, guaranteed.v_max)
+        if u0 > u1 or v0 > v1:
+            return guaranteed
+        return ImageWindow(u0, v0, u1, v1)
 
     def _look(self, frame: Frame, window: ImageWindow) -> tuple[float, Detection | None, Observation | None]:
         """Run the strategy in the window; return the value, and the detection and observation of a hit."""
