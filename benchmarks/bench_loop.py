@@ -7,8 +7,10 @@ landmarks active) driven through :func:`aura_ums.sim.run_scenario`; a frame's ti
 the map manager's growth, the schemas (Expecter windows, line finder, evaluation,
 observation) and the reductions, not the synthetic rendering. Only frames in which all
 three landmarks were searched count. The same seeded runs are timed with perception in
-the Expecter's windows and on the full frame. Targets: <= 10 ms per frame and >= 5x
-faster than full frame. Speed depends on the machine and its load; nothing is asserted.
+the Expecter's windows and on the full frame, interleaved seed by seed (windows, then
+full frame) so that a change in the machine's load weighs on both alike. Targets: <= 10
+ms per frame and >= 5x faster than full frame. Speed depends on the machine and its
+load; nothing is asserted.
 """
 
 from __future__ import annotations
@@ -26,21 +28,26 @@ TARGET_MS = 10.0
 TARGET_RATIO = 5.0
 
 
-def frame_times(scenario: Scenario, mode: PerceptionMode, runs: int) -> list[float]:
-    """Milliseconds of the frames with three landmarks searched, over ``runs`` seeded runs."""
-    times: list[float] = []
+MODES = (PerceptionMode.WINDOWS, PerceptionMode.FULL_FRAME)
+
+
+def frame_times(scenario: Scenario, runs: int) -> dict[PerceptionMode, list[float]]:
+    """Milliseconds of the frames with three landmarks searched, per mode, over ``runs`` seeded runs."""
+    times: dict[PerceptionMode, list[float]] = {mode: [] for mode in MODES}
     for seed in range(runs):
-        result = run_scenario(scenario, np.random.default_rng(seed), perception=mode)
-        times.extend(r.frame_ms for r in result.records if len(r.windows) >= 3)
+        for mode in MODES:
+            result = run_scenario(scenario, np.random.default_rng(seed), perception=mode)
+            times[mode].extend(r.frame_ms for r in result.records if len(r.windows) >= 3)
     return times
 
 
 def main() -> None:
     runs = int(sys.argv[1]) if len(sys.argv) > 1 else 30
     scenario = Scenario.from_toml(SCENARIO)
-    frame_times(scenario, PerceptionMode.WINDOWS, 2)  # warm up
-    windows = statistics.median(frame_times(scenario, PerceptionMode.WINDOWS, runs))
-    full = statistics.median(frame_times(scenario, PerceptionMode.FULL_FRAME, runs))
+    frame_times(scenario, 2)  # warm up
+    times = frame_times(scenario, runs)
+    windows = statistics.median(times[PerceptionMode.WINDOWS])
+    full = statistics.median(times[PerceptionMode.FULL_FRAME])
     k = scenario.camera.intrinsics
     print(f"closed loop, {k.width}x{k.height}, three active landmarks, {runs} runs")
     print(f"{'perception':<12} {'median ms/frame':>16}")

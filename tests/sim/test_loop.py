@@ -11,13 +11,14 @@ import pytest
 from aura_ums.errors import InputError
 from aura_ums.manager import ManagerState
 from aura_ums.sim import (
+    FrameRecord,
     PerceptionMode,
     Scenario,
     check_render_consistency,
     run_scenario,
     summarize_runs,
 )
-from aura_ums.uncertainty import PointLandmark, VerticalLineLandmark
+from aura_ums.uncertainty import LandmarkClass, PointLandmark, VerticalLineLandmark
 from aura_ums.world import MeadowMap
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -111,6 +112,29 @@ def test_kill_half_way_and_resume_gives_the_same_final_map(name: str) -> None:
     assert a.center.tobytes() == b.center.tobytes()
     assert (a.wedge.center, a.wedge.cw, a.wedge.ccw) == (b.wedge.center, b.wedge.cw, b.wedge.ccw)
     assert [r.true_pose for r in whole.records] == [r.true_pose for r in resumed.records]
+    assert [r.detections for r in whole.records] == [r.detections for r in resumed.records]
+
+
+def test_records_hold_each_found_landmarks_detection() -> None:
+    corridor = Scenario.from_toml(SCENARIOS / "indoor_corridor.toml")
+    classes = {r.id: r.landmark.landmark_class for r in corridor.meadow_map.landmarks}
+    result = run_scenario(corridor, np.random.default_rng(0))
+    seen = set()
+    for record in result.records:
+        assert [ident for ident, _ in record.detections] == list(record.found)
+        windows = dict(record.windows)
+        for ident, (u1, v1, u2, v2) in record.detections:
+            # What perception matched lies in the window it searched: the pixels the window
+            # overlaps (centres up to half a pixel out), a fitted line's ends a little beyond.
+            window = windows[ident]
+            for u, v in ((u1, v1), (u2, v2)):
+                assert window.u_min - 2.0 <= u <= window.u_max + 2.0
+                assert window.v_min - 2.0 <= v <= window.v_max + 2.0
+            point = classes[ident] is LandmarkClass.POINT
+            assert point == ((u1, v1) == (u2, v2))  # points as zero-length segments, lines not
+            seen.add(classes[ident])
+    assert seen == set(LandmarkClass)
+    assert dataclasses.fields(FrameRecord)[-1].name == "detections"
 
 
 def test_full_frame_perception_searches_the_whole_image(paper: Scenario) -> None:

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
 from aura_ums.manager import Blackboard, ManagerState, PositionReport, UncertaintyMapManager
-from aura_ums.schemas import Frame, Pilot, SchemaManager, SchemaManagerState
+from aura_ums.schemas import Frame, Pilot, SchemaManager, SchemaManagerState, StepReport
 from aura_ums.sim._scenario import Scenario, waypoints_array
 from aura_ums.sim._scene import CORNER_MATCH_DISTANCE
 from aura_ums.uncertainty import (
@@ -99,6 +99,11 @@ class FrameRecord:
         The manager's state after the frame.
     frame_ms : float
         Milliseconds of the loop (schemas, perception and manager; not the rendering).
+    detections : tuple of (str, (float, float, float, float))
+        Per found landmark id (in :attr:`found` order), the image-space detection the
+        perception matched, ``(u1, v1, u2, v2)`` full-image pixels: a line finder's segment
+        (Class I and III); a point as ``(u, v, u, v)`` (a Class II interest point, or the
+        centroid of a Class I region, the point its observation uses). Empty by default.
     """
 
     index: int
@@ -116,6 +121,7 @@ class FrameRecord:
     rejected: tuple[str, ...]
     state: ManagerState
     frame_ms: float
+    detections: tuple[tuple[str, tuple[float, float, float, float]], ...] = ()
 
     @property
     def area_before(self) -> float:
@@ -443,6 +449,7 @@ class _Loop:
                 rejected=tuple(o.reason for o in after.rejected),
                 state=after.state,
                 frame_ms=elapsed,
+                detections=_detections(report),
             )
         )
         self.next_index += 1
@@ -465,6 +472,22 @@ class _Loop:
             scene_rng=dict(self.scene_state),
             records=tuple(self.records),
         )
+
+
+def _detections(report: StepReport) -> tuple[tuple[str, tuple[float, float, float, float]], ...]:
+    """Per found landmark, its matched segment, or its point as a zero-length one (FrameRecord)."""
+    found: list[tuple[str, tuple[float, float, float, float]]] = []
+    for schema in report.schemas:
+        detection = schema.detection
+        if not schema.hit or detection is None:
+            continue
+        if detection.segment is not None:
+            u1, v1, u2, v2 = (float(c) for c in detection.segment)
+            found.append((schema.landmark_id, (u1, v1, u2, v2)))
+        else:
+            u, v = float(detection.point[0]), float(detection.point[1])
+            found.append((schema.landmark_id, (u, v, u, v)))
+    return tuple(found)
 
 
 def _with_map(scenario: Scenario, world: MeadowMap) -> Scenario:
