@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -50,6 +50,9 @@ class ConvexPolygon:
     """
 
     vertices: NDArray[np.float64]
+    # The area, computed on first use: managers, reports and lost detection ask it many
+    # times of the same immutable polygon.
+    _area: float = field(init=False, repr=False, compare=False)
 
     def __init__(self, vertices: ArrayLike) -> None:
         vertices = points_array(vertices, "ConvexPolygon.vertices", min_rows=1)
@@ -61,12 +64,14 @@ class ConvexPolygon:
                 f"ConvexPolygon.vertices: expected a convex counter-clockwise polygon, got {defect}"
             )
         object.__setattr__(self, "vertices", read_only(_convex.remove_collinear(vertices).copy()))
+        object.__setattr__(self, "_area", math.nan)
 
     @classmethod
     def _trusted(cls, vertices: NDArray[np.float64]) -> ConvexPolygon:
         """Wrap vertices that the library itself computed (already convex, CCW, finite)."""
         polygon = object.__new__(cls)
         object.__setattr__(polygon, "vertices", read_only(vertices))
+        object.__setattr__(polygon, "_area", math.nan)
         return polygon
 
     @classmethod
@@ -128,7 +133,9 @@ class ConvexPolygon:
     @property
     def area(self) -> float:
         """Area in square metres (0 for a point or a segment)."""
-        return _convex.polygon_area(self.vertices)
+        if math.isnan(self._area):
+            object.__setattr__(self, "_area", _convex.polygon_area(self.vertices))
+        return self._area
 
     @property
     def centroid(self) -> NDArray[np.float64]:
