@@ -10,6 +10,7 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
+from aura_ums.cli._common import fail
 from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._replay import calibrate, compare, replay
@@ -51,11 +52,6 @@ def demo(
     _console.print(f"wrote {summary}")
 
 
-def _fail(message: str) -> typer.Exit:
-    _console.print(f"[red]error:[/red] {message}", highlight=False)
-    return typer.Exit(code=2)
-
-
 @app.command()
 def simulate(
     scenario: Annotated[Path, typer.Argument(help="Scenario TOML file (see aura_ums.sim).")],
@@ -78,15 +74,15 @@ def simulate(
     from aura_ums.sim import Scenario, run_scenario, summarize_runs
 
     if runs < 1:
-        raise _fail(f"--runs: expected an integer >= 1, got {runs}")
+        raise fail(f"--runs: expected an integer >= 1, got {runs}")
     if seed < 0:
-        raise _fail(f"--seed: expected an integer >= 0, got {seed}")
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
     if not scenario.is_file():
-        raise _fail(f"{scenario}: expected a scenario TOML file, got no such file")
+        raise fail(f"{scenario}: expected a scenario TOML file, got no such file")
     try:
         loaded = Scenario.from_toml(scenario)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
+        raise fail(str(exc)) from None
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
     try:
@@ -96,7 +92,7 @@ def simulate(
                 results.append(run_scenario(loaded, rng, prune=prune))
                 progress.advance(task)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
+        raise fail(str(exc)) from None
     metrics: dict[str, object] = {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune}
     metrics.update(summarize_runs(results))
     for key, value in metrics.items():
@@ -109,7 +105,7 @@ def simulate(
             metrics_json.parent.mkdir(parents=True, exist_ok=True)
             metrics_json.write_text(json.dumps(clean, indent=2) + "\n")
         except OSError as exc:
-            raise _fail(
+            raise fail(
                 f"--metrics-json: expected a writable path, got {metrics_json}: {exc.strerror}"
             ) from None
         _console.print(f"wrote {metrics_json}")

@@ -7,31 +7,16 @@ the commands that run a scenario or replay a log.
 
 from __future__ import annotations
 
-import math
-from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
-from rich.markup import escape
+
+from aura_ums.cli._common import console, fail, print_log_summary
 
 if TYPE_CHECKING:
     from aura_ums.export._types import ReplayLike
     from aura_ums.sim import Scenario
-
-_console = Console(soft_wrap=True)
-
-
-def _fail(message: str) -> typer.Exit:
-    _console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
-    return typer.Exit(code=2)
-
-
-def _span(first: float, last: float) -> str:
-    if not (math.isfinite(first) and math.isfinite(last)):
-        return "none"
-    return f"{first:.3f} .. {last:.3f} s ({last - first:.1f} s)"
 
 
 def rosbag_command(
@@ -90,31 +75,8 @@ def rosbag_command(
             overwrite=overwrite,
         )
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
-    kinds = Counter(observation.kind.value for observation in log.observations)
-    seen = len({observation.landmark_id for observation in log.observations})
-    times = [observation.time for observation in log.observations]
-    _console.print(f"wrote {log.path}", highlight=False, markup=False)
-    rows = [
-        ("log", log.meta.name),
-        ("source", log.meta.source),
-        ("landmarks", f"{len(log.landmarks)} ({seen} observed)"),
-        (
-            "observations",
-            f"{len(log.observations)} ("
-            + ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items()))
-            + ")",
-        ),
-        ("observation span", _span(min(times, default=math.nan), max(times, default=math.nan))),
-        ("odometry rows", str(len(log.odometry) if log.odometry is not None else 0)),
-        ("odometry span", _span(*log.motion_span)),
-    ]
-    if log.groundtruth is not None:
-        truth = log.groundtruth
-        rows.append(("ground truth rows", str(len(truth))))
-        rows.append(("ground truth span", _span(float(truth.time[0]), float(truth.time[-1]))))
-    for key, value in rows:
-        _console.print(f"{key:18s} {value}", highlight=False, markup=False)
+        raise fail(str(exc)) from None
+    print_log_summary(log)
 
 
 # --- MCAP export, for the commands that run or replay (``--mcap``) ---------------------------
@@ -140,8 +102,8 @@ def write_simulation_mcap_option(path: Path, scenario: Scenario, seed: int, *, p
         result = run_scenario(scenario, rng, prune=prune, keep_images=True)
         written = write_simulation_mcap(path, scenario, result)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
-    _console.print(
+        raise fail(str(exc)) from None
+    console.print(
         f"wrote {written} (run 1 of seed {seed}; open it in Foxglove)", highlight=False, markup=False
     )
     return written
@@ -155,6 +117,6 @@ def write_replay_mcap_option(path: Path, replay: ReplayLike) -> Path:
     try:
         written = write_replay_mcap(path, replay)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
-    _console.print(f"wrote {written} (open it in Foxglove)", highlight=False, markup=False)
+        raise fail(str(exc)) from None
+    console.print(f"wrote {written} (open it in Foxglove)", highlight=False, markup=False)
     return written

@@ -8,19 +8,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from aura_ums.cli._common import console, fail
+
 if TYPE_CHECKING:
     from aura_ums.logs import ReplayOptions
-
-_console = Console(soft_wrap=True)
-
-
-def _fail(message: str) -> typer.Exit:
-    _console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
-    return typer.Exit(code=2)
 
 
 _CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
@@ -31,7 +25,7 @@ def _options(classes: str, sigmas: float, sensors: Path | None, robust: bool) ->
     from aura_ums.uncertainty import LandmarkClass
 
     if classes not in _CLASSES:
-        raise _fail(f"--classes: expected I or II, got {classes!r}")
+        raise fail(f"--classes: expected I or II, got {classes!r}")
     landmark_class = LandmarkClass[_CLASSES[classes]]
     if sensors is None:
         return ReplayOptions(sigmas=sigmas, landmark_class=landmark_class, robust=robust)
@@ -66,24 +60,24 @@ def calibrate(
         logs = [load_log(folder) for folder in log_dirs]
         calibration = calibrate_logs(logs, quantile=quantile, horizon=horizon)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
+        raise fail(str(exc)) from None
     sensors = sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml")
     out.parent.mkdir(parents=True, exist_ok=True)
     sensors.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(calibration.terrain_table().to_toml())
     sensors.write_text(calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
-    _console.print(
+    console.print(
         f"motion: delay {motion.delay_s:.2f} s, run scale {motion.run_scale:.3f}, "
         f"turn scale {motion.turn_scale:.3f} ({calibration.motion_windows} windows)"
     )
     for name, bounds in (("working", working), ("envelope", envelope)):
-        _console.print(
+        console.print(
             f"{name}: bearing +-{bounds.bearing_error:.4f} rad, range "
             f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
             f"({calibration.observations} observations)"
         )
-    _console.print(f"wrote {out} and {sensors}")
+    console.print(f"wrote {out} and {sensors}")
 
 
 def replay(
@@ -121,15 +115,15 @@ def replay(
         options = _options(classes, sigmas, sensors, robust)
         result = replay_log(log, table, options)
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
+        raise fail(str(exc)) from None
     metrics = result.metrics()
     for key, value in metrics.items():
         shown = f"{value:.6g}" if isinstance(value, float) else str(value)
-        _console.print(f"{key}: {escape(shown)}", highlight=False)
+        console.print(f"{key}: {escape(shown)}", highlight=False)
     if metrics_json is not None:
         metrics_json.parent.mkdir(parents=True, exist_ok=True)
         metrics_json.write_text(json.dumps(metrics, indent=2, allow_nan=True) + "\n")
-        _console.print(f"wrote {metrics_json}")
+        console.print(f"wrote {metrics_json}")
     if steps_csv is not None:
         steps_csv.parent.mkdir(parents=True, exist_ok=True)
         lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
@@ -140,11 +134,11 @@ def replay(
                 f"{s.update_us:.3f},{s.state.value},{int(s.relocalized)}"
             )
         steps_csv.write_text("\n".join(lines) + "\n")
-        _console.print(f"wrote {steps_csv}")
+        console.print(f"wrote {steps_csv}")
     if plot is not None:
         from aura_ums.plot import draw_replay
 
-        _console.print(f"wrote {draw_replay(result, plot)}")
+        console.print(f"wrote {draw_replay(result, plot)}")
     if mcap is not None:
         from aura_ums.cli._interop import write_replay_mcap_option
 
@@ -180,7 +174,7 @@ def compare(
     from aura_ums.uncertainty import TerrainTable
 
     if particles < 1:
-        raise _fail(f"--particles: expected an integer >= 1, got {particles}")
+        raise fail(f"--particles: expected an integer >= 1, got {particles}")
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
@@ -188,7 +182,7 @@ def compare(
         noise_logs = [load_log(p) for p in calibration_logs] if calibration_logs else [log]
         bearing, ranges = observation_errors(noise_logs)
         if bearing.size < 2:
-            raise _fail("--noise-from: expected logs with observations inside their ground truth, got none")
+            raise fail("--noise-from: expected logs with observations inside their ground truth, got none")
         bearing_sd = float(np.std(bearing))
         range_sd = float(np.std(ranges)) if ranges.size > 1 else 0.05
         rows = compare_on_log(
@@ -201,7 +195,7 @@ def compare(
             particles=particles,
         )
     except AuraUmsError as exc:
-        raise _fail(str(exc)) from None
+        raise fail(str(exc)) from None
     grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters")
     for column in (
         "method",
@@ -223,7 +217,7 @@ def compare(
             f"{row.median_update_us:.1f}",
             str(row.rejected),
         )
-    _console.print(grid)
+    console.print(grid)
     if metrics_json is not None:
         metrics_json.parent.mkdir(parents=True, exist_ok=True)
         payload = {
@@ -260,4 +254,4 @@ def compare(
             ],
         }
         metrics_json.write_text(json.dumps(payload, indent=2) + "\n")
-        _console.print(f"wrote {metrics_json}")
+        console.print(f"wrote {metrics_json}")
