@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from aura_ums.logs import (
+    MethodSummary,
     ReplayOptions,
     RobotLog,
     calibrate_logs,
@@ -36,6 +37,19 @@ def main() -> None:
         logs = [synthetic_log(np.random.default_rng(0), duration=300.0)]
     calibration = calibrate_logs(logs[:1])
     bearing, ranges = observation_errors(logs[:1])
+
+    def compare(log: RobotLog, options: ReplayOptions) -> tuple[tuple[MethodSummary, ...], float]:
+        rows = compare_on_log(
+            log,
+            calibration.terrain_table(),
+            options,
+            bearing_sd=float(np.std(bearing)),
+            range_sd_fraction=max(float(np.std(ranges)), 1e-3),
+            rng=np.random.default_rng(0),
+        )
+        ekf = next(r for r in rows if r.method == "EKF").median_update_us
+        return rows, ekf
+
     print(
         f"{'log':16s} {'class':5s} {'method':10s} {'inside':>7s} {'area m2':>9s} {'head rad':>8s} "
         f"{'RMSE m':>7s} {'us/step':>8s} {'/ EKF':>6s}"
@@ -48,15 +62,7 @@ def main() -> None:
                 envelope=calibration.envelope,
                 motion=calibration.motion,
             )
-            rows = compare_on_log(
-                log,
-                calibration.terrain_table(),
-                options,
-                bearing_sd=float(np.std(bearing)),
-                range_sd_fraction=max(float(np.std(ranges)), 1e-3),
-                rng=np.random.default_rng(0),
-            )
-            ekf = next(r for r in rows if r.method == "EKF").median_update_us
+            rows, ekf = compare(log, options)
             for row in rows:
                 print(
                     f"{log.meta.name:16s} {landmark_class.value:5s} {row.method:10s} "
@@ -72,16 +78,7 @@ def main() -> None:
         motion=calibration.motion,
         robust=False,
     )
-    rows = compare_on_log(
-        log,
-        calibration.terrain_table(),
-        options,
-        bearing_sd=float(np.std(bearing)),
-        range_sd_fraction=max(float(np.std(ranges)), 1e-3),
-        rng=np.random.default_rng(0),
-        particles=1000,
-    )
-    ekf = next(r for r in rows if r.method == "EKF").median_update_us
+    rows, ekf = compare(log, options)
     print(
         f"gate only ({log.meta.name}, II): ours {rows[0].median_update_us:.1f} us/step, "
         f"{rows[0].median_update_us / ekf:.2f} x EKF, containment {rows[0].containment_rate:.4f}"

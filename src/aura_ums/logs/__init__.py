@@ -41,12 +41,14 @@ from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
     ReplayStep,
+    frames_after,
     log_meadow_map,
     meta_bounds,
     observation_for,
     position_reports_for,
     replay_log,
     replay_start,
+    with_motion,
 )
 from aura_ums.logs._robust import EnvelopeLocalizer, EnvelopeStep
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
@@ -74,6 +76,7 @@ __all__ = [
     "SensorBounds",
     "calibrate_logs",
     "compare_on_log",
+    "frames_after",
     "import_mrclam",
     "import_rosbag",
     "load_log",
@@ -89,5 +92,6 @@ __all__ = [
     "replay_log",
     "replay_start",
     "synthetic_log",
+    "with_motion",
     "write_log",
 ]

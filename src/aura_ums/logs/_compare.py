@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time as _time
 from dataclasses import dataclass
@@ -12,15 +11,17 @@ import numpy as np
 from aura_ums._validate import finite_float
 from aura_ums.baselines import ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
-from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._log import RobotLog
 from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
+    frames_after,
     meta_bounds,
     observation_for,
     position_reports_for,
     replay_log,
     replay_start,
+    with_motion,
 )
 from aura_ums.uncertainty import BearingObservation, RangeBearingObservation, TerrainTable
 
@@ -57,14 +58,6 @@ class MethodSummary:
     position_rmse_m: float
     median_update_us: float
     rejected: int
-
-
-def _frames(log: RobotLog, start: float) -> dict[float, list[LogObservation]]:
-    frames: dict[float, list[LogObservation]] = {}
-    for row in log.observations:
-        if row.time > start:
-            frames.setdefault(row.time, []).append(row)
-    return frames
 
 
 def _ours(result: ReplayResult) -> MethodSummary:
@@ -152,16 +145,11 @@ def compare_on_log(
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
     ours = replay_log(log, table, opts)
-    if opts.motion is not None:
-        motion = opts.motion
-        meta = dataclasses.replace(
-            log.meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
-        )
-        log = dataclasses.replace(log, meta=meta)
+    log = with_motion(log, opts.motion)
     terrain = table[log.meta.terrain]
     start_time, start_pose = replay_start(log)
     reports = position_reports_for(log, opts)
-    frames = _frames(log, start_time)
+    frames = frames_after(log, start_time)
     bounds = opts.working if opts.working is not None else meta_bounds(log)
     common = {
         "position_sd": max(log.meta.start_radius / 3.0, 1e-3),

@@ -367,19 +367,7 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         raise InputError(f"options: expected ReplayOptions or None, got {type(opts).__name__}")
     if log.meta.terrain not in table:
         raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
-    if opts.motion is not None:
-        motion = opts.motion
-        log = RobotLog(
-            dataclasses.replace(
-                log.meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
-            ),
-            log.landmarks,
-            log.observations,
-            odometry=log.odometry,
-            commands=log.commands,
-            groundtruth=log.groundtruth,
-            path=log.path,
-        )
+    log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     envelope_bounds = (
         opts.envelope if opts.envelope is not None else working_bounds.widened(opts.envelope_factor)
@@ -399,10 +387,7 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         relocalize_after=opts.relocalize_after,
         relocalize_window=opts.relocalize_window,
     )
-    frames: dict[float, list[LogObservation]] = {}
-    for row in log.observations:
-        if row.time > start_time:
-            frames.setdefault(row.time, []).append(row)
+    frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
     reports = log.position_reports(frame_times, max_interval=opts.max_interval, start=start_time, end=end)
@@ -458,9 +443,32 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     )
 
 
+def with_motion(log: RobotLog, motion: MotionCalibration | None) -> RobotLog:
+    """Return ``log`` with its meta's delay and scales replaced by ``motion`` (unchanged for None)."""
+    if motion is None:
+        return log
+    meta = dataclasses.replace(
+        log.meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
+    )
+    return dataclasses.replace(log, meta=meta)
+
+
+def frames_after(log: RobotLog, start: float) -> dict[float, list[LogObservation]]:
+    """Group the observations after ``start`` (s) into frames: time stamp -> rows, in time order."""
+    frames: dict[float, list[LogObservation]] = {}
+    for row in log.observations:
+        if row.time > start:
+            frames.setdefault(row.time, []).append(row)
+    return frames
+
+
 def position_reports_for(log: RobotLog, options: ReplayOptions) -> tuple[PositionReport, ...]:
-    """Return the position reports :func:`replay_log` grows by, cut at the log's frame times."""
+    """Return the position reports :func:`replay_log` grows by, cut at the log's frame times.
+
+    The options' motion calibration is applied as :func:`replay_log` applies it.
+    """
+    log = with_motion(log, options.motion)
     start_time, _ = replay_start(log)
-    times = np.unique([o.time for o in log.observations if o.time > start_time])
+    times = np.array(sorted(frames_after(log, start_time)), dtype=np.float64)
     end = float(times[-1]) if times.size else start_time
     return log.position_reports(times, max_interval=options.max_interval, start=start_time, end=end)
