@@ -51,6 +51,17 @@ def test_dark_to_light_and_light_to_dark_bars_give_two_lines() -> None:
     assert sorted(segments[:, 0]) == pytest.approx([39.5, 59.5])
 
 
+@pytest.mark.parametrize("finder", [FastLineFinder(VERTICAL), FastLineFinder(overlap=False)])
+def test_touching_edges_of_opposite_polarity_stay_two_lines(finder: FastLineFinder) -> None:
+    # A 2-pixel bar: the dark-to-light support (columns 39, 40) touches the
+    # light-to-dark support (41, 42); one region across both would be one fat line.
+    image = np.zeros((100, 100))
+    image[:, 40:42] = 150.0
+    lines = finder.find_detailed(image)
+    assert len(lines) == 2
+    assert sorted(lines.midpoints[:, 0]) == pytest.approx([39.5, 41.5])
+
+
 @pytest.mark.parametrize("degrees", [0.0, 20.0, 45.0, 70.0, 110.0, 160.0])
 def test_tilted_edge_direction_and_position(degrees: float) -> None:
     angle = math.radians(degrees)

@@ -21,7 +21,8 @@ line-support regions:
    target direction.
 
 Everything is vectorized (no per-pixel Python): the work per region is a few
-``bincount`` and ``reduceat`` calls over all regions at once.
+``bincount`` and ``ufunc.at`` calls over all regions at once, and a tuned search labels
+both polarities in one call. A window's search costs little beyond its pixels.
 """
 
 from __future__ import annotations
@@ -191,13 +192,18 @@ class FastLineFinder:
             segments, contrast = self._untuned(gx, gy, magnitude, strong)
         else:
             segments, contrast = self._tuned(gx, gy, magnitude, strong, self.orientation)
-        offset = np.array([crop.inner_u0, crop.inner_v0, crop.inner_u0, crop.inner_v0], dtype=np.float64)
-        lines = LineSegments(segments + offset, contrast)
-        keep = (lines.length >= self.min_length) & (lines.contrast >= self.min_contrast)
+        # Plain arrays until the end: a window's call is dominated by fixed costs, and
+        # these are the lines' own fits, finite by construction.
+        segments += np.array([crop.inner_u0, crop.inner_v0, crop.inner_u0, crop.inner_v0], dtype=np.float64)
+        du, dv = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
+        length = np.hypot(du, dv)
+        keep = (length >= self.min_length) & (contrast >= self.min_contrast)
         if self.orientation is not None:
-            keep &= angle_difference(lines.orientation, self.orientation) <= self.tolerance
-        kept = lines.select(keep)
-        return kept.select(np.argsort(-kept.strength, kind="stable"))
+            direction = np.mod(np.arctan2(dv, du), math.pi)
+            keep &= angle_difference(direction, self.orientation) <= self.tolerance
+        kept = np.flatnonzero(keep)
+        order = kept[np.argsort(-(length[kept] * contrast[kept]), kind="stable")]
+        return LineSegments(segments[order], contrast[order])
 
     # -- steps ------------------------------------------------------------------------
 
@@ -244,51 +250,61 @@ class FastLineFinder:
         return total, count
 
     def _fit(self, labels: NDArray[np.int32], count: int, magnitude: NDArray[np.float32]) -> _Regions:
-        """Fit a line to every region with enough pixels to reach ``min_length``."""
-        width = labels.shape[1]
+        """Fit a line to every region of a labelled window with enough pixels to reach ``min_length``."""
         pixel_index = np.flatnonzero(labels)
         lab = labels.ravel()[pixel_index]
-        sizes = np.bincount(lab, minlength=count + 1)
-        # An 8-connected region spanning a length L has at least L / sqrt(2) + 1 pixels.
-        min_pixels = max(2, int(self.min_length / math.sqrt(2.0)))
-        big = sizes >= min_pixels
-        big[0] = False
-        use = big[lab]
-        idx, lab = pixel_index[use], lab[use]
-        ys, xs = np.divmod(idx, width)
-        xs_f, ys_f = xs.astype(np.float64), ys.astype(np.float64)
-        wgt = magnitude.ravel()[idx].astype(np.float64)
+        ys, xs = np.divmod(pixel_index, labels.shape[1])
+        wgt = magnitude.ravel()[pixel_index]
+        region, sizes, segments, contrast = self._fit_support(lab, xs, ys, wgt, count)
+        return _Regions(lab, pixel_index, region, sizes, segments, contrast, count)
+
+    def _fit_support(
+        self,
+        lab: NDArray[np.int32],
+        xs: NDArray[np.intp],
+        ys: NDArray[np.intp],
+        wgt: NDArray[np.float32],
+        count: int,
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
+        """Fit lines to the regions of support pixels ``(lab, xs, ys)`` weighted by ``wgt``.
+
+        Labels run 1 .. ``count``; returns the fitted regions' labels (increasing), pixel
+        counts, segments ``(k, 4)`` in window pixels and contrasts.
+        """
         n = count + 1
-        w_sum = np.bincount(lab, wgt, n)
+        sizes = np.bincount(lab, minlength=n)
+        # An 8-connected region spanning a length L has at least L / sqrt(2) + 1 pixels.
+        big = sizes >= max(2, int(self.min_length / math.sqrt(2.0)))
+        big[0] = False
+        region = np.flatnonzero(big)
+        if region.size == 0:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, empty, np.zeros((0, 4)), np.zeros(0)
+        use = big[lab]
+        lab = lab[use]
+        xs_f, ys_f = xs[use].astype(np.float64), ys[use].astype(np.float64)
+        w = wgt[use].astype(np.float64)
+        w_sum = np.bincount(lab, w, n)
         safe = np.where(w_sum > 0.0, w_sum, 1.0)
-        cx = np.bincount(lab, wgt * xs_f, n) / safe
-        cy = np.bincount(lab, wgt * ys_f, n) / safe
+        cx = np.bincount(lab, w * xs_f, n) / safe
+        cy = np.bincount(lab, w * ys_f, n) / safe
         dx, dy = xs_f - cx[lab], ys_f - cy[lab]
-        sxx = np.bincount(lab, wgt * dx * dx, n)
-        syy = np.bincount(lab, wgt * dy * dy, n)
-        sxy = np.bincount(lab, wgt * dx * dy, n)
+        wdx, wdy = w * dx, w * dy
+        sxx = np.bincount(lab, wdx * dx, n)
+        syy = np.bincount(lab, wdy * dy, n)
+        sxy = np.bincount(lab, wdx * dy, n)
         # Direction in [0, pi): segments run from (x1, y1) to (x2, y2) along their orientation.
         theta = np.mod(0.5 * np.arctan2(2.0 * sxy, sxx - syy), math.pi)
         ux, uy = np.cos(theta), np.sin(theta)
         t = dx * ux[lab] + dy * uy[lab]
-        order = np.argsort(lab, kind="stable")
-        sorted_lab = lab[order]
-        if sorted_lab.size == 0:
-            empty = np.zeros(0, dtype=np.int64)
-            return _Regions(
-                labels.ravel()[pixel_index], pixel_index, empty, empty, np.zeros((0, 4)), np.zeros(0), count
-            )
-        starts = np.flatnonzero(np.r_[True, sorted_lab[1:] != sorted_lab[:-1]])
-        region = sorted_lab[starts].astype(np.int64)
-        t_sorted = t[order]
-        t_min = np.minimum.reduceat(t_sorted, starts)
-        t_max = np.maximum.reduceat(t_sorted, starts)
+        t_min = np.full(n, np.inf)
+        t_max = np.full(n, -np.inf)
+        np.minimum.at(t_min, lab, t)
+        np.maximum.at(t_max, lab, t)
         rx, ry, rux, ruy = cx[region], cy[region], ux[region], uy[region]
-        segments = np.column_stack([rx + t_min * rux, ry + t_min * ruy, rx + t_max * rux, ry + t_max * ruy])
-        contrast = w_sum[region] / sizes[region]
-        return _Regions(
-            labels.ravel()[pixel_index], pixel_index, region, sizes[region], segments, contrast, count
-        )
+        lo, hi = t_min[region], t_max[region]
+        segments = np.column_stack([rx + lo * rux, ry + lo * ruy, rx + hi * rux, ry + hi * ruy])
+        return region.astype(np.int64), sizes[region], segments, w_sum[region] / sizes[region]
 
     def _tuned(
         self,
@@ -301,12 +317,24 @@ class FastLineFinder:
         """Regions of the two buckets centred on the gradient directions normal to ``orientation``."""
         nx, ny = np.float32(-math.sin(orientation)), np.float32(math.cos(orientation))
         dot = gx * nx + gy * ny
-        cos_half = np.float32(math.cos(math.pi / self.buckets))
-        positive = strong & (dot >= cos_half * magnitude)
-        negative = strong & (-dot >= cos_half * magnitude)
-        labels, count = self._label([positive, negative])
-        regions = self._fit(labels, count, magnitude)
-        return regions.segments, regions.contrast
+        bound = np.float32(math.cos(math.pi / self.buckets)) * magnitude
+        # One labelling of both polarities: the dark-to-light mask above the light-to-dark
+        # one, a row of background between them so that their regions never touch. The
+        # labels come out as two separate labellings numbered on would give them.
+        h, w = gx.shape
+        stacked = np.zeros((2 * h + 1, w), dtype=bool)
+        np.greater_equal(dot, bound, out=stacked[:h])
+        np.less_equal(dot, -bound, out=stacked[h + 1 :])
+        stacked[:h] &= strong
+        stacked[h + 1 :] &= strong
+        labels, count = self._label([stacked])
+        pixel_index = np.flatnonzero(labels)
+        lab = labels.ravel()[pixel_index]
+        ys, xs = np.divmod(pixel_index, w)
+        ys[ys > h] -= h + 1
+        wgt = magnitude[ys, xs]
+        _, _, segments, contrast = self._fit_support(lab, xs, ys, wgt, count)
+        return segments, contrast
 
     def _untuned(
         self,
