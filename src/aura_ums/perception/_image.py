@@ -64,13 +64,15 @@ def window_pixels(window: ImageWindow, width: int, height: int) -> tuple[int, in
         raise InputError(f"window: expected an ImageWindow or None, got {window!r}")
     if width <= 0 or height <= 0:
         raise InputError(f"window: expected a window inside the {width} x {height} image, got {window}")
-    inside = window.clipped(width, height)
-    if inside is None:
+    # ImageWindow.clipped's bounds, without building a window (this runs for every search).
+    u_lo, u_hi = max(window.u_min, -0.5), min(window.u_max, width - 0.5)
+    v_lo, v_hi = max(window.v_min, -0.5), min(window.v_max, height - 0.5)
+    if u_lo > u_hi or v_lo > v_hi:
         raise InputError(f"window: expected a window overlapping the {width} x {height} image, got {window}")
-    col_lo = min(max(math.floor(inside.u_min + 0.5), 0), width - 1)
-    row_lo = min(max(math.floor(inside.v_min + 0.5), 0), height - 1)
-    col_hi = max(min(math.ceil(inside.u_max - 0.5), width - 1), col_lo) + 1
-    row_hi = max(min(math.ceil(inside.v_max - 0.5), height - 1), row_lo) + 1
+    col_lo = min(max(math.floor(u_lo + 0.5), 0), width - 1)
+    row_lo = min(max(math.floor(v_lo + 0.5), 0), height - 1)
+    col_hi = max(min(math.ceil(u_hi - 0.5), width - 1), col_lo) + 1
+    row_hi = max(min(math.ceil(v_hi - 0.5), height - 1), row_lo) + 1
     return col_lo, row_lo, col_hi, row_hi
 
 

@@ -194,6 +194,8 @@ class FastLineFinder:
             segments, contrast = self._tuned(gx, gy, magnitude, strong, self.orientation)
         # Plain arrays until the end: a window's call is dominated by fixed costs, and
         # these are the lines' own fits, finite by construction.
+        if len(segments) == 0:
+            return LineSegments.empty()
         segments += np.array([crop.inner_u0, crop.inner_v0, crop.inner_u0, crop.inner_v0], dtype=np.float64)
         du, dv = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
         length = np.hypot(du, dv)
@@ -203,7 +205,7 @@ class FastLineFinder:
             keep &= angle_difference(direction, self.orientation) <= self.tolerance
         kept = np.flatnonzero(keep)
         order = kept[np.argsort(-(length[kept] * contrast[kept]), kind="stable")]
-        return LineSegments(segments[order], contrast[order])
+        return LineSegments._trusted(segments[order], contrast[order])
 
     # -- steps ------------------------------------------------------------------------
 
@@ -248,6 +250,13 @@ class FastLineFinder:
             total += labels  # masks are disjoint and labels are 0 outside their mask
             count += n
         return total, count
+
+    def _label_one(self, mask: NDArray[np.bool_]) -> tuple[NDArray[np.int32], int]:
+        """Label the 8-connected components of one mask: ``_label([mask])`` in fewer steps."""
+        if self.backend is LineBackend.OPENCV:
+            return self._label([mask])
+        labels = np.empty(mask.shape, dtype=np.int32)
+        return labels, int(ndimage.label(mask, structure=_EIGHT, output=labels))
 
     def _fit(self, labels: NDArray[np.int32], count: int, magnitude: NDArray[np.float32]) -> _Regions:
         """Fit a line to every region of a labelled window with enough pixels to reach ``min_length``."""
@@ -327,8 +336,8 @@ class FastLineFinder:
         np.less_equal(dot, -bound, out=stacked[h + 1 :])
         stacked[:h] &= strong
         stacked[h + 1 :] &= strong
-        labels, count = self._label([stacked])
-        pixel_index = np.flatnonzero(labels)
+        labels, count = self._label_one(stacked)
+        pixel_index = np.flatnonzero(stacked)  # the labelled pixels; a bool scan is far cheaper
         lab = labels.ravel()[pixel_index]
         ys, xs = np.divmod(pixel_index, w)
         ys[ys > h] -= h + 1

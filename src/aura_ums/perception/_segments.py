@@ -87,6 +87,16 @@ class LineSegments:
         object.__setattr__(self, "contrast", values)
 
     @classmethod
+    def _trusted(cls, segments: NDArray[np.float64], contrast: NDArray[np.float64]) -> LineSegments:
+        """Wrap arrays a detector has just computed (float64, ``(n, 4)`` and ``(n,)``, finite)."""
+        lines = object.__new__(cls)
+        segments.setflags(write=False)
+        contrast.setflags(write=False)
+        object.__setattr__(lines, "segments", segments)
+        object.__setattr__(lines, "contrast", contrast)
+        return lines
+
+    @classmethod
     def empty(cls) -> LineSegments:
         """Return no segments: ``segments`` of shape ``(0, 4)``."""
         return cls(np.zeros((0, 4)), np.zeros(0))
