@@ -285,3 +285,61 @@ def test_a_run_shorter_than_the_tolerance_is_one_piece_in_its_meadow(distance: f
     world = make_grid_world(1, 3, cell=5.0)
     pieces = split_run(world, (2.5, 2.5), 0.0, distance)
     assert [(piece.distance, piece.meadow_id) for piece in pieces] == [(distance, "cell_0_0")]
+
+
+def _shapely_spans(
+    world: MeadowMap, start: tuple[float, float], heading: float, length: float
+) -> list[tuple[float, float, int]]:
+    """The parts of a run in each meadow by shapely intersections (the reference)."""
+    direction = np.array([math.cos(heading), math.sin(heading)])
+    origin = np.array(start)
+    line = shapely.LineString([origin, origin + length * direction])
+    spans = []
+    for index, meadow in enumerate(world.meadows):
+        coordinates = shapely.get_coordinates(
+            shapely.intersection(line, shapely.Polygon(meadow.polygon.vertices))
+        )
+        if len(coordinates):
+            along = (coordinates - origin) @ direction
+            lo, hi = max(float(along.min()), 0.0), min(float(along.max()), length)
+            if hi - lo > 1e-9:
+                spans.append((lo, hi, index))
+    return spans
+
+
+def _tilted_world() -> MeadowMap:
+    """Convex meadows with slanted shared edges (no axis-aligned shortcut)."""
+    fan = [(0.0, 0.0), (6.0, -1.0), (7.0, 4.0), (2.0, 6.0), (-3.0, 3.0)]
+    meadows = [
+        Meadow(f"m{i}", ConvexPolygon([(2.0, 2.0), fan[i], fan[(i + 1) % len(fan)]]), "concrete")
+        for i in range(len(fan))
+    ]
+    return MeadowMap(meadows)
+
+
+@pytest.mark.parametrize("name", ["tilted", "grid_1000", "indoor_corridor", "paper_sidewalk"])
+def test_run_clipping_matches_shapely_intersections(name: str) -> None:
+    from aura_ums.world._navigator import _run_spans
+
+    if name == "tilted":
+        world = _tilted_world()
+    elif name == "grid_1000":
+        world = make_grid_world(25, 42, cell=5.0, remove=OBSTACLES)
+    else:
+        world = sample_world(name)
+    rng = np.random.default_rng(11)
+    lo = np.min([m.polygon.vertices.min(axis=0) for m in world.meadows], axis=0) - 1.0
+    hi = np.max([m.polygon.vertices.max(axis=0) for m in world.meadows], axis=0) + 1.0
+    compared = 0
+    for _ in range(150):
+        x, y = rng.uniform(lo, hi)
+        heading = float(rng.uniform(-math.pi, math.pi))
+        length = float(rng.uniform(0.0, 0.5 * float(np.max(hi - lo))))
+        ours = _run_spans(world, float(x), float(y), heading, length)
+        reference = _shapely_spans(world, (float(x), float(y)), heading, length)
+        assert [i for _, _, i in ours] == [i for _, _, i in reference]
+        for (a, b, _), (c, d, _) in zip(ours, reference, strict=True):
+            assert a == pytest.approx(c, abs=1e-9)
+            assert b == pytest.approx(d, abs=1e-9)
+        compared += len(ours)
+    assert compared > 50  # the runs do cross meadows

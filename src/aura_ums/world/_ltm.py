@@ -309,6 +309,7 @@ class MeadowMap:
     _landmark_index: Mapping[str, int]
     _shapes: tuple[Polygon, ...]
     _tree: shapely.STRtree
+    _clip: tuple[tuple[float, float, float, float, tuple[tuple[float, float, float, float], ...]], ...]
     _portals: Mapping[tuple[str, str], NDArray[np.float64]]
     _adjacent: Mapping[str, tuple[str, ...]]
 
@@ -398,6 +399,7 @@ class MeadowMap:
         object.__setattr__(self, "_landmark_index", types.MappingProxyType(landmark_index))
         object.__setattr__(self, "_shapes", shapes)
         object.__setattr__(self, "_tree", tree)
+        object.__setattr__(self, "_clip", tuple(_clip_edges(m.polygon.vertices) for m in meadow_tuple))
         object.__setattr__(self, "_portals", types.MappingProxyType(portals))
         object.__setattr__(self, "_adjacent", types.MappingProxyType(adjacent))
 
@@ -644,6 +646,22 @@ expected the id of a landmark feature, got 'pole'
         return f"MeadowMap({len(self.meadows)} meadows, {len(self.landmarks)} landmarks)"
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _clip_edges(
+    vertices: NDArray[np.float64],
+) -> tuple[float, float, float, float, tuple[tuple[float, float, float, float], ...]]:
+    """Return a convex meadow as plain floats for clipping runs: bounding box and edges.
+
+    Per edge: a point ``(ax, ay)`` and the outward normal ``(nx, ny)``; inside is
+    ``n . (p - a) <= 0``.
+    """
+    points = [(float(x), float(y)) for x, y in vertices]
+    edges = []
+    for (ax, ay), (bx, by) in zip(points, points[1:] + points[:1], strict=True):
+        edges.append((ax, ay, by - ay, ax - bx))  # counter-clockwise: outward is the edge turned right
+    xs, ys = [x for x, _ in points], [y for _, y in points]
+    return min(xs), min(ys), max(xs), max(ys), tuple(edges)
 
 
 def _adjacency(

@@ -10,6 +10,7 @@ meadow's terrain statistics to the part of the run made on it.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -25,6 +26,9 @@ from aura_ums.world._ltm import MeadowMap
 
 #: Stretches of a run shorter than this (m) are rounding, not a meadow crossed.
 RUN_TOLERANCE = 1e-9
+
+#: Maps with more meadows than this find those near a run through their tree, not a scan.
+_SCAN_LIMIT = 32
 
 _START = -1
 _GOAL = -2
@@ -245,7 +249,7 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
     """Cut a straight run where it crosses meadow boundaries, in order along the run.
 
     The run goes ``distance`` metres from ``start`` in direction ``heading`` (radians,
-    counter-clockwise from +x). It is intersected (shapely) with the meadows it meets;
+    counter-clockwise from +x). It is clipped against the (convex) meadows it meets;
     each maximal part inside one meadow is a piece. Consecutive pieces on the same terrain
     stay separate when their meadows differ (one piece per meadow crossed). Where the run
     follows a boundary shared by two meadows, the first in map order takes it.
@@ -299,21 +303,7 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
             raise InputError(
                 f"start: expected a point inside a meadow for a zero-length run, got {_xy(origin)}"
             )
-    direction = np.array([math.cos(angle), math.sin(angle)])
-    line = shapely.LineString([origin, origin + length * direction])
-    candidates = np.sort(meadow_map._tree.query(line, predicate="intersects"))
-    spans: list[tuple[float, float, int]] = []
-    if len(candidates):
-        shapes = np.array(meadow_map._shapes, dtype=object)[candidates]
-        for index, piece in zip(candidates, shapely.intersection(line, shapes), strict=True):
-            coordinates = shapely.get_coordinates(piece)
-            if len(coordinates) == 0:
-                continue
-            along = (coordinates - origin) @ direction
-            lo = min(max(float(along.min()), 0.0), length)
-            hi = min(max(float(along.max()), 0.0), length)
-            if hi - lo > RUN_TOLERANCE:
-                spans.append((lo, hi, int(index)))
+    spans = _run_spans(meadow_map, float(origin[0]), float(origin[1]), angle, length)
     if not spans:
         raise OutsideMapError(
             f"start, heading, distance: expected a run that meets a meadow, got one from "
@@ -340,6 +330,50 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
             pieces.append(RunPiece(end - begin, meadow.terrain, meadow.id))
             begin = end
     return pieces
+
+
+def _run_spans(
+    meadow_map: MeadowMap, x: float, y: float, heading: float, length: float
+) -> list[tuple[float, float, int]]:
+    """Return the parts of a run inside each meadow: ``(from, to, meadow index)``, metres along it.
+
+    Meadows are convex, so each part is one interval, found by clipping the run against
+    the meadow's edges (Cyrus-Beck) on plain floats: a run is split at every growth step,
+    and this is far cheaper than building shapely geometries for it. Boundaries belong to
+    the meadow (closed sets), as in a shapely intersection.
+    """
+    dx, dy = math.cos(heading), math.sin(heading)
+    ex, ey = x + length * dx, y + length * dy
+    left, right, bottom, top = min(x, ex), max(x, ex), min(y, ey), max(y, ey)
+    spans: list[tuple[float, float, int]] = []
+    clip = meadow_map._clip
+    candidates: Iterable[int] = range(len(clip))
+    if len(clip) > _SCAN_LIMIT:  # a large map: let its tree pick the meadows near the run
+        line = shapely.LineString([(x, y), (ex, ey)])
+        candidates = sorted(int(i) for i in meadow_map._tree.query(line, predicate="intersects"))
+    for index in candidates:
+        xmin, ymin, xmax, ymax, edges = clip[index]
+        if xmax < left or xmin > right or ymax < bottom or ymin > top:
+            continue
+        lo, hi = 0.0, length
+        for ax, ay, ux, uy in edges:
+            outside = ux * (x - ax) + uy * (y - ay)  # > 0: the start is outside this edge
+            rate = ux * dx + uy * dy  # how fast the run moves outward
+            if rate == 0.0:
+                if outside > 0.0:
+                    hi = -1.0
+                    break
+                continue
+            t = -outside / rate
+            if rate > 0.0:
+                hi = min(hi, t)
+            else:
+                lo = max(lo, t)
+            if lo > hi:
+                break
+        if hi - lo > RUN_TOLERANCE:
+            spans.append((lo, hi, index))
+    return spans
 
 
 def commands_for(
