@@ -23,6 +23,11 @@
 #define SKITTER_SIDES 8
 #define FULL_DISK_SIDES 32
 
+/* fmin and fmax without the libm calls (no NaN reaches them from checked input). Where a
+   +0/-0 choice could differ from libm's, the result is only compared, never returned. */
+static inline double lesser(double a, double b) { return b < a ? b : a; }
+static inline double greater(double a, double b) { return b > a ? b : a; }
+
 typedef struct {
     double x, y, angle;
 } Edge;
@@ -175,16 +180,16 @@ static Py_ssize_t minkowski_sum(const double **parts, const Py_ssize_t *sizes, i
         count += length[p];
     }
     for (Py_ssize_t i = 0; i < count; i++) {
-        double size = fmax(fabs(edges[i].x), fabs(edges[i].y));
+        double size = greater(fabs(edges[i].x), fabs(edges[i].y));
         if (size > largest) largest = size;
     }
-    double threshold = fmax(4e-16 * fmax(fabs(sx), fabs(sy)), NOISE_EDGE * largest);
+    double threshold = greater(4e-16 * greater(fabs(sx), fabs(sy)), NOISE_EDGE * largest);
     /* Drop vanishing edges and compute directions (as pseudo-angles), per operand. */
     for (int p = 0; p < part_count; p++) {
         Py_ssize_t kept = 0;
         for (Py_ssize_t k = 0; k < length[p]; k++) {
             Edge e = edges[begin[p] + k];
-            if (fmax(fabs(e.x), fabs(e.y)) <= threshold) continue;
+            if (greater(fabs(e.x), fabs(e.y)) <= threshold) continue;
             e.angle = pseudo_angle(e.x, e.y);
             edges[begin[p] + kept] = e;
             kept++;
@@ -250,22 +255,24 @@ static Py_ssize_t simplify_outer(double *v, Py_ssize_t n, Py_ssize_t max_vertice
         /* Edges too short for their direction to be accurate are never extended to
            replace a removed neighbour (see _convex.simplify_outer). */
         double longest = 0.0, magnitude = 0.0, xmin = v[0], xmax = v[0], ymin = v[1], ymax = v[1];
-        for (Py_ssize_t i = 0; i < n; i++) magnitude = fmax(magnitude, fmax(fabs(v[2 * i]), fabs(v[2 * i + 1])));
+        for (Py_ssize_t i = 0; i < n; i++) magnitude = greater(magnitude, greater(fabs(v[2 * i]), fabs(v[2 * i + 1])));
         for (Py_ssize_t i = 1; i < n; i++) {
-            xmin = fmin(xmin, v[2 * i]);
-            xmax = fmax(xmax, v[2 * i]);
-            ymin = fmin(ymin, v[2 * i + 1]);
-            ymax = fmax(ymax, v[2 * i + 1]);
+            xmin = lesser(xmin, v[2 * i]);
+            xmax = greater(xmax, v[2 * i]);
+            ymin = lesser(ymin, v[2 * i + 1]);
+            ymax = greater(ymax, v[2 * i + 1]);
         }
-        double farthest = FARTHEST_MERGE * fmax(xmax - xmin, ymax - ymin);
+        double farthest = FARTHEST_MERGE * greater(xmax - xmin, ymax - ymin);
         for (Py_ssize_t i = 0; i < n; i++) {
             Py_ssize_t next = i + 1 < n ? i + 1 : 0;
-            double size = fmax(fabs(v[2 * next] - v[2 * i]), fabs(v[2 * next + 1] - v[2 * i + 1]));
+            double size = greater(fabs(v[2 * next] - v[2 * i]), fabs(v[2 * next + 1] - v[2 * i + 1]));
             scratch[i] = size;
             if (size > longest) longest = size;
         }
         /* An edge's direction is good to ~1e-16 * |coordinates| / length radians. */
-        for (Py_ssize_t i = 0; i < n; i++) blocked[i] = scratch[i] > EXTENDABLE * fmax(magnitude, longest);
+        double extendable = EXTENDABLE * greater(magnitude, longest);
+        for (Py_ssize_t i = 0; i < n; i++) blocked[i] = scratch[i] > extendable;
+        Py_ssize_t candidates = 0;
         for (Py_ssize_t i = 0; i < n; i++) {
             Py_ssize_t next = i + 1 < n ? i + 1 : 0, after = next + 1 < n ? next + 1 : 0;
             Py_ssize_t prev = i > 0 ? i - 1 : n - 1;
@@ -280,19 +287,23 @@ static Py_ssize_t simplify_outer(double *v, Py_ssize_t n, Py_ssize_t max_vertice
                 /* Nearly parallel neighbours meet far away: the cap yields instead. */
                 double turn_in = cross(px, py, ex, ey);
                 /* Both corners must turn left (t >= 0 is the far one), see _convex.py. */
-                if (t[i] >= 0.0 && turn_in >= 0.0 && t[i] * fmax(fabs(px), fabs(py)) <= farthest)
+                if (t[i] >= 0.0 && turn_in >= 0.0 && t[i] * greater(fabs(px), fabs(py)) <= farthest)
                     cost = 0.5 * t[i] * turn_in;
             }
-            ranked[i].cost = cost;
-            ranked[i].index = i;
+            /* Only removable edges are ranked: the pick stops at the first one that is not. */
+            if (cost != HUGE_VAL) {
+                ranked[candidates].cost = cost;
+                ranked[candidates].index = i;
+                candidates++;
+            }
         }
         for (Py_ssize_t i = 0; i < n; i++) {
             blocked[i] = 0;
             chosen[i] = 0;
         }
         /* A heap gives the cheapest edges in order without sorting them all. */
-        for (Py_ssize_t i = n / 2; i-- > 0;) sift_down(ranked, n, i);
-        Py_ssize_t needed = n - max_vertices, picked = 0, size = n;
+        for (Py_ssize_t i = candidates / 2; i-- > 0;) sift_down(ranked, candidates, i);
+        Py_ssize_t needed = n - max_vertices, picked = 0, size = candidates;
         while (size > 0) {
             Ranked top = ranked[0];
             ranked[0] = ranked[--size];
@@ -347,19 +358,29 @@ static PyObject *grow_polygon(PyObject *self, PyObject *args) {
     }
     const double *vertices = (const double *)buffer.buf;
     Py_ssize_t capacity = n + 2 * FULL_DISK_SIDES + SKITTER_SIDES + 8;
-    double *sector = PyMem_Malloc(sizeof(double) * 2 * (size_t)(FULL_DISK_SIDES + 40));
-    double *disk = PyMem_Malloc(sizeof(double) * 2 * SKITTER_SIDES);
-    Edge *edges = PyMem_Malloc(sizeof(Edge) * 2 * (size_t)capacity);
-    double *out = PyMem_Malloc(sizeof(double) * 2 * (size_t)capacity);
-    double *scratch = PyMem_Malloc(sizeof(double) * 2 * (size_t)capacity);
-    double *t = PyMem_Malloc(sizeof(double) * (size_t)capacity);
-    Ranked *ranked = PyMem_Malloc(sizeof(Ranked) * (size_t)capacity);
-    char *flags = PyMem_Malloc(2 * (size_t)capacity);
+    /* One block for every buffer (8-byte items first, the flags last). */
+    size_t sector_size = sizeof(double) * 2 * (size_t)(FULL_DISK_SIDES + 40);
+    size_t disk_size = sizeof(double) * 2 * SKITTER_SIDES;
+    size_t edges_size = sizeof(Edge) * 2 * (size_t)capacity;
+    size_t points_size = sizeof(double) * 2 * (size_t)capacity;
+    size_t t_size = sizeof(double) * (size_t)capacity;
+    size_t ranked_size = sizeof(Ranked) * (size_t)capacity;
+    char *block =
+        PyMem_Malloc(sector_size + disk_size + edges_size + 2 * points_size + t_size + ranked_size + 2 * (size_t)capacity);
     PyObject *result = NULL;
-    if (!sector || !disk || !edges || !out || !scratch || !t || !ranked || !flags) {
+    if (!block) {
         PyErr_NoMemory();
-        goto done;
+        PyBuffer_Release(&buffer);
+        return NULL;
     }
+    double *sector = (double *)block;
+    double *disk = (double *)(block + sector_size);
+    Edge *edges = (Edge *)(block + sector_size + disk_size);
+    double *out = (double *)(block + sector_size + disk_size + edges_size);
+    double *scratch = (double *)(block + sector_size + disk_size + edges_size + points_size);
+    double *t = (double *)(block + sector_size + disk_size + edges_size + 2 * points_size);
+    Ranked *ranked = (Ranked *)(block + sector_size + disk_size + edges_size + 2 * points_size + t_size);
+    char *flags = block + sector_size + disk_size + edges_size + 2 * points_size + t_size + ranked_size;
     const double *parts[3] = {vertices, NULL, NULL};
     Py_ssize_t sizes[3] = {n, 0, 0};
     int part_count = 1;
@@ -386,15 +407,7 @@ static PyObject *grow_polygon(PyObject *self, PyObject *args) {
             m = simplify_outer(out, m, max_vertices, t, ranked, flags, flags + capacity, scratch);
     }
     result = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)(sizeof(double) * 2 * (size_t)m));
-done:
-    PyMem_Free(sector);
-    PyMem_Free(disk);
-    PyMem_Free(edges);
-    PyMem_Free(out);
-    PyMem_Free(scratch);
-    PyMem_Free(t);
-    PyMem_Free(ranked);
-    PyMem_Free(flags);
+    PyMem_Free(block);
     PyBuffer_Release(&buffer);
     return result;
 }
@@ -420,9 +433,6 @@ done:
 #define TANGENT_STEP (M_PI / 8.0)
 #define SENSOR_ARC_SIDES 16
 
-/* fmin and fmax without the libm calls (no NaN reaches them from checked input). */
-static inline double lesser(double a, double b) { return b < a ? b : a; }
-static inline double greater(double a, double b) { return b > a ? b : a; }
 
 /* Why a reduction is empty: _reduce.py maps these codes to its messages. */
 enum {
@@ -457,13 +467,13 @@ typedef struct {
     Poly arc, mirrored;    /* the sensor arc polygon and its negation */
     Poly sum;              /* Minkowski sums */
     Poly sensors, positions, narrowed;
-    Scratch values, flags, cuts, planes, points, edges;
+    Scratch values, flags, cuts, planes, points, edges, lengths;
 } Work;
 
 static void work_free(Work *w) {
     Poly *polys[] = {&w->ping,  &w->pong, &w->part,    &w->parts,     &w->arc_points, &w->arc,
                      &w->mirrored, &w->sum, &w->sensors, &w->positions, &w->narrowed};
-    Scratch *scratches[] = {&w->values, &w->flags, &w->cuts, &w->planes, &w->points, &w->edges};
+    Scratch *scratches[] = {&w->values, &w->flags, &w->cuts, &w->planes, &w->points, &w->edges, &w->lengths};
     for (size_t i = 0; i < sizeof(polys) / sizeof(polys[0]); i++) PyMem_Free(polys[i]->v);
     for (size_t i = 0; i < sizeof(scratches) / sizeof(scratches[0]); i++) PyMem_Free(scratches[i]->data);
 }
@@ -552,16 +562,22 @@ static int remove_collinear(Poly *p, Work *w) {
     /* Drop each vertex too close to the next; the write index never passes the read one,
        and the first vertex (which the last edge needs) is saved first. */
     double x0 = v[0], y0 = v[1];
+    /* Edge lengths, kept for the straightness test when no vertex goes (the same hypot of
+       the same differences). */
+    double *lengths = scratch(&w->lengths, n, sizeof(double));
+    if (!lengths) return -1;
     Py_ssize_t m = 0;
     for (Py_ssize_t i = 0; i < n; i++) {
         double nx = i + 1 < n ? v[2 * i + 2] : x0, ny = i + 1 < n ? v[2 * i + 3] : y0;
-        if (hypot(nx - v[2 * i], ny - v[2 * i + 1]) > MERGE_EPS * span) {
+        lengths[i] = hypot(nx - v[2 * i], ny - v[2 * i + 1]);
+        if (lengths[i] > MERGE_EPS * span) {
             double x = v[2 * i], y = v[2 * i + 1];
             v[2 * m] = x;
             v[2 * m + 1] = y;
             m++;
         }
     }
+    int measured = m == n;
     if (m < n) {
         if (m == 0) {
             v[0] = x0;
@@ -582,7 +598,8 @@ static int remove_collinear(Poly *p, Work *w) {
         Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
         double fx = v[2 * next] - v[2 * i], fy = v[2 * next + 1] - v[2 * i + 1];
         double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
-        double length = hypot(fx, fy), preceding_length = hypot(px, py);
+        double length = measured ? lengths[i] : hypot(fx, fy);
+        double preceding_length = measured ? lengths[prev] : hypot(px, py);
         double turn = px * fy - py * fx;
         double noise =
             COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length);
@@ -1034,22 +1051,37 @@ static double distance_to_boundary(const double *v, Py_ssize_t n, double x, doub
     return best;
 }
 
-/* See _convex.points_in_convex (its dense test), for one point. */
-static int point_in_convex(const double *v, Py_ssize_t n, int solid, double x, double y, double tolerance) {
-    if (!solid) return distance_to_boundary(v, n, x, y) <= tolerance;
+/* See _convex.points_in_convex (its dense test), for one point. `lengths` holds the
+   polygon's edge lengths (hypot of each edge, computed once per polygon) when it is solid,
+   NULL when it is not. */
+static int point_in_convex(const double *v, Py_ssize_t n, const double *lengths, double x, double y,
+                           double tolerance) {
+    if (!lengths) return distance_to_boundary(v, n, x, y) <= tolerance;
     for (Py_ssize_t i = 0; i < n; i++) {
         Py_ssize_t j = i + 1 < n ? i + 1 : 0;
         double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
-        double signed_distance = (ex * (y - v[2 * i + 1]) - ey * (x - v[2 * i])) / hypot(ex, ey);
+        double signed_distance = (ex * (y - v[2 * i + 1]) - ey * (x - v[2 * i])) / lengths[i];
         if (!(signed_distance >= -tolerance)) return 0;
     }
     return 1;
 }
 
-/* See _reduce.cap_inside; works in place. */
-static void cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssize_t max_vertices) {
+/* See _reduce.cap_inside; works in place. -1 with MemoryError set on failure. */
+static int cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssize_t max_vertices) {
     Py_ssize_t floor_count = max_vertices > 3 ? max_vertices : 3;
-    int solid = prior_n >= 3 && polygon_area(prior, prior_n) > 0.0;
+    if (p->n <= floor_count) return 0;
+    double *lengths = NULL;
+    if (prior_n >= 3 && polygon_area(prior, prior_n) > 0.0) {
+        lengths = PyMem_Malloc(sizeof(double) * (size_t)prior_n);
+        if (!lengths) {
+            PyErr_NoMemory();
+            return -1;
+        }
+        for (Py_ssize_t i = 0; i < prior_n; i++) {
+            Py_ssize_t j = i + 1 < prior_n ? i + 1 : 0;
+            lengths[i] = hypot(prior[2 * j] - prior[2 * i], prior[2 * j + 1] - prior[2 * i + 1]);
+        }
+    }
     while (p->n > floor_count) {
         Py_ssize_t n = p->n, best = 0;
         double *v = p->v, best_cost = HUGE_VAL, best_x = 0.0, best_y = 0.0;
@@ -1064,7 +1096,7 @@ static void cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssiz
             int removable = denominator > 1e-12 * hypot(px, py) * hypot(fx, fy);
             double t = removable ? (ex * fy - ey * fx) / denominator : 0.0;
             double x = v[2 * i] + t * px, y = v[2 * i + 1] + t * py;
-            removable = removable && point_in_convex(prior, prior_n, solid, x, y, TOLERANCE);
+            removable = removable && point_in_convex(prior, prior_n, lengths, x, y, TOLERANCE);
             double cost = removable ? 0.5 * t * (px * ey - py * ex) : HUGE_VAL;
             any |= removable;
             /* np.argmin: the first of the cheapest. */
@@ -1082,6 +1114,8 @@ static void cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssiz
         memmove(v + 2 * gone, v + 2 * gone + 2, 2 * sizeof(double) * (size_t)(n - gone - 1));
         p->n = n - 1;
     }
+    PyMem_Free(lengths);
+    return 0;
 }
 
 /* The bearing-cone constraint of _reduce._cone_reduction on one polygon. */
@@ -1260,7 +1294,7 @@ static int get_vertices(PyObject *object, Py_buffer *view, Py_ssize_t *n) {
    (vertex bytes, arc lo, arc width, centre x, centre y, area before, area after). */
 static PyObject *finish(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices,
                         double center_x, double center_y, double arc_lo, double arc_width) {
-    if (positions->n > max_vertices) cap_inside(positions, prior, n, max_vertices);
+    if (positions->n > max_vertices && cap_inside(positions, prior, n, max_vertices) < 0) return NULL;
     double distance, x, y;
     nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, &x, &y);
     double values[6] = {arc_lo, arc_width, x, y, polygon_area(prior, n), polygon_area(positions->v, positions->n)};
