@@ -8,6 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from aura_ums import HeadingWedge, InputError
+from aura_ums.geometry import wrap_angle
 
 angles = st.floats(min_value=-4 * math.pi, max_value=4 * math.pi, allow_nan=False)
 extents = st.floats(min_value=0.0, max_value=3.5, allow_nan=False)
@@ -108,3 +109,15 @@ def test_bad_wedges_are_refused(kwargs: dict[str, float], message: str) -> None:
 def test_contains_refuses_nan() -> None:
     with pytest.raises(InputError, match=r"heading: expected finite numbers"):
         HeadingWedge(0.0, 0.1, 0.1).contains(float("nan"))
+
+
+@given(
+    st.one_of(
+        st.floats(-50.0, 50.0), st.sampled_from([math.pi, -math.pi, 3 * math.pi, -3 * math.pi, 0.0, -0.0])
+    )
+)
+def test_trusted_wraps_the_centre_as_wrap_angle_does(center: float) -> None:
+    """The library's unchecked constructor wraps exactly as wrap_angle and HeadingWedge() do."""
+    wedge = HeadingWedge._trusted(center, 0.25, 0.5)
+    assert wedge == HeadingWedge(center, 0.25, 0.5)
+    assert math.copysign(1.0, wedge.center) == math.copysign(1.0, wrap_angle(center))

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 from aura_ums.geometry import ConvexPolygon, convex_hull, polygon_area
 from aura_ums.geometry._convex import convexity_defect
-from aura_ums.uncertainty import _growth
-from aura_ums.uncertainty._growth import MotionBounds, grow_polygon, grow_polygon_reference
+from aura_ums.uncertainty import TerrainStats, TurnAndRun, _growth
+from aura_ums.uncertainty._growth import MotionBounds, grow_polygon, grow_polygon_reference, motion_bounds
 
 KERNEL = _growth.compiled_kernel()
 compiled = pytest.mark.skipif(KERNEL is None, reason="the C growth kernel was not built (no compiler)")
@@ -79,3 +79,53 @@ def test_compiled_kernel_refuses_a_malformed_buffer() -> None:
     assert KERNEL is not None
     with pytest.raises(ValueError, match=r"vertices: expected a C-contiguous \(n, 2\) float64 buffer"):
         KERNEL(b"abc", 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 16)
+
+
+def _clipped(value: float, lo: float, hi: float) -> float:
+    return lo if value < lo else hi if value > hi else value
+
+
+def _motion_bounds_as_documented(stats: TerrainStats, command: TurnAndRun, sigmas: float) -> MotionBounds:
+    """The bounds of MotionBounds' documentation, written plainly (min, max and a clip function)."""
+    turn, run = command.turn, command.run
+    fraction_lo = _clipped(1.0 - stats.rotation_loss - sigmas * stats.rotation_sd, 0.0, 1.0)
+    fraction_hi = _clipped(1.0 - stats.rotation_loss + sigmas * stats.rotation_sd, 0.0, 1.0)
+    loss, spread = stats.translation_loss, sigmas * stats.translation_sd
+    run_lo = _clipped(run * (1.0 - loss - spread) - stats.translation_inertial_loss, 0.0, run)
+    run_hi = _clipped(run * (1.0 - loss + spread) - stats.translation_inertial_loss, 0.0, run)
+    drift_max = stats.drift * run_hi
+    if stats.drift == 0.0:
+        chord_min = run_lo
+    elif drift_max <= math.pi:
+        chord_min = 2.0 * math.sin(stats.drift * run_lo / 2.0) / stats.drift
+    else:
+        chord_min = 0.0
+    return MotionBounds(
+        min(turn * fraction_lo, turn * fraction_hi),
+        max(turn * fraction_lo, turn * fraction_hi),
+        turn * _clipped(1.0 - stats.rotation_loss, 0.0, 1.0),
+        run_lo,
+        run_hi,
+        _clipped(run * (1.0 - loss) - stats.translation_inertial_loss, 0.0, run),
+        chord_min,
+        abs(turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd),
+        drift_max,
+    )
+
+
+fraction = st.floats(0.0, 0.99)
+spread = st.floats(0.0, 2.0)
+
+
+@given(
+    st.tuples(fraction, st.floats(0.0, 0.5), spread, st.floats(0.0, 0.5), fraction, spread, spread, spread),
+    st.floats(-7.0, 7.0),
+    st.floats(0.0, 30.0),
+    st.sampled_from([0.5, 1.0, 3.0, 5.0]),
+)
+def test_motion_bounds_are_exactly_the_documented_formulas(
+    stats: tuple[float, ...], turn: float, run: float, sigmas: float
+) -> None:
+    """The clipping written out in motion_bounds gives the very same floats (any turn, zero runs)."""
+    terrain, command = TerrainStats(*stats), TurnAndRun(turn, run)
+    assert motion_bounds(terrain, command, sigmas) == _motion_bounds_as_documented(terrain, command, sigmas)

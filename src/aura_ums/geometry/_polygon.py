@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -69,9 +70,11 @@ class ConvexPolygon:
     @classmethod
     def _trusted(cls, vertices: NDArray[np.float64]) -> ConvexPolygon:
         """Wrap vertices that the library itself computed (already convex, CCW, finite)."""
+        # The slots' own setters: the library builds a polygon for every growth and reduction.
         polygon = object.__new__(cls)
-        object.__setattr__(polygon, "vertices", read_only(vertices))
-        object.__setattr__(polygon, "_area", math.nan)
+        vertices.setflags(write=False)
+        _set_vertices(polygon, vertices)
+        _set_area(polygon, math.nan)
         return polygon
 
     @classmethod
@@ -247,6 +250,13 @@ class ConvexPolygon:
         return f"ConvexPolygon({self.vertex_count} vertices, area={self.area:.6g} m^2)"
 
     __hash__ = None  # type: ignore[assignment]
+
+
+# Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
+_set_vertices: Callable[[ConvexPolygon, NDArray[np.float64]], None] = ConvexPolygon.__dict__[
+    "vertices"
+].__set__
+_set_area: Callable[[ConvexPolygon, float], None] = ConvexPolygon.__dict__["_area"].__set__
 
 
 def regular_polygon(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import overload
 
@@ -61,10 +62,13 @@ class HeadingWedge:
     @classmethod
     def _trusted(cls, center: float, cw: float, ccw: float) -> HeadingWedge:
         """Build from values the library computed: finite, extents >= 0; wraps the centre."""
+        # wrap_angle written out, and the slots' own setters: every growth and reduction
+        # builds a wedge.
+        wrapped = math.pi - (math.pi - center) % TWO_PI
         wedge = object.__new__(cls)
-        object.__setattr__(wedge, "center", wrap_angle(center))
-        object.__setattr__(wedge, "cw", cw)
-        object.__setattr__(wedge, "ccw", ccw)
+        _set_center(wedge, wrapped + TWO_PI if wrapped <= -math.pi else wrapped)
+        _set_cw(wedge, cw)
+        _set_ccw(wedge, ccw)
         return wedge
 
     @classmethod
@@ -150,6 +154,12 @@ class HeadingWedge:
     def rotated(self, angle: float) -> HeadingWedge:
         """Return the wedge turned by ``angle`` radians (counter-clockwise positive)."""
         return _normalized(self.center + angle, self.cw, self.ccw)
+
+
+# Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
+_set_center: Callable[[HeadingWedge, float], None] = HeadingWedge.__dict__["center"].__set__
+_set_cw: Callable[[HeadingWedge, float], None] = HeadingWedge.__dict__["cw"].__set__
+_set_ccw: Callable[[HeadingWedge, float], None] = HeadingWedge.__dict__["ccw"].__set__
 
 
 def _normalized(center: float, cw: float, ccw: float) -> HeadingWedge:

@@ -36,10 +36,6 @@ DEFAULT_MAX_VERTICES = 64
 _SKITTER_SIDES = 8
 
 
-def _clip(value: float, lo: float, hi: float) -> float:
-    return lo if value < lo else hi if value > hi else value
-
-
 class MotionBounds(NamedTuple):
     """Bounds on one turn-and-run outcome at a given number of standard deviations.
 
@@ -83,42 +79,44 @@ def motion_bounds(stats: TerrainStats, command: TurnAndRun, sigmas: float) -> Mo
     (0.0, 0.0, 0.0, 0.0)
     """
     turn, run = command.turn, command.run
-    fraction_lo = _clip(1.0 - stats.rotation_loss - sigmas * stats.rotation_sd, 0.0, 1.0)
-    fraction_hi = _clip(1.0 - stats.rotation_loss + sigmas * stats.rotation_sd, 0.0, 1.0)
-    fraction_mean = _clip(1.0 - stats.rotation_loss, 0.0, 1.0)
+    # Clipping written out (no calls): this runs for every growth of every map.
+    rotation_kept = 1.0 - stats.rotation_loss
+    rotation_spread = sigmas * stats.rotation_sd
+    value = rotation_kept - rotation_spread
+    fraction_lo = 0.0 if value < 0.0 else 1.0 if value > 1.0 else value
+    value = rotation_kept + rotation_spread
+    fraction_hi = 0.0 if value < 0.0 else 1.0 if value > 1.0 else value
+    fraction_mean = 0.0 if rotation_kept < 0.0 else 1.0 if rotation_kept > 1.0 else rotation_kept
     a, b = turn * fraction_lo, turn * fraction_hi
-    run_lo = _clip(
-        run * (1.0 - stats.translation_loss - sigmas * stats.translation_sd)
-        - stats.translation_inertial_loss,
-        0.0,
-        run,
-    )
-    run_hi = _clip(
-        run * (1.0 - stats.translation_loss + sigmas * stats.translation_sd)
-        - stats.translation_inertial_loss,
-        0.0,
-        run,
-    )
-    run_mean = _clip(run * (1.0 - stats.translation_loss) - stats.translation_inertial_loss, 0.0, run)
-    drift_max = stats.drift * run_hi
+    run_kept = 1.0 - stats.translation_loss
+    run_spread = sigmas * stats.translation_sd
+    inertial = stats.translation_inertial_loss
+    value = run * (run_kept - run_spread) - inertial
+    run_lo = 0.0 if value < 0.0 else run if value > run else value
+    value = run * (run_kept + run_spread) - inertial
+    run_hi = 0.0 if value < 0.0 else run if value > run else value
+    value = run * run_kept - inertial
+    run_mean = 0.0 if value < 0.0 else run if value > run else value
+    drift = stats.drift
+    drift_max = drift * run_hi
     # The chord of an arc of length d turning by at most drift*d is at least
     # 2*sin(drift*d/2)/drift, which grows with d while drift*d <= pi.
-    if stats.drift == 0.0:
+    if drift == 0.0:
         chord_min = run_lo
     elif drift_max <= math.pi:
-        chord_min = 2.0 * math.sin(stats.drift * run_lo / 2.0) / stats.drift
+        chord_min = 2.0 * math.sin(drift * run_lo / 2.0) / drift
     else:
         chord_min = 0.0
     return MotionBounds(
-        turn_min=min(a, b),
-        turn_max=max(a, b),
-        turn_mean=turn * fraction_mean,
-        run_min=run_lo,
-        run_max=run_hi,
-        run_mean=run_mean,
-        chord_min=chord_min,
-        skitter_radius=abs(turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd),
-        drift_max=drift_max,
+        b if b < a else a,  # turn_min, turn_max: min(a, b), max(a, b)
+        b if b > a else a,
+        turn * fraction_mean,
+        run_lo,
+        run_hi,
+        run_mean,
+        chord_min,
+        abs(turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd),
+        drift_max,
     )
 
 

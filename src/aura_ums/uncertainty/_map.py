@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import overload
 
@@ -72,10 +73,12 @@ class SpatialUncertaintyMap:
     def _trusted(
         cls, polygon: ConvexPolygon, center: NDArray[np.float64], wedge: HeadingWedge
     ) -> SpatialUncertaintyMap:
+        # The slots' own setters: every growth and reduction builds a map.
         result = object.__new__(cls)
-        object.__setattr__(result, "polygon", polygon)
-        object.__setattr__(result, "center", read_only(center))
-        object.__setattr__(result, "wedge", wedge)
+        center.setflags(write=False)
+        _set_polygon(result, polygon)
+        _set_center(result, center)
+        _set_wedge(result, wedge)
         return result
 
     @classmethod
@@ -160,13 +163,15 @@ class SpatialUncertaintyMap:
             raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
         bounds = motion_bounds(terrain, command, float(sigmas))
         wedge = self.wedge
-        heading_lo = wedge.center - wedge.cw
+        heading, cw, ccw = wedge.center, wedge.cw, wedge.ccw
+        heading_lo = heading - cw
         vertices = grow_polygon(
-            self.polygon.vertices, heading_lo, heading_lo + wedge.cw + wedge.ccw, bounds, max_vertices
+            self.polygon.vertices, heading_lo, heading_lo + cw + ccw, bounds, max_vertices
         )
-        heading, cw, ccw = grow_wedge(wedge.center, wedge.cw, wedge.ccw, bounds)
+        heading, cw, ccw = grow_wedge(heading, cw, ccw, bounds)
         x, y = self.center.tolist()
-        center = np.array([x + bounds.run_mean * math.cos(heading), y + bounds.run_mean * math.sin(heading)])
+        run = bounds.run_mean
+        center = np.array([x + run * math.cos(heading), y + run * math.sin(heading)])
         return SpatialUncertaintyMap._trusted(
             ConvexPolygon._trusted(vertices), center, HeadingWedge._trusted(heading, cw, ccw)
         )
@@ -281,3 +286,15 @@ class SpatialUncertaintyMap:
             f"area={self.area:.4g} m^2, vertices={self.polygon.vertex_count}, "
             f"heading={self.wedge.center:.4g} rad -{self.wedge.cw:.3g}/+{self.wedge.ccw:.3g})"
         )
+
+
+# Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
+_set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon], None] = SpatialUncertaintyMap.__dict__[
+    "polygon"
+].__set__
+_set_center: Callable[[SpatialUncertaintyMap, NDArray[np.float64]], None] = SpatialUncertaintyMap.__dict__[
+    "center"
+].__set__
+_set_wedge: Callable[[SpatialUncertaintyMap, HeadingWedge], None] = SpatialUncertaintyMap.__dict__[
+    "wedge"
+].__set__

@@ -478,10 +478,10 @@ _PAIRS: dict[type, type] = {
 
 def check_pair(observation: object, landmark: object) -> None:
     """Raise :class:`InputError` unless the observation and landmark are of one class and id."""
-    if type(observation) not in _PAIRS:
+    expected = _PAIRS.get(type(observation))
+    if expected is None:
         names = ", ".join(kind.__name__ for kind in _PAIRS)
         raise InputError(f"observation: expected one of {names}, got {type(observation).__name__}")
-    expected = _PAIRS[type(observation)]
     if not isinstance(landmark, expected):
         raise InputError(
             f"landmark: expected a {expected.__name__} for a {type(observation).__name__}, "
@@ -526,35 +526,14 @@ def _reduce_map_compiled(
     max_vertices: int,
 ) -> Reduction:
     """:func:`reduce_map` with the geometry in one call of a compiled kernel (arguments checked)."""
-    vertices = np.ascontiguousarray(prior.polygon.vertices, dtype=np.float64)
+    vertices = prior.polygon.vertices
+    if not vertices.flags.c_contiguous:  # polygons hold C-contiguous float64 arrays already
+        vertices = np.ascontiguousarray(vertices, dtype=np.float64)
     wedge = prior.wedge
     center_x, center_y = prior.center.tolist()
     forward, left = observation.sensor_offset
     found: _KernelResult
-    if isinstance(observation, GroundLineObservation) and isinstance(landmark, GroundLineLandmark):
-        start_x, start_y = landmark.start.tolist()
-        end_x, end_y = landmark.end.tolist()
-        found = reduce_strip(
-            vertices,
-            center_x,
-            center_y,
-            wedge.center,
-            wedge.cw,
-            wedge.ccw,
-            forward,
-            left,
-            start_x,
-            start_y,
-            end_x,
-            end_y,
-            landmark.position_uncertainty,
-            observation.offset,
-            observation.offset_error,
-            observation.angle,
-            observation.angle_error,
-            max_vertices,
-        )
-    elif isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
+    if isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
         landmark, (VerticalLineLandmark, PointLandmark)
     ):
         if isinstance(observation, RangeBearingObservation):
@@ -580,6 +559,29 @@ def _reduce_map_compiled(
             piece,
             max_vertices,
         )
+    elif isinstance(observation, GroundLineObservation) and isinstance(landmark, GroundLineLandmark):
+        start_x, start_y = landmark.start.tolist()
+        end_x, end_y = landmark.end.tolist()
+        found = reduce_strip(
+            vertices,
+            center_x,
+            center_y,
+            wedge.center,
+            wedge.cw,
+            wedge.ccw,
+            forward,
+            left,
+            start_x,
+            start_y,
+            end_x,
+            end_y,
+            landmark.position_uncertainty,
+            observation.offset,
+            observation.offset_error,
+            observation.angle,
+            observation.angle_error,
+            max_vertices,
+        )
     else:  # pragma: no cover - check_pair refused every other pairing
         raise InputError(f"observation: expected a known pairing, got {type(observation).__name__}")
     if isinstance(found, int):
@@ -587,12 +589,15 @@ def _reduce_map_compiled(
         return Reduction(prior, False, area, area, wedge, wedge, _REASONS[found])
     raw, lo, width, x, y, area_before, area_after = found
     # Bytes are immutable, so the array is read-only as map values must be.
-    reduced_vertices = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
+    reduced_vertices = np.frombuffer(raw, _FLOAT64).reshape(-1, 2)
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
     reduced = type(prior)._trusted(
         type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
     )
     return Reduction(reduced, True, area_before, area_after, wedge, reduced_wedge)
+
+
+_FLOAT64 = np.dtype(np.float64)
 
 
 def reduce_map_reference(
