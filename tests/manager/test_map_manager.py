@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from aura_ums.errors import FileFormatError, InputError
+from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon, wrap_angle
 from aura_ums.manager import (
@@ -658,3 +658,30 @@ def test_a_run_from_an_estimate_outside_every_meadow_grows_on_the_nearest_terrai
     expected = outside.grow(TurnAndRun(0.0, 2.0), TABLE["concrete"])  # "west" is the nearest meadow
     assert np.array_equal(step.map.polygon.vertices, expected.polygon.vertices)
     assert manager.grown_reports == 1
+
+
+def test_a_terrain_missing_from_the_table_fails_every_update_of_a_one_meadow_map() -> None:
+    """The one meadow's terrain is looked up when first grown on; a missing one is never remembered."""
+    only = Meadow("only", box(0, -5, 20, 5), "marsh", tuple(landmark.id for landmark in LANDMARKS))
+    world = MeadowMap([only], [record(landmark) for landmark in LANDMARKS])  # no table to check against
+    manager = UncertaintyMapManager(start_map(), world, TABLE)
+    board = Blackboard()
+    board.post_report(PositionReport(1.0, TurnAndRun(0.0, 0.5)))
+    for _ in range(2):
+        with pytest.raises(UnknownTerrainError, match="got 'marsh'"):
+            manager.update(board, now=1.0)
+        assert manager.consumed_reports == 0
+
+
+def test_a_one_meadow_manager_grows_as_the_map_does_on_its_terrain() -> None:
+    """Report after report, the manager's map is the map grown by each command on the meadow's terrain."""
+    world = world_of([("only", box(-50, -50, 50, 50), "gravel")], LANDMARKS)
+    manager = UncertaintyMapManager(start_map(), world, TABLE, sigmas=2.5)
+    board, expected = Blackboard(), start_map()
+    for k, command in enumerate([TurnAndRun(0.3, 1.0), TurnAndRun(-0.2, 0.0), TurnAndRun(0.0, 2.0)]):
+        board.post_report(PositionReport(float(k + 1), command))
+        expected = expected.grow(command, TABLE["gravel"], sigmas=2.5)
+        grown = manager.update(board, now=float(k + 1)).map
+        assert grown.polygon.vertices.tobytes() == expected.polygon.vertices.tobytes()
+        assert grown.wedge == expected.wedge
+        assert grown.center.tolist() == expected.center.tolist()

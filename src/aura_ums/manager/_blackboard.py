@@ -172,6 +172,13 @@ class Blackboard:
         stop = bisect.bisect_right(self._reports, limit, lo=min(start, len(self._reports)), key=_report_time)
         return tuple(self._reports[start:stop])
 
+    def _report_stop(self, until: float, start: int) -> int:
+        """Index after the last report from ``start`` on with ``time <= until`` (arguments trusted).
+
+        :meth:`reports_until` without its checks and its copy, for the manager's update.
+        """
+        return bisect.bisect_right(self._reports, until, lo=start, key=_report_time)
+
     # --- command buffer ----------------------------------------------------------------
 
     def push_command(self, command: TurnAndRun) -> None:

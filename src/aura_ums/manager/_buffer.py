@@ -110,6 +110,10 @@ or GroundLineObservation, got str
         del self._items[:stop]
         return taken
 
+    def _discard(self, count: int) -> None:
+        """Remove the ``count`` oldest observations (what a :meth:`peek` returned, not copied again)."""
+        del self._items[:count]
+
     def peek(self, until: float | None = None) -> tuple[Observation, ...]:
         """Return what :meth:`drain` would, without removing anything."""
         return tuple(self._items[: self._stop(until)])

@@ -11,9 +11,16 @@ import shapely
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
-from aura_ums.manager._blackboard import Blackboard, PositionReport
+from aura_ums.manager._blackboard import Blackboard, PositionReport  # noqa: F401 (the doctests)
 from aura_ums.manager._codec import Reader, dump_document, encode_map
-from aura_ums.uncertainty import Observation, Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+from aura_ums.uncertainty import (
+    Observation,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainStats,
+    TerrainTable,
+    TurnAndRun,
+)
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
@@ -192,6 +199,7 @@ class UncertaintyMapManager:
         "_map_time",
         "_meadow_map",
         "_missed_limit",
+        "_only_terrain",
         "_rejected",
         "_relocalizations",
         "_sigmas",
@@ -220,6 +228,7 @@ class UncertaintyMapManager:
             raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
         self._meadow_map = meadow_map
         self._table = table
+        self._only_terrain: TerrainStats | None = None
         self._sigmas = _positive(sigmas, "sigmas")
         self._area_limit = None if area_limit is None else _positive(area_limit, "area_limit")
         if isinstance(missed_limit, bool) or not isinstance(missed_limit, int) or missed_limit < 1:
@@ -370,31 +379,39 @@ class UncertaintyMapManager:
         self._check_blackboard(blackboard)
 
         current, index, map_time = self._map, self._consumed, self._map_time
+        reports = blackboard._reports  # read in place (the manager's own subpackage): no copies
+        identified = blackboard.identified
         outcomes: list[ObservationOutcome] = []
-        grown = 0
-        pending = blackboard.identified.peek(until=time)
+        pending = identified.peek(until=time)
         for observation in pending:
-            reports = blackboard.reports_until(observation.time, start=index)
-            current, map_time = self._grow(current, reports, map_time)
-            index += len(reports)
-            grown += len(reports)
+            stop = blackboard._report_stop(observation.time, index)
+            while index < stop:
+                report = reports[index]
+                current = self._grow_one(current, report.command)
+                map_time = report.time
+                index += 1
             outcome, current = self._reduce(current, observation, map_time)
             outcomes.append(outcome)
-        reports = blackboard.reports_until(time, start=index)
-        current, map_time = self._grow(current, reports, map_time)
-        index += len(reports)
-        grown += len(reports)
+        stop = blackboard._report_stop(time, index)
+        while index < stop:
+            report = reports[index]
+            current = self._grow_one(current, report.command)
+            map_time = report.time
+            index += 1
+        grown = index - self._consumed
 
         # Commit: nothing above changed the manager or the blackboard.
-        blackboard.identified.drain(until=time)  # exactly ``pending``: single-threaded by contract
+        identified._discard(len(pending))  # exactly ``pending``: single-threaded by contract
         self._map, self._consumed, self._map_time = current, index, map_time
         self._grown += grown
+        found = False
         for outcome in outcomes:
             if outcome.accepted:
                 self._accepted += 1
+                found = True
             else:
                 self._rejected[outcome.reason] = self._rejected.get(outcome.reason, 0) + 1
-        self._update_state(any(o.accepted for o in outcomes), missed_in_a_row)
+        self._update_state(found, missed_in_a_row)
         return ManagerStep(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
 
     def relocalize(self, new_map: SpatialUncertaintyMap) -> None:
@@ -447,23 +464,17 @@ class UncertaintyMapManager:
                     f"is at t={self._map_time!r}, got t={last!r}"
                 )
 
-    def _grow(
-        self,
-        current: SpatialUncertaintyMap,
-        reports: tuple[PositionReport, ...],
-        map_time: float | None,
-    ) -> tuple[SpatialUncertaintyMap, float | None]:
-        for report in reports:
-            current = self._grow_one(current, report.command)
-            map_time = report.time
-        return current, map_time
-
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
+        terrain = self._only_terrain
+        if terrain is not None:
+            return current.grow(command, terrain, sigmas=self._sigmas)
         meadows = self._meadow_map.meadows
         if len(meadows) == 1:
             # One meadow, one terrain: there is nothing to split the run by (and a run that
-            # leaves it would fall back to this terrain anyway).
-            return current.grow(command, self._table[meadows[0].terrain], sigmas=self._sigmas)
+            # leaves it would fall back to this terrain anyway). Both are immutable: look
+            # the terrain up once (here, so that a missing one fails where it always did).
+            terrain = self._only_terrain = self._table[meadows[0].terrain]
+            return current.grow(command, terrain, sigmas=self._sigmas)
         pose = current.most_probable_pose()
         if command.run <= RUN_TOLERANCE:
             # A run too short to cut by meadows: whole, on the start meadow's terrain.
@@ -486,32 +497,40 @@ class UncertaintyMapManager:
     def _reduce(
         self, current: SpatialUncertaintyMap, observation: Observation, map_time: float | None
     ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
-        area, width = current.area, current.wedge.width
-
-        def rejected(reason: str) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
-            return ObservationOutcome(observation, False, reason, area, area, width, width), current
-
+        reason = ""
         if map_time is not None and observation.time < map_time:
-            return rejected(REJECT_STALE)
-        try:
-            landmark = self._meadow_map.landmark(observation.landmark_id).landmark
-        except UnknownTerrainError:
-            return rejected(REJECT_UNKNOWN_LANDMARK)
-        if observation.landmark_class is not landmark.landmark_class:
-            return rejected(REJECT_CLASS_MISMATCH)
-        reduction = current.reduce(observation, landmark)
-        if not reduction.consistent:
-            return rejected(reduction.reason)
-        reduced = reduction.map
-        outcome = ObservationOutcome(
-            observation, True, "", reduction.area_before, reduction.area_after, width, reduced.wedge.width
-        )
-        return outcome, reduced
+            reason = REJECT_STALE
+        else:
+            try:
+                landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+            except UnknownTerrainError:
+                reason = REJECT_UNKNOWN_LANDMARK
+            else:
+                if observation.landmark_class is not landmark.landmark_class:
+                    reason = REJECT_CLASS_MISMATCH
+                else:
+                    reduction = current.reduce(observation, landmark)
+                    if reduction.consistent:
+                        reduced = reduction.map
+                        outcome = ObservationOutcome(
+                            observation,
+                            True,
+                            "",
+                            reduction.area_before,
+                            reduction.area_after,
+                            current.wedge.width,
+                            reduced.wedge.width,
+                        )
+                        return outcome, reduced
+                    reason = reduction.reason
+        # Rejected: the map stays, and so do its area and width.
+        area, width = current.area, current.wedge.width
+        return ObservationOutcome(observation, False, reason, area, area, width, width), current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:
         reasons: list[str] = []
-        area = self._map.area
-        if self._area_limit is not None and area > self._area_limit:
+        # The area only against a limit: most maps are new each update, their area not yet known.
+        if self._area_limit is not None and (area := self._map.area) > self._area_limit:
             reasons.append(f"map area {area:.6g} m^2 > area_limit {self._area_limit:g} m^2")
         if not found and missed_in_a_row >= self._missed_limit:
             reasons.append(
