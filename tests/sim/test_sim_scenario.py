@@ -10,7 +10,7 @@ import pytest
 
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.sim import LostLimits, Scenario, StartState, waypoints_array
-from aura_ums.uncertainty import FOOT, LandmarkClass, TurnAndRun
+from aura_ums.uncertainty import FOOT, LandmarkClass, TerrainStats, TurnAndRun
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SCENARIO_FILES = sorted(p for p in SCENARIOS.glob("*.toml") if not p.name.endswith("camera.toml"))
@@ -146,27 +146,15 @@ def test_route_from_waypoints_and_from_a_goal(folder: Path) -> None:
     assert all(c.turn == pytest.approx(0.0) for c in commands)
 
 
+def terrain_table_toml(terrains: tuple[str, ...], value: float) -> str:
+    """A terrain table in TOML: every statistic of every terrain set to ``value``."""
+    row = "".join(f"{key} = {value}\n" for key in TerrainStats.field_names())
+    return "".join(f"[{name}]\n{row}" for name in terrains)
+
+
 def test_relative_geojson_map_and_terrain_files(folder: Path) -> None:
     shutil.copy(SCENARIOS / "four_terrains.geojson", folder / "sub_map.geojson")
-    (folder / "terrain.toml").write_text(
-        "".join(
-            f"[{name}]\n"
-            + "".join(
-                f"{key} = 0.01\n"
-                for key in (
-                    "translation_loss",
-                    "translation_inertial_loss",
-                    "translation_sd",
-                    "drift",
-                    "rotation_loss",
-                    "rotation_sd",
-                    "skitter",
-                    "skitter_sd",
-                )
-            )
-            for name in ("tile", "concrete", "grass", "gravel")
-        )
-    )
+    (folder / "terrain.toml").write_text(terrain_table_toml(("tile", "concrete", "grass", "gravel"), 0.01))
     text = GOOD.replace('map = "sample:paper_sidewalk"', 'map = "sub_map.geojson"\nterrain = "terrain.toml"')
     text = text.replace("x = 0.0\n", "x = 1.0\n")
     (folder / "m.toml").write_text(text)
@@ -275,22 +263,7 @@ def test_missing_and_unreadable_scenario_files(tmp_path: Path) -> None:
 
 
 def test_sample_map_with_a_table_lacking_its_terrain(folder: Path) -> None:
-    (folder / "t.toml").write_text(
-        "[concrete]\n"
-        + "".join(
-            f"{key} = 0.0\n"
-            for key in (
-                "translation_loss",
-                "translation_inertial_loss",
-                "translation_sd",
-                "drift",
-                "rotation_loss",
-                "rotation_sd",
-                "skitter",
-                "skitter_sd",
-            )
-        )
-    )
+    (folder / "t.toml").write_text(terrain_table_toml(("concrete",), 0.0))
     (folder / "bad.toml").write_text(
         GOOD.replace('camera = "cam.toml"', 'camera = "cam.toml"\nterrain = "t.toml"')
     )
