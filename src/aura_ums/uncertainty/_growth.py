@@ -36,6 +36,10 @@ DEFAULT_MAX_VERTICES = 64
 _SKITTER_SIDES = 8
 
 
+def _clip(value: float, lo: float, hi: float) -> float:
+    return lo if value < lo else hi if value > hi else value
+
+
 class MotionBounds(NamedTuple):
     """Bounds on one turn-and-run outcome at a given number of standard deviations.
 
@@ -79,24 +83,18 @@ def motion_bounds(stats: TerrainStats, command: TurnAndRun, sigmas: float) -> Mo
     (0.0, 0.0, 0.0, 0.0)
     """
     turn, run = command.turn, command.run
-    # Clipping written out (no calls): this runs for every growth of every map.
     rotation_kept = 1.0 - stats.rotation_loss
     rotation_spread = sigmas * stats.rotation_sd
-    value = rotation_kept - rotation_spread
-    fraction_lo = 0.0 if value < 0.0 else 1.0 if value > 1.0 else value
-    value = rotation_kept + rotation_spread
-    fraction_hi = 0.0 if value < 0.0 else 1.0 if value > 1.0 else value
-    fraction_mean = 0.0 if rotation_kept < 0.0 else 1.0 if rotation_kept > 1.0 else rotation_kept
+    fraction_lo = _clip(rotation_kept - rotation_spread, 0.0, 1.0)
+    fraction_hi = _clip(rotation_kept + rotation_spread, 0.0, 1.0)
+    fraction_mean = _clip(rotation_kept, 0.0, 1.0)
     a, b = turn * fraction_lo, turn * fraction_hi
     run_kept = 1.0 - stats.translation_loss
     run_spread = sigmas * stats.translation_sd
     inertial = stats.translation_inertial_loss
-    value = run * (run_kept - run_spread) - inertial
-    run_lo = 0.0 if value < 0.0 else run if value > run else value
-    value = run * (run_kept + run_spread) - inertial
-    run_hi = 0.0 if value < 0.0 else run if value > run else value
-    value = run * run_kept - inertial
-    run_mean = 0.0 if value < 0.0 else run if value > run else value
+    run_lo = _clip(run * (run_kept - run_spread) - inertial, 0.0, run)
+    run_hi = _clip(run * (run_kept + run_spread) - inertial, 0.0, run)
+    run_mean = _clip(run * run_kept - inertial, 0.0, run)
     drift = stats.drift
     drift_max = drift * run_hi
     # The chord of an arc of length d turning by at most drift*d is at least
@@ -108,15 +106,15 @@ def motion_bounds(stats: TerrainStats, command: TurnAndRun, sigmas: float) -> Mo
     else:
         chord_min = 0.0
     return MotionBounds(
-        b if b < a else a,  # turn_min, turn_max: min(a, b), max(a, b)
-        b if b > a else a,
-        turn * fraction_mean,
-        run_lo,
-        run_hi,
-        run_mean,
-        chord_min,
-        abs(turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd),
-        drift_max,
+        turn_min=min(a, b),
+        turn_max=max(a, b),
+        turn_mean=turn * fraction_mean,
+        run_min=run_lo,
+        run_max=run_hi,
+        run_mean=run_mean,
+        chord_min=chord_min,
+        skitter_radius=abs(turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd),
+        drift_max=drift_max,
     )
 
 
