@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import enum
 import types
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import shapely
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
-from aura_ums.manager._blackboard import Blackboard, PositionReport  # noqa: F401 (the doctests)
+from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
 from aura_ums.uncertainty import (
     Observation,
@@ -385,19 +385,13 @@ class UncertaintyMapManager:
         pending = identified.peek(until=time)
         for observation in pending:
             stop = blackboard._report_stop(observation.time, index)
-            while index < stop:
-                report = reports[index]
-                current = self._grow_one(current, report.command)
-                map_time = report.time
-                index += 1
+            current, map_time = self._grow(current, reports, index, stop, map_time)
+            index = stop
             outcome, current = self._reduce(current, observation, map_time)
             outcomes.append(outcome)
         stop = blackboard._report_stop(time, index)
-        while index < stop:
-            report = reports[index]
-            current = self._grow_one(current, report.command)
-            map_time = report.time
-            index += 1
+        current, map_time = self._grow(current, reports, index, stop, map_time)
+        index = stop
         grown = index - self._consumed
 
         # Commit: nothing above changed the manager or the blackboard.
@@ -463,6 +457,21 @@ class UncertaintyMapManager:
                     f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
                     f"is at t={self._map_time!r}, got t={last!r}"
                 )
+
+    def _grow(
+        self,
+        current: SpatialUncertaintyMap,
+        reports: Sequence[PositionReport],
+        start: int,
+        stop: int,
+        map_time: float | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None]:
+        """Grow by ``reports[start:stop]``; return the map and the last report's time."""
+        for index in range(start, stop):
+            report = reports[index]
+            current = self._grow_one(current, report.command)
+            map_time = report.time
+        return current, map_time
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
         terrain = self._only_terrain
