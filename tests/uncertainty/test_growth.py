@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from aura_ums.geometry import ConvexPolygon, convex_hull, polygon_area
 from aura_ums.geometry._convex import convexity_defect
-from aura_ums.uncertainty import TerrainStats, TurnAndRun, _growth
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun, _growth
 from aura_ums.uncertainty._growth import MotionBounds, grow_polygon, grow_polygon_reference, motion_bounds
 
 KERNEL = _growth.compiled_kernel()
@@ -129,3 +129,71 @@ def test_motion_bounds_are_exactly_the_documented_formulas(
     """The clipping written out in motion_bounds gives the very same floats (any turn, zero runs)."""
     terrain, command = TerrainStats(*stats), TurnAndRun(turn, run)
     assert motion_bounds(terrain, command, sigmas) == _motion_bounds_as_documented(terrain, command, sigmas)
+
+
+SEQUENCE_KERNEL = _growth.compiled_sequence_kernel()
+
+
+def _same_map(a: SpatialUncertaintyMap, b: SpatialUncertaintyMap) -> bool:
+    return (
+        a.polygon.vertices.tobytes() == b.polygon.vertices.tobytes()
+        and a.center.tobytes() == b.center.tobytes()
+        and (a.wedge.center, a.wedge.cw, a.wedge.ccw) == (b.wedge.center, b.wedge.cw, b.wedge.ccw)
+    )
+
+
+@given(
+    st.tuples(fraction, st.floats(0.0, 0.5), spread, st.floats(0.0, 0.5), fraction, spread, spread, spread),
+    st.lists(st.tuples(st.floats(-7.0, 7.0), st.floats(0.0, 30.0)), max_size=6),
+    st.floats(-math.pi, math.pi),
+    st.sampled_from([0.0, 0.05, 1.0, math.pi]),
+    st.sampled_from([1.0, 3.0]),
+    st.sampled_from([3, 8, 64]),
+)
+def test_a_run_of_growths_is_bit_for_bit_a_loop_of_grow(
+    stats: tuple[float, ...],
+    commands: list[tuple[float, float]],
+    heading: float,
+    halfwidth: float,
+    sigmas: float,
+    cap: int,
+) -> None:
+    """The manager's one-call growth (compiled when built) equals growing report by report.
+
+    Full-circle wedges, headings at the +-pi seam, zero-length commands and the vertex
+    cap included: the polygon, the centre and the wedge are the very same floats.
+    """
+    terrain = TerrainStats(*stats)
+    start = SpatialUncertaintyMap.from_pose(Pose(3.0, -2.0, heading), 0.3, halfwidth)
+    runs = [TurnAndRun(turn, run) for turn, run in commands]
+    expected = start
+    for command in runs:
+        expected = expected.grow(command, terrain, sigmas=sigmas, max_vertices=cap)
+    grown = start._grow_many(runs, terrain, sigmas, cap)
+    assert _same_map(grown, expected)
+    assert not grown.polygon.vertices.flags.writeable
+
+
+def test_a_run_of_growths_without_the_kernel_is_the_loop(monkeypatch: pytest.MonkeyPatch) -> None:
+    terrain = TerrainTable.default()["grass"]
+    start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 3.0), 0.1, 0.05)
+    runs = [TurnAndRun(0.4, 2.0), TurnAndRun(-1.0, 0.0), TurnAndRun(0.0, 5.0)]
+    compiled_result = start._grow_many(runs, terrain, 3.0)
+    monkeypatch.setattr(_growth, "_compiled_grow_commands", None)
+    assert start._grow_many([], terrain, 3.0) is start
+    assert _same_map(start._grow_many(runs, terrain, 3.0), compiled_result)
+
+
+@pytest.mark.skipif(SEQUENCE_KERNEL is None, reason="the C growth kernel was not built (no compiler)")
+def test_the_run_kernel_refuses_bad_commands() -> None:
+    assert SEQUENCE_KERNEL is not None
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    stats = (0.5, 0.5, 0.0, 0.1, 0.1, 0.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 3.0)
+    with pytest.raises(ValueError, match=r"commands: expected \(turn, run\) pairs, got 3 numbers"):
+        SEQUENCE_KERNEL(square, *stats, [0.0, 1.0, 2.0], 16)
+    with pytest.raises(ValueError, match=r"commands: expected finite numbers, got 0.0, nan at pair 1"):
+        SEQUENCE_KERNEL(square, *stats, [0.0, 1.0, 0.0, math.nan], 16)
+    with pytest.raises(TypeError, match="commands: expected a sequence of numbers"):
+        SEQUENCE_KERNEL(square, *stats, 5, 16)
+    with pytest.raises(ValueError, match="max_vertices: expected at least 3, got 2"):
+        SEQUENCE_KERNEL(square, *stats, [], 2)

@@ -342,6 +342,78 @@ static Py_ssize_t simplify_outer(double *v, Py_ssize_t n, Py_ssize_t max_vertice
     return n;
 }
 
+/* Every buffer of a growth of polygons of up to `n_max` vertices, in one block. */
+typedef struct {
+    char *block;
+    double *sector, *disk, *scratch, *t;
+    Edge *edges;
+    Ranked *ranked;
+    char *flags;
+    Py_ssize_t capacity;
+} Growth;
+
+/* The growth's buffers and, after them, `extra` arrays of capacity points each (their
+   first returned in *extra_out); -1 with MemoryError set on failure. */
+static int growth_alloc(Growth *g, Py_ssize_t n_max, int extra, double **extra_out) {
+    Py_ssize_t capacity = n_max + 2 * FULL_DISK_SIDES + SKITTER_SIDES + 8;
+    /* 8-byte items first, the flags last. */
+    size_t sector_size = sizeof(double) * 2 * (size_t)(FULL_DISK_SIDES + 40);
+    size_t disk_size = sizeof(double) * 2 * SKITTER_SIDES;
+    size_t edges_size = sizeof(Edge) * 2 * (size_t)capacity;
+    size_t points_size = sizeof(double) * 2 * (size_t)capacity;
+    size_t t_size = sizeof(double) * (size_t)capacity;
+    size_t ranked_size = sizeof(Ranked) * (size_t)capacity;
+    size_t extra_size = points_size * (size_t)extra;
+    char *block = PyMem_Malloc(sector_size + disk_size + edges_size + points_size + t_size + ranked_size +
+                               extra_size + 2 * (size_t)capacity);
+    if (!block) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    g->block = block;
+    g->capacity = capacity;
+    g->sector = (double *)block;
+    g->disk = (double *)(block + sector_size);
+    g->edges = (Edge *)(block + sector_size + disk_size);
+    g->scratch = (double *)(block + sector_size + disk_size + edges_size);
+    g->t = (double *)(block + sector_size + disk_size + edges_size + points_size);
+    g->ranked = (Ranked *)(block + sector_size + disk_size + edges_size + points_size + t_size);
+    *extra_out = (double *)(block + sector_size + disk_size + edges_size + points_size + t_size + ranked_size);
+    g->flags = block + sector_size + disk_size + edges_size + points_size + t_size + ranked_size + extra_size;
+    return 0;
+}
+
+/* One growth (see _growth.grow_polygon) of the n vertices into `out` (room for the
+   growth's capacity, not `vertices`' buffer); returns the result's vertex count. */
+static Py_ssize_t grow_step(Growth *g, const double *vertices, Py_ssize_t n, double heading_lo, double heading_hi,
+                            double turn_min, double turn_max, double drift_max, double chord_min, double run_max,
+                            double skitter_radius, Py_ssize_t max_vertices, double *out) {
+    const double *parts[3] = {vertices, NULL, NULL};
+    Py_ssize_t sizes[3] = {n, 0, 0};
+    int part_count = 1;
+    if (run_max > 0.0) {
+        double start = heading_lo + turn_min - drift_max / 2.0;
+        double stop = heading_hi + turn_max + drift_max / 2.0;
+        if (heading_hi - heading_lo >= TWO_PI) stop = start + TWO_PI;
+        parts[part_count] = g->sector;
+        sizes[part_count] = outer_annular_sector(chord_min, run_max, start, stop, g->sector);
+        part_count++;
+    }
+    if (skitter_radius > 0.0) {
+        parts[part_count] = g->disk;
+        sizes[part_count] = outer_disk(skitter_radius, SKITTER_SIDES, g->disk);
+        part_count++;
+    }
+    if (part_count == 1) {
+        memcpy(out, vertices, sizeof(double) * 2 * (size_t)n);
+        return n;
+    }
+    Py_ssize_t m = minkowski_sum(parts, sizes, part_count, g->edges, out);
+    if (m > max_vertices)
+        m = simplify_outer(out, m, max_vertices, g->t, g->ranked, g->flags, g->flags + g->capacity, g->scratch);
+    return m;
+}
+
 static PyObject *grow_polygon(PyObject *self, PyObject *args) {
     (void)self;
     Py_buffer buffer;
@@ -356,58 +428,16 @@ static PyObject *grow_polygon(PyObject *self, PyObject *args) {
         PyErr_SetString(PyExc_ValueError, "vertices: expected a C-contiguous (n, 2) float64 buffer");
         return NULL;
     }
-    const double *vertices = (const double *)buffer.buf;
-    Py_ssize_t capacity = n + 2 * FULL_DISK_SIDES + SKITTER_SIDES + 8;
-    /* One block for every buffer (8-byte items first, the flags last). */
-    size_t sector_size = sizeof(double) * 2 * (size_t)(FULL_DISK_SIDES + 40);
-    size_t disk_size = sizeof(double) * 2 * SKITTER_SIDES;
-    size_t edges_size = sizeof(Edge) * 2 * (size_t)capacity;
-    size_t points_size = sizeof(double) * 2 * (size_t)capacity;
-    size_t t_size = sizeof(double) * (size_t)capacity;
-    size_t ranked_size = sizeof(Ranked) * (size_t)capacity;
-    char *block =
-        PyMem_Malloc(sector_size + disk_size + edges_size + 2 * points_size + t_size + ranked_size + 2 * (size_t)capacity);
-    PyObject *result = NULL;
-    if (!block) {
-        PyErr_NoMemory();
+    Growth g;
+    double *out;
+    if (growth_alloc(&g, n, 1, &out) < 0) {
         PyBuffer_Release(&buffer);
         return NULL;
     }
-    double *sector = (double *)block;
-    double *disk = (double *)(block + sector_size);
-    Edge *edges = (Edge *)(block + sector_size + disk_size);
-    double *out = (double *)(block + sector_size + disk_size + edges_size);
-    double *scratch = (double *)(block + sector_size + disk_size + edges_size + points_size);
-    double *t = (double *)(block + sector_size + disk_size + edges_size + 2 * points_size);
-    Ranked *ranked = (Ranked *)(block + sector_size + disk_size + edges_size + 2 * points_size + t_size);
-    char *flags = block + sector_size + disk_size + edges_size + 2 * points_size + t_size + ranked_size;
-    const double *parts[3] = {vertices, NULL, NULL};
-    Py_ssize_t sizes[3] = {n, 0, 0};
-    int part_count = 1;
-    if (run_max > 0.0) {
-        double start = heading_lo + turn_min - drift_max / 2.0;
-        double stop = heading_hi + turn_max + drift_max / 2.0;
-        if (heading_hi - heading_lo >= TWO_PI) stop = start + TWO_PI;
-        parts[part_count] = sector;
-        sizes[part_count] = outer_annular_sector(chord_min, run_max, start, stop, sector);
-        part_count++;
-    }
-    if (skitter_radius > 0.0) {
-        parts[part_count] = disk;
-        sizes[part_count] = outer_disk(skitter_radius, SKITTER_SIDES, disk);
-        part_count++;
-    }
-    Py_ssize_t m;
-    if (part_count == 1) {
-        memcpy(out, vertices, sizeof(double) * 2 * (size_t)n);
-        m = n;
-    } else {
-        m = minkowski_sum(parts, sizes, part_count, edges, out);
-        if (m > max_vertices)
-            m = simplify_outer(out, m, max_vertices, t, ranked, flags, flags + capacity, scratch);
-    }
-    result = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)(sizeof(double) * 2 * (size_t)m));
-    PyMem_Free(block);
+    Py_ssize_t m = grow_step(&g, (const double *)buffer.buf, n, heading_lo, heading_hi, turn_min, turn_max,
+                             drift_max, chord_min, run_max, skitter_radius, max_vertices, out);
+    PyObject *result = PyBytes_FromStringAndSize((const char *)out, (Py_ssize_t)(sizeof(double) * 2 * (size_t)m));
+    PyMem_Free(g.block);
     PyBuffer_Release(&buffer);
     return result;
 }
@@ -1722,6 +1752,121 @@ static PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssiz
     return PyFloat_FromDouble(best);
 }
 
+/* ===========================================================================
+ * A run of growths on one terrain: _growth.motion_bounds, SpatialUncertaintyMap.grow
+ * (polygon, _growth.grow_wedge, centre) and HeadingWedge._trusted's wrap, operation for
+ * operation, for each command in turn. One call replaces a Python loop of grows.
+ * ========================================================================= */
+
+/* _growth._clip */
+static double clip_to(double value, double lo, double hi) { return value < lo ? lo : value > hi ? hi : value; }
+
+/* HeadingWedge._trusted's wrap of an unwrapped centre to (-pi, pi]. */
+static double wrap_center(double center) {
+    double wrapped = M_PI - floor_mod(M_PI - center, TWO_PI);
+    return wrapped <= -M_PI ? wrapped + TWO_PI : wrapped;
+}
+
+static PyObject *grow_commands(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {
+        "center_x",      "center_y",      "wedge_center",    "wedge_cw",      "wedge_ccw",
+        "rotation_loss", "rotation_sd",   "translation_loss", "translation_sd", "translation_inertial_loss",
+        "drift",         "skitter",       "skitter_sd",      "sigmas"};
+    enum { DOUBLES = sizeof(names) / sizeof(names[0]) };
+    if (nargs != DOUBLES + 3) {
+        PyErr_Format(PyExc_TypeError, "grow_commands: expected %d arguments, got %zd", DOUBLES + 3, nargs);
+        return NULL;
+    }
+    double a[DOUBLES];
+    Py_ssize_t max_vertices, n;
+    if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 2], &max_vertices) < 0)
+        return NULL;
+    PyObject *commands = PySequence_Fast(args[DOUBLES + 1], "commands: expected a sequence of numbers");
+    if (!commands) return NULL;
+    Py_ssize_t values = PySequence_Fast_GET_SIZE(commands);
+    if (values % 2 != 0) {
+        PyErr_Format(PyExc_ValueError, "commands: expected (turn, run) pairs, got %zd numbers", values);
+        Py_DECREF(commands);
+        return NULL;
+    }
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) {
+        Py_DECREF(commands);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    Growth g = {0};
+    double *ping;
+    /* The polygon alternates between two buffers, each with the growth's capacity. */
+    if (growth_alloc(&g, n > max_vertices ? n : max_vertices, 2, &ping) < 0) goto done;
+    double *pong = ping + 2 * g.capacity;
+    memcpy(ping, view.buf, sizeof(double) * 2 * (size_t)n);
+    double x = a[0], y = a[1], center = a[2], cw = a[3], ccw = a[4];
+    const double rotation_loss = a[5], rotation_sd = a[6], translation_loss = a[7], translation_sd = a[8];
+    const double inertial = a[9], drift = a[10], skitter = a[11], skitter_sd = a[12], sigmas = a[13];
+    double unwrapped = center;
+    PyObject **items = PySequence_Fast_ITEMS(commands);
+    for (Py_ssize_t i = 0; i < values; i += 2) {
+        double turn = PyFloat_AsDouble(items[i]), run = PyFloat_AsDouble(items[i + 1]);
+        if (PyErr_Occurred()) goto done;
+        if (!isfinite(turn) || !isfinite(run)) {
+            PyErr_Format(PyExc_ValueError, "commands: expected finite numbers, got %R, %R at pair %zd", items[i],
+                         items[i + 1], i / 2);
+            goto done;
+        }
+        /* _growth.motion_bounds */
+        double rotation_kept = 1.0 - rotation_loss, rotation_spread = sigmas * rotation_sd;
+        double fraction_lo = clip_to(rotation_kept - rotation_spread, 0.0, 1.0);
+        double fraction_hi = clip_to(rotation_kept + rotation_spread, 0.0, 1.0);
+        double fraction_mean = clip_to(rotation_kept, 0.0, 1.0);
+        double ta = turn * fraction_lo, tb = turn * fraction_hi;
+        double run_kept = 1.0 - translation_loss, run_spread = sigmas * translation_sd;
+        double run_lo = clip_to(run * (run_kept - run_spread) - inertial, 0.0, run);
+        double run_hi = clip_to(run * (run_kept + run_spread) - inertial, 0.0, run);
+        double run_mean = clip_to(run * run_kept - inertial, 0.0, run);
+        double drift_max = drift * run_hi, chord_min;
+        if (drift == 0.0)
+            chord_min = run_lo;
+        else if (drift_max <= M_PI)
+            chord_min = 2.0 * sin(drift * run_lo / 2.0) / drift;
+        else
+            chord_min = 0.0;
+        double turn_min = lesser(ta, tb), turn_max = greater(ta, tb), turn_mean = turn * fraction_mean;
+        double skitter_bound = skitter + sigmas * skitter_sd;
+        double skitter_radius = fabs(turn) * (skitter_bound > 0.0 ? skitter_bound : 0.0);
+        /* SpatialUncertaintyMap.grow */
+        double heading_lo = center - cw;
+        n = grow_step(&g, ping, n, heading_lo, heading_lo + cw + ccw, turn_min, turn_max, drift_max, chord_min,
+                      run_hi, skitter_radius, max_vertices, pong);
+        double *swap = ping;
+        ping = pong;
+        pong = swap;
+        /* _growth.grow_wedge */
+        unwrapped = center + turn_mean;
+        double new_cw = cw + (turn_mean - turn_min) + drift_max;
+        double new_ccw = ccw + (turn_max - turn_mean) + drift_max;
+        if (new_cw + new_ccw >= TWO_PI) {
+            cw = M_PI;
+            ccw = M_PI;
+        } else {
+            cw = new_cw;
+            ccw = new_ccw;
+        }
+        x = x + run_mean * cos(unwrapped);
+        y = y + run_mean * sin(unwrapped);
+        center = wrap_center(unwrapped);
+    }
+    /* The last centre unwrapped: HeadingWedge._trusted wraps it (wrapping twice may move it). */
+    result = Py_BuildValue("(y#ddddd)", (const char *)ping, (Py_ssize_t)(sizeof(double) * 2 * (size_t)n), x, y,
+                           unwrapped, cw, ccw);
+done:
+    if (g.block) PyMem_Free(g.block);
+    PyBuffer_Release(&view);
+    Py_DECREF(commands);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"grow_polygon", grow_polygon, METH_VARARGS,
      "grow_polygon(vertices, heading_lo, heading_hi, turn_min, turn_max, drift_max, chord_min, run_max, "
@@ -1739,6 +1884,11 @@ static PyMethodDef methods[] = {
      "base_by, radius, heading_lo, heading_width, arc_step, r00, r01, r02, r10, r11, r12, r20, r21, r22, forward, "
      "left, dz_lo, dz_hi, cut_plane) -> None (behind the camera) or (bytes of (k, 2) float64 normalized points, "
      "x_min, y_min, x_max, y_max)"},
+    {"grow_commands", (PyCFunction)(void (*)(void))grow_commands, METH_FASTCALL,
+     "grow_commands(vertices, center_x, center_y, wedge_center, wedge_cw, wedge_ccw, rotation_loss, rotation_sd, "
+     "translation_loss, translation_sd, translation_inertial_loss, drift, skitter, skitter_sd, sigmas, commands, "
+     "max_vertices) -> (vertex bytes, center_x, center_y, wedge_center unwrapped, wedge_cw, wedge_ccw) after "
+     "growing by each (turn, run) of the flat sequence commands in turn"},
     {"polygon_distance", (PyCFunction)(void (*)(void))polygon_distance, METH_FASTCALL,
      "polygon_distance(vertices, ax, ay, bx, by) -> distance from the convex polygon to the segment [a, b]"},
     {NULL, NULL, 0, NULL},

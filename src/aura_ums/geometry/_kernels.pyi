@@ -1,3 +1,5 @@
+from collections.abc import Sequence
+
 from typing_extensions import Buffer
 
 def grow_polygon(
@@ -85,3 +87,23 @@ def expecter_points(
     /,
 ) -> tuple[bytes, float, float, float, float] | None: ...
 def polygon_distance(vertices: Buffer, ax: float, ay: float, bx: float, by: float, /) -> float: ...
+def grow_commands(
+    vertices: Buffer,
+    center_x: float,
+    center_y: float,
+    wedge_center: float,
+    wedge_cw: float,
+    wedge_ccw: float,
+    rotation_loss: float,
+    rotation_sd: float,
+    translation_loss: float,
+    translation_sd: float,
+    translation_inertial_loss: float,
+    drift: float,
+    skitter: float,
+    skitter_sd: float,
+    sigmas: float,
+    commands: Sequence[float],
+    max_vertices: int,
+    /,
+) -> tuple[bytes, float, float, float, float, float]: ...

@@ -467,6 +467,17 @@ class UncertaintyMapManager:
         map_time: float | None,
     ) -> tuple[SpatialUncertaintyMap, float | None]:
         """Grow by ``reports[start:stop]``; return the map and the last report's time."""
+        if start == stop:
+            return current, map_time
+        terrain = self._only_terrain
+        if terrain is None and len(self._meadow_map.meadows) == 1:
+            # One meadow, one terrain: there is nothing to split the runs by (and a run that
+            # leaves it would fall back to this terrain anyway). Both are immutable: look
+            # the terrain up once (here, so that a missing one fails where it always did).
+            terrain = self._only_terrain = self._table[self._meadow_map.meadows[0].terrain]
+        if terrain is not None:
+            commands = [reports[index].command for index in range(start, stop)]
+            return current._grow_many(commands, terrain, self._sigmas), reports[stop - 1].time
         for index in range(start, stop):
             report = reports[index]
             current = self._grow_one(current, report.command)
@@ -474,16 +485,6 @@ class UncertaintyMapManager:
         return current, map_time
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
-        terrain = self._only_terrain
-        if terrain is not None:
-            return current.grow(command, terrain, sigmas=self._sigmas)
-        meadows = self._meadow_map.meadows
-        if len(meadows) == 1:
-            # One meadow, one terrain: there is nothing to split the run by (and a run that
-            # leaves it would fall back to this terrain anyway). Both are immutable: look
-            # the terrain up once (here, so that a missing one fails where it always did).
-            terrain = self._only_terrain = self._table[meadows[0].terrain]
-            return current.grow(command, terrain, sigmas=self._sigmas)
         pose = current.most_probable_pose()
         if command.run <= RUN_TOLERANCE:
             # A run too short to cut by meadows: whole, on the start meadow's terrain.

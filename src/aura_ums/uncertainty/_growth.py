@@ -19,15 +19,22 @@ from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _compiled_grow_polygon: Callable[..., bytes] | None
-try:  # the compiled kernel, when the build had a C compiler
+_compiled_grow_commands: Callable[..., tuple[bytes, float, float, float, float, float]] | None
+try:  # the compiled kernels, when the build had a C compiler
+    from aura_ums.geometry._kernels import grow_commands as _compiled_grow_commands
     from aura_ums.geometry._kernels import grow_polygon as _compiled_grow_polygon
 except ImportError:  # pragma: no cover - exercised on machines without a compiler
-    _compiled_grow_polygon = None
+    _compiled_grow_polygon = _compiled_grow_commands = None
 
 
 def compiled_kernel() -> Callable[..., bytes] | None:
     """Return the compiled growth kernel, or None when the extension was not built."""
     return _compiled_grow_polygon
+
+
+def compiled_sequence_kernel() -> Callable[..., tuple[bytes, float, float, float, float, float]] | None:
+    """Return the compiled kernel of a run of growths on one terrain, or None when not built."""
+    return _compiled_grow_commands
 
 
 #: Largest vertex count a grown map keeps; beyond it an outer approximation merges edges.
