@@ -25,10 +25,9 @@ from collections.abc import Callable
 from typing import TypedDict
 
 import numpy as np
-from filterpy.kalman import ExtendedKalmanFilter as FilterpyEkf
 from numpy.typing import NDArray
 
-from aura_ums.baselines import ExtendedKalmanFilter, ParticleFilter, motion_moments
+from aura_ums.baselines import ExtendedKalmanFilter, ParticleFilter
 from aura_ums.geometry import HeadingWedge, regular_polygon
 from aura_ums.uncertainty import (
     BearingObservation,
@@ -36,11 +35,11 @@ from aura_ums.uncertainty import (
     Pose,
     RangeBearingObservation,
     SpatialUncertaintyMap,
-    TerrainStats,
     TerrainTable,
     TurnAndRun,
     VerticalLineLandmark,
 )
+from filterpy_ekf import FilterpyPose, filterpy_predict, jacobian, measure, residual
 
 Array = NDArray[np.float64]
 
@@ -105,65 +104,22 @@ SDS: Sds = {
 }
 
 
-# --- filterpy with the same model -------------------------------------------------------------
+# --- filterpy with the same model (benchmarks/filterpy_ekf.py) ---------------------------------
 
 
-class FilterpyPose(FilterpyEkf):  # type: ignore[misc]
-    """filterpy's EKF on (x, y, heading); ``predict_x`` moves the mean by the model's mean motion."""
-
-    x: Array
-
-    def __init__(self) -> None:
-        super().__init__(dim_x=3, dim_z=2)
-        self.motion = (0.0, 0.0)
-
-    def predict_x(self, u: object = 0) -> None:
-        turn_mean, run_mean = self.motion
-        heading = float(self.x[2]) + turn_mean
-        self.x = np.array(
-            [
-                self.x[0] + run_mean * math.cos(heading),
-                self.x[1] + run_mean * math.sin(heading),
-                math.remainder(heading, 2 * math.pi),
-            ]
-        )
+def _measure(x: Array) -> Array:
+    return measure(x, LANDMARK)
 
 
-def filterpy_predict(ekf: FilterpyPose, command: TurnAndRun, terrain: TerrainStats) -> None:
-    moments = motion_moments(terrain, command)
-    heading = float(ekf.x[2]) + moments.turn_mean
-    c, s, m = math.cos(heading), math.sin(heading), moments.run_mean
-    ekf.F = np.array([[1.0, 0.0, -m * s], [0.0, 1.0, m * c], [0.0, 0.0, 1.0]])
-    noise = np.array([[-m * s, c, -m * s / 2], [m * c, s, m * c / 2], [1.0, 0.0, 1.0]])
-    variances = np.diag([moments.turn_var, moments.run_var, moments.drift_var])
-    ekf.Q = noise @ variances @ noise.T + np.diag([moments.skitter_var, moments.skitter_var, 0.0])
-    ekf.motion = (moments.turn_mean, moments.run_mean)
-    ekf.predict()
-
-
-def measure(x: Array) -> Array:
-    dx, dy = LANDMARK[0] - x[0], LANDMARK[1] - x[1]
-    return np.array([math.hypot(dx, dy), math.atan2(dy, dx) - x[2]])
-
-
-def jacobian(x: Array) -> Array:
-    dx, dy = LANDMARK[0] - x[0], LANDMARK[1] - x[1]
-    q = dx * dx + dy * dy
-    r = math.sqrt(q)
-    return np.array([[-dx / r, -dy / r, 0.0], [dy / q, -dx / q, -1.0]])
-
-
-def residual(a: Array, b: Array) -> Array:
-    y = a - b
-    y[-1] = math.remainder(float(y[-1]), 2 * math.pi)
-    return y
+def _jacobian(x: Array) -> Array:
+    return jacobian(x, LANDMARK)
 
 
 def filterpy_bearing(ekf: FilterpyPose, observation: BearingObservation) -> None:
     ekf.update(
         np.array([observation.bearing]),
-        lambda x: jacobian(x)[1:],
-        lambda x: measure(x)[1:],
+        lambda x: _jacobian(x)[1:],
+        lambda x: _measure(x)[1:],
         R=np.array([[SDS["bearing_sd"] ** 2]]),
         residual=residual,
     )
@@ -172,7 +128,7 @@ def filterpy_bearing(ekf: FilterpyPose, observation: BearingObservation) -> None
 def filterpy_range_bearing(ekf: FilterpyPose, observation: RangeBearingObservation) -> None:
     z = np.array([0.5 * (observation.range_min + observation.range_max), observation.bearing])
     r = np.diag([SDS["range_sd"] ** 2, SDS["bearing_sd"] ** 2])
-    ekf.update(z, jacobian, measure, R=r, residual=residual)
+    ekf.update(z, _jacobian, _measure, R=r, residual=residual)
 
 
 # --- the run ----------------------------------------------------------------------------------
