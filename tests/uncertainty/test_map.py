@@ -316,3 +316,20 @@ def test_simulate_containment_refuses_zero_poses(
 ) -> None:
     with pytest.raises(InputError, match=r"poses: expected at least 1, got 0"):
         simulate_containment(point_map, [], rng, poses=0)
+
+
+@given(st.floats(-50, 50), st.floats(-50, 50), st.floats(-4.0, 4.0), st.floats(0.0, 0.3))
+def test_most_probable_pose_is_built_once_and_equals_a_fresh_pose(
+    x: float, y: float, heading: float, halfwidth: float
+) -> None:
+    """The cached pose is the validated one: the centre and the wedge's (wrapped) centre."""
+    start = SpatialUncertaintyMap.from_pose(Pose(x, y, heading), 0.2, halfwidth)
+    grown = start.grow(TurnAndRun(0.3, 1.0), TerrainTable.default()["grass"])
+    for uncertainty_map in (start, grown):
+        pose = uncertainty_map.most_probable_pose()
+        fresh = Pose(
+            float(uncertainty_map.center[0]), float(uncertainty_map.center[1]), uncertainty_map.wedge.center
+        )
+        assert pose == fresh
+        assert uncertainty_map.most_probable_pose() is pose
+    assert grown.most_probable_pose() != start.most_probable_pose()

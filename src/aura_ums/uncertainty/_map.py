@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import overload
 
 import numpy as np
@@ -60,6 +60,9 @@ class SpatialUncertaintyMap:
     polygon: ConvexPolygon
     center: NDArray[np.float64]
     wedge: HeadingWedge
+    # The most probable pose, built on first use: the Expecter, the schemas and the
+    # manager's meadow lookups ask for it several times per frame.
+    _pose: Pose | None = field(init=False, repr=False, compare=False)
 
     def __init__(self, polygon: ConvexPolygon, center: ArrayLike, wedge: HeadingWedge) -> None:
         if not isinstance(polygon, ConvexPolygon):
@@ -74,6 +77,7 @@ class SpatialUncertaintyMap:
         object.__setattr__(self, "polygon", polygon)
         object.__setattr__(self, "center", read_only(point[0].copy()))
         object.__setattr__(self, "wedge", wedge)
+        object.__setattr__(self, "_pose", None)
 
     @classmethod
     def _trusted(
@@ -85,6 +89,7 @@ class SpatialUncertaintyMap:
         _set_polygon(result, polygon)
         _set_center(result, center)
         _set_wedge(result, wedge)
+        _set_pose(result, None)
         return result
 
     @classmethod
@@ -130,7 +135,11 @@ class SpatialUncertaintyMap:
 
     def most_probable_pose(self) -> Pose:
         """Return the map's centre and most probable heading as a Pose."""
-        return Pose(float(self.center[0]), float(self.center[1]), self.wedge.center)
+        pose = self._pose
+        if pose is None:
+            pose = Pose(float(self.center[0]), float(self.center[1]), self.wedge.center)
+            _set_pose(self, pose)
+        return pose
 
     def grow(
         self,
@@ -353,4 +362,7 @@ _set_center: Callable[[SpatialUncertaintyMap, NDArray[np.float64]], None] = Spat
 ].__set__
 _set_wedge: Callable[[SpatialUncertaintyMap, HeadingWedge], None] = SpatialUncertaintyMap.__dict__[
     "wedge"
+].__set__
+_set_pose: Callable[[SpatialUncertaintyMap, Pose | None], None] = SpatialUncertaintyMap.__dict__[
+    "_pose"
 ].__set__
