@@ -422,12 +422,12 @@ def _check_camera(camera: object, bounds: object) -> tuple[Camera, CalibrationBo
     if not isinstance(bounds, CalibrationBounds):
         raise InputError(f"bounds: expected CalibrationBounds, got {type(bounds).__name__}")
     k = camera.intrinsics
-    for name in ("fx", "fy"):
-        if getattr(bounds, name) >= getattr(k, name):
-            raise InputError(
-                f"bounds.{name}: expected less than the focal length {name} ({getattr(k, name)}), "
-                f"got {getattr(bounds, name)}"
-            )
+    if bounds.fx >= k.fx or bounds.fy >= k.fy:
+        name = "fx" if bounds.fx >= k.fx else "fy"
+        raise InputError(
+            f"bounds.{name}: expected less than the focal length {name} ({getattr(k, name)}), "
+            f"got {getattr(bounds, name)}"
+        )
     return camera, bounds
 
 

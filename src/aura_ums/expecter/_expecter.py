@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 from aura_ums.camera import NEAR_PLANE, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter._distortion import distorted_range
-from aura_ums.expecter._window import PerceptualStrategy, margin_pixels
+from aura_ums.expecter._window import PerceptualStrategy, margin_pixels, trusted_window
 from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow, convex_hull, minkowski_sum, outer_disk
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -237,7 +237,7 @@ def _pixel_window(
     fx: float, fy: float, cx: float, cy: float, x_lo: float, y_lo: float, x_hi: float, y_hi: float
 ) -> ImageWindow:
     """Pixels of a box of normalized coordinates (fx, fy > 0: monotone), pushed outward."""
-    return ImageWindow(
+    return trusted_window(
         _outward(fx * x_lo + cx, -1.0),
         _outward(fy * y_lo + cy, -1.0),
         _outward(fx * x_hi + cx, 1.0),

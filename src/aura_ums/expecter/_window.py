@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import enum
+import math
 import types
 from collections.abc import Mapping
 
 from aura_ums._validate import nonnegative_float
+from aura_ums.geometry import ImageWindow
 
 
 class PerceptualStrategy(enum.Enum):
@@ -51,3 +53,21 @@ def margin_pixels(margin: float | PerceptualStrategy) -> float:
     if isinstance(margin, PerceptualStrategy):
         return DEFAULT_MARGINS[margin]
     return nonnegative_float(margin, "margin")
+
+
+def trusted_window(u_min: float, v_min: float, u_max: float, v_max: float) -> ImageWindow:
+    """Build an :class:`ImageWindow` from bounds computed inside aura-ums, skipping validation.
+
+    For internal paths only: the bounds must be Python floats. Bounds that are not finite
+    or out of order go through the validated constructor, which raises; otherwise the
+    result equals ``ImageWindow(u_min, v_min, u_max, v_max)``.
+    """
+    if not (-math.inf < u_min <= u_max < math.inf and -math.inf < v_min <= v_max < math.inf):
+        return ImageWindow(u_min, v_min, u_max, v_max)
+    window = object.__new__(ImageWindow)
+    setattr_ = object.__setattr__
+    setattr_(window, "u_min", u_min)
+    setattr_(window, "v_min", v_min)
+    setattr_(window, "u_max", u_max)
+    setattr_(window, "v_max", v_max)
+    return window
