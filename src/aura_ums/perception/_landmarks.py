@@ -130,7 +130,12 @@ def evaluate_vertical_line(
     _check_lines(lines)
     target = finite_float(orientation, "orientation")
     limit = nonnegative_float(tolerance, "tolerance")
-    return _best_line(lines, angle_difference(lines.orientation, target) <= limit)
+    return strongest_within(lines, target, limit)
+
+
+def strongest_within(lines: LineSegments, orientation: float, tolerance: float) -> LineEvidence:
+    """:func:`evaluate_vertical_line` on checked arguments (a float orientation and tolerance >= 0)."""
+    return _best_line(lines, angle_difference(lines.orientation, orientation) <= tolerance)
 
 
 def evaluate_path_edge(

@@ -41,7 +41,7 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
 from aura_ums.perception._opencv import import_cv2
-from aura_ums.perception._segments import LineSegments, angle_difference
+from aura_ums.perception._segments import LineSegments
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 
@@ -199,10 +199,13 @@ class FastLineFinder:
         segments += np.array([crop.inner_u0, crop.inner_v0, crop.inner_u0, crop.inner_v0], dtype=np.float64)
         du, dv = segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1]
         length = np.hypot(du, dv)
-        keep = (length >= self.min_length) & (contrast >= self.min_contrast)
+        keep = length >= self.min_length
+        if self.min_contrast > 0.0:  # contrasts are means of magnitudes: never below 0
+            keep &= contrast >= self.min_contrast
         if self.orientation is not None:
-            direction = np.mod(np.arctan2(dv, du), math.pi)
-            keep &= angle_difference(direction, self.orientation) <= self.tolerance
+            # angle_difference(direction, orientation) <= tolerance, operation for operation.
+            turn = np.mod(np.mod(np.arctan2(dv, du), math.pi) - self.orientation, math.pi)
+            keep &= np.minimum(turn, math.pi - turn) <= self.tolerance
         kept = np.flatnonzero(keep)
         order = kept[np.argsort(-(length[kept] * contrast[kept]), kind="stable")]
         return LineSegments._trusted(segments[order], contrast[order])
@@ -306,14 +309,21 @@ class FastLineFinder:
         theta = np.mod(0.5 * np.arctan2(2.0 * sxy, sxx - syy), math.pi)
         ux, uy = np.cos(theta), np.sin(theta)
         t = dx * ux[lab] + dy * uy[lab]
-        t_min = np.full(n, np.inf)
-        t_max = np.full(n, -np.inf)
+        t_min = np.empty(n)
+        t_min.fill(np.inf)
+        t_max = np.empty(n)
+        t_max.fill(-np.inf)
         np.minimum.at(t_min, lab, t)
         np.maximum.at(t_max, lab, t)
         rx, ry, rux, ruy = cx[region], cy[region], ux[region], uy[region]
         lo, hi = t_min[region], t_max[region]
-        segments = np.column_stack([rx + lo * rux, ry + lo * ruy, rx + hi * rux, ry + hi * ruy])
-        return region.astype(np.int64), sizes[region], segments, w_sum[region] / sizes[region]
+        segments = np.empty((region.size, 4))
+        segments[:, 0] = rx + lo * rux
+        segments[:, 1] = ry + lo * ruy
+        segments[:, 2] = rx + hi * rux
+        segments[:, 3] = ry + hi * ruy
+        counts = sizes[region]
+        return region.astype(np.int64), counts, segments, w_sum[region] / counts
 
     def _tuned(
         self,
