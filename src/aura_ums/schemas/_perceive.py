@@ -40,14 +40,15 @@ from aura_ums.camera import (
 )
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow, PerceptualStrategy
+from aura_ums.expecter._window import trusted_window
 from aura_ums.perception import (
     FastLineFinder,
     MoravecOperator,
     RegionSegmenter,
     evaluate_corner,
     evaluate_path_edge,
-    evaluate_vertical_line,
 )
+from aura_ums.perception._landmarks import strongest_within
 from aura_ums.schemas._state import Detection
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -190,7 +191,7 @@ def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: 
 
 
 def _box(u1: float, v1: float, u2: float, v2: float) -> ImageWindow:
-    return ImageWindow(min(u1, u2), min(v1, v2), max(u1, u2), max(v1, v2))
+    return trusted_window(min(u1, u2), min(v1, v2), max(u1, u2), max(v1, v2))
 
 
 def detect(
@@ -200,11 +201,13 @@ def detect(
     window: ImageWindow,
     *,
     camera: Camera,
-    map: SpatialUncertaintyMap,
+    pose: Pose,
     time: float,
 ) -> tuple[float, Detection | None]:
-    """Run the strategy on the window only and evaluate what it found; ``(value, detection or None)``."""
-    pose = map.most_probable_pose()
+    """Run the strategy on the window only and evaluate what it found; ``(value, detection or None)``.
+
+    ``pose`` is the map's most probable pose (the detection's reference for motion prediction).
+    """
     landmark = record.landmark
     if isinstance(detector, FastLineFinder):
         if isinstance(landmark, GroundLineLandmark):
@@ -224,7 +227,8 @@ def detect(
         else:
             orientation = math.pi / 2 if detector.orientation is None else detector.orientation
             lines = detector.find_detailed(image, window)
-            evidence = evaluate_vertical_line(lines, orientation=orientation, tolerance=detector.tolerance)
+            # evaluate_vertical_line without re-checking what the detector validated.
+            evidence = strongest_within(lines, orientation, detector.tolerance)
         if evidence.segment is None or evidence.point is None:
             return evidence.value, None
         u1, v1, u2, v2 = (float(c) for c in evidence.segment)

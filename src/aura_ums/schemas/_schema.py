@@ -9,6 +9,7 @@ from aura_ums._validate import nonnegative_float
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
 from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow
+from aura_ums.expecter._window import trusted_window
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._perceive import (
     Detector,
@@ -34,7 +35,7 @@ def _grown_clipped(window: ImageWindow, margin: float, width: int, height: int) 
     u1, v1 = min(window.u_max + margin, width - 0.5), min(window.v_max + margin, height - 0.5)
     if u0 > u1 or v0 > v1:
         return None
-    return ImageWindow(u0, v0, u1, v1)
+    return trusted_window(u0, v0, u1, v1)
 
 
 def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWindow:
@@ -50,7 +51,7 @@ def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWi
     ImageWindow(u_min=-0.5, v_min=-0.5, u_max=639.5, v_max=479.5)
     """
     if math.isinf(scale):
-        return ImageWindow(-0.5, -0.5, width - 0.5, height - 0.5)
+        return trusted_window(-0.5, -0.5, width - 0.5, height - 0.5)
     du = 0.5 * (scale - 1.0) * (window.u_max - window.u_min)
     dv = 0.5 * (scale - 1.0) * (window.v_max - window.v_min)
     wide = ImageWindow(window.u_min - du, window.v_min - dv, window.u_max + du, window.v_max + dv)
@@ -244,30 +245,18 @@ class FindLandmarkSchema:
         elif not isinstance(status, SchemaStatus):
             raise InputError(f"status: expected a SchemaStatus or None, got {type(status).__name__}")
         k = self.expecter.camera.intrinsics
-        if (frame.width, frame.height) != (k.width, k.height):
+        height, width = frame.image.shape
+        if width != k.width or height != k.height:
             raise InputError(
-                f"frame.image: expected the camera's {k.width}x{k.height} image, "
-                f"got {frame.width}x{frame.height}"
+                f"frame.image: expected the camera's {k.width}x{k.height} image, got {width}x{height}"
             )
-        ident = self.record.id
         if not self.is_active(frame):
-            return SchemaReport(ident, SchemaStatus(SchemaState.HIBERNATING), None, None, False, None, None)
+            return SchemaReport(
+                self.record.id, SchemaStatus(SchemaState.HIBERNATING), None, None, False, None, None
+            )
         # The guaranteed bounds go into the report too, so that the manager's ambiguity
         # check reuses them instead of asking the Expecter again.
-        bounds = self.expecter.bounds(frame.map, self.record.landmark)
-        report = self._step_awake(frame, status, bounds)
-        if bounds is None:
-            return report
-        return SchemaReport(
-            report.landmark_id,
-            report.status,
-            report.window,
-            report.value,
-            report.hit,
-            report.observation,
-            report.detection,
-            bounds,
-        )
+        return self._step_awake(frame, status, self.expecter.bounds(frame.map, self.record.landmark))
 
     def _step_awake(self, frame: Frame, status: SchemaStatus, bounds: ImageWindow | None) -> SchemaReport:
         k = self.expecter.camera.intrinsics
@@ -276,9 +265,11 @@ class FindLandmarkSchema:
         if guaranteed is not None and frame.window_scale != 1.0:
             guaranteed = widen(guaranteed, frame.window_scale, k.width, k.height)
         if status.state is SchemaState.TRACKING and status.detection is not None:
-            return self._track(frame, status, status.detection, guaranteed)
+            return self._track(frame, status, status.detection, guaranteed, bounds)
         if guaranteed is None:  # awake, but the landmark cannot be in view
-            return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
+            return SchemaReport(
+                ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None, bounds
+            )
         search: ImageWindow | None = guaranteed
         following = status.state is SchemaState.DISCOVERING and status.hits > 0
         if following and status.detection is not None and not math.isinf(frame.window_scale):
@@ -289,19 +280,24 @@ class FindLandmarkSchema:
         value, detection, observation = self._look(frame, search)
         if detection is None or observation is None:
             return SchemaReport(
-                ident, SchemaStatus(SchemaState.DISCOVERING), search, value, False, None, None
+                ident, SchemaStatus(SchemaState.DISCOVERING), search, value, False, None, None, bounds
             )
         hits = status.hits + 1 if status.state is SchemaState.DISCOVERING else 1
         if hits >= self.record.confirm_frames:
             confirmed = SchemaStatus(SchemaState.TRACKING, hits, 0, detection)
-            return SchemaReport(ident, confirmed, search, value, True, observation, detection)
+            return SchemaReport(ident, confirmed, search, value, True, observation, detection, bounds)
         pending = SchemaStatus(SchemaState.DISCOVERING, hits, 0, detection)
-        return SchemaReport(ident, pending, search, value, True, None, detection)
+        return SchemaReport(ident, pending, search, value, True, None, detection, bounds)
 
     # -- internals ---------------------------------------------------------------------
 
     def _track(
-        self, frame: Frame, status: SchemaStatus, last: Detection, guaranteed: ImageWindow | None
+        self,
+        frame: Frame,
+        status: SchemaStatus,
+        last: Detection,
+        guaranteed: ImageWindow | None,
+        bounds: ImageWindow | None,
     ) -> SchemaReport:
         ident = self.record.id
         if guaranteed is not None and math.isinf(frame.window_scale):
@@ -309,18 +305,20 @@ class FindLandmarkSchema:
         else:
             window = None if guaranteed is None else self.tracking_window(frame, last, guaranteed)
         if guaranteed is None or window is None:  # left the view: discover again, not suspect
-            return SchemaReport(ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None)
+            return SchemaReport(
+                ident, SchemaStatus(SchemaState.DISCOVERING), None, None, False, None, None, bounds
+            )
         value, detection, observation = self._look(frame, window)
         if detection is not None and observation is not None:
             kept = SchemaStatus(SchemaState.TRACKING, status.hits + 1, 0, detection)
-            return SchemaReport(ident, kept, window, value, True, observation, detection)
+            return SchemaReport(ident, kept, window, value, True, observation, detection, bounds)
         misses = status.misses + 1
         if misses >= self.lost_frames:
             return SchemaReport(
-                ident, SchemaStatus(SchemaState.SUSPECT, 0, misses), window, value, False, None, None
+                ident, SchemaStatus(SchemaState.SUSPECT, 0, misses), window, value, False, None, None, bounds
             )
         waiting = SchemaStatus(SchemaState.TRACKING, status.hits, misses, last)
-        return SchemaReport(ident, waiting, window, value, False, None, None)
+        return SchemaReport(ident, waiting, window, value, False, None, None, bounds)
 
     def tracking_window(self, frame: Frame, last: Detection, guaranteed: ImageWindow) -> ImageWindow | None:
         """Return the window in which a tracked landmark is searched (see *Tracking window* above).
@@ -343,13 +341,19 @@ class FindLandmarkSchema:
         u1, v1 = min(u1, guaranteed.u_max), min(v1, guaranteed.v_max)
         if u0 > u1 or v0 > v1:
             return guaranteed
-        return ImageWindow(u0, v0, u1, v1)
+        return trusted_window(u0, v0, u1, v1)
 
     def _look(self, frame: Frame, window: ImageWindow) -> tuple[float, Detection | None, Observation | None]:
         """Run the strategy in the window; return the value, and the detection and observation of a hit."""
         camera = self.expecter.camera
         value, detection = detect(
-            self.detector, self.record, frame.image, window, camera=camera, map=frame.map, time=frame.time
+            self.detector,
+            self.record,
+            frame.image,
+            window,
+            camera=camera,
+            pose=frame.map.most_probable_pose(),
+            time=frame.time,
         )
         if detection is None or not value >= self.record.recognition_threshold or not math.isfinite(value):
             return value, None, None
