@@ -33,6 +33,13 @@ def nonnegative_float(value: object, name: str) -> float:
     return result
 
 
+def integer_at_least(value: object, name: str, minimum: int) -> int:
+    """Return ``value`` if it is an integer (not a bool) >= ``minimum``, or raise naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return value
+
+
 def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:
     """Return ``value`` as a finite ``(n, 2)`` float array, or raise naming ``name``."""
     try:

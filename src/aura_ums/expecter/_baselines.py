@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter._expecter import Expecter
 from aura_ums.expecter._window import PerceptualStrategy, margin_pixels
@@ -44,8 +44,7 @@ def disk_model_map(map: SpatialUncertaintyMap, *, sides: int = DISK_SIDES) -> Sp
     0.0
     """
     _check_map(map)
-    if isinstance(sides, bool) or not isinstance(sides, int) or sides < 3:
-        raise InputError(f"sides: expected an integer >= 3, got {sides!r}")
+    integer_at_least(sides, "sides", 3)
     center = np.asarray(map.center, dtype=np.float64)
     offsets = map.polygon.vertices - center
     radius = float(np.max(np.hypot(offsets[:, 0], offsets[:, 1])))

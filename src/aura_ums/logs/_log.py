@@ -12,7 +12,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, float_array, read_only
+from aura_ums._validate import finite_float, float_array, integer_at_least, read_only
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
@@ -261,8 +261,7 @@ class LogObservation:
             )
         if self.range_error is not None:
             object.__setattr__(self, "range_error", _bounded(self.range_error, "LogObservation.range_error"))
-        if isinstance(self.line, bool) or not isinstance(self.line, int) or self.line < 0:
-            raise InputError(f"LogObservation.line: expected an integer >= 0, got {self.line!r}")
+        integer_at_least(self.line, "LogObservation.line", 0)
 
     @property
     def kind(self) -> ObservationKind:

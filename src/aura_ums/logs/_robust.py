@@ -25,6 +25,7 @@ from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from aura_ums._validate import integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.manager import (
     REJECT_CLASS_MISMATCH,
@@ -131,8 +132,7 @@ class EnvelopeLocalizer:
         relocalize_window: int = 1,
     ) -> None:
         for name, value in (("relocalize_after", relocalize_after), ("relocalize_window", relocalize_window)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise InputError(f"{name}: expected an integer >= 1, got {value!r}")
+            integer_at_least(value, name, 1)
         if relocalize_window < relocalize_after:
             raise InputError(
                 f"relocalize_window: expected >= relocalize_after ({relocalize_after}), "

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog
 from aura_ums.manager import PositionReport
@@ -100,8 +100,7 @@ def synthetic_log(
     hz = finite_float(rate, "rate")
     if not hz > 0.0:
         raise InputError(f"rate: expected a positive number of commands per second, got {hz!r}")
-    if isinstance(frame_every, bool) or not isinstance(frame_every, int) or frame_every < 1:
-        raise InputError(f"frame_every: expected an integer >= 1, got {frame_every!r}")
+    integer_at_least(frame_every, "frame_every", 1)
     stats = TerrainTable.default()["tile"] if terrain is None else terrain
     if not isinstance(stats, TerrainStats):
         raise InputError(f"terrain: expected TerrainStats or None, got {type(stats).__name__}")

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import shapely
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
@@ -231,9 +231,7 @@ class UncertaintyMapManager:
         self._only_terrain: TerrainStats | None = None
         self._sigmas = _positive(sigmas, "sigmas")
         self._area_limit = None if area_limit is None else _positive(area_limit, "area_limit")
-        if isinstance(missed_limit, bool) or not isinstance(missed_limit, int) or missed_limit < 1:
-            raise InputError(f"missed_limit: expected an integer >= 1, got {missed_limit!r}")
-        self._missed_limit = missed_limit
+        self._missed_limit = integer_at_least(missed_limit, "missed_limit", 1)
         scale = finite_float(lost_window_scale, "lost_window_scale")
         if scale < 1.0:
             raise InputError(f"lost_window_scale: expected a number >= 1, got {scale!r}")

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from aura_ums._validate import nonnegative_float
 from aura_ums.camera import CalibrationBounds, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter import Expecter
 from aura_ums.manager import IdentifiedLandmarkBuffer
 from aura_ums.schemas._manager import SchemaManager
-from aura_ums.schemas._schema import DEFAULT_LOST_FRAMES, TRACKING_MARGIN, FindLandmarkSchema
+from aura_ums.schemas._schema import (
+    DEFAULT_LOST_FRAMES,
+    TRACKING_MARGIN,
+    FindLandmarkSchema,
+    check_tracking_settings,
+)
 from aura_ums.world import ShortTermMemory
 
 
@@ -75,15 +79,11 @@ class Pilot:
             raise InputError(
                 f"expecter: expected an Expecter for the pilot's camera, got one for {self.expecter.camera!r}"
             )
-        frames = self.lost_frames
-        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
-            raise InputError(f"lost_frames: expected an integer >= 1, got {frames!r}")
-        object.__setattr__(
-            self, "tracking_margin", nonnegative_float(self.tracking_margin, "tracking_margin")
+        margin, error = check_tracking_settings(
+            self.lost_frames, self.tracking_margin, self.pixel_error, self.bounds
         )
-        object.__setattr__(self, "pixel_error", nonnegative_float(self.pixel_error, "pixel_error"))
-        if self.bounds is not None and not isinstance(self.bounds, CalibrationBounds):
-            raise InputError(f"bounds: expected CalibrationBounds or None, got {type(self.bounds).__name__}")
+        object.__setattr__(self, "tracking_margin", margin)
+        object.__setattr__(self, "pixel_error", error)
 
     def schemas_for_leg(self, stm: ShortTermMemory) -> tuple[FindLandmarkSchema, ...]:
         """Return one slot-filled find-landmark schema per candidate landmark of ``stm``, in its order.

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from aura_ums._validate import nonnegative_float
+from aura_ums._validate import integer_at_least, nonnegative_float
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
 from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow
@@ -27,6 +27,22 @@ from aura_ums.world import LandmarkRecord
 TRACKING_MARGIN = 16.0
 #: Consecutive tracking frames without a match after which a tracked landmark becomes suspect.
 DEFAULT_LOST_FRAMES = 2
+
+
+def check_tracking_settings(
+    lost_frames: object, tracking_margin: object, pixel_error: object, bounds: object
+) -> tuple[float, float]:
+    """Check the tracking settings of a schema (and of the pilot that hands them on).
+
+    Returns ``(tracking_margin, pixel_error)`` as floats; raises :class:`InputError` naming
+    the bad one.
+    """
+    integer_at_least(lost_frames, "lost_frames", 1)
+    margin = nonnegative_float(tracking_margin, "tracking_margin")
+    error = nonnegative_float(pixel_error, "pixel_error")
+    if bounds is not None and not isinstance(bounds, CalibrationBounds):
+        raise InputError(f"bounds: expected CalibrationBounds or None, got {type(bounds).__name__}")
+    return margin, error
 
 
 def _grown_clipped(window: ImageWindow, margin: float, width: int, height: int) -> ImageWindow | None:
@@ -180,15 +196,11 @@ class FindLandmarkSchema:
             raise InputError(f"record: expected a LandmarkRecord, got {type(self.record).__name__}")
         if not isinstance(self.expecter, Expecter):
             raise InputError(f"expecter: expected an Expecter, got {type(self.expecter).__name__}")
-        frames = self.lost_frames
-        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
-            raise InputError(f"lost_frames: expected an integer >= 1, got {frames!r}")
-        object.__setattr__(
-            self, "tracking_margin", nonnegative_float(self.tracking_margin, "tracking_margin")
+        margin, error = check_tracking_settings(
+            self.lost_frames, self.tracking_margin, self.pixel_error, self.bounds
         )
-        object.__setattr__(self, "pixel_error", nonnegative_float(self.pixel_error, "pixel_error"))
-        if self.bounds is not None and not isinstance(self.bounds, CalibrationBounds):
-            raise InputError(f"bounds: expected CalibrationBounds or None, got {type(self.bounds).__name__}")
+        object.__setattr__(self, "tracking_margin", margin)
+        object.__setattr__(self, "pixel_error", error)
         object.__setattr__(self, "detector", build_detector(self.record))
         object.__setattr__(self, "margin", DEFAULT_MARGINS[self.record.strategy])
 

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtri
 
-from aura_ums._validate import nonnegative_float
+from aura_ums._validate import integer_at_least, nonnegative_float
 from aura_ums.camera import Camera, undistort_points
 from aura_ums.errors import InputError
 from aura_ums.sim._scene import Building, Pole, Scene
@@ -176,9 +176,7 @@ class SyntheticCamera:
         if not isinstance(rng, np.random.Generator):
             raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
         self._noise = nonnegative_float(noise, "noise")
-        if isinstance(clutter_lines, bool) or not isinstance(clutter_lines, int) or clutter_lines < 0:
-            raise InputError(f"clutter_lines: expected an integer >= 0, got {clutter_lines!r}")
-        self._clutter = clutter_lines
+        self._clutter = integer_at_least(clutter_lines, "clutter_lines", 0)
         self._camera = camera
         self._scene = scene
         self._rng = rng

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, read_only
+from aura_ums._validate import finite_float, integer_at_least, nonnegative_float, read_only
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
@@ -147,9 +147,7 @@ class LostLimits:
         area = float(self.area_limit) if isinstance(self.area_limit, (int, float)) else math.nan
         if isinstance(self.area_limit, bool) or not area > 0.0:
             raise InputError(f"LostLimits.area_limit: expected a positive number, got {self.area_limit!r}")
-        missed = self.missed_limit
-        if isinstance(missed, bool) or not isinstance(missed, int) or missed < 1:
-            raise InputError(f"LostLimits.missed_limit: expected an integer >= 1, got {missed!r}")
+        integer_at_least(self.missed_limit, "LostLimits.missed_limit", 1)
         object.__setattr__(self, "area_limit", area)
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
-from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
+from aura_ums._validate import finite_float, integer_at_least, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, VerticalLineLandmark
 from aura_ums.world import MeadowMap
@@ -323,8 +323,7 @@ def random_clutter(
     ...
     aura_ums.errors.InputError: count: expected an integer >= 0, got -1
     """
-    if isinstance(count, bool) or not isinstance(count, int) or count < 0:
-        raise InputError(f"count: expected an integer >= 0, got {count!r}")
+    integer_at_least(count, "count", 0)
     x0, y0, x1, y1 = (finite_float(v, "bounds") for v in bounds)
     centre = np.column_stack([rng.uniform(x0, x1, count), rng.uniform(y0, y1, count)])
     angle = rng.uniform(-math.pi, math.pi, count)

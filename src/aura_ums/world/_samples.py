@@ -8,7 +8,7 @@ from importlib import resources
 
 import numpy as np
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
@@ -94,8 +94,7 @@ def make_grid_world(
     aura_ums.errors.InputError: rows: expected an integer >= 1, got 0
     """
     for name, value in (("rows", rows), ("cols", cols)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise InputError(f"{name}: expected an integer >= 1, got {value!r}")
+        integer_at_least(value, name, 1)
     side = finite_float(cell, "cell")
     if side <= 0.0:
         raise InputError(f"cell: expected a positive number, got {side!r}")
