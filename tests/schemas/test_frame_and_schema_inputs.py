@@ -11,8 +11,8 @@ from schema_scenes import CAMERA, map_around, pole_record
 
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
-from aura_ums.expecter import DEFAULT_MARGINS, Expecter, PerceptualStrategy
-from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
+from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow, PerceptualStrategy
+from aura_ums.perception import FastLineFinder, LineSegments, MoravecOperator, RegionSegmenter
 from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaStatus
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, Pose, VerticalLineLandmark
 from aura_ums.world import LandmarkRecord
@@ -164,3 +164,34 @@ def test_schema_validates_its_arguments() -> None:
     with pytest.raises(InputError, match="status: expected a SchemaStatus or None, got str"):
         schema.step(frame, "tracking")  # type: ignore[arg-type]
     assert schema.step(frame, SchemaStatus()).value == 0.0  # a blank image: nothing fits
+
+
+def test_frame_lines_runs_each_finder_once_per_window(monkeypatch: pytest.MonkeyPatch) -> None:
+    image = np.zeros((60, 80), dtype=np.uint8)
+    image[:, 40:] = 200
+    frame = Frame(0.0, image, SNAPSHOT)
+    calls: list[tuple[FastLineFinder, ImageWindow]] = []
+    original = FastLineFinder.find_detailed
+
+    def counted(self: FastLineFinder, pixels: object, window: ImageWindow | None = None) -> LineSegments:
+        assert window is not None
+        calls.append((self, window))
+        return original(self, pixels, window)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(FastLineFinder, "find_detailed", counted)
+    whole, left = ImageWindow(-0.5, -0.5, 79.5, 59.5), ImageWindow(-0.5, -0.5, 30.5, 59.5)
+    vertical = FastLineFinder(orientation=math.pi / 2)
+    first = frame.lines(vertical, whole)
+    again = frame.lines(FastLineFinder(orientation=math.pi / 2), whole)  # equal, not the same object
+    assert again is first
+    assert len(calls) == 1
+    assert first.segments.tolist() == original(vertical, image, whole).segments.tolist()
+    assert first.segments.shape == (1, 4)
+    assert not first.segments.flags.writeable  # shared: nobody may change it
+    # Another window, or another finder, is another search.
+    assert frame.lines(vertical, left).segments.shape == (0, 4)
+    assert frame.lines(dataclasses.replace(vertical, min_length=70.0), whole).segments.shape == (0, 4)
+    assert len(calls) == 3
+    # Another frame of the same image searches again: nothing is shared across frames.
+    Frame(0.1, image, SNAPSHOT).lines(vertical, whole)
+    assert len(calls) == 4

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -11,6 +12,7 @@ from schema_scenes import CAMERA, assert_sound, map_around, pole_image, pole_rec
 from aura_ums.errors import InputError
 from aura_ums.expecter import Expecter
 from aura_ums.manager import IdentifiedLandmarkBuffer
+from aura_ums.perception import FastLineFinder, LineSegments
 from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaManager, SchemaState, StepReport
 from aura_ums.uncertainty import Pose, VerticalLineLandmark
 
@@ -172,3 +174,33 @@ def test_a_detection_inside_another_landmarks_bounds_is_withheld(rng: np.random.
     step = apart.step(Frame(1.0, pole_image(rng, TRUTH, [LEFT, RIGHT]), snapshot))
     assert {o.landmark_id for o in step.posted} == {"left_pole", "right_pole"}
     assert step.ambiguous == ()
+
+
+def test_full_frame_schemas_with_equal_finders_share_one_search(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    image = pole_image(rng, TRUTH, [LEFT, RIGHT])
+    snapshot = map_around(TRUTH)
+
+    def run() -> tuple[StepReport, int]:
+        calls = 0
+        original = FastLineFinder.find_detailed
+
+        def counted(self: FastLineFinder, *args: object, **kwargs: object) -> LineSegments:
+            nonlocal calls
+            calls += 1
+            return original(self, *args, **kwargs)  # type: ignore[arg-type]
+
+        with monkeypatch.context() as patch:
+            patch.setattr(FastLineFinder, "find_detailed", counted)
+            report = manager_for(LEFT, RIGHT).step(Frame(0.0, image, snapshot, window_scale=math.inf))
+        return report, calls
+
+    shared, shared_calls = run()
+    # The two schemas' finders are equal (the same record parameters) and both search the
+    # whole image: one line finding serves both, and both still find their pole.
+    assert shared_calls == 1
+    assert shared.found == ("left_pole", "right_pole")
+    windowed = manager_for(LEFT, RIGHT).step(Frame(0.0, image, snapshot))
+    assert windowed.found == shared.found
+    assert windowed.report("left_pole").window != windowed.report("right_pole").window

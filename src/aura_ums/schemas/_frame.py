@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError
+from aura_ums.expecter import ImageWindow
+from aura_ums.perception import FastLineFinder, LineSegments
 from aura_ums.uncertainty import SpatialUncertaintyMap
 
 
@@ -34,7 +36,9 @@ class Frame:
 
     Notes
     -----
-    Frames compare by identity (they hold an image array).
+    Frames compare by identity (they hold an image array). A frame remembers the lines
+    found in it (:meth:`lines`), so that schemas sharing a line finder and a window (the
+    full-frame baseline; windows widened to the whole image while lost) share its work.
 
     Raises
     ------
@@ -59,6 +63,7 @@ class Frame:
     image: NDArray[np.generic]
     map: SpatialUncertaintyMap
     window_scale: float
+    _lines: dict[tuple[FastLineFinder, ImageWindow], LineSegments] = field(repr=False)
 
     def __init__(
         self, time: float, image: ArrayLike, map: SpatialUncertaintyMap, *, window_scale: float = 1.0
@@ -87,6 +92,31 @@ class Frame:
         object.__setattr__(self, "image", array)
         object.__setattr__(self, "map", map)
         object.__setattr__(self, "window_scale", scale)
+        object.__setattr__(self, "_lines", {})
+
+    def lines(self, finder: FastLineFinder, window: ImageWindow) -> LineSegments:
+        """Return ``finder.find_detailed(self.image, window)``, computed once per equal finder and window.
+
+        The result is immutable (read-only arrays), so callers may share it.
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import Pose
+        >>> image = np.zeros((60, 80), dtype=np.uint8)
+        >>> image[:, 40:] = 200
+        >>> frame = Frame(0.0, image, SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.2, 0.05))
+        >>> whole = ImageWindow(-0.5, -0.5, 79.5, 59.5)
+        >>> first = frame.lines(FastLineFinder(orientation=np.pi / 2), whole)
+        >>> frame.lines(FastLineFinder(orientation=np.pi / 2), whole) is first    # equal finder: shared
+        True
+        >>> frame.lines(FastLineFinder(orientation=0.0), whole).segments.shape     # another finder
+        (0, 4)
+        """
+        key = (finder, window)
+        found = self._lines.get(key)
+        if found is None:
+            found = self._lines[key] = finder.find_detailed(self.image, window)
+        return found
 
     @property
     def width(self) -> int:

@@ -26,7 +26,6 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 import shapely
-from numpy.typing import NDArray
 
 from aura_ums.camera import (
     NEAR_PLANE,
@@ -49,6 +48,7 @@ from aura_ums.perception import (
     evaluate_path_edge,
 )
 from aura_ums.perception._landmarks import strongest_within
+from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._state import Detection
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -195,20 +195,16 @@ def _box(u1: float, v1: float, u2: float, v2: float) -> ImageWindow:
 
 
 def detect(
-    detector: Detector,
-    record: LandmarkRecord,
-    image: NDArray[np.generic],
-    window: ImageWindow,
-    *,
-    camera: Camera,
-    pose: Pose,
-    time: float,
+    detector: Detector, record: LandmarkRecord, frame: Frame, window: ImageWindow, *, camera: Camera
 ) -> tuple[float, Detection | None]:
-    """Run the strategy on the window only and evaluate what it found; ``(value, detection or None)``.
+    """Run the strategy on the frame's window only and evaluate what it found; ``(value, detection or None)``.
 
-    ``pose`` is the map's most probable pose (the detection's reference for motion prediction).
+    Lines come from :meth:`Frame.lines` (shared by schemas with an equal finder and
+    window). The detection's pose is the map's most probable pose (the reference for
+    motion prediction).
     """
     landmark = record.landmark
+    image, time, pose = frame.image, frame.time, frame.map.most_probable_pose()
     if isinstance(detector, FastLineFinder):
         if isinstance(landmark, GroundLineLandmark):
             expected = detector.orientation
@@ -220,13 +216,13 @@ def detect(
                 expected, tolerance = 0.0, math.pi / 2
             elif detector.orientation is None:
                 finder = dataclasses.replace(detector, orientation=expected)
-            lines = finder.find_detailed(image, window)
+            lines = frame.lines(finder, window)
             evidence = evaluate_path_edge(
                 lines, expected, tolerance=tolerance, min_length=detector.min_length
             )
         else:
             orientation = math.pi / 2 if detector.orientation is None else detector.orientation
-            lines = detector.find_detailed(image, window)
+            lines = frame.lines(detector, window)
             # evaluate_vertical_line without re-checking what the detector validated.
             evidence = strongest_within(lines, orientation, detector.tolerance)
         if evidence.segment is None or evidence.point is None:

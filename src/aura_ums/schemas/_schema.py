@@ -358,15 +358,7 @@ class FindLandmarkSchema:
     def _look(self, frame: Frame, window: ImageWindow) -> tuple[float, Detection | None, Observation | None]:
         """Run the strategy in the window; return the value, and the detection and observation of a hit."""
         camera = self.expecter.camera
-        value, detection = detect(
-            self.detector,
-            self.record,
-            frame.image,
-            window,
-            camera=camera,
-            pose=frame.map.most_probable_pose(),
-            time=frame.time,
-        )
+        value, detection = detect(self.detector, self.record, frame, window, camera=camera)
         if detection is None or not value >= self.record.recognition_threshold or not math.isfinite(value):
             return value, None, None
         try:
