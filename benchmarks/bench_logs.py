@@ -3,8 +3,8 @@
 Each step is one camera frame of the log: the growth (or prediction) by the position
 reports since the previous frame, then the frame's observations (built before the clock
 starts, for every method). All methods see the same reports and observations
-(aura_ums.logs.compare_on_log; filterpy's EKF through benchmarks/filterpy_ekf.py, the same
-model in numpy matrices with the same gate). Uses the MRCLAM Dataset 6 logs in
+(aura_ums.logs.compare_on_log; filterpy's EKF joins through its ``others``, with the same
+model in numpy matrices and the same gate, from benchmarks/filterpy_ekf.py). Uses the MRCLAM Dataset 6 logs in
 ../shared/data when present (calibrated on robot 1), else a synthetic log. Each log is
 run ``REPEATS`` times; a method's figure is the lowest of its per-run medians, so that a
 burst of load on this machine does not land on one method only.
@@ -15,8 +15,6 @@ burst of load on this machine does not land on one method only.
 from __future__ import annotations
 
 import math
-import statistics
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,73 +24,15 @@ from aura_ums.logs import (
     RobotLog,
     calibrate_logs,
     compare_on_log,
-    frames_after,
-    meta_bounds,
     observation_errors,
-    observation_for,
-    position_reports_for,
     read_mrclam,
-    replay_start,
     synthetic_log,
-    with_motion,
 )
-from aura_ums.uncertainty import (
-    BearingObservation,
-    LandmarkClass,
-    RangeBearingObservation,
-    TerrainTable,
-)
+from aura_ums.uncertainty import LandmarkClass, Pose
 from filterpy_ekf import FilterpyLogEkf
 
 MRCLAM = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "mrclam6"
 REPEATS = 2
-
-
-def filterpy_on_log(
-    log: RobotLog, table: TerrainTable, options: ReplayOptions, bearing_sd: float, range_sd_fraction: float
-) -> tuple[float, float]:
-    """(median us per step, position RMSE m) of filterpy's EKF, stepped as compare_on_log steps ours."""
-    moved = with_motion(log, options.motion)
-    terrain = table[moved.meta.terrain]
-    start_time, start_pose = replay_start(moved)
-    reports = position_reports_for(log, options)
-    frames = frames_after(moved, start_time)
-    bounds = options.working if options.working is not None else meta_bounds(moved)
-    ekf = FilterpyLogEkf(
-        start_pose,
-        position_sd=max(moved.meta.start_radius / 3.0, 1e-3),
-        heading_sd=max(moved.meta.start_heading_halfwidth / 3.0, 1e-3),
-        bearing_sd=bearing_sd,
-        range_sd=0.01,
-        range_sd_fraction=range_sd_fraction,
-    )
-    landmarks = {lm.id: (lm.x, lm.y) for lm in moved.landmarks}
-    micros: list[float] = []
-    errors: list[float] = []
-    next_report = 0
-    for frame_time in sorted(frames):
-        seen = [
-            (observation, landmarks[row.landmark_id])
-            for row in frames[frame_time]
-            if isinstance(
-                observation := observation_for(row, options.landmark_class, bounds),
-                (BearingObservation, RangeBearingObservation),
-            )
-        ]
-        began = time.perf_counter()
-        while next_report < len(reports) and reports[next_report].time <= frame_time:
-            ekf.predict(reports[next_report].command, terrain)
-            next_report += 1
-        for observation, landmark in seen:
-            ekf.update(observation, landmark)
-        micros.append((time.perf_counter() - began) * 1e6)
-        if moved.groundtruth is not None:
-            x, y, _ = moved.groundtruth.at([frame_time])[0]
-            if not math.isnan(x):
-                mean = ekf.mean
-                errors.append(math.hypot(mean.x - x, mean.y - y))
-    rmse = float(np.sqrt(np.mean(np.square(errors)))) if errors else math.nan
-    return statistics.median(micros), rmse
 
 
 def main() -> None:
@@ -108,6 +48,17 @@ def main() -> None:
     table = calibration.terrain_table()
 
     def run(log: RobotLog, options: ReplayOptions, label: str) -> None:
+        def filterpy_ekf(start: Pose) -> FilterpyLogEkf:
+            # The settings compare_on_log gives its own EKF.
+            return FilterpyLogEkf(
+                start,
+                position_sd=max(log.meta.start_radius / 3.0, 1e-3),
+                heading_sd=max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
+                bearing_sd=bearing_sd,
+                range_sd=0.01,
+                range_sd_fraction=range_sd_fraction,
+            )
+
         best: dict[str, float] = {}
         rows = {}
         for _ in range(REPEATS):
@@ -118,11 +69,10 @@ def main() -> None:
                 bearing_sd=bearing_sd,
                 range_sd_fraction=range_sd_fraction,
                 rng=np.random.default_rng(0),
+                others={"filterpy EKF": filterpy_ekf},
             ):
                 rows[row.method] = row
                 best[row.method] = min(best.get(row.method, math.inf), row.median_update_us)
-            micros, rmse = filterpy_on_log(log, table, options, bearing_sd, range_sd_fraction)
-            best["filterpy EKF"] = min(best.get("filterpy EKF", math.inf), micros)
         ekf, filterpy = best["EKF"], best["filterpy EKF"]
         for method, row in rows.items():
             print(
@@ -130,10 +80,6 @@ def main() -> None:
                 f"{row.median_area_m2:9.4g} {row.median_heading_width_rad:8.3f} {row.position_rmse_m:7.3f} "
                 f"{best[method]:8.1f} {best[method] / ekf:6.2f} {best[method] / filterpy:6.2f}"
             )
-        print(
-            f"{log.meta.name:16s} {label:11s} {'filterpy EKF':13s} {'':7s} {'':9s} {'':8s} {rmse:7.3f} "
-            f"{filterpy:8.1f} {filterpy / ekf:6.2f} {1.0:6.2f}"
-        )
 
     print(
         f"{'log':16s} {'class':11s} {'method':13s} {'inside':>7s} {'area m2':>9s} {'head rad':>8s} "

@@ -5,8 +5,10 @@ The benchmarks' off-the-shelf EKF: the same mean motion and moments
 Joseph update, with F, Q, H and R built with numpy per call. ``FilterpyLogEkf`` adds what
 a replay needs: any landmark, bearing-only or range-and-bearing observations, and the same
 99.9% Mahalanobis gate as :class:`aura_ums.baselines.ExtendedKalmanFilter` (computed from
-filterpy's state with numpy before its update, as a user adds a gate to filterpy). The
-sensor sits at the robot's reference point (as on the MRCLAM robots).
+filterpy's state with numpy before its update, as a user adds a gate to filterpy), and
+the confidence region (:meth:`aura_ums.baselines.ConfidenceRegion.gaussian`), so that it
+is an :class:`aura_ums.baselines.Estimator` that :func:`aura_ums.logs.compare_on_log`
+steps next to ours. The sensor sits at the robot's reference point (as on the MRCLAM robots).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter as FilterpyEkf
 from numpy.typing import NDArray
 
-from aura_ums.baselines import chi2_quantile, motion_moments
+from aura_ums.baselines import ConfidenceRegion, chi2_quantile, motion_moments
 from aura_ums.uncertainty import (
     BearingObservation,
     Pose,
@@ -117,6 +119,9 @@ class FilterpyLogEkf:
 
     def predict(self, command: TurnAndRun, terrain: TerrainStats) -> None:
         filterpy_predict(self.ekf, command, terrain)
+
+    def region(self, probability: float = 0.99) -> ConfidenceRegion:
+        return ConfidenceRegion.gaussian(self.ekf.x, self.ekf.P, probability)
 
     def update(
         self, observation: BearingObservation | RangeBearingObservation, landmark: tuple[float, float]

@@ -216,3 +216,53 @@ def test_prefiltered_hull_is_the_hull(n: int, seed: int, kind: str) -> None:
     assert hull.vertex_count == reference.vertex_count
     assert hull.area == pytest.approx(reference.area, rel=1e-12, abs=1e-12)
     assert np.all(hull.contains(points, tolerance=1e-9))
+
+
+@pytest.mark.parametrize("correlated", [False, True])
+def test_gaussian_region_is_the_ekf_region(correlated: bool) -> None:
+    ekf = _ekf_with_covariance(correlated)
+    mean = ekf.mean
+    for p in (0.5, 0.99):
+        ours = ConfidenceRegion.gaussian([mean.x, mean.y, mean.heading], ekf.covariance, p)
+        theirs = ekf.region(p)
+        assert ours.polygon.vertices.tobytes() == theirs.polygon.vertices.tobytes()
+        assert (ours.heading_center, ours.heading_halfwidth, ours.probability) == (
+            theirs.heading_center,
+            theirs.heading_halfwidth,
+            theirs.probability,
+        )
+
+
+def test_gaussian_region_edge_cases() -> None:
+    point = ConfidenceRegion.gaussian((2.0, -1.0, 4.0), np.zeros((3, 3)))
+    assert point.area == 0.0
+    assert point.heading_halfwidth == 0.0
+    assert point.heading_center == pytest.approx(4.0 - 2 * math.pi)  # wrapped
+    assert point.contains(2.0, -1.0, 4.0) is True
+    assert point.contains(2.0, -0.99, 4.0) is False
+    # Known along x, unknown along y: a segment; a huge heading variance: the full circle.
+    segment = ConfidenceRegion.gaussian((0.0, 0.0, 0.0), np.diag([0.0, 1.0, 100.0]))
+    assert segment.area == 0.0
+    assert segment.contains(0.0, 3.0, math.pi) is True
+    assert segment.contains(0.1, 0.0, 0.0) is False
+    assert segment.heading_width == 2 * math.pi
+
+
+@pytest.mark.parametrize(
+    ("mean", "covariance", "probability", "match"),
+    [
+        ((0, 0), np.eye(3), 0.99, r"mean: expected \(x, y, heading\), 3 numbers, got shape \(2,\)"),
+        ((0, 0, 0), np.eye(2), 0.99, r"covariance: expected a 3 x 3 array, got shape \(2, 2\)"),
+        ((0, 0, math.nan), np.eye(3), 0.99, "mean: expected finite numbers"),
+        ((0, 0, 0), np.full((3, 3), math.inf), 0.99, "covariance: expected finite numbers"),
+        ((0, 0, 0), [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]], 0.99, "covariance: expected a symmetric matrix"),
+        ((0, 0, 0), np.diag([1.0, -1.0, 1.0]), 0.99, "covariance: expected non-negative variances"),
+        ((0, 0, 0), np.eye(3), 1.0, "probability"),
+        ("here", np.eye(3), 0.99, "mean: expected numbers, got 'here'"),
+    ],
+)
+def test_gaussian_region_rejects_bad_input(
+    mean: object, covariance: object, probability: float, match: str
+) -> None:
+    with pytest.raises(InputError, match=match):
+        ConfidenceRegion.gaussian(mean, covariance, probability)  # type: ignore[arg-type]

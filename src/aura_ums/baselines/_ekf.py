@@ -46,17 +46,8 @@ from numpy.typing import NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float
 from aura_ums.baselines._moments import motion_moments
-from aura_ums.baselines._region import (
-    ELLIPSE_SIDES,
-    ConfidenceRegion,
-    check_probability,
-    chi2_quantile,
-    ellipse_polygon,
-    marginal_probability,
-    normal_halfwidth,
-)
+from aura_ums.baselines._region import ConfidenceRegion, check_probability, chi2_quantile, gaussian_region
 from aura_ums.errors import InputError
-from aura_ums.geometry import ConvexPolygon, wrap_angle
 from aura_ums.uncertainty import BearingObservation, Pose, RangeBearingObservation, TerrainStats, TurnAndRun
 
 _PI = math.pi
@@ -453,16 +444,8 @@ class ExtendedKalmanFilter:
         >>> r.area, r.heading_halfwidth, r.contains(1.0, 2.0, 3.0)     # a point, known heading
         (0.0, 0.0, True)
         """
-        p = check_probability(probability)
-        q = marginal_probability(p)
         xx, xy, _, yy, _, hh = self._p
-        vertices = ellipse_polygon((self._x, self._y), (xx, xy, yy), chi2_quantile(q, 2), ELLIPSE_SIDES)
-        try:
-            polygon = ConvexPolygon(vertices)
-        except InputError:  # a (nearly) singular ellipse: its hull is a segment or a point
-            polygon = ConvexPolygon.from_points(vertices)
-        halfwidth = normal_halfwidth(q) * math.sqrt(max(hh, 0.0))
-        return ConfidenceRegion(polygon, wrap_angle(self._h), min(halfwidth, math.pi), p)
+        return gaussian_region(self._x, self._y, self._h, xx, xy, yy, hh, probability)
 
     def __repr__(self) -> str:
         return (

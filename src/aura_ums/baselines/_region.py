@@ -347,6 +347,60 @@ class ConfidenceRegion:
         object.__setattr__(self, "heading_halfwidth", min(halfwidth, math.pi))
         object.__setattr__(self, "probability", check_probability(self.probability))
 
+    @classmethod
+    def gaussian(cls, mean: ArrayLike, covariance: ArrayLike, probability: float = 0.99) -> ConfidenceRegion:
+        """Return the confidence region of ``probability`` of a Gaussian pose belief.
+
+        What :meth:`ExtendedKalmanFilter.region` returns, for any filter that keeps a
+        Gaussian belief (e.g. your own EKF or UKF, to compare it with
+        :func:`~aura_ums.logs.compare_on_log`). Position: the ellipse of
+        ``sqrt(probability)`` (chi-square, 2 degrees of freedom) of the (x, y) marginal,
+        as a circumscribed 64-gon; heading: the mean +- the normal quantile of
+        ``sqrt(probability)`` times its standard deviation (see the module notes).
+
+        Parameters
+        ----------
+        mean : array_like, shape (3,)
+            ``(x, y, heading)``: metres, metres, radians.
+        covariance : array_like, shape (3, 3)
+            Covariance of ``(x, y, heading)`` (m^2, m rad, rad^2): symmetric, with a
+            non-negative diagonal.
+        probability : float
+            Joint probability, in (0, 1).
+
+        Raises
+        ------
+        InputError
+            For a mean or covariance of the wrong shape, non-finite values, an asymmetric
+            covariance, a negative variance or a bad probability.
+
+        Examples
+        --------
+        >>> region = ConfidenceRegion.gaussian([1.0, 2.0, 0.5], np.diag([0.04, 0.01, 0.0025]))
+        >>> round(region.area, 3), round(region.heading_halfwidth, 4), region.contains(1.0, 2.0, 0.5)
+        (0.666, 0.1403, True)
+        >>> ConfidenceRegion.gaussian([0, 0, 0], np.zeros((3, 3))).area        # a known pose: a point
+        0.0
+        >>> ConfidenceRegion.gaussian([0, 0, 0], np.eye(2))
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: covariance: expected a 3 x 3 array, got shape (2, 2)
+        """
+        centre = float_array(mean, "mean")
+        if centre.shape != (3,):
+            raise InputError(f"mean: expected (x, y, heading), 3 numbers, got shape {centre.shape}")
+        cov = float_array(covariance, "covariance")
+        if cov.shape != (3, 3):
+            raise InputError(f"covariance: expected a 3 x 3 array, got shape {cov.shape}")
+        if np.abs(cov - cov.T).max() > 1e-9 * max(float(np.abs(cov).max()), 1e-300):
+            raise InputError(f"covariance: expected a symmetric matrix, got {cov.tolist()}")
+        if (np.diag(cov) < 0.0).any():
+            raise InputError(f"covariance: expected non-negative variances, got {np.diag(cov).tolist()}")
+        x, y, heading = centre.tolist()
+        return gaussian_region(
+            x, y, heading, float(cov[0, 0]), float(cov[0, 1]), float(cov[1, 1]), float(cov[2, 2]), probability
+        )
+
     @property
     def area(self) -> float:
         """Area of the position polygon, square metres."""
@@ -400,3 +454,18 @@ class ConfidenceRegion:
         if xs.ndim == 0:
             return bool(inside[0])
         return np.asarray(inside.reshape(xs.shape), dtype=np.bool_)
+
+
+def gaussian_region(
+    x: float, y: float, heading: float, xx: float, xy: float, yy: float, hh: float, probability: object
+) -> ConfidenceRegion:
+    """:meth:`ConfidenceRegion.gaussian` on checked numbers: mean (m, m, rad) and covariance entries."""
+    p = check_probability(probability)
+    q = marginal_probability(p)
+    vertices = ellipse_polygon((x, y), (xx, xy, yy), chi2_quantile(q, 2), ELLIPSE_SIDES)
+    try:
+        polygon = ConvexPolygon(vertices)
+    except InputError:  # a (nearly) singular ellipse: its hull is a segment or a point
+        polygon = ConvexPolygon.from_points(vertices)
+    halfwidth = normal_halfwidth(q) * math.sqrt(max(hh, 0.0))
+    return ConfidenceRegion(polygon, wrap_angle(heading), min(halfwidth, math.pi), p)

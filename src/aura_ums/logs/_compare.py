@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 import time as _time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from aura_ums._validate import finite_float
-from aura_ums.baselines import ExtendedKalmanFilter, ParticleFilter
+from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.logs._replay import (
@@ -23,7 +24,7 @@ from aura_ums.logs._replay import (
     replay_start,
     with_motion,
 )
-from aura_ums.uncertainty import BearingObservation, RangeBearingObservation, TerrainTable
+from aura_ums.uncertainty import BearingObservation, Pose, RangeBearingObservation, TerrainTable
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,7 +34,7 @@ class MethodSummary:
     Attributes
     ----------
     method : str
-        ``"aura-ums"``, ``"EKF"`` or ``"PF (n)"``.
+        ``"aura-ums"``, ``"EKF"``, ``"PF (n)"``, or the name of one of ``others``.
     containment_rate : float
         Fraction of the steps whose ground truth is inside the method's region (our map;
         the filters' 99% regions).
@@ -87,6 +88,7 @@ def compare_on_log(
     rng: np.random.Generator,
     particles: int = 1000,
     probability: float = 0.99,
+    others: Mapping[str, Callable[[Pose], Estimator]] | None = None,
 ) -> tuple[MethodSummary, ...]:
     """Run our map, an EKF and a particle filter over the same log and judge each against ground truth.
 
@@ -95,6 +97,8 @@ def compare_on_log(
     the same pose with standard deviations of a third of our start bounds, use
     ``bearing_sd`` (rad) and ``range_sd_fraction`` (of the range) as their measurement
     noise, and gate at 99.9%; their region is the ``probability`` confidence region.
+    Your own estimators join through ``others``: each is built from the start pose and
+    stepped, timed and judged exactly as the EKF is.
 
     Parameters
     ----------
@@ -114,11 +118,16 @@ def compare_on_log(
         Particles, >= 1.
     probability : float
         Probability of the filters' confidence regions, in (0, 1).
+    others : mapping of str to callable, or None
+        More methods: name -> factory taking the start :class:`~aura_ums.uncertainty.Pose`
+        and returning an :class:`~aura_ums.baselines.Estimator` (a filter of yours;
+        :meth:`ConfidenceRegion.gaussian <aura_ums.baselines.ConfidenceRegion.gaussian>`
+        gives a Gaussian one its region). Its start spread and noise are its own.
 
     Returns
     -------
     tuple of MethodSummary
-        Ours, the EKF's and the particle filter's.
+        Ours, the EKF's, the particle filter's, then one per entry of ``others``.
 
     Raises
     ------
@@ -134,6 +143,17 @@ def compare_on_log(
     ...                       rng=np.random.default_rng(0), particles=200)
     >>> [row.method for row in rows], rows[0].containment_rate
     (['aura-ums', 'EKF', 'PF (200)'], 1.0)
+
+    A filter of your own, here a second EKF that trusts its bearings ten times more:
+
+    >>> def confident(start):
+    ...     return ExtendedKalmanFilter(start, position_sd=0.1, heading_sd=0.02,
+    ...                                 bearing_sd=0.0006, range_sd=0.01, gate_probability=0.999)
+    >>> rows = compare_on_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}),
+    ...                       bearing_sd=0.006, range_sd_fraction=0.012, rng=np.random.default_rng(0),
+    ...                       particles=200, others={"confident EKF": confident})
+    >>> rows[-1].method, rows[-1].containment_rate < rows[1].containment_rate
+    ('confident EKF', True)
     """
     if not isinstance(log, RobotLog):
         raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
@@ -144,6 +164,7 @@ def compare_on_log(
     r_sd = finite_float(range_sd_fraction, "range_sd_fraction")
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
+    extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})"})
     ours = replay_log(log, table, opts)
     log = with_motion(log, opts.motion)
     terrain = table[log.meta.terrain]
@@ -158,13 +179,21 @@ def compare_on_log(
         "range_sd": 0.01,
         "range_sd_fraction": r_sd,
     }
-    filters: list[tuple[str, ExtendedKalmanFilter | ParticleFilter]] = [
+    filters: list[tuple[str, Estimator]] = [
         ("EKF", ExtendedKalmanFilter(start_pose, gate_probability=0.999, **common)),
         (
             f"PF ({particles})",
             ParticleFilter(start_pose, rng, particles=particles, gate_probability=0.999, **common),
         ),
     ]
+    for name, factory in extra:
+        built = factory(start_pose)
+        if not isinstance(built, Estimator):
+            raise InputError(
+                f"others[{name!r}]: expected a factory returning an Estimator (predict, update, region, "
+                f"mean, rejected_count), got {type(built).__name__}"
+            )
+        filters.append((name, built))
     landmarks = {lm.id: (lm.x, lm.y) for lm in log.landmarks}
     truth = log.groundtruth
     if truth is None:  # replaced above by the motion calibration, never dropped
@@ -215,3 +244,23 @@ def compare_on_log(
             )
         )
     return tuple(summaries)
+
+
+def _check_others(others: object, taken: set[str]) -> list[tuple[str, Callable[[Pose], Estimator]]]:
+    """Check :func:`compare_on_log`'s ``others``; return its (name, factory) pairs in order."""
+    if others is None:
+        return []
+    if not isinstance(others, Mapping):
+        raise InputError(
+            f"others: expected a mapping of names to estimator factories, got {type(others).__name__}"
+        )
+    checked: list[tuple[str, Callable[[Pose], Estimator]]] = []
+    for name, factory in others.items():
+        if not isinstance(name, str) or not name or name in taken:
+            raise InputError(
+                f"others: expected names that are new non-empty strings (not {sorted(taken)}), got {name!r}"
+            )
+        if not callable(factory):
+            raise InputError(f"others[{name!r}]: expected a callable taking the start Pose, got {factory!r}")
+        checked.append((name, factory))
+    return checked
