@@ -351,7 +351,7 @@ class ConfidenceRegion:
     def gaussian(cls, mean: ArrayLike, covariance: ArrayLike, probability: float = 0.99) -> ConfidenceRegion:
         """Return the confidence region of ``probability`` of a Gaussian pose belief.
 
-        What :meth:`ExtendedKalmanFilter.region` returns, for any filter that keeps a
+        What :meth:`~aura_ums.baselines.ExtendedKalmanFilter.region` returns, for any filter that keeps a
         Gaussian belief (e.g. your own EKF or UKF, to compare it with
         :func:`~aura_ums.logs.compare_on_log`). Position: the ellipse of
         ``sqrt(probability)`` (chi-square, 2 degrees of freedom) of the (x, y) marginal,
