@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import FrozenInstanceError, dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -22,6 +22,7 @@ from aura_ums.manager import (
     Blackboard,
     ManagerState,
     ManagerStep,
+    ObservationOutcome,
     PositionReport,
     UncertaintyMapManager,
 )
@@ -167,6 +168,25 @@ def test_grows_to_each_observation_then_reduces_as_by_hand() -> None:
     assert (manager.consumed_reports, manager.map_time, manager.grown_reports) == (4, 4.0, 4)
     assert (manager.accepted_count, manager.rejected_count) == (2, 0)
     assert not board.identified
+
+
+def test_the_update_records_are_those_the_public_constructors_build() -> None:
+    # The manager builds its records through the slots (faster than the frozen __init__).
+    _, first, second = by_hand()
+    unknown = BearingObservation("nowhere", 3.0, 0.0, 0.01)
+    board = board_with(*[(float(t), STRIDE) for t in (1, 2, 3, 4)], observations=(first, second, unknown))
+    step = manager_for().update(board, now=4.0)
+    assert [o.accepted for o in step.outcomes] == [True, False, True]
+    for outcome in step.outcomes:
+        rebuilt = ObservationOutcome(*(getattr(outcome, field.name) for field in fields(outcome)))
+        assert rebuilt == outcome
+        assert hash(rebuilt) == hash(outcome)
+    public = ManagerStep(*(getattr(step, field.name) for field in fields(step)))
+    assert repr(public) == repr(step)
+    with pytest.raises(FrozenInstanceError, match="cannot assign"):
+        step.outcomes[0].accepted = False  # type: ignore[misc]
+    with pytest.raises(FrozenInstanceError, match="cannot assign"):
+        step.time = 0.0  # type: ignore[misc]
 
 
 def test_split_updates_consume_each_report_once_and_give_the_same_map() -> None:

@@ -377,6 +377,31 @@ def test_empty_intersection_returns_prior_unchanged(reduce_kernel: str) -> None:
         assert "no " in reduction.reason
 
 
+def test_the_managers_unchecked_reduction_gives_what_reduce_does(reduce_kernel: str) -> None:
+    prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.2), 2.0, 0.3)
+    edge = GroundLineLandmark("e", (-10.0, -1.0), (10.0, -1.0), "path edge", 0.1)
+    cases: list[Case] = [
+        (BearingObservation("pole", 0.0, -0.2, 0.02, (0.3, 0.1)), _pole(uncertainty=0.2)),
+        (RangeBearingObservation("c", 0.0, -0.2, 0.02, 19.0, 21.0), PointLandmark("c", 20.0, 0.0, 0.5)),
+        (GroundLineObservation("e", 0.0, 1.0, 0.2, -0.2, 0.02), edge),
+        (BearingObservation("pole", 0.0, math.pi, 0.1), _pole()),  # inconsistent: behind
+    ]
+    for observation, landmark in cases:
+        reduction = prior.reduce(observation, landmark)
+        found = prior._reduce_checked(observation, landmark)
+        if not reduction.consistent:
+            assert found == reduction.reason
+            continue
+        assert not isinstance(found, str)
+        reduced, area_before, area_after = found
+        assert (area_before, area_after) == (reduction.area_before, reduction.area_after)
+        assert reduced.polygon.vertices.tobytes() == reduction.map.polygon.vertices.tobytes()
+        assert reduced.center.tobytes() == reduction.map.center.tobytes()
+        assert reduced.wedge == reduction.wedge_after
+        # Each case reduces something, so a result that ignored the observation would show.
+        assert reduced.area < prior.area or reduced.wedge.width < prior.wedge.width
+
+
 def test_landmark_inside_polygon(rng: np.random.Generator, reduce_kernel: str) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, 0.3)
     poses = prior.sample_poses(300, rng)

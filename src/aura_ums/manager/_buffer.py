@@ -123,6 +123,10 @@ or GroundLineObservation, got str
         """Time of the oldest observation held, seconds; None when the buffer is empty."""
         return self._items[0].time if self._items else None
 
+    def _peek_until(self, until: float) -> list[Observation]:
+        """:meth:`peek` for a time the caller checked (the manager's ``now``), as a list."""
+        return self._items[: bisect.bisect_right(self._items, until, key=_time)]
+
     def _stop(self, until: float | None) -> int:
         if until is None:
             return len(self._items)

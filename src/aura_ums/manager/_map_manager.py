@@ -69,6 +69,29 @@ class ObservationOutcome:
     wedge_width_before: float
     wedge_width_after: float
 
+    @classmethod
+    def _new(
+        cls,
+        observation: Observation,
+        accepted: bool,
+        reason: str,
+        area_before: float,
+        area_after: float,
+        wedge_width_before: float,
+        wedge_width_after: float,
+    ) -> ObservationOutcome:
+        # The slots' own setters: the frozen __init__'s object.__setattr__ per field costs
+        # about twice as much, and the manager records an outcome for every observation.
+        outcome = object.__new__(cls)
+        _set_observation(outcome, observation)
+        _set_accepted(outcome, accepted)
+        _set_reason(outcome, reason)
+        _set_area_before(outcome, area_before)
+        _set_area_after(outcome, area_after)
+        _set_width_before(outcome, wedge_width_before)
+        _set_width_after(outcome, wedge_width_after)
+        return outcome
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ManagerStep:
@@ -97,6 +120,26 @@ class ManagerStep:
     outcomes: tuple[ObservationOutcome, ...]
     grown_reports: int
 
+    @classmethod
+    def _new(
+        cls,
+        time: float,
+        uncertainty_map: SpatialUncertaintyMap,
+        state: ManagerState,
+        lost_reason: str,
+        outcomes: tuple[ObservationOutcome, ...],
+        grown_reports: int,
+    ) -> ManagerStep:
+        # As ObservationOutcome._new: one step per update.
+        step = object.__new__(cls)
+        _set_time(step, time)
+        _set_map(step, uncertainty_map)
+        _set_state(step, state)
+        _set_lost_reason(step, lost_reason)
+        _set_outcomes(step, outcomes)
+        _set_grown_reports(step, grown_reports)
+        return step
+
     @property
     def accepted(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that reduced the map."""
@@ -106,6 +149,33 @@ class ManagerStep:
     def rejected(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that were rejected, with their reasons."""
         return tuple(o for o in self.outcomes if not o.accepted)
+
+
+# Setters of the records' slots (frozen: the dataclasses' own __setattr__ refuses).
+(
+    _set_observation,
+    _set_accepted,
+    _set_reason,
+    _set_area_before,
+    _set_area_after,
+    _set_width_before,
+    _set_width_after,
+) = (
+    ObservationOutcome.__dict__[name].__set__
+    for name in (
+        "observation",
+        "accepted",
+        "reason",
+        "area_before",
+        "area_after",
+        "wedge_width_before",
+        "wedge_width_after",
+    )
+)
+(_set_time, _set_map, _set_state, _set_lost_reason, _set_outcomes, _set_grown_reports) = (
+    ManagerStep.__dict__[name].__set__
+    for name in ("time", "map", "state", "lost_reason", "outcomes", "grown_reports")
+)
 
 
 class UncertaintyMapManager:
@@ -380,7 +450,7 @@ class UncertaintyMapManager:
         reports = blackboard._reports  # read in place (the manager's own subpackage): no copies
         identified = blackboard.identified
         outcomes: list[ObservationOutcome] = []
-        pending = identified.peek(until=time)
+        pending = identified._peek_until(time)
         for observation in pending:
             stop = blackboard._report_stop(observation.time, index)
             current, map_time = self._grow(current, reports, index, stop, map_time)
@@ -404,7 +474,7 @@ class UncertaintyMapManager:
             else:
                 self._rejected[outcome.reason] = self._rejected.get(outcome.reason, 0) + 1
         self._update_state(found, missed_in_a_row)
-        return ManagerStep(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
+        return ManagerStep._new(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
 
     def relocalize(self, new_map: SpatialUncertaintyMap) -> None:
         """Replace the map by one re-derived elsewhere (re-localization), keeping the clock.
@@ -517,23 +587,24 @@ class UncertaintyMapManager:
                 if observation.landmark_class is not landmark.landmark_class:
                     reason = REJECT_CLASS_MISMATCH
                 else:
-                    reduction = current.reduce(observation, landmark)
-                    if reduction.consistent:
-                        reduced = reduction.map
-                        outcome = ObservationOutcome(
+                    # Found by the observation's id, of its class: the pair reduce() would check.
+                    found = current._reduce_checked(observation, landmark)
+                    if not isinstance(found, str):
+                        reduced, area_before, area_after = found
+                        outcome = ObservationOutcome._new(
                             observation,
                             True,
                             "",
-                            reduction.area_before,
-                            reduction.area_after,
+                            area_before,
+                            area_after,
                             current.wedge.width,
                             reduced.wedge.width,
                         )
                         return outcome, reduced
-                    reason = reduction.reason
+                    reason = found
         # Rejected: the map stays, and so do its area and width.
         area, width = current.area, current.wedge.width
-        return ObservationOutcome(observation, False, reason, area, area, width, width), current
+        return ObservationOutcome._new(observation, False, reason, area, area, width, width), current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:
         reasons: list[str] = []

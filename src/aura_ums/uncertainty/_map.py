@@ -22,7 +22,7 @@ from aura_ums.uncertainty._growth import (
 )
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
-from aura_ums.uncertainty._reduce import Reduction, reduce_map
+from aura_ums.uncertainty._reduce import Reduced, Reduction, reduce_checked, reduce_map
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _START_DISK_SIDES = 16
@@ -303,6 +303,14 @@ class SpatialUncertaintyMap:
         (False, True, True)
         """
         return reduce_map(self, observation, landmark, max_vertices)
+
+    def _reduce_checked(self, observation: Observation, landmark: Landmark) -> Reduced:
+        """:meth:`reduce` for a caller that paired the landmark with the observation by id and class.
+
+        Returns (reduced map, area before, area after), or why no pose agrees: the
+        manager reads nothing else, so no :class:`Reduction` is built.
+        """
+        return reduce_checked(self, observation, landmark, DEFAULT_MAX_VERTICES)
 
     @overload
     def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...

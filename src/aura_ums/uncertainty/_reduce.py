@@ -503,6 +503,10 @@ _REASONS = (
 )
 
 
+#: A reduction without its record: (reduced map, area before, area after), or why it is empty.
+Reduced = tuple["SpatialUncertaintyMap", float, float] | str
+
+
 def reduce_map(
     prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
 ) -> Reduction:
@@ -510,11 +514,31 @@ def reduce_map(
     check_pair(observation, landmark)
     if max_vertices < 3:
         raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
+    found = reduce_checked(prior, observation, landmark, max_vertices)
+    wedge = prior.wedge
+    if isinstance(found, str):
+        area = prior.polygon.area
+        return Reduction(prior, False, area, area, wedge, wedge, found)
+    reduced, area_before, area_after = found
+    return Reduction(reduced, True, area_before, area_after, wedge, reduced.wedge)
+
+
+def reduce_checked(
+    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+) -> Reduced:
+    """:func:`reduce_map` for arguments already checked, without its :class:`Reduction` record.
+
+    For the map manager, which pairs each observation with its landmark by id and class
+    itself and reads only the reduced map and the areas (``max_vertices >= 3``).
+    """
     if _compiled_reduce_cone is not None and _compiled_reduce_strip is not None:
         return _reduce_map_compiled(
             _compiled_reduce_cone, _compiled_reduce_strip, prior, observation, landmark, max_vertices
         )
-    return reduce_map_reference(prior, observation, landmark, max_vertices)
+    reduction = reduce_map_reference(prior, observation, landmark, max_vertices)
+    if not reduction.consistent:
+        return reduction.reason
+    return reduction.map, reduction.area_before, reduction.area_after
 
 
 def _reduce_map_compiled(
@@ -524,8 +548,8 @@ def _reduce_map_compiled(
     observation: Observation,
     landmark: Landmark,
     max_vertices: int,
-) -> Reduction:
-    """:func:`reduce_map` with the geometry in one call of a compiled kernel (arguments checked)."""
+) -> Reduced:
+    """:func:`reduce_checked` with the geometry in one call of a compiled kernel."""
     vertices = prior.polygon.vertices
     if not vertices.flags.c_contiguous:  # polygons hold C-contiguous float64 arrays already
         vertices = np.ascontiguousarray(vertices, dtype=np.float64)
@@ -582,11 +606,10 @@ def _reduce_map_compiled(
             observation.angle_error,
             max_vertices,
         )
-    else:  # pragma: no cover - check_pair refused every other pairing
+    else:  # pragma: no cover - the callers refused every other pairing
         raise InputError(f"observation: expected a known pairing, got {type(observation).__name__}")
     if isinstance(found, int):
-        area = prior.polygon.area
-        return Reduction(prior, False, area, area, wedge, wedge, _REASONS[found])
+        return _REASONS[found]
     raw, lo, width, x, y, area_before, area_after = found
     # Bytes are immutable, so the array is read-only as map values must be.
     reduced_vertices = np.frombuffer(raw, _FLOAT64).reshape(-1, 2)
@@ -594,7 +617,7 @@ def _reduce_map_compiled(
     reduced = type(prior)._trusted(
         type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
     )
-    return Reduction(reduced, True, area_before, area_after, wedge, reduced_wedge)
+    return reduced, area_before, area_after
 
 
 _FLOAT64 = np.dtype(np.float64)
