@@ -10,6 +10,7 @@ from aura_ums.uncertainty._checks import (
     simulate_containment,
 )
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, MotionBounds, motion_bounds
+from aura_ums.uncertainty._joint import DEFAULT_SECTOR, JOINT_INCONSISTENT, reduce_jointly
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -28,7 +29,9 @@ from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 
 __all__ = [
     "DEFAULT_MAX_VERTICES",
+    "DEFAULT_SECTOR",
     "FOOT",
+    "JOINT_INCONSISTENT",
     "BearingObservation",
     "ContainmentResult",
     "GroundLineLandmark",
@@ -49,5 +52,6 @@ __all__ = [
     "VerticalLineLandmark",
     "growth_tightness",
     "motion_bounds",
+    "reduce_jointly",
     "simulate_containment",
 ]

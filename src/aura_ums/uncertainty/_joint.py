@@ -1,0 +1,206 @@
+"""Observations taken together: a joint reduction that splits the heading wedge into sectors.
+
+When the heading is wide open, one bearing says little about position: the cone it cuts
+is as wide as the wedge. Two bearings taken at the same instant say much more, since
+their difference does not depend on the heading; but reducing by them one after the
+other forgets that both were seen from one heading. The joint reduction keeps it: the
+wedge is split into sectors no wider than ``sector``, the map restricted to each sector
+is reduced by every observation in turn, and the result is the convex hull of what the
+sectors keep, with the smallest wedge (inside the prior's) that holds their headings.
+
+Soundness follows from the single reductions': a true pose's heading lies in some
+sector, whose reductions keep the pose; the hull and the covering wedge only add. Every
+sector's result lies inside the prior, so their hull does too.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from aura_ums._validate import finite_float, integer_at_least
+from aura_ums.errors import InputError
+from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.geometry._convex import convex_hull
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
+from aura_ums.uncertainty._landmarks import Landmark, Observation
+from aura_ums.uncertainty._map import SpatialUncertaintyMap
+from aura_ums.uncertainty._reduce import TOLERANCE, Reduction, arc_wedge, cap_inside
+
+#: Default widest heading sector of :func:`reduce_jointly`, radians (10 degrees).
+DEFAULT_SECTOR = math.radians(10.0)
+
+_TWO_PI = 2.0 * math.pi
+
+#: Why a joint reduction is empty.
+JOINT_INCONSISTENT = "no heading of the map agrees with all the observations together"
+
+
+def reduce_jointly(
+    prior: SpatialUncertaintyMap,
+    sightings: Sequence[tuple[Observation, Landmark]],
+    *,
+    sector: float = DEFAULT_SECTOR,
+    max_vertices: int = DEFAULT_MAX_VERTICES,
+) -> Reduction:
+    """Reduce a map by observations taken together, sector by sector of its heading wedge.
+
+    See the module notes. With one sector (a wedge no wider than ``sector``) it is the
+    reduction by each observation in turn, :meth:`SpatialUncertaintyMap.reduce`.
+
+    Parameters
+    ----------
+    prior : SpatialUncertaintyMap
+        The map, grown to the observations' time.
+    sightings : sequence of (observation, landmark)
+        Observations of one instant with the landmarks they name (each pair as
+        :meth:`SpatialUncertaintyMap.reduce` takes it), at least one.
+    sector : float
+        Widest heading sector, radians, in (0, 2 pi]. Narrower sectors keep less
+        (tighter maps) and cost more: one reduction per observation and sector.
+    max_vertices : int
+        Cap on the polygon's vertex count (>= 3), as for a single reduction.
+
+    Returns
+    -------
+    Reduction
+        The reduced map; ``consistent=False`` and the prior itself when no sector's
+        heading agrees with all the observations (:data:`JOINT_INCONSISTENT`).
+
+    Raises
+    ------
+    InputError
+        For a bad argument, or an observation whose landmark is of another class or id.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import BearingObservation, Pose, VerticalLineLandmark
+    >>> truth = Pose(3.0, 4.0, 1.0)
+    >>> lost = SpatialUncertaintyMap.from_pose(Pose(5.0, 5.0, 0.0), 15.0, math.pi)  # any heading
+    >>> a = VerticalLineLandmark("a", 12.0, 4.0, 0.0, 5.0)
+    >>> b = VerticalLineLandmark("b", 3.0, 14.0, 0.0, 5.0)
+    >>> c = VerticalLineLandmark("c", -4.0, 2.0, 0.0, 5.0)
+    >>> def seen(*poles):
+    ...     return [(BearingObservation(p.id, 0.0, math.atan2(p.y - truth.y, p.x - truth.x) - truth.heading,
+    ...                                 0.02), p) for p in poles]
+    >>> one_by_one = lost
+    >>> for observation, pole in seen(a, b):
+    ...     one_by_one = one_by_one.reduce(observation, pole).map
+    >>> one_by_one.area == lost.area, one_by_one.wedge.is_full_circle    # each alone says nothing
+    (True, True)
+    >>> two = reduce_jointly(lost, seen(a, b))
+    >>> two.consistent, two.map.contains(truth), two.area_ratio < 0.2, two.map.wedge.width < 2.0
+    (True, True, True, True)
+    >>> three = reduce_jointly(lost, seen(a, b, c))
+    >>> three.map.contains(truth), round(three.area_after, 1), round(three.map.wedge.width, 2)
+    (True, 2.2, 0.16)
+
+    All three dead ahead: they are not in line, so no pose sees them so.
+
+    >>> ahead = [(BearingObservation(p.id, 0.0, 0.0, 0.02), p) for p in (a, b, c)]
+    >>> reduce_jointly(lost, ahead).reason
+    'no heading of the map agrees with all the observations together'
+    """
+    if not isinstance(prior, SpatialUncertaintyMap):
+        raise InputError(f"prior: expected a SpatialUncertaintyMap, got {type(prior).__name__}")
+    pairs = _checked_sightings(sightings)
+    width_limit = finite_float(sector, "sector")
+    if not 0.0 < width_limit <= _TWO_PI:
+        raise InputError(f"sector: expected radians in (0, 2 pi], got {width_limit!r}")
+    cap = integer_at_least(max_vertices, "max_vertices", 3)
+
+    wedge = prior.wedge
+    lo, width = wedge.center - wedge.cw, min(wedge.width, _TWO_PI)
+    count = max(1, math.ceil(width / width_limit - 1e-9))
+    if count == 1:
+        return _in_turn(prior, pairs, cap)
+    step = width / count
+    # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
+    half = 0.5 * step + TOLERANCE
+    kept: list[tuple[float, SpatialUncertaintyMap]] = []
+    for k in range(count):
+        start = lo + k * step
+        restricted = SpatialUncertaintyMap._trusted(
+            prior.polygon, prior.center, HeadingWedge(start + 0.5 * step, half, half)
+        )
+        reduction = _in_turn(restricted, pairs, cap)
+        if reduction.consistent:
+            kept.append((start, reduction.map))
+    if not kept:
+        area = prior.area
+        return Reduction(prior, False, area, area, wedge, wedge, JOINT_INCONSISTENT)
+    return _combined(prior, kept, wedge.is_full_circle, cap)
+
+
+def _checked_sightings(sightings: object) -> list[tuple[Observation, Landmark]]:
+    if isinstance(sightings, (str, bytes)) or not isinstance(sightings, Sequence):
+        raise InputError(
+            f"sightings: expected a sequence of (observation, landmark) pairs, got {type(sightings).__name__}"
+        )
+    pairs: list[tuple[Observation, Landmark]] = []
+    for index, pair in enumerate(sightings):
+        if not isinstance(pair, tuple) or len(pair) != 2:
+            raise InputError(f"sightings[{index}]: expected an (observation, landmark) pair, got {pair!r}")
+        pairs.append(pair)
+    if not pairs:
+        raise InputError("sightings: expected at least one (observation, landmark) pair, got none")
+    return pairs
+
+
+def _in_turn(
+    current: SpatialUncertaintyMap, pairs: Sequence[tuple[Observation, Landmark]], cap: int
+) -> Reduction:
+    """Reduce by each observation in turn; the first inconsistent one makes it all inconsistent."""
+    area, wedge = current.area, current.wedge
+    for observation, landmark in pairs:
+        reduction = current.reduce(observation, landmark, max_vertices=cap)
+        if not reduction.consistent:
+            return Reduction(current, False, area, area, wedge, wedge, reduction.reason)
+        current = reduction.map
+    return Reduction(current, True, area, current.area, wedge, current.wedge)
+
+
+def _combined(
+    prior: SpatialUncertaintyMap,
+    kept: Sequence[tuple[float, SpatialUncertaintyMap]],
+    full_circle: bool,
+    cap: int,
+) -> Reduction:
+    """One map holding every sector's result: their hull, and one wedge over their headings."""
+    hull = convex_hull(np.concatenate([m.polygon.vertices for _, m in kept]))
+    polygon = ConvexPolygon._trusted(cap_inside(hull, prior.polygon.vertices, cap))
+    # Each result's headings as an interval unwrapped next to its sector, in sector order.
+    spans = []
+    for start, result in kept:
+        result_wedge = result.wedge
+        low = start + math.remainder(result_wedge.center - result_wedge.cw - start, _TWO_PI)
+        spans.append((low, low + min(result_wedge.width, _TWO_PI)))
+    first, last = spans[0][0], max(high for _, high in spans)
+    arc = (first, last - first)
+    if full_circle:
+        # Any heading was possible: the wedge may leave out the widest gap between results.
+        gaps = [(spans[i + 1][0] - spans[i][1], i) for i in range(len(spans) - 1)]
+        gaps.append((first + _TWO_PI - last, len(spans) - 1))
+        gap, after = max(gaps)
+        if gap <= 0.0:
+            arc = (first, _TWO_PI)
+        else:
+            begin = spans[(after + 1) % len(spans)][0]
+            arc = (begin, _TWO_PI - gap)
+    # The most probable pose: the prior's heading where it is still possible (else the new
+    # wedge's middle), and the centre of the sector result nearest to that heading.
+    target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
+    nearest = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[1]
+    heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center
+    reduced = SpatialUncertaintyMap(polygon, nearest.center, arc_wedge(arc, heading))
+    return Reduction(reduced, True, prior.area, reduced.area, prior.wedge, reduced.wedge)
+
+
+def _angular_gap(angle: float, wedge: HeadingWedge) -> float:
+    """Radians from ``angle`` to the nearest heading of ``wedge`` (0 inside it)."""
+    offset = (angle - (wedge.center - wedge.cw)) % _TWO_PI
+    if offset <= wedge.width:
+        return 0.0
+    return min(offset - wedge.width, _TWO_PI - offset)
