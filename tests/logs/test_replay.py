@@ -124,3 +124,37 @@ def test_mrclam_range_bearing_replay_keeps_the_truth_on_both_robots() -> None:
         result = replay_log(log, calibration.terrain_table(), options)
         assert result.containment_rate >= 0.99, log.meta.name
         assert result.median_area_m2 < 2.0
+
+
+@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
+def test_mrclam_bearing_only_replay_is_sound_and_informative_with_joint_reductions() -> None:
+    # Bearings alone, one by one, leave the map sound but useless once the heading has
+    # opened up (robot 1: 2586 m^2, any heading); together they keep closing it.
+    robot1, robot2 = read_mrclam(MRCLAM, 1), read_mrclam(MRCLAM, 2)
+    calibration = calibrate_logs([robot1])
+    options = ReplayOptions(
+        landmark_class=LandmarkClass.VERTICAL_LINE,
+        working=calibration.working,
+        envelope=calibration.envelope,
+        motion=calibration.motion,
+    )
+    for log in (robot1, robot2):
+        result = replay_log(log, calibration.terrain_table(), options)
+        assert result.containment_rate >= 0.99, log.meta.name
+        assert result.median_area_m2 < 50.0, log.meta.name
+        assert result.median_wedge_width_rad < 2.0, log.meta.name
+    one_by_one = replay_log(
+        robot1, calibration.terrain_table(), dataclasses.replace(options, joint_above=None)
+    )
+    assert one_by_one.median_area_m2 > 1000.0
+    assert one_by_one.metrics()["joint_above_rad"] is None
+
+
+def test_joint_above_is_checked() -> None:
+    assert ReplayOptions().joint_above == pytest.approx(np.pi / 2)
+    with pytest.raises(
+        InputError, match=r"ReplayOptions.joint_above: expected a number >= 0 or None, got -1.0"
+    ):
+        ReplayOptions(joint_above=-1.0)
+    with pytest.raises(InputError, match=r"ReplayOptions\.joint_above: expected a finite number"):
+        ReplayOptions(joint_above=float("nan"))

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import ConvexPolygon, wrap_angle
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
 from aura_ums.manager import (
     REJECT_CLASS_MISMATCH,
     REJECT_STALE,
@@ -27,6 +27,7 @@ from aura_ums.manager import (
     UncertaintyMapManager,
 )
 from aura_ums.uncertainty import (
+    DEFAULT_SECTOR,
     BearingObservation,
     GroundLineLandmark,
     GroundLineObservation,
@@ -39,6 +40,7 @@ from aura_ums.uncertainty import (
     TerrainTable,
     TurnAndRun,
     VerticalLineLandmark,
+    reduce_jointly,
 )
 from aura_ums.world import RUN_TOLERANCE, LandmarkRecord, Meadow, MeadowMap, grow_through
 
@@ -705,3 +707,88 @@ def test_a_one_meadow_manager_grows_as_the_map_does_on_its_terrain() -> None:
         assert grown.polygon.vertices.tobytes() == expected.polygon.vertices.tobytes()
         assert grown.wedge == expected.wedge
         assert grown.center.tolist() == expected.center.tolist()
+
+
+# --- observations of one instant, reduced together ---------------------------------------
+
+#: Lost in the west meadow: any heading.
+LOST_HERE = SpatialUncertaintyMap.from_polygon(box(1, -4, 9, 4), (5.0, 0.0), HeadingWedge.full_circle(0.0))
+TRUTH_HERE = Pose(4.0, 1.0, 2.5)
+
+
+def instant(*landmarks: VerticalLineLandmark, time: float = 0.0) -> tuple[Observation, ...]:
+    return tuple(bearing_of(TRUTH_HERE, landmark, time, 0.02) for landmark in landmarks)
+
+
+def test_observations_of_one_instant_reduce_together_while_the_heading_is_wide_open() -> None:
+    seen = instant(POLE_NORTH, POLE_SOUTH)
+    joint = UncertaintyMapManager(LOST_HERE, WORLD, TABLE).update(board_with(observations=seen), now=0.0)
+    one_by_one = UncertaintyMapManager(LOST_HERE, WORLD, TABLE, joint_above=None).update(
+        board_with(observations=seen), now=0.0
+    )
+    expected = reduce_jointly(LOST_HERE, [(seen[0], POLE_NORTH), (seen[1], POLE_SOUTH)])
+    assert_same_map(joint.map, expected.map)
+    assert joint.map.contains(TRUTH_HERE)
+    assert one_by_one.map.contains(TRUTH_HERE)
+    assert one_by_one.map.area == LOST_HERE.area  # each bearing alone: no position learnt
+    assert joint.map.wedge.width < 0.8 * one_by_one.map.wedge.width
+    assert joint.map.area < 0.3 * one_by_one.map.area
+    # Both accepted, sharing the joint reduction's figures.
+    assert [o.accepted for o in joint.outcomes] == [True, True]
+    assert {(o.area_before, o.area_after, o.wedge_width_after) for o in joint.outcomes} == {
+        (LOST_HERE.area, expected.area_after, expected.map.wedge.width)
+    }
+    # Observations at different instants, or a narrow wedge, are reduced one by one.
+    apart = (bearing_of(TRUTH_HERE, POLE_NORTH, 0.0, 0.02), bearing_of(TRUTH_HERE, POLE_SOUTH, 0.5, 0.02))
+    step = UncertaintyMapManager(LOST_HERE, WORLD, TABLE).update(board_with(observations=apart), now=1.0)
+    assert_same_map(step.map, one_by_one.map)
+    narrow = UncertaintyMapManager(LOST_HERE, WORLD, TABLE, joint_above=2 * math.pi)
+    assert_same_map(narrow.update(board_with(observations=seen), now=0.0).map, one_by_one.map)
+
+
+def test_a_joint_instant_still_rejects_unknown_ids_and_falls_back_when_no_heading_agrees() -> None:
+    seen = (*instant(POLE_NORTH), BearingObservation("ghost", 0.0, 0.0, 0.01), *instant(POLE_SOUTH))
+    manager = UncertaintyMapManager(LOST_HERE, WORLD, TABLE)
+    step = manager.update(board_with(observations=seen), now=0.0)
+    assert [(o.accepted, o.reason) for o in step.outcomes] == [
+        (True, ""),
+        (False, REJECT_UNKNOWN_LANDMARK),
+        (True, ""),
+    ]
+    assert step.map.area < 0.5 * LOST_HERE.area  # the two poles together
+    assert manager.rejected_counts == {REJECT_UNKNOWN_LANDMARK: 1}
+    # The south pole where the truth cannot see it with the north one: no heading agrees
+    # with both, so each is taken alone and the consistency gate decides.
+    north = bearing_of(TRUTH_HERE, POLE_NORTH, 0.0, 0.02)
+    wrong = (north, BearingObservation("pole_south", 0.0, north.bearing, 0.0))
+    assert not reduce_jointly(LOST_HERE, [(wrong[0], POLE_NORTH), (wrong[1], POLE_SOUTH)]).consistent
+    manager = UncertaintyMapManager(LOST_HERE, WORLD, TABLE)
+    alone = manager.update(board_with(observations=wrong), now=0.0)
+    one_by_one = UncertaintyMapManager(LOST_HERE, WORLD, TABLE, joint_above=None)
+    assert_same_map(alone.map, one_by_one.update(board_with(observations=wrong), now=0.0).map)
+    assert alone.outcomes[0].accepted
+
+
+def test_joint_settings_are_saved_and_an_older_document_restores_without_them() -> None:
+    manager = manager_for(joint_above=1.0, joint_sector=0.2)
+    again = UncertaintyMapManager.from_json(manager.to_json(), WORLD, TABLE)
+    assert (again.joint_above, again.joint_sector) == (1.0, 0.2)
+    assert (manager_for().joint_above, manager_for().joint_sector) == (math.pi / 2, DEFAULT_SECTOR)
+    document = json.loads(manager.to_json())
+    del document["settings"]["joint_above"], document["settings"]["joint_sector"]
+    older = UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
+    assert (older.joint_above, older.joint_sector) == (None, DEFAULT_SECTOR)  # as such a manager ran
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"joint_above": -0.1}, "joint_above: expected a non-negative number or None, got -0.1"),
+        ({"joint_above": math.nan}, "joint_above: expected a finite number, got nan"),
+        ({"joint_sector": 0.0}, r"joint_sector: expected radians in \(0, 2 pi\], got 0.0"),
+        ({"joint_sector": 7.0}, r"joint_sector: expected radians in \(0, 2 pi\], got 7.0"),
+    ],
+)
+def test_bad_joint_settings_are_refused(settings: dict[str, Any], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        manager_for(**settings)

@@ -20,20 +20,26 @@ if TYPE_CHECKING:
 _CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
 
 
-def _options(classes: str, sigmas: float, sensors: Path | None, robust: bool) -> ReplayOptions:
+def _options(
+    classes: str, sigmas: float, sensors: Path | None, robust: bool, joint: bool = True
+) -> ReplayOptions:
     from aura_ums.logs import ReplayOptions, load_sensors
     from aura_ums.uncertainty import LandmarkClass
 
     if classes not in _CLASSES:
         raise fail(f"--classes: expected I or II, got {classes!r}")
     landmark_class = LandmarkClass[_CLASSES[classes]]
+    joint_above = math.pi / 2 if joint else None
     if sensors is None:
-        return ReplayOptions(sigmas=sigmas, landmark_class=landmark_class, robust=robust)
+        return ReplayOptions(
+            sigmas=sigmas, landmark_class=landmark_class, robust=robust, joint_above=joint_above
+        )
     motion, working, envelope = load_sensors(sensors)
     return ReplayOptions(
         sigmas=sigmas,
         landmark_class=landmark_class,
         robust=robust,
+        joint_above=joint_above,
         working=working,
         envelope=envelope,
         motion=motion,
@@ -93,6 +99,13 @@ def replay(
     robust: Annotated[
         bool, typer.Option("--robust/--gate-only", help="Re-localize from an envelope map (default).")
     ] = True,
+    joint: Annotated[
+        bool,
+        typer.Option(
+            "--joint/--one-by-one",
+            help="Reduce by a frame's observations together while the heading is wider than pi/2 (default).",
+        ),
+    ] = True,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
     ] = None,
@@ -112,7 +125,7 @@ def replay(
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, sigmas, sensors, robust)
+        options = _options(classes, sigmas, sensors, robust, joint)
         result = replay_log(log, table, options)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None

@@ -65,6 +65,9 @@ class ReplayOptions:
     arena_margin : float
         Metres, >= 0, by which the one meadow of the replay (the log's terrain) extends
         beyond the landmarks, the start and the ground truth.
+    joint_above : float or None
+        Wedge width (radians, >= 0) above which the observations of one frame reduce the
+        map together (:func:`~aura_ums.uncertainty.reduce_jointly`); None: one by one.
 
     Examples
     --------
@@ -87,6 +90,7 @@ class ReplayOptions:
     relocalize_after: int = 1
     relocalize_window: int = 1
     arena_margin: float = 5.0
+    joint_above: float | None = math.pi / 2
 
     def __post_init__(self) -> None:
         if self.landmark_class not in _REPLAY_CLASSES:
@@ -104,6 +108,11 @@ class ReplayOptions:
         margin = finite_float(self.arena_margin, "ReplayOptions.arena_margin")
         if margin < 0.0:
             raise InputError(f"ReplayOptions.arena_margin: expected a number >= 0, got {margin!r}")
+        if self.joint_above is not None:
+            above = finite_float(self.joint_above, "ReplayOptions.joint_above")
+            if above < 0.0:
+                raise InputError(f"ReplayOptions.joint_above: expected a number >= 0 or None, got {above!r}")
+            object.__setattr__(self, "joint_above", above)
         for name in ("working", "envelope"):
             value = getattr(self, name)
             if value is not None and not isinstance(value, SensorBounds):
@@ -212,6 +221,7 @@ class ReplayResult:
             "landmark_class": self.options.landmark_class.value,
             "sigmas": self.options.sigmas,
             "robust": self.options.robust,
+            "joint_above_rad": self.options.joint_above,
             "steps": len(self.steps),
             "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
             "containment_rate": self.containment_rate,
@@ -386,6 +396,7 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         envelope=opts.robust,
         relocalize_after=opts.relocalize_after,
         relocalize_window=opts.relocalize_window,
+        joint_above=opts.joint_above,
     )
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)

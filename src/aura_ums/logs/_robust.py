@@ -21,6 +21,7 @@ under typical bounds, and the count of re-localizations goes up.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -83,6 +84,9 @@ class EnvelopeLocalizer:
         the working map presumed wrong.
     relocalize_window : int
         Observations remembered, >= ``relocalize_after``.
+    joint_above : float or None
+        Wedge width (radians) above which both managers reduce by the observations of one
+        instant together (see :class:`~aura_ums.manager.UncertaintyMapManager`); None: one by one.
 
     Raises
     ------
@@ -130,6 +134,7 @@ class EnvelopeLocalizer:
         envelope: bool = True,
         relocalize_after: int = 1,
         relocalize_window: int = 1,
+        joint_above: float | None = math.pi / 2,
     ) -> None:
         for name, value in (("relocalize_after", relocalize_after), ("relocalize_window", relocalize_window)):
             integer_at_least(value, name, 1)
@@ -138,13 +143,17 @@ class EnvelopeLocalizer:
                 f"relocalize_window: expected >= relocalize_after ({relocalize_after}), "
                 f"got {relocalize_window}"
             )
-        self._working = UncertaintyMapManager(initial_map, meadow_map, table, sigmas=sigmas)
+        self._working = UncertaintyMapManager(
+            initial_map, meadow_map, table, sigmas=sigmas, joint_above=joint_above
+        )
         self._meadow_map = meadow_map
         self._working_board = Blackboard()
         self._envelope: UncertaintyMapManager | None = None
         self._envelope_board = Blackboard()
         if envelope:
-            self._envelope = UncertaintyMapManager(initial_map, meadow_map, table, sigmas=sigmas)
+            self._envelope = UncertaintyMapManager(
+                initial_map, meadow_map, table, sigmas=sigmas, joint_above=joint_above
+            )
         self._relocalize_after = relocalize_after
         self._recent: deque[bool] = deque(maxlen=relocalize_window)
 

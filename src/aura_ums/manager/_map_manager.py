@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 import types
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -14,12 +15,15 @@ from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
 from aura_ums.uncertainty import (
+    DEFAULT_SECTOR,
+    Landmark,
     Observation,
     Pose,
     SpatialUncertaintyMap,
     TerrainStats,
     TerrainTable,
     TurnAndRun,
+    reduce_jointly,
 )
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
@@ -201,6 +205,14 @@ class UncertaintyMapManager:
     another class than its landmark, and an inconsistent reduction (no pose of the map
     agrees with it: most likely a misidentified landmark) -- never an emptied map.
 
+    Observations of one instant (equal time stamps) reduce the map together
+    (:func:`~aura_ums.uncertainty.reduce_jointly`, the wedge split into sectors of
+    ``joint_sector``) when the map's wedge is wider than ``joint_above``: one by one, a
+    bearing says nearly nothing about position while the heading is wide open, but two
+    or more seen from one heading do. Those that pass the checks above share the joint
+    reduction's areas and widths in their outcomes. When no heading agrees with all of
+    them, they are taken one by one instead, so the consistency gate rejects the odd one.
+
     Lost detection (the paper: "if no landmarks are recognized even though several have
     been predicted, the robot would declare itself lost, stop, and then start searching
     larger windows"): after an update the state is :attr:`ManagerState.LOST` when the
@@ -228,6 +240,11 @@ class UncertaintyMapManager:
         Frames in a row with predicted landmarks and none found that make the robot lost, >= 1.
     lost_window_scale : float
         :attr:`window_scale` while lost, >= 1.
+    joint_above : float or None
+        Wedge width (radians, >= 0) above which the observations of one instant reduce the
+        map together; None: always one by one.
+    joint_sector : float
+        Widest heading sector of the joint reduction, radians, in (0, 2 pi].
 
     Raises
     ------
@@ -263,6 +280,8 @@ class UncertaintyMapManager:
         "_area_limit",
         "_consumed",
         "_grown",
+        "_joint_above",
+        "_joint_sector",
         "_lost_reason",
         "_lost_window_scale",
         "_map",
@@ -287,6 +306,8 @@ class UncertaintyMapManager:
         area_limit: float | None = None,
         missed_limit: int = 3,
         lost_window_scale: float = 2.0,
+        joint_above: float | None = math.pi / 2,
+        joint_sector: float = DEFAULT_SECTOR,
     ) -> None:
         if not isinstance(initial_map, SpatialUncertaintyMap):
             raise InputError(
@@ -306,6 +327,16 @@ class UncertaintyMapManager:
         if scale < 1.0:
             raise InputError(f"lost_window_scale: expected a number >= 1, got {scale!r}")
         self._lost_window_scale = scale
+        self._joint_above: float | None = None
+        if joint_above is not None:
+            above = finite_float(joint_above, "joint_above")
+            if above < 0.0:
+                raise InputError(f"joint_above: expected a non-negative number or None, got {above!r}")
+            self._joint_above = above
+        sector = finite_float(joint_sector, "joint_sector")
+        if not 0.0 < sector <= 2.0 * math.pi:
+            raise InputError(f"joint_sector: expected radians in (0, 2 pi], got {sector!r}")
+        self._joint_sector = sector
         self._map = initial_map
         self._map_time: float | None = None
         self._consumed = 0
@@ -389,6 +420,16 @@ class UncertaintyMapManager:
         return self._area_limit
 
     @property
+    def joint_above(self) -> float | None:
+        """Wedge width (radians) above which observations of one instant reduce the map together."""
+        return self._joint_above
+
+    @property
+    def joint_sector(self) -> float:
+        """Widest heading sector of the joint reduction, radians."""
+        return self._joint_sector
+
+    @property
     def missed_limit(self) -> int:
         """Missed frames in a row that make the robot lost."""
         return self._missed_limit
@@ -451,12 +492,21 @@ class UncertaintyMapManager:
         identified = blackboard.identified
         outcomes: list[ObservationOutcome] = []
         pending = identified._peek_until(time)
-        for observation in pending:
-            stop = blackboard._report_stop(observation.time, index)
+        first = 0
+        while first < len(pending):
+            instant = pending[first].time
+            last = first + 1
+            while last < len(pending) and pending[last].time == instant:
+                last += 1
+            stop = blackboard._report_stop(instant, index)
             current, map_time = self._grow(current, reports, index, stop, map_time)
             index = stop
-            outcome, current = self._reduce(current, observation, map_time)
-            outcomes.append(outcome)
+            if last - first == 1:
+                outcome, current = self._reduce(current, pending[first], map_time)
+                outcomes.append(outcome)
+            else:
+                current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
+            first = last
         stop = blackboard._report_stop(time, index)
         current, map_time = self._grow(current, reports, index, stop, map_time)
         index = stop
@@ -572,36 +622,72 @@ class UncertaintyMapManager:
         point = shapely.Point(pose.x, pose.y)
         return min(self._meadow_map.meadows, key=lambda meadow: meadow.polygon.to_shapely().distance(point))
 
+    def _reduce_instant(
+        self,
+        current: SpatialUncertaintyMap,
+        observations: Sequence[Observation],
+        map_time: float | None,
+        outcomes: list[ObservationOutcome],
+    ) -> SpatialUncertaintyMap:
+        """Reduce by observations of one instant: jointly when the wedge is wide, else one by one."""
+        if self._joint_above is not None and current.wedge.width > self._joint_above:
+            checked = [self._landmark_for(observation, map_time) for observation in observations]
+            sightings = [
+                (o, found)
+                for o, found in zip(observations, checked, strict=True)
+                if not isinstance(found, str)
+            ]
+            if len(sightings) >= 2:
+                joint = reduce_jointly(current, sightings, sector=self._joint_sector)
+                if joint.consistent:
+                    reduced = joint.map
+                    area, width = current.area, current.wedge.width
+                    for observation, found in zip(observations, checked, strict=True):
+                        if isinstance(found, str):
+                            outcomes.append(
+                                ObservationOutcome._new(observation, False, found, area, area, width, width)
+                            )
+                        else:
+                            outcomes.append(
+                                ObservationOutcome._new(
+                                    observation, True, "", area, joint.area_after, width, reduced.wedge.width
+                                )
+                            )
+                    return reduced
+        for observation in observations:
+            outcome, current = self._reduce(current, observation, map_time)
+            outcomes.append(outcome)
+        return current
+
+    def _landmark_for(self, observation: Observation, map_time: float | None) -> Landmark | str:
+        """Return the landmark an observation names, or why it is rejected before any reduction."""
+        if map_time is not None and observation.time < map_time:
+            return REJECT_STALE
+        try:
+            landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+        except UnknownTerrainError:
+            return REJECT_UNKNOWN_LANDMARK
+        if observation.landmark_class is not landmark.landmark_class:
+            return REJECT_CLASS_MISMATCH
+        return landmark
+
     def _reduce(
         self, current: SpatialUncertaintyMap, observation: Observation, map_time: float | None
     ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
-        reason = ""
-        if map_time is not None and observation.time < map_time:
-            reason = REJECT_STALE
+        landmark = self._landmark_for(observation, map_time)
+        if isinstance(landmark, str):
+            reason = landmark
         else:
-            try:
-                landmark = self._meadow_map.landmark(observation.landmark_id).landmark
-            except UnknownTerrainError:
-                reason = REJECT_UNKNOWN_LANDMARK
-            else:
-                if observation.landmark_class is not landmark.landmark_class:
-                    reason = REJECT_CLASS_MISMATCH
-                else:
-                    # Found by the observation's id, of its class: the pair reduce() would check.
-                    found = current._reduce_checked(observation, landmark)
-                    if not isinstance(found, str):
-                        reduced, area_before, area_after = found
-                        outcome = ObservationOutcome._new(
-                            observation,
-                            True,
-                            "",
-                            area_before,
-                            area_after,
-                            current.wedge.width,
-                            reduced.wedge.width,
-                        )
-                        return outcome, reduced
-                    reason = found
+            # Found by the observation's id, of its class: the pair reduce() would check.
+            found = current._reduce_checked(observation, landmark)
+            if not isinstance(found, str):
+                reduced, area_before, area_after = found
+                width_before, width_after = current.wedge.width, reduced.wedge.width
+                outcome = ObservationOutcome._new(
+                    observation, True, "", area_before, area_after, width_before, width_after
+                )
+                return outcome, reduced
+            reason = found
         # Rejected: the map stays, and so do its area and width.
         area, width = current.area, current.wedge.width
         return ObservationOutcome._new(observation, False, reason, area, area, width, width), current
@@ -663,6 +749,8 @@ class UncertaintyMapManager:
                     "area_limit": self._area_limit,
                     "missed_limit": self._missed_limit,
                     "lost_window_scale": self._lost_window_scale,
+                    "joint_above": self._joint_above,
+                    "joint_sector": self._joint_sector,
                 },
             },
         )
@@ -711,7 +799,11 @@ class UncertaintyMapManager:
         keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
         data = reader.mapping(reader.document(text, _KIND), "", (*keys, "counters", "settings"))
         settings = reader.mapping(
-            data["settings"], "settings", ("sigmas", "area_limit", "missed_limit", "lost_window_scale")
+            data["settings"],
+            "settings",
+            ("sigmas", "area_limit", "missed_limit", "lost_window_scale"),
+            # Saved before joint reductions existed: restored without them, as they ran.
+            optional=("joint_above", "joint_sector"),
         )
         uncertainty_map = reader.uncertainty_map(data["map"], "map")
         try:
@@ -723,6 +815,10 @@ class UncertaintyMapManager:
                 area_limit=reader.optional_number(settings["area_limit"], "settings.area_limit"),
                 missed_limit=reader.integer(settings["missed_limit"], "settings.missed_limit", 1),
                 lost_window_scale=reader.number(settings["lost_window_scale"], "settings.lost_window_scale"),
+                joint_above=reader.optional_number(settings.get("joint_above"), "settings.joint_above"),
+                joint_sector=reader.number(
+                    settings.get("joint_sector", DEFAULT_SECTOR), "settings.joint_sector"
+                ),
             )
         except InputError as exc:
             reader.fail("settings", str(exc))

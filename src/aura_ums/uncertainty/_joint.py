@@ -29,8 +29,8 @@ from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._reduce import TOLERANCE, Reduction, arc_wedge, cap_inside
 
-#: Default widest heading sector of :func:`reduce_jointly`, radians (10 degrees).
-DEFAULT_SECTOR = math.radians(10.0)
+#: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
+DEFAULT_SECTOR = math.radians(5.0)
 
 _TWO_PI = 2.0 * math.pi
 
@@ -95,7 +95,7 @@ def reduce_jointly(
     (True, True, True, True)
     >>> three = reduce_jointly(lost, seen(a, b, c))
     >>> three.map.contains(truth), round(three.area_after, 1), round(three.map.wedge.width, 2)
-    (True, 2.2, 0.16)
+    (True, 1.2, 0.09)
 
     All three dead ahead: they are not in line, so no pose sees them so.
 

@@ -1,0 +1,59 @@
+"""``aura-ums calibrate``, ``replay`` and ``compare`` on a synthetic log written to a folder."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from aura_ums.cli import app
+from aura_ums.logs import synthetic_log, write_log
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def log_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    log = synthetic_log(np.random.default_rng(4), duration=20.0)
+    return write_log(log, tmp_path_factory.mktemp("log") / "r1")
+
+
+def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    result = runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)])
+    assert result.exit_code == 0, result.output
+    sensors = terrain.with_suffix(".sensors.toml")
+    assert terrain.is_file()
+    assert sensors.is_file()
+    common = [str(log_folder), "--terrain", str(terrain), "--sensors", str(sensors)]
+
+    metrics: dict[str, dict[str, object]] = {}
+    for label, extra in (("joint", []), ("one by one", ["--one-by-one"]), ("gate only", ["--gate-only"])):
+        out = tmp_path / f"{label}.json"
+        result = runner.invoke(app, ["replay", *common, "--classes", "I", *extra, "--metrics-json", str(out)])
+        assert result.exit_code == 0, result.output
+        assert "containment_rate" in result.output
+        metrics[label] = json.loads(out.read_text())
+    assert metrics["joint"]["joint_above_rad"] == pytest.approx(math.pi / 2)
+    assert metrics["one by one"]["joint_above_rad"] is None
+    assert (metrics["joint"]["robust"], metrics["gate only"]["robust"]) == (True, False)
+    for figures in metrics.values():
+        assert figures["containment_rate"] == 1.0
+        assert isinstance(figures["median_update_us"], float)
+
+    table = tmp_path / "compare.json"
+    result = runner.invoke(app, ["compare", *common, "--particles", "50", "--metrics-json", str(table)])
+    assert result.exit_code == 0, result.output
+    rows = json.loads(table.read_text())
+    assert [row["method"] for row in rows["methods"]] == ["aura-ums", "EKF", "PF (50)"]
+
+
+def test_replay_names_a_missing_terrain_file(log_folder: Path, tmp_path: Path) -> None:
+    missing = tmp_path / "nowhere.toml"
+    result = runner.invoke(app, ["replay", str(log_folder), "--terrain", str(missing)])
+    assert result.exit_code != 0
+    assert "nowhere.toml" in result.output
