@@ -189,8 +189,13 @@ def _combined(
         else:
             begin = spans[(after + 1) % len(spans)][0]
             arc = (begin, _TWO_PI - gap)
-    # The most probable pose: the prior's heading where it is still possible (else the new
-    # wedge's middle), and the centre of the sector result nearest to that heading.
+    # The most probable pose: the prior's where it is still possible, as a single reduction
+    # keeps it; else the prior's heading (the new wedge's middle when any heading was
+    # possible) in the sector result nearest to it, with that result's centre.
+    heading_kept = (prior.wedge.center - arc[0]) % _TWO_PI <= arc[1]
+    if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
+        reduced = SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
+        return Reduction(reduced, True, prior.area, reduced.area, prior.wedge, reduced.wedge)
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
     nearest = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[1]
     heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center
