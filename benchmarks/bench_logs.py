@@ -24,6 +24,7 @@ from aura_ums.logs import (
     RobotLog,
     calibrate_logs,
     compare_on_log,
+    filter_settings,
     observation_errors,
     read_mrclam,
     synthetic_log,
@@ -49,14 +50,9 @@ def main() -> None:
 
     def run(log: RobotLog, options: ReplayOptions, label: str) -> None:
         def filterpy_ekf(start: Pose) -> FilterpyLogEkf:
-            # The settings compare_on_log gives its own EKF.
+            # Started as compare_on_log starts its own EKF.
             return FilterpyLogEkf(
-                start,
-                position_sd=max(log.meta.start_radius / 3.0, 1e-3),
-                heading_sd=max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
-                bearing_sd=bearing_sd,
-                range_sd=0.01,
-                range_sd_fraction=range_sd_fraction,
+                start, **filter_settings(log, bearing_sd=bearing_sd, range_sd_fraction=range_sd_fraction)
             )
 
         best: dict[str, float] = {}

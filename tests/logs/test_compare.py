@@ -9,7 +9,7 @@ import pytest
 
 from aura_ums.baselines import ExtendedKalmanFilter
 from aura_ums.errors import InputError
-from aura_ums.logs import RobotLog, compare_on_log, synthetic_log
+from aura_ums.logs import MethodSummary, RobotLog, compare_on_log, filter_settings, synthetic_log
 from aura_ums.uncertainty import Pose, TerrainTable
 
 FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
@@ -22,15 +22,19 @@ def log() -> RobotLog:
 
 
 def _as_built_in(start: Pose, log: RobotLog) -> ExtendedKalmanFilter:
-    # The settings compare_on_log gives its own EKF.
-    return ExtendedKalmanFilter(
-        start,
-        position_sd=max(log.meta.start_radius / 3.0, 1e-3),
-        heading_sd=max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
+    settings = filter_settings(log, bearing_sd=BEARING_SD, range_sd_fraction=RANGE_SD_FRACTION)
+    return ExtendedKalmanFilter(start, gate_probability=0.999, **settings)
+
+
+def compare(log: RobotLog, *, particles: int, others: object) -> tuple[MethodSummary, ...]:
+    return compare_on_log(
+        log,
+        FLOOR,
         bearing_sd=BEARING_SD,
-        range_sd=0.01,
         range_sd_fraction=RANGE_SD_FRACTION,
-        gate_probability=0.999,
+        rng=np.random.default_rng(0),
+        particles=particles,
+        others=others,  # type: ignore[arg-type]
     )
 
 
@@ -57,15 +61,7 @@ def test_an_estimator_of_ones_own_is_stepped_and_judged_as_the_ekf(log: RobotLog
     def blind(start: Pose) -> ExtendedKalmanFilter:  # the same EKF gating every update out
         return gating_everything_out(_as_built_in(start, log))
 
-    rows = compare_on_log(
-        log,
-        FLOOR,
-        bearing_sd=BEARING_SD,
-        range_sd_fraction=RANGE_SD_FRACTION,
-        rng=np.random.default_rng(0),
-        particles=100,
-        others={"twin EKF": twin, "blind EKF": blind},
-    )
+    rows = compare(log, particles=100, others={"twin EKF": twin, "blind EKF": blind})
     assert [row.method for row in rows] == ["aura-ums", "EKF", "PF (100)", "twin EKF", "blind EKF"]
     assert len(starts) == 1
     truth = log.groundtruth
@@ -110,12 +106,4 @@ class _NotAnEstimator:
 )
 def test_bad_others_are_named(log: RobotLog, others: object, match: str) -> None:
     with pytest.raises(InputError, match=match):
-        compare_on_log(
-            log,
-            FLOOR,
-            bearing_sd=BEARING_SD,
-            range_sd_fraction=RANGE_SD_FRACTION,
-            rng=np.random.default_rng(0),
-            particles=10,
-            others=others,  # type: ignore[arg-type]
-        )
+        compare(log, particles=10, others=others)

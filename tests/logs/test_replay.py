@@ -10,6 +10,7 @@ from log_helpers import MRCLAM6
 
 from aura_ums.errors import InputError
 from aura_ums.logs import (
+    Calibration,
     MotionCalibration,
     ReplayOptions,
     RobotLog,
@@ -108,44 +109,51 @@ def test_zero_length_log_gives_no_steps() -> None:
     assert np.isnan(result.containment_rate)
 
 
-@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
-def test_mrclam_range_bearing_replay_keeps_the_truth_on_both_robots() -> None:
-    # Calibrated on robot 1, replayed on robot 1 and on robot 2 (the acceptance figure).
+@pytest.fixture(scope="module")
+def mrclam() -> tuple[RobotLog, RobotLog, Calibration]:
+    """Robots 1 and 2 of MRCLAM Dataset 6, and the calibration on robot 1 (the acceptance setup)."""
+    if not MRCLAM.is_dir():
+        pytest.skip(f"MRCLAM data not found at {MRCLAM}")
     robot1, robot2 = read_mrclam(MRCLAM, 1), read_mrclam(MRCLAM, 2)
-    calibration = calibrate_logs([robot1])
-    assert isinstance(calibration.motion, MotionCalibration)
-    options = ReplayOptions(
-        landmark_class=LandmarkClass.POINT,
+    return robot1, robot2, calibrate_logs([robot1])
+
+
+def calibrated(calibration: Calibration, landmark_class: LandmarkClass) -> ReplayOptions:
+    return ReplayOptions(
+        landmark_class=landmark_class,
         working=calibration.working,
         envelope=calibration.envelope,
         motion=calibration.motion,
     )
+
+
+def test_mrclam_range_bearing_replay_keeps_the_truth_on_both_robots(
+    mrclam: tuple[RobotLog, RobotLog, Calibration],
+) -> None:
+    # Calibrated on robot 1, replayed on robot 1 and on robot 2 (the acceptance figure).
+    robot1, robot2, calibration = mrclam
+    assert isinstance(calibration.motion, MotionCalibration)
+    options = calibrated(calibration, LandmarkClass.POINT)
     for log in (robot1, robot2):
         result = replay_log(log, calibration.terrain_table(), options)
         assert result.containment_rate >= 0.99, log.meta.name
         assert result.median_area_m2 < 2.0
 
 
-@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
-def test_mrclam_bearing_only_replay_is_sound_and_informative_with_joint_reductions() -> None:
+def test_mrclam_bearing_only_replay_is_sound_and_informative_with_joint_reductions(
+    mrclam: tuple[RobotLog, RobotLog, Calibration],
+) -> None:
     # Bearings alone, one by one, leave the map sound but useless once the heading has
     # opened up (robot 1: 2586 m^2, any heading); together they keep closing it.
-    robot1, robot2 = read_mrclam(MRCLAM, 1), read_mrclam(MRCLAM, 2)
-    calibration = calibrate_logs([robot1])
-    options = ReplayOptions(
-        landmark_class=LandmarkClass.VERTICAL_LINE,
-        working=calibration.working,
-        envelope=calibration.envelope,
-        motion=calibration.motion,
-    )
+    robot1, robot2, calibration = mrclam
+    options = calibrated(calibration, LandmarkClass.VERTICAL_LINE)
     for log in (robot1, robot2):
         result = replay_log(log, calibration.terrain_table(), options)
         assert result.containment_rate >= 0.99, log.meta.name
         assert result.median_area_m2 < 50.0, log.meta.name
         assert result.median_wedge_width_rad < 2.0, log.meta.name
-    one_by_one = replay_log(
-        robot1, calibration.terrain_table(), dataclasses.replace(options, joint_above=None)
-    )
+    alone = dataclasses.replace(options, joint_above=None)
+    one_by_one = replay_log(robot1, calibration.terrain_table(), alone)
     assert one_by_one.median_area_m2 > 1000.0
     assert one_by_one.metrics()["joint_above_rad"] is None
 

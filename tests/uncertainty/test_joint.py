@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
+from test_reduce import map_inside, wedge_inside
 
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
@@ -28,23 +29,6 @@ from aura_ums.uncertainty import (
 Array = NDArray[np.float64]
 Sighting = tuple[Observation, Landmark]
 TWO_PI = 2.0 * math.pi
-
-
-def wedge_inside(inner: HeadingWedge, outer: HeadingWedge, tolerance: float = 1e-8) -> bool:
-    if outer.is_full_circle:
-        return True
-    if inner.width > outer.width + tolerance:
-        return False
-    start = (inner.center - inner.cw - (outer.center - outer.cw)) % TWO_PI
-    if start > TWO_PI - tolerance:
-        start -= TWO_PI
-    return start >= -tolerance and start + inner.width <= outer.width + tolerance
-
-
-def inside(reduced: SpatialUncertaintyMap, prior: SpatialUncertaintyMap) -> bool:
-    return bool(np.all(prior.polygon.contains(reduced.polygon.vertices))) and wedge_inside(
-        reduced.wedge, prior.wedge
-    )
 
 
 def wide_prior(rng: np.random.Generator) -> SpatialUncertaintyMap:
@@ -130,7 +114,7 @@ def test_every_true_pose_is_kept_and_the_joint_map_bites(rng: np.random.Generato
             joint = reduce_jointly(prior, sightings, sector=sector)
             total += 1
             kept += joint.consistent and bool(joint.map.contains(pose))
-            assert inside(joint.map, prior), (prior, sightings)
+            assert map_inside(joint.map, prior), (prior, sightings)
             # Never looser than one by one, beyond the hull's and the sectors' slack.
             tighter += joint.area_after < 0.9 * in_turn(prior, sightings).area
     assert total >= 1400
@@ -230,7 +214,7 @@ def test_joint_map_lies_inside_the_prior_with_its_centre(seed: int, sector: floa
     x, y = rng.uniform(-10.0, 10.0, 2).tolist()
     pose = Pose(x, y, float(rng.uniform(-math.pi, math.pi)))  # anywhere: the map may not hold it
     joint = reduce_jointly(prior, sightings_of(rng, prior, pose, int(rng.integers(1, 4))), sector=sector)
-    assert inside(joint.map, prior)
+    assert map_inside(joint.map, prior)
     assert joint.map.polygon.contains(joint.map.center[None, :], tolerance=1e-6)[0]
     assert joint.area_after <= joint.area_before * (1.0 + 1e-9) + 1e-12
     assert joint.map.polygon.vertex_count <= max(64, prior.polygon.vertex_count)

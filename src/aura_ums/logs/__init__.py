@@ -24,7 +24,7 @@ from aura_ums.logs._calibrate import (
     load_sensors,
     observation_errors,
 )
-from aura_ums.logs._compare import MethodSummary, compare_on_log
+from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
 from aura_ums.logs._io import LOG_FILES, load_log, write_log
 from aura_ums.logs._log import (
     GroundTruth,
@@ -76,6 +76,7 @@ __all__ = [
     "SensorBounds",
     "calibrate_logs",
     "compare_on_log",
+    "filter_settings",
     "frames_after",
     "import_mrclam",
     "import_rosbag",

@@ -78,6 +78,30 @@ def _ours(result: ReplayResult) -> MethodSummary:
     )
 
 
+def filter_settings(log: RobotLog, *, bearing_sd: float, range_sd_fraction: float) -> dict[str, float]:
+    """Return the start spread and noise :func:`compare_on_log` gives its filters, as keyword arguments.
+
+    ``position_sd`` and ``heading_sd`` are a third of the log's start bounds (at least
+    1e-3), ``range_sd`` is 0.01 m; ``bearing_sd`` (rad) and ``range_sd_fraction`` are
+    passed through. Give them to a filter of yours to start it as the EKF starts.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> settings = filter_settings(synthetic_log(np.random.default_rng(3), duration=5.0),
+    ...                            bearing_sd=0.006, range_sd_fraction=0.012)
+    >>> sorted(settings), settings["range_sd"]
+    (['bearing_sd', 'heading_sd', 'position_sd', 'range_sd', 'range_sd_fraction'], 0.01)
+    """
+    return {
+        "position_sd": max(log.meta.start_radius / 3.0, 1e-3),
+        "heading_sd": max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
+        "bearing_sd": bearing_sd,
+        "range_sd": 0.01,
+        "range_sd_fraction": range_sd_fraction,
+    }
+
+
 def compare_on_log(
     log: RobotLog,
     table: TerrainTable,
@@ -96,7 +120,8 @@ def compare_on_log(
     terrain statistics and the same observations, step by step. The filters start from
     the same pose with standard deviations of a third of our start bounds, use
     ``bearing_sd`` (rad) and ``range_sd_fraction`` (of the range) as their measurement
-    noise, and gate at 99.9%; their region is the ``probability`` confidence region.
+    noise (:func:`filter_settings`), and gate at 99.9%; their region is the
+    ``probability`` confidence region.
     Your own estimators join through ``others``: each is built from the start pose and
     stepped, timed and judged exactly as the EKF is.
 
@@ -172,13 +197,7 @@ def compare_on_log(
     reports = position_reports_for(log, opts)
     frames = frames_after(log, start_time)
     bounds = opts.working if opts.working is not None else meta_bounds(log)
-    common = {
-        "position_sd": max(log.meta.start_radius / 3.0, 1e-3),
-        "heading_sd": max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
-        "bearing_sd": b_sd,
-        "range_sd": 0.01,
-        "range_sd_fraction": r_sd,
-    }
+    common = filter_settings(log, bearing_sd=b_sd, range_sd_fraction=r_sd)
     filters: list[tuple[str, Estimator]] = [
         ("EKF", ExtendedKalmanFilter(start_pose, gate_probability=0.999, **common)),
         (

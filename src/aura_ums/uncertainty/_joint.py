@@ -23,6 +23,7 @@ import numpy as np
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.geometry._arcs import Arc, intersect_arcs
 from aura_ums.geometry._convex import convex_hull
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
@@ -178,8 +179,13 @@ def _combined(
         low = start + math.remainder(result_wedge.center - result_wedge.cw - start, _TWO_PI)
         spans.append((low, low + min(result_wedge.width, _TWO_PI)))
     first, last = spans[0][0], max(high for _, high in spans)
-    arc = (first, last - first)
-    if full_circle:
+    arc: Arc = (first, last - first)
+    if not full_circle:
+        # The sectors overlap their neighbours, and the prior's ends, by the tolerance:
+        # trim that off, so the wedge stays inside the prior's.
+        prior_wedge = prior.wedge
+        arc = intersect_arcs((prior_wedge.center - prior_wedge.cw, prior_wedge.width), arc) or arc
+    else:
         # Any heading was possible: the wedge may leave out the widest gap between results.
         gaps = [(spans[i + 1][0] - spans[i][1], i) for i in range(len(spans) - 1)]
         gaps.append((first + _TWO_PI - last, len(spans) - 1))
