@@ -25,6 +25,7 @@ from aura_ums.uncertainty import (
     TurnAndRun,
     reduce_jointly,
 )
+from aura_ums.uncertainty._joint import check_sector
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
@@ -333,10 +334,7 @@ class UncertaintyMapManager:
             if above < 0.0:
                 raise InputError(f"joint_above: expected a non-negative number or None, got {above!r}")
             self._joint_above = above
-        sector = finite_float(joint_sector, "joint_sector")
-        if not 0.0 < sector <= 2.0 * math.pi:
-            raise InputError(f"joint_sector: expected radians in (0, 2 pi], got {sector!r}")
-        self._joint_sector = sector
+        self._joint_sector = check_sector(joint_sector, "joint_sector")
         self._map = initial_map
         self._map_time: float | None = None
         self._consumed = 0

@@ -22,13 +22,20 @@ import numpy as np
 
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
-from aura_ums.geometry import ConvexPolygon, HeadingWedge
-from aura_ums.geometry._arcs import Arc, intersect_arcs
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, intersect_arcs
+from aura_ums.geometry._arcs import Arc
 from aura_ums.geometry._convex import convex_hull
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._reduce import TOLERANCE, Reduction, arc_wedge, cap_inside
+from aura_ums.uncertainty._reduce import (
+    TOLERANCE,
+    Reduction,
+    arc_wedge,
+    cap_inside,
+    check_pair,
+    reduce_checked,
+)
 
 #: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
 DEFAULT_SECTOR = math.radians(5.0)
@@ -107,16 +114,18 @@ def reduce_jointly(
     if not isinstance(prior, SpatialUncertaintyMap):
         raise InputError(f"prior: expected a SpatialUncertaintyMap, got {type(prior).__name__}")
     pairs = _checked_sightings(sightings)
-    width_limit = finite_float(sector, "sector")
-    if not 0.0 < width_limit <= _TWO_PI:
-        raise InputError(f"sector: expected radians in (0, 2 pi], got {width_limit!r}")
+    width_limit = check_sector(sector, "sector")
     cap = integer_at_least(max_vertices, "max_vertices", 3)
 
     wedge = prior.wedge
     lo, width = wedge.center - wedge.cw, min(wedge.width, _TWO_PI)
     count = max(1, math.ceil(width / width_limit - 1e-9))
     if count == 1:
-        return _in_turn(prior, pairs, cap)
+        found = _in_turn(prior, pairs, cap)
+        if isinstance(found, str):
+            area = prior.area
+            return Reduction(prior, False, area, area, wedge, wedge, found)
+        return Reduction(found, True, prior.area, found.area, wedge, found.wedge)
     step = width / count
     # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
     half = 0.5 * step + TOLERANCE
@@ -126,13 +135,21 @@ def reduce_jointly(
         restricted = SpatialUncertaintyMap._trusted(
             prior.polygon, prior.center, HeadingWedge(start + 0.5 * step, half, half)
         )
-        reduction = _in_turn(restricted, pairs, cap)
-        if reduction.consistent:
-            kept.append((start, reduction.map))
+        found = _in_turn(restricted, pairs, cap)
+        if not isinstance(found, str):
+            kept.append((start, found))
     if not kept:
         area = prior.area
         return Reduction(prior, False, area, area, wedge, wedge, JOINT_INCONSISTENT)
     return _combined(prior, kept, wedge.is_full_circle, cap)
+
+
+def check_sector(value: object, name: str) -> float:
+    """Return a sector width (radians, in (0, 2 pi]) or raise naming ``name``."""
+    width = finite_float(value, name)
+    if not 0.0 < width <= _TWO_PI:
+        raise InputError(f"{name}: expected radians in (0, 2 pi], got {width!r}")
+    return width
 
 
 def _checked_sightings(sightings: object) -> list[tuple[Observation, Landmark]]:
@@ -144,6 +161,7 @@ def _checked_sightings(sightings: object) -> list[tuple[Observation, Landmark]]:
     for index, pair in enumerate(sightings):
         if not isinstance(pair, tuple) or len(pair) != 2:
             raise InputError(f"sightings[{index}]: expected an (observation, landmark) pair, got {pair!r}")
+        check_pair(*pair)  # once here: every sector reduces by the same pairs
         pairs.append(pair)
     if not pairs:
         raise InputError("sightings: expected at least one (observation, landmark) pair, got none")
@@ -152,15 +170,14 @@ def _checked_sightings(sightings: object) -> list[tuple[Observation, Landmark]]:
 
 def _in_turn(
     current: SpatialUncertaintyMap, pairs: Sequence[tuple[Observation, Landmark]], cap: int
-) -> Reduction:
-    """Reduce by each observation in turn; the first inconsistent one makes it all inconsistent."""
-    area, wedge = current.area, current.wedge
+) -> SpatialUncertaintyMap | str:
+    """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is."""
     for observation, landmark in pairs:
-        reduction = current.reduce(observation, landmark, max_vertices=cap)
-        if not reduction.consistent:
-            return Reduction(current, False, area, area, wedge, wedge, reduction.reason)
-        current = reduction.map
-    return Reduction(current, True, area, current.area, wedge, current.wedge)
+        found = reduce_checked(current, observation, landmark, cap)
+        if isinstance(found, str):
+            return found
+        current = found[0]
+    return current
 
 
 def _combined(
