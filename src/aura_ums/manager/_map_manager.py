@@ -500,7 +500,10 @@ class UncertaintyMapManager:
             current, map_time = self._grow(current, reports, index, stop, map_time)
             index = stop
             if last - first == 1:
-                outcome, current = self._reduce(current, pending[first], map_time)
+                observation = pending[first]
+                outcome, current = self._reduce(
+                    current, observation, self._landmark_for(observation, map_time)
+                )
                 outcomes.append(outcome)
             else:
                 current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
@@ -628,8 +631,9 @@ class UncertaintyMapManager:
         outcomes: list[ObservationOutcome],
     ) -> SpatialUncertaintyMap:
         """Reduce by observations of one instant: jointly when the wedge is wide, else one by one."""
+        # One map time for the instant: each observation's landmark (or rejection) holds for both ways.
+        checked = [self._landmark_for(observation, map_time) for observation in observations]
         if self._joint_above is not None and current.wedge.width > self._joint_above:
-            checked = [self._landmark_for(observation, map_time) for observation in observations]
             sightings = [
                 (o, found)
                 for o, found in zip(observations, checked, strict=True)
@@ -652,8 +656,8 @@ class UncertaintyMapManager:
                                 )
                             )
                     return reduced
-        for observation in observations:
-            outcome, current = self._reduce(current, observation, map_time)
+        for observation, found in zip(observations, checked, strict=True):
+            outcome, current = self._reduce(current, observation, found)
             outcomes.append(outcome)
         return current
 
@@ -670,9 +674,9 @@ class UncertaintyMapManager:
         return landmark
 
     def _reduce(
-        self, current: SpatialUncertaintyMap, observation: Observation, map_time: float | None
+        self, current: SpatialUncertaintyMap, observation: Observation, landmark: Landmark | str
     ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
-        landmark = self._landmark_for(observation, map_time)
+        """Reduce by one observation and its landmark (from :meth:`_landmark_for`, or why not)."""
         if isinstance(landmark, str):
             reason = landmark
         else:
