@@ -7,7 +7,9 @@ starts, for every method). All methods see the same reports and observations
 model in numpy matrices and the same gate, from benchmarks/filterpy_ekf.py). Uses the MRCLAM Dataset 6 logs in
 ../shared/data when present (calibrated on robot 1), else a synthetic log. Each log is
 run ``REPEATS`` times; a method's figure is the lowest of its per-run medians, so that a
-burst of load on this machine does not land on one method only.
+burst of load on this machine does not land on one method only. Robot 1 is also replayed
+with the map polygon capped at 16 vertices (``ReplayOptions.max_vertices``, default 64):
+the speed a coarser polygon buys and the area it costs.
 
     .venv/bin/python benchmarks/bench_logs.py
 """
@@ -98,6 +100,16 @@ def main() -> None:
         robust=False,
     )
     run(logs[-1], options, "II gate only")
+    # A coarser polygon (ReplayOptions.max_vertices, replay --max-vertices): speed for area.
+    for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
+        options = ReplayOptions(
+            landmark_class=landmark_class,
+            working=calibration.working,
+            envelope=calibration.envelope,
+            motion=calibration.motion,
+            max_vertices=16,
+        )
+        run(logs[0], options, f"{landmark_class.value} cap 16")
     print(
         "us/step: the lowest of the per-run medians; / EKF: against aura-ums's ExtendedKalmanFilter "
         "(written out on floats); / fpy: against filterpy's ExtendedKalmanFilter"

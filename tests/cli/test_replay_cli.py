@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 
 from aura_ums.cli import app
 from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import DEFAULT_MAX_VERTICES
 
 runner = CliRunner()
 
@@ -32,7 +33,13 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     common = [str(log_folder), "--terrain", str(terrain), "--sensors", str(sensors)]
 
     metrics: dict[str, dict[str, object]] = {}
-    for label, extra in (("joint", []), ("one by one", ["--one-by-one"]), ("gate only", ["--gate-only"])):
+    runs: tuple[tuple[str, list[str]], ...] = (
+        ("joint", []),
+        ("one by one", ["--one-by-one"]),
+        ("gate only", ["--gate-only"]),
+        ("coarse", ["--max-vertices", "8"]),
+    )
+    for label, extra in runs:
         out = tmp_path / f"{label}.json"
         result = runner.invoke(app, ["replay", *common, "--classes", "I", *extra, "--metrics-json", str(out)])
         assert result.exit_code == 0, result.output
@@ -41,6 +48,12 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     assert metrics["joint"]["joint_above_rad"] == pytest.approx(math.pi / 2)
     assert metrics["one by one"]["joint_above_rad"] is None
     assert (metrics["joint"]["robust"], metrics["gate only"]["robust"]) == (True, False)
+    assert (metrics["joint"]["max_vertices"], metrics["coarse"]["max_vertices"]) == (DEFAULT_MAX_VERTICES, 8)
+    # A coarser polygon: looser on this log.
+    coarse, fine = metrics["coarse"]["median_area_m2"], metrics["joint"]["median_area_m2"]
+    assert isinstance(coarse, float)
+    assert isinstance(fine, float)
+    assert coarse >= fine
     for figures in metrics.values():
         assert figures["containment_rate"] == 1.0
         assert isinstance(figures["median_update_us"], float)
@@ -57,3 +70,18 @@ def test_replay_names_a_missing_terrain_file(log_folder: Path, tmp_path: Path) -
     result = runner.invoke(app, ["replay", str(log_folder), "--terrain", str(missing)])
     assert result.exit_code != 0
     assert "nowhere.toml" in result.output
+
+
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_a_vertex_cap_below_three_is_refused_by_name(command: str, log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text("")
+    result = runner.invoke(app, [command, str(log_folder), "--terrain", str(terrain), "--max-vertices", "2"])
+    assert result.exit_code != 0
+    assert "--max-vertices: expected an integer >= 3, got 2" in result.output
+
+
+def test_the_cli_default_cap_is_the_library_default() -> None:
+    from aura_ums.cli import _replay
+
+    assert _replay._MAX_VERTICES == DEFAULT_MAX_VERTICES

@@ -166,3 +166,13 @@ def test_joint_above_is_checked() -> None:
         ReplayOptions(joint_above=-1.0)
     with pytest.raises(InputError, match=r"ReplayOptions\.joint_above: expected a finite number"):
         ReplayOptions(joint_above=float("nan"))
+
+
+def test_vertex_caps_are_checked_and_reported(clean_log: RobotLog) -> None:
+    with pytest.raises(InputError, match=r"ReplayOptions\.max_vertices: expected an integer >= 3, got 2"):
+        ReplayOptions(max_vertices=2)
+    with pytest.raises(InputError, match=r"ReplayOptions\.envelope_max_vertices: expected an integer >= 3"):
+        ReplayOptions(envelope_max_vertices=1.5)  # type: ignore[arg-type]
+    metrics = replay_log(clean_log, FLOOR, ReplayOptions(max_vertices=8)).metrics()
+    assert (metrics["max_vertices"], metrics["envelope_max_vertices"]) == (8, None)
+    assert metrics["containment_rate"] == 1.0

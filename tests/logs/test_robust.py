@@ -72,3 +72,17 @@ def test_localizer_arguments_are_checked() -> None:
         EnvelopeLocalizer(start, world, FLOOR, relocalize_after=0)
     with pytest.raises(InputError, match="relocalize_window: expected >= relocalize_after"):
         EnvelopeLocalizer(start, world, FLOOR, relocalize_after=3, relocalize_window=2)
+    with pytest.raises(InputError, match="envelope_max_vertices: expected an integer >= 3, got 2"):
+        EnvelopeLocalizer(start, world, FLOOR, envelope=False, envelope_max_vertices=2)
+    with pytest.raises(InputError, match="max_vertices: expected an integer >= 3, got 0"):
+        EnvelopeLocalizer(start, world, FLOOR, max_vertices=0)
+
+
+def test_a_coarse_envelope_stays_sound_and_re_seeds_within_the_working_cap(clean_log: RobotLog) -> None:
+    wrong = inject(clean_log, 20.0, 23.0, lambda o: dataclasses.replace(o, bearing=o.bearing + 2.0))
+    options = ReplayOptions(landmark_class=LandmarkClass.POINT, max_vertices=24, envelope_max_vertices=6)
+    steps = replay_log(wrong, FLOOR, options).steps
+    assert any(step.relocalized for step in steps)
+    assert all(step.envelope_inside for step in steps)
+    assert all(len(step.map.polygon.vertices) <= 24 for step in steps[1:])
+    assert sum(step.inside is True for step in steps) == len(steps)

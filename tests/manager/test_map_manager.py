@@ -27,6 +27,7 @@ from aura_ums.manager import (
     UncertaintyMapManager,
 )
 from aura_ums.uncertainty import (
+    DEFAULT_MAX_VERTICES,
     DEFAULT_SECTOR,
     BearingObservation,
     GroundLineLandmark,
@@ -224,6 +225,24 @@ def test_each_piece_of_a_run_grows_with_its_meadows_terrain() -> None:
     assert step.map.area > concrete_only.area * 1.05  # gravel is rougher than concrete
 
 
+def test_the_vertex_cap_holds_through_growth_across_meadows_and_reductions() -> None:
+    initial = SpatialUncertaintyMap.from_pose(Pose(7.0, 0.0, 0.0), 0.1, 0.02)
+    crossing = TurnAndRun(0.1, 7.0)
+    truth = Pose(14.0, 0.7, 0.1)  # within the grown map: the reduction below keeps it
+    coarse, fine = manager_for(initial, max_vertices=6), manager_for(initial)
+    seen = (bearing_of(truth, POLE_NORTH, 1.0, 0.02),)
+    steps = [m.update(board_with((1.0, crossing), observations=seen), now=1.0) for m in (coarse, fine)]
+    grown = grow_through(initial, WORLD, crossing, TABLE, max_vertices=6)
+    uncapped = grow_through(initial, WORLD, crossing, TABLE)
+    assert len(grown.polygon.vertices) <= 6 < len(uncapped.polygon.vertices)
+    assert_same_map(steps[0].map, grown.reduce(seen[0], POLE_NORTH, max_vertices=6).map)
+    assert len(steps[0].map.polygon.vertices) <= 6
+    assert coarse.max_vertices == 6
+    # Fewer vertices, a coarser outer approximation: looser here, and still sound.
+    assert steps[0].map.area > steps[1].map.area
+    assert steps[0].map.contains(truth)
+
+
 # --- rejections --------------------------------------------------------------------------
 
 
@@ -365,6 +384,8 @@ def test_a_different_blackboard_is_refused() -> None:
         ({"missed_limit": 0}, "missed_limit: expected an integer >= 1, got 0"),
         ({"missed_limit": True}, "missed_limit: expected an integer >= 1, got True"),
         ({"lost_window_scale": 0.5}, "lost_window_scale: expected a number >= 1, got 0.5"),
+        ({"max_vertices": 2}, "max_vertices: expected an integer >= 3, got 2"),
+        ({"max_vertices": 16.0}, "max_vertices: expected an integer >= 3, got 16.0"),
     ],
 )
 def test_bad_settings_are_refused(settings: dict[str, Any], message: str) -> None:
@@ -646,16 +667,18 @@ def observe(pose: Pose, landmark: Landmark, time: float, rng: np.random.Generato
     commands=st.lists(st.tuples(st.floats(-1.0, 1.0), st.floats(0.0, 3.0)), min_size=1, max_size=12),
     seen=st.lists(st.integers(-1, len(FIELD_LANDMARKS) - 1), min_size=12, max_size=12),
     stride=st.integers(1, 3),
+    cap=st.sampled_from([3, 5, 16, 64]),
 )
 def test_the_map_contains_the_true_pose_after_any_run(
-    seed: int, terrain: str, commands: list[tuple[float, float]], seen: list[int], stride: int
+    seed: int, terrain: str, commands: list[tuple[float, float]], seen: list[int], stride: int, cap: int
 ) -> None:
     rng = np.random.default_rng(seed)
     truth = Pose(float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)), float(rng.uniform(-math.pi, math.pi)))
     guess = Pose(truth.x + 0.1, truth.y - 0.1, truth.heading + 0.02)
-    manager = UncertaintyMapManager(
-        SpatialUncertaintyMap.from_pose(guess, 0.3, 0.05), FIELDS[terrain], TABLE, sigmas=3.0
-    )
+    initial = SpatialUncertaintyMap.from_pose(guess, 0.3, 0.05)
+    manager = UncertaintyMapManager(initial, FIELDS[terrain], TABLE, sigmas=3.0, max_vertices=cap)
+    # Growth caps the polygons it moves; one that no motion moved keeps its vertices.
+    most = max(cap, len(initial.polygon.vertices))
     board = Blackboard()
     for k, (turn, run) in enumerate(commands, start=1):
         command = TurnAndRun(turn, run)
@@ -667,6 +690,7 @@ def test_the_map_contains_the_true_pose_after_any_run(
             step = manager.update(board, now=float(k))
             assert step.rejected == (), [o.reason for o in step.rejected]
             assert step.map.contains(truth), (k, truth, step.map)
+            assert len(step.map.polygon.vertices) <= most
 
 
 def test_a_run_from_an_estimate_outside_every_meadow_grows_on_the_nearest_terrain() -> None:
@@ -778,6 +802,18 @@ def test_joint_settings_are_saved_and_an_older_document_restores_without_them() 
     del document["settings"]["joint_above"], document["settings"]["joint_sector"]
     older = UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
     assert (older.joint_above, older.joint_sector) == (None, DEFAULT_SECTOR)  # as such a manager ran
+
+
+def test_the_vertex_cap_is_saved_and_an_older_document_restores_the_default() -> None:
+    manager = manager_for(max_vertices=12)
+    assert UncertaintyMapManager.from_json(manager.to_json(), WORLD, TABLE).max_vertices == 12
+    document = json.loads(manager.to_json())
+    del document["settings"]["max_vertices"]
+    older = UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
+    assert older.max_vertices == DEFAULT_MAX_VERTICES == manager_for().max_vertices
+    document["settings"]["max_vertices"] = 2
+    with pytest.raises(FileFormatError, match=r"settings\.max_vertices: expected an integer >= 3, got 2"):
+        UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
 
 
 @pytest.mark.parametrize(

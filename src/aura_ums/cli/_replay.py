@@ -18,21 +18,39 @@ if TYPE_CHECKING:
 
 
 _CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
+_MAX_VERTICES = 64  # aura_ums.uncertainty.DEFAULT_MAX_VERTICES, without importing numpy for --help
+_MAX_VERTICES_HELP = "Cap on the map polygon's vertices (>= 3): fewer is faster and looser."
+
+
+def _check_cap(max_vertices: int) -> None:
+    # Before any file is read: a bad argument is named first.
+    if max_vertices < 3:
+        raise fail(f"--max-vertices: expected an integer >= 3, got {max_vertices}")
 
 
 def _options(
-    classes: str, sigmas: float, sensors: Path | None, robust: bool, joint: bool = True
+    classes: str,
+    sigmas: float,
+    sensors: Path | None,
+    robust: bool,
+    joint: bool = True,
+    max_vertices: int = _MAX_VERTICES,
 ) -> ReplayOptions:
     from aura_ums.logs import ReplayOptions, load_sensors
     from aura_ums.uncertainty import LandmarkClass
 
     if classes not in _CLASSES:
         raise fail(f"--classes: expected I or II, got {classes!r}")
+
     landmark_class = LandmarkClass[_CLASSES[classes]]
     joint_above = math.pi / 2 if joint else None
     if sensors is None:
         return ReplayOptions(
-            sigmas=sigmas, landmark_class=landmark_class, robust=robust, joint_above=joint_above
+            sigmas=sigmas,
+            landmark_class=landmark_class,
+            robust=robust,
+            joint_above=joint_above,
+            max_vertices=max_vertices,
         )
     motion, working, envelope = load_sensors(sensors)
     return ReplayOptions(
@@ -40,6 +58,7 @@ def _options(
         landmark_class=landmark_class,
         robust=robust,
         joint_above=joint_above,
+        max_vertices=max_vertices,
         working=working,
         envelope=envelope,
         motion=motion,
@@ -106,6 +125,7 @@ def replay(
             help="Reduce by a frame's observations together while the heading is wider than pi/2 (default).",
         ),
     ] = True,
+    max_vertices: Annotated[int, typer.Option("--max-vertices", help=_MAX_VERTICES_HELP)] = _MAX_VERTICES,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
     ] = None,
@@ -122,10 +142,11 @@ def replay(
     from aura_ums.logs import load_log, replay_log
     from aura_ums.uncertainty import TerrainTable
 
+    _check_cap(max_vertices)
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, sigmas, sensors, robust, joint)
+        options = _options(classes, sigmas, sensors, robust, joint, max_vertices)
         result = replay_log(log, table, options)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
@@ -175,6 +196,7 @@ def compare(
     ] = "II",
     particles: Annotated[int, typer.Option("--particles", help="Particles of the particle filter.")] = 1000,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
+    max_vertices: Annotated[int, typer.Option("--max-vertices", help=_MAX_VERTICES_HELP)] = _MAX_VERTICES,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
     ] = None,
@@ -188,10 +210,11 @@ def compare(
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
+    _check_cap(max_vertices)
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, 3.0, sensors, True)
+        options = _options(classes, 3.0, sensors, True, max_vertices=max_vertices)
         noise_logs = [load_log(p) for p in calibration_logs] if calibration_logs else [log]
         bearing, ranges = observation_errors(noise_logs)
         if bearing.size < 2:

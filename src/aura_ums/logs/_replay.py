@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
@@ -20,6 +20,7 @@ from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.logs._robust import EnvelopeLocalizer
 from aura_ums.manager import ManagerState, PositionReport
 from aura_ums.uncertainty import (
+    DEFAULT_MAX_VERTICES,
     BearingObservation,
     LandmarkClass,
     Observation,
@@ -68,6 +69,10 @@ class ReplayOptions:
     joint_above : float or None
         Wedge width (radians, >= 0) above which the observations of one frame reduce the
         map together (:func:`~aura_ums.uncertainty.reduce_jointly`); None: one by one.
+    max_vertices : int
+        Cap on the working map polygon's vertex count, >= 3: fewer is faster and looser.
+    envelope_max_vertices : int or None
+        The same cap for the envelope map, >= 3; None: ``max_vertices``.
 
     Examples
     --------
@@ -91,6 +96,8 @@ class ReplayOptions:
     relocalize_window: int = 1
     arena_margin: float = 5.0
     joint_above: float | None = math.pi / 2
+    max_vertices: int = DEFAULT_MAX_VERTICES
+    envelope_max_vertices: int | None = None
 
     def __post_init__(self) -> None:
         if self.landmark_class not in _REPLAY_CLASSES:
@@ -113,6 +120,9 @@ class ReplayOptions:
             if above < 0.0:
                 raise InputError(f"ReplayOptions.joint_above: expected a number >= 0 or None, got {above!r}")
             object.__setattr__(self, "joint_above", above)
+        integer_at_least(self.max_vertices, "ReplayOptions.max_vertices", 3)
+        if self.envelope_max_vertices is not None:
+            integer_at_least(self.envelope_max_vertices, "ReplayOptions.envelope_max_vertices", 3)
         for name in ("working", "envelope"):
             value = getattr(self, name)
             if value is not None and not isinstance(value, SensorBounds):
@@ -222,6 +232,8 @@ class ReplayResult:
             "sigmas": self.options.sigmas,
             "robust": self.options.robust,
             "joint_above_rad": self.options.joint_above,
+            "max_vertices": self.options.max_vertices,
+            "envelope_max_vertices": self.options.envelope_max_vertices,
             "steps": len(self.steps),
             "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
             "containment_rate": self.containment_rate,
@@ -397,6 +409,8 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         relocalize_after=opts.relocalize_after,
         relocalize_window=opts.relocalize_window,
         joint_above=opts.joint_above,
+        max_vertices=opts.max_vertices,
+        envelope_max_vertices=opts.envelope_max_vertices,
     )
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)

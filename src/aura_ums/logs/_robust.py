@@ -37,7 +37,7 @@ from aura_ums.manager import (
     PositionReport,
     UncertaintyMapManager,
 )
-from aura_ums.uncertainty import Observation, SpatialUncertaintyMap, TerrainTable
+from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, Observation, SpatialUncertaintyMap, TerrainTable
 from aura_ums.world import MeadowMap
 
 _NOT_GEOMETRIC = {REJECT_STALE, REJECT_UNKNOWN_LANDMARK, REJECT_CLASS_MISMATCH}
@@ -87,6 +87,12 @@ class EnvelopeLocalizer:
     joint_above : float or None
         Wedge width (radians) above which both managers reduce by the observations of one
         instant together (see :class:`~aura_ums.manager.UncertaintyMapManager`); None: one by one.
+    max_vertices : int
+        Cap on the working map polygon's vertex count, >= 3 (see
+        :class:`~aura_ums.manager.UncertaintyMapManager`).
+    envelope_max_vertices : int or None
+        The same cap for the envelope map, >= 3; None: ``max_vertices``. The envelope only
+        guards the working map, so a coarser one costs little but a looser re-seed.
 
     Raises
     ------
@@ -135,16 +141,20 @@ class EnvelopeLocalizer:
         relocalize_after: int = 1,
         relocalize_window: int = 1,
         joint_above: float | None = math.pi / 2,
+        max_vertices: int = DEFAULT_MAX_VERTICES,
+        envelope_max_vertices: int | None = None,
     ) -> None:
         for name, value in (("relocalize_after", relocalize_after), ("relocalize_window", relocalize_window)):
             integer_at_least(value, name, 1)
+        if envelope_max_vertices is not None:
+            integer_at_least(envelope_max_vertices, "envelope_max_vertices", 3)
         if relocalize_window < relocalize_after:
             raise InputError(
                 f"relocalize_window: expected >= relocalize_after ({relocalize_after}), "
                 f"got {relocalize_window}"
             )
         self._working = UncertaintyMapManager(
-            initial_map, meadow_map, table, sigmas=sigmas, joint_above=joint_above
+            initial_map, meadow_map, table, sigmas=sigmas, joint_above=joint_above, max_vertices=max_vertices
         )
         self._meadow_map = meadow_map
         self._working_board = Blackboard()
@@ -152,7 +162,12 @@ class EnvelopeLocalizer:
         self._envelope_board = Blackboard()
         if envelope:
             self._envelope = UncertaintyMapManager(
-                initial_map, meadow_map, table, sigmas=sigmas, joint_above=joint_above
+                initial_map,
+                meadow_map,
+                table,
+                sigmas=sigmas,
+                joint_above=joint_above,
+                max_vertices=max_vertices if envelope_max_vertices is None else envelope_max_vertices,
             )
         self._relocalize_after = relocalize_after
         self._recent: deque[bool] = deque(maxlen=relocalize_window)
@@ -232,7 +247,7 @@ class EnvelopeLocalizer:
                 continue
             if observation.landmark_class is not landmark.landmark_class:
                 continue
-            reduction = current.reduce(observation, landmark)
+            reduction = current.reduce(observation, landmark, max_vertices=self._working.max_vertices)
             if reduction.consistent:
                 current = reduction.map
         return current

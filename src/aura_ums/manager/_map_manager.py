@@ -15,6 +15,7 @@ from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
 from aura_ums.uncertainty import (
+    DEFAULT_MAX_VERTICES,
     DEFAULT_SECTOR,
     Landmark,
     Observation,
@@ -246,6 +247,10 @@ class UncertaintyMapManager:
         map together; None: always one by one.
     joint_sector : float
         Widest heading sector of the joint reduction, radians, in (0, 2 pi].
+    max_vertices : int
+        Cap on the map polygon's vertex count, >= 3: a growth that moves the polygon, and
+        a reduction, keep an outer polygon of at most this many vertices (or of its prior's
+        count, when that is more). Fewer is faster and looser.
 
     Raises
     ------
@@ -287,6 +292,7 @@ class UncertaintyMapManager:
         "_lost_window_scale",
         "_map",
         "_map_time",
+        "_max_vertices",
         "_meadow_map",
         "_missed_limit",
         "_only_terrain",
@@ -309,6 +315,7 @@ class UncertaintyMapManager:
         lost_window_scale: float = 2.0,
         joint_above: float | None = math.pi / 2,
         joint_sector: float = DEFAULT_SECTOR,
+        max_vertices: int = DEFAULT_MAX_VERTICES,
     ) -> None:
         if not isinstance(initial_map, SpatialUncertaintyMap):
             raise InputError(
@@ -335,6 +342,7 @@ class UncertaintyMapManager:
                 raise InputError(f"joint_above: expected a non-negative number or None, got {above!r}")
             self._joint_above = above
         self._joint_sector = check_sector(joint_sector, "joint_sector")
+        self._max_vertices = integer_at_least(max_vertices, "max_vertices", 3)
         self._map = initial_map
         self._map_time: float | None = None
         self._consumed = 0
@@ -426,6 +434,11 @@ class UncertaintyMapManager:
     def joint_sector(self) -> float:
         """Widest heading sector of the joint reduction, radians."""
         return self._joint_sector
+
+    @property
+    def max_vertices(self) -> int:
+        """Cap on the map polygon's vertex count."""
+        return self._max_vertices
 
     @property
     def missed_limit(self) -> int:
@@ -596,7 +609,10 @@ class UncertaintyMapManager:
             terrain = self._only_terrain = self._table[self._meadow_map.meadows[0].terrain]
         if terrain is not None:
             commands = [reports[index].command for index in range(start, stop)]
-            return current._grow_many(commands, terrain, self._sigmas), reports[stop - 1].time
+            return (
+                current._grow_many(commands, terrain, self._sigmas, self._max_vertices),
+                reports[stop - 1].time,
+            )
         for index in range(start, stop):
             report = reports[index]
             current = self._grow_one(current, report.command)
@@ -609,15 +625,24 @@ class UncertaintyMapManager:
             # A run too short to cut by meadows: whole, on the start meadow's terrain.
             meadow = self._meadow_map.meadow_at(pose.x, pose.y)
             if meadow is not None:
-                return current.grow(command, self._table[meadow.terrain], sigmas=self._sigmas)
+                return current.grow(
+                    command, self._table[meadow.terrain], sigmas=self._sigmas, max_vertices=self._max_vertices
+                )
         try:
-            return grow_through(current, self._meadow_map, command, self._table, sigmas=self._sigmas)
+            return grow_through(
+                current,
+                self._meadow_map,
+                command,
+                self._table,
+                sigmas=self._sigmas,
+                max_vertices=self._max_vertices,
+            )
         except OutsideMapError:
             pass
         # The estimate's run leaves every meadow (it grazes the edge of mapped free space,
         # the map knows no walls): grow on the nearest meadow's terrain, not give up.
         terrain = self._table[self._nearest_meadow(pose).terrain]
-        return current.grow(command, terrain, sigmas=self._sigmas)
+        return current.grow(command, terrain, sigmas=self._sigmas, max_vertices=self._max_vertices)
 
     def _nearest_meadow(self, pose: Pose) -> Meadow:
         point = shapely.Point(pose.x, pose.y)
@@ -640,7 +665,9 @@ class UncertaintyMapManager:
                 if not isinstance(found, str)
             ]
             if len(sightings) >= 2:
-                joint = reduce_jointly(current, sightings, sector=self._joint_sector)
+                joint = reduce_jointly(
+                    current, sightings, sector=self._joint_sector, max_vertices=self._max_vertices
+                )
                 if joint.consistent:
                     reduced = joint.map
                     area, width = current.area, current.wedge.width
@@ -681,7 +708,7 @@ class UncertaintyMapManager:
             reason = landmark
         else:
             # Found by the observation's id, of its class: the pair reduce() would check.
-            found = current._reduce_checked(observation, landmark)
+            found = current._reduce_checked(observation, landmark, self._max_vertices)
             if not isinstance(found, str):
                 reduced, area_before, area_after = found
                 width_before, width_after = current.wedge.width, reduced.wedge.width
@@ -753,6 +780,7 @@ class UncertaintyMapManager:
                     "lost_window_scale": self._lost_window_scale,
                     "joint_above": self._joint_above,
                     "joint_sector": self._joint_sector,
+                    "max_vertices": self._max_vertices,
                 },
             },
         )
@@ -804,8 +832,8 @@ class UncertaintyMapManager:
             data["settings"],
             "settings",
             ("sigmas", "area_limit", "missed_limit", "lost_window_scale"),
-            # Saved before joint reductions existed: restored without them, as they ran.
-            optional=("joint_above", "joint_sector"),
+            # Saved before joint reductions (or the vertex cap) were settings: restored as they ran.
+            optional=("joint_above", "joint_sector", "max_vertices"),
         )
         uncertainty_map = reader.uncertainty_map(data["map"], "map")
         try:
@@ -820,6 +848,9 @@ class UncertaintyMapManager:
                 joint_above=reader.optional_number(settings.get("joint_above"), "settings.joint_above"),
                 joint_sector=reader.number(
                     settings.get("joint_sector", DEFAULT_SECTOR), "settings.joint_sector"
+                ),
+                max_vertices=reader.integer(
+                    settings.get("max_vertices", DEFAULT_MAX_VERTICES), "settings.max_vertices", 3
                 ),
             )
         except InputError as exc:

@@ -304,13 +304,15 @@ class SpatialUncertaintyMap:
         """
         return reduce_map(self, observation, landmark, max_vertices)
 
-    def _reduce_checked(self, observation: Observation, landmark: Landmark) -> Reduced:
+    def _reduce_checked(
+        self, observation: Observation, landmark: Landmark, max_vertices: int = DEFAULT_MAX_VERTICES
+    ) -> Reduced:
         """:meth:`reduce` for a caller that paired the landmark with the observation by id and class.
 
         Returns (reduced map, area before, area after), or why no pose agrees: the
         manager reads nothing else, so no :class:`Reduction` is built.
         """
-        return reduce_checked(self, observation, landmark, DEFAULT_MAX_VERTICES)
+        return reduce_checked(self, observation, landmark, max_vertices)
 
     @overload
     def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...
