@@ -6,6 +6,7 @@ and ratios measured in the same run. Nothing here is asserted: speed is reported
 
 from __future__ import annotations
 
+import functools
 import math
 import statistics
 import time
@@ -86,7 +87,7 @@ def main() -> None:
         rows.append(
             (
                 f"grow, {vertices}-vertex map (cap {vertices}, result {grown.polygon.vertex_count} vertices)",
-                median_us(lambda start=start, cap=vertices: start.grow(command, terrain, max_vertices=cap)),
+                median_us(functools.partial(start.grow, command, terrain, max_vertices=vertices)),
             )
         )
     print("## One growth step (median µs)")

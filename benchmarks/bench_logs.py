@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -83,33 +84,24 @@ def main() -> None:
         f"{'log':16s} {'class':11s} {'method':13s} {'inside':>7s} {'area m2':>9s} {'head rad':>8s} "
         f"{'RMSE m':>7s} {'us/step':>8s} {'/ EKF':>6s} {'/ fpy':>6s}"
     )
-    for log in logs:
-        for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
-            options = ReplayOptions(
-                landmark_class=landmark_class,
-                working=calibration.working,
-                envelope=calibration.envelope,
-                motion=calibration.motion,
-            )
-            run(log, options, landmark_class.value)
-    # Without the envelope (the consistency gate alone): one manager instead of two.
-    options = ReplayOptions(
-        landmark_class=LandmarkClass.POINT,
-        working=calibration.working,
-        motion=calibration.motion,
-        robust=False,
-    )
-    run(logs[-1], options, "II gate only")
-    # A coarser polygon (ReplayOptions.max_vertices, replay --max-vertices): speed for area.
-    for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
-        options = ReplayOptions(
+
+    def calibrated(landmark_class: LandmarkClass, **settings: Any) -> ReplayOptions:
+        return ReplayOptions(
             landmark_class=landmark_class,
             working=calibration.working,
             envelope=calibration.envelope,
             motion=calibration.motion,
-            max_vertices=16,
+            **settings,
         )
-        run(logs[0], options, f"{landmark_class.value} cap 16")
+
+    for log in logs:
+        for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
+            run(log, calibrated(landmark_class), landmark_class.value)
+    # Without the envelope (the consistency gate alone): one manager instead of two.
+    run(logs[-1], calibrated(LandmarkClass.POINT, robust=False), "II gate only")
+    # A coarser polygon (ReplayOptions.max_vertices, replay --max-vertices): speed for area.
+    for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
+        run(logs[0], calibrated(landmark_class, max_vertices=16), f"{landmark_class.value} cap 16")
     print(
         "us/step: the lowest of the per-run medians; / EKF: against aura-ums's ExtendedKalmanFilter "
         "(written out on floats); / fpy: against filterpy's ExtendedKalmanFilter"
