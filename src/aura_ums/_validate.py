@@ -25,6 +25,14 @@ def finite_float(value: object, name: str) -> float:
     return result
 
 
+def positive_float(value: object, name: str) -> float:
+    """Return ``value`` as a finite float > 0, or raise naming ``name``."""
+    result = finite_float(value, name)
+    if result <= 0.0:
+        raise InputError(f"{name}: expected a positive number, got {result!r}")
+    return result
+
+
 def nonnegative_float(value: object, name: str) -> float:
     """Return ``value`` as a finite float >= 0, or raise naming ``name``."""
     result = finite_float(value, name)

@@ -44,7 +44,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float
+from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.baselines._moments import motion_moments
 from aura_ums.baselines._region import ConfidenceRegion, check_probability, chi2_quantile, gaussian_region
 from aura_ums.errors import InputError
@@ -62,13 +62,6 @@ MIN_LANDMARK_DISTANCE = 1e-9
 def _wrap(angle: float) -> float:
     result = _PI - (_PI - angle) % _TWO_PI
     return result + _TWO_PI if result <= -_PI else result
-
-
-def _positive(value: object, name: str) -> float:
-    result = finite_float(value, name)
-    if result <= 0.0:
-        raise InputError(f"{name}: expected a positive number, got {result!r}")
-    return result
 
 
 def _gate_threshold(gate_probability: float | None, dof: int) -> float:
@@ -196,12 +189,12 @@ class ExtendedKalmanFilter:
             raise InputError(f"initial: expected a Pose, got {type(initial).__name__}")
         position_var = nonnegative_float(position_sd, "position_sd") ** 2
         heading_var = nonnegative_float(heading_sd, "heading_sd") ** 2
-        self._bearing_var = _positive(bearing_sd, "bearing_sd") ** 2
-        self._range_var = _positive(range_sd, "range_sd") ** 2
+        self._bearing_var = positive_float(bearing_sd, "bearing_sd") ** 2
+        self._range_var = positive_float(range_sd, "range_sd") ** 2
         self._range_fraction_sq = nonnegative_float(range_sd_fraction, "range_sd_fraction") ** 2
         self._bearing_gate = _gate_threshold(gate_probability, 1)
         self._range_bearing_gate = _gate_threshold(gate_probability, 2)
-        self._scale = _positive(process_noise_scale, "process_noise_scale")
+        self._scale = positive_float(process_noise_scale, "process_noise_scale")
         self._x, self._y, self._h = initial.x, initial.y, initial.heading
         # Upper triangle of P: xx, xy, xh, yy, yh, hh.
         self._p = (position_var, 0.0, 0.0, position_var, 0.0, heading_var)

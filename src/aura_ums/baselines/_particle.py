@@ -26,8 +26,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float
-from aura_ums.baselines._ekf import _gate_threshold, _positive, check_observation, landmark_position
+from aura_ums._validate import finite_float, nonnegative_float, positive_float
+from aura_ums.baselines._ekf import _gate_threshold, check_observation, landmark_position
 from aura_ums.baselines._region import (
     ConfidenceRegion,
     check_probability,
@@ -185,8 +185,8 @@ class ParticleFilter:
         n = int(particles)
         position = nonnegative_float(position_sd, "position_sd")
         heading = nonnegative_float(heading_sd, "heading_sd")
-        self._bearing_var = _positive(bearing_sd, "bearing_sd") ** 2
-        self._range_var = _positive(range_sd, "range_sd") ** 2
+        self._bearing_var = positive_float(bearing_sd, "bearing_sd") ** 2
+        self._range_var = positive_float(range_sd, "range_sd") ** 2
         self._range_fraction_sq = nonnegative_float(range_sd_fraction, "range_sd_fraction") ** 2
         self._floor = nonnegative_float(outlier_floor, "outlier_floor")
         self._bearing_gate = _gate_threshold(gate_probability, 1)

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import TerrainStats, TerrainTable
@@ -76,10 +76,9 @@ class SensorBounds:
     range_fraction_high: float = 0.0
 
     def __post_init__(self) -> None:
-        value = finite_float(self.bearing_error, "SensorBounds.bearing_error")
-        if not value > 0.0:
-            raise InputError(f"SensorBounds.bearing_error: expected a positive number, got {value!r}")
-        object.__setattr__(self, "bearing_error", value)
+        object.__setattr__(
+            self, "bearing_error", positive_float(self.bearing_error, "SensorBounds.bearing_error")
+        )
         value = finite_float(self.range_error, "SensorBounds.range_error")
         if value < 0.0:
             raise InputError(f"SensorBounds.range_error: expected a number >= 0, got {value!r}")
@@ -129,10 +128,7 @@ class MotionCalibration:
             raise InputError(f"MotionCalibration.delay_s: expected a number >= 0, got {delay!r}")
         object.__setattr__(self, "delay_s", delay)
         for name in ("run_scale", "turn_scale"):
-            value = finite_float(getattr(self, name), f"MotionCalibration.{name}")
-            if not value > 0.0:
-                raise InputError(f"MotionCalibration.{name}: expected a positive number, got {value!r}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, positive_float(getattr(self, name), f"MotionCalibration.{name}"))
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import finite_float, integer_at_least, positive_float
 from aura_ums.errors import InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
@@ -105,10 +105,7 @@ class ReplayOptions:
                 f"ReplayOptions.landmark_class: expected Class I or II, got {self.landmark_class.name}"
             )
         for name in ("sigmas", "max_interval"):
-            value = finite_float(getattr(self, name), f"ReplayOptions.{name}")
-            if not value > 0.0:
-                raise InputError(f"ReplayOptions.{name}: expected a positive number, got {value!r}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, positive_float(getattr(self, name), f"ReplayOptions.{name}"))
         factor = finite_float(self.envelope_factor, "ReplayOptions.envelope_factor")
         if factor < 1.0:
             raise InputError(f"ReplayOptions.envelope_factor: expected a number >= 1, got {factor!r}")

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import shapely
 
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import finite_float, integer_at_least, positive_float
 from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
@@ -328,8 +328,8 @@ class UncertaintyMapManager:
         self._meadow_map = meadow_map
         self._table = table
         self._only_terrain: TerrainStats | None = None
-        self._sigmas = _positive(sigmas, "sigmas")
-        self._area_limit = None if area_limit is None else _positive(area_limit, "area_limit")
+        self._sigmas = positive_float(sigmas, "sigmas")
+        self._area_limit = None if area_limit is None else positive_float(area_limit, "area_limit")
         self._missed_limit = integer_at_least(missed_limit, "missed_limit", 1)
         scale = finite_float(lost_window_scale, "lost_window_scale")
         if scale < 1.0:
@@ -883,10 +883,3 @@ class UncertaintyMapManager:
             f"UncertaintyMapManager({self._state.value}, area={self._map.area:.4g} m^2, "
             f"reports consumed={self._consumed}, accepted={self._accepted}, rejected={self.rejected_count})"
         )
-
-
-def _positive(value: object, name: str) -> float:
-    result = finite_float(value, name)
-    if not result > 0.0:
-        raise InputError(f"{name}: expected a positive number, got {result!r}")
-    return result

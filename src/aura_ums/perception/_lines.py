@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
-from aura_ums._validate import finite_float, nonnegative_float
+from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
@@ -138,10 +138,7 @@ class FastLineFinder:
             object.__setattr__(self, "orientation", finite_float(self.orientation, "orientation") % math.pi)
         object.__setattr__(self, "tolerance", nonnegative_float(self.tolerance, "tolerance"))
         object.__setattr__(self, "min_length", nonnegative_float(self.min_length, "min_length"))
-        min_gradient = finite_float(self.min_gradient, "min_gradient")
-        if min_gradient <= 0.0:
-            raise InputError(f"min_gradient: expected a positive number, got {min_gradient!r}")
-        object.__setattr__(self, "min_gradient", min_gradient)
+        object.__setattr__(self, "min_gradient", positive_float(self.min_gradient, "min_gradient"))
         object.__setattr__(self, "min_contrast", nonnegative_float(self.min_contrast, "min_contrast"))
         object.__setattr__(self, "buckets", int_at_least(self.buckets, "buckets", 4))
         if not isinstance(self.overlap, bool):

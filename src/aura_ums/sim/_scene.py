@@ -23,7 +23,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
-from aura_ums._validate import finite_float, integer_at_least, nonnegative_float, points_array, read_only
+from aura_ums._validate import (
+    finite_float,
+    integer_at_least,
+    nonnegative_float,
+    points_array,
+    positive_float,
+    read_only,
+)
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, VerticalLineLandmark
 from aura_ums.world import MeadowMap
@@ -45,13 +52,6 @@ def _shade(value: object, name: str) -> float:
     result = finite_float(value, name)
     if not 0.0 <= result <= 255.0:
         raise InputError(f"{name}: expected a gray level in [0, 255], got {result!r}")
-    return result
-
-
-def _positive(value: object, name: str) -> float:
-    result = finite_float(value, name)
-    if result <= 0.0:
-        raise InputError(f"{name}: expected a positive number, got {result!r}")
     return result
 
 
@@ -105,7 +105,7 @@ class Pole:
             object.__setattr__(self, name, finite_float(getattr(self, name), f"Pole.{name}"))
         if not self.z_top > self.z_bottom:
             raise InputError(f"Pole.z_top: expected > z_bottom ({self.z_bottom}), got {self.z_top}")
-        object.__setattr__(self, "radius", _positive(self.radius, "Pole.radius"))
+        object.__setattr__(self, "radius", positive_float(self.radius, "Pole.radius"))
         object.__setattr__(self, "shade", _shade(self.shade, "Pole.shade"))
 
 
@@ -196,7 +196,7 @@ class Building:
         ``toward[0]``, and ``depth`` metres along the perpendicular (direction + pi/2) times
         the sign of ``toward[1]``.
         """
-        w, d = _positive(width, "width"), _positive(depth, "depth")
+        w, d = positive_float(width, "width"), positive_float(depth, "depth")
         angle = finite_float(direction, "direction")
         along = np.array([math.cos(angle), math.sin(angle)]) * (w if toward[0] >= 0.0 else -w)
         across = np.array([-math.sin(angle), math.cos(angle)]) * (d if toward[1] >= 0.0 else -d)
@@ -265,7 +265,7 @@ class GroundStripe:
             raise InputError(f"GroundStripe.end: expected a point distinct from start, got {b[0].tolist()}")
         object.__setattr__(self, "start", read_only(a[0].copy()))
         object.__setattr__(self, "end", read_only(b[0].copy()))
-        object.__setattr__(self, "width", _positive(width, "GroundStripe.width"))
+        object.__setattr__(self, "width", positive_float(width, "GroundStripe.width"))
         object.__setattr__(self, "shade", _shade(shade, "GroundStripe.shade"))
 
     def polygon(self) -> NDArray[np.float64]:
@@ -404,7 +404,7 @@ class Scene:
                 raise InputError("Scene.texture: expected finite values, got non-finite ones")
             tile.setflags(write=False)
             object.__setattr__(self, "texture", tile)
-        object.__setattr__(self, "texture_cell", _positive(self.texture_cell, "Scene.texture_cell"))
+        object.__setattr__(self, "texture_cell", positive_float(self.texture_cell, "Scene.texture_cell"))
         object.__setattr__(
             self, "texture_contrast", nonnegative_float(self.texture_contrast, "Scene.texture_contrast")
         )
@@ -475,8 +475,8 @@ class Scene:
         """
         if not isinstance(meadow_map, MeadowMap):
             raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
-        radius = _positive(pole_radius, "pole_radius")
-        width, depth = (_positive(v, "building_size") for v in building_size)
+        radius = positive_float(pole_radius, "pole_radius")
+        width, depth = (positive_float(v, "building_size") for v in building_size)
         base = finite_float(building_base, "building_base")
         x_min, y_min, x_max, y_max = meadow_map.bounds
         centre = (0.5 * (x_min + x_max), 0.5 * (y_min + y_max))
