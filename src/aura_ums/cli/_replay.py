@@ -19,7 +19,14 @@ if TYPE_CHECKING:
 
 _CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
 _MAX_VERTICES = 64  # aura_ums.uncertainty.DEFAULT_MAX_VERTICES, without importing numpy for --help
-_MAX_VERTICES_HELP = "Cap on the map polygon's vertices (>= 3): fewer is faster and looser."
+_MaxVertices = Annotated[
+    int,
+    typer.Option("--max-vertices", help="Cap on the map polygon's vertices (>= 3): fewer is faster, looser."),
+]
+_Terrain = Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")]
+_Sensors = Annotated[
+    Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
+]
 
 
 def _check_cap(max_vertices: int) -> None:
@@ -41,23 +48,13 @@ def _options(
 
     if classes not in _CLASSES:
         raise fail(f"--classes: expected I or II, got {classes!r}")
-
-    landmark_class = LandmarkClass[_CLASSES[classes]]
-    joint_above = math.pi / 2 if joint else None
-    if sensors is None:
-        return ReplayOptions(
-            sigmas=sigmas,
-            landmark_class=landmark_class,
-            robust=robust,
-            joint_above=joint_above,
-            max_vertices=max_vertices,
-        )
-    motion, working, envelope = load_sensors(sensors)
+    # Without a sensors file, the options' defaults: the log's meta.toml.
+    motion, working, envelope = load_sensors(sensors) if sensors is not None else (None, None, None)
     return ReplayOptions(
         sigmas=sigmas,
-        landmark_class=landmark_class,
+        landmark_class=LandmarkClass[_CLASSES[classes]],
         robust=robust,
-        joint_above=joint_above,
+        joint_above=math.pi / 2 if joint else None,
         max_vertices=max_vertices,
         working=working,
         envelope=envelope,
@@ -107,10 +104,8 @@ def calibrate(
 
 def replay(
     log_dir: Annotated[Path, typer.Argument(help="Log folder (docs/log-format.md).")],
-    terrain: Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")],
-    sensors: Annotated[
-        Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
-    ] = None,
+    terrain: _Terrain,
+    sensors: _Sensors = None,
     sigmas: Annotated[
         float, typer.Option("--sigmas", help="Standard deviations bounded by the growth.")
     ] = 3.0,
@@ -125,7 +120,7 @@ def replay(
             help="Reduce by a frame's observations together while the heading is wider than pi/2 (default).",
         ),
     ] = True,
-    max_vertices: Annotated[int, typer.Option("--max-vertices", help=_MAX_VERTICES_HELP)] = _MAX_VERTICES,
+    max_vertices: _MaxVertices = _MAX_VERTICES,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
     ] = None,
@@ -181,10 +176,8 @@ def replay(
 
 def compare(
     log_dir: Annotated[Path, typer.Argument(help="Log folder with groundtruth.csv.")],
-    terrain: Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")],
-    sensors: Annotated[
-        Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
-    ] = None,
+    terrain: _Terrain,
+    sensors: _Sensors = None,
     calibration_logs: Annotated[
         list[Path] | None,
         typer.Option(
@@ -196,7 +189,7 @@ def compare(
     ] = "II",
     particles: Annotated[int, typer.Option("--particles", help="Particles of the particle filter.")] = 1000,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
-    max_vertices: Annotated[int, typer.Option("--max-vertices", help=_MAX_VERTICES_HELP)] = _MAX_VERTICES,
+    max_vertices: _MaxVertices = _MAX_VERTICES,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
     ] = None,
