@@ -12,6 +12,7 @@ the same undefined value. Everything else must match to the last digit, or, with
     .venv/bin/python benchmarks/check_identity.py record /tmp/identity-before
     .venv/bin/python benchmarks/check_identity.py check /tmp/identity-before
     AURA_UMS_NATIVE=0 .venv/bin/python benchmarks/check_identity.py check /tmp/identity-before --rtol 1e-9
+    .venv/bin/python benchmarks/check_identity.py check /tmp/identity-before --sim-args="--gate-only"
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ def _run(*args: str | Path) -> None:
         raise SystemExit(f"aura-ums {' '.join(map(str, args))} exited {done.returncode}:\n{done.stderr}")
 
 
-def produce(out: Path, extra: list[str]) -> list[str]:
+def produce(out: Path, extra: list[str], sim_extra: list[str]) -> list[str]:
     """Run every replay and the simulation into ``out``; return the files written."""
     out.mkdir(parents=True, exist_ok=True)
     names: list[str] = []
@@ -70,7 +71,17 @@ def produce(out: Path, extra: list[str]) -> list[str]:
                     names += [f"{name}.json", f"{name}.csv"]
         else:
             print(f"no data at {DATA}: simulation only")
-        _run("simulate", SCENARIO, "--runs", "20", "--seed", "1", "--metrics-json", out / "simulate.json")
+        _run(
+            "simulate",
+            SCENARIO,
+            "--runs",
+            "20",
+            "--seed",
+            "1",
+            "--metrics-json",
+            out / "simulate.json",
+            *sim_extra,
+        )
         names.append("simulate.json")
     return names
 
@@ -137,18 +148,19 @@ def main() -> None:
     parser.add_argument("mode", choices=["record", "check"])
     parser.add_argument("folder", type=Path, help="where the reference outputs are (record: written)")
     parser.add_argument("--rtol", type=float, default=0.0, help="relative tolerance (default: exact)")
+    parser.add_argument("--sim-args", default="", help="extra arguments for the simulation, one string")
     parser.add_argument("extra", nargs="*", help="extra arguments for every replay (after --)")
     args = parser.parse_args()
     if args.mode == "record":
         if args.folder.exists():
             shutil.rmtree(args.folder)
-        names = produce(args.folder, args.extra)
+        names = produce(args.folder, args.extra, args.sim_args.split())
         (args.folder / "index.json").write_text(json.dumps(names))
         print(f"recorded {len(names)} files in {args.folder}")
         return
     names = json.loads((args.folder / "index.json").read_text())
     with tempfile.TemporaryDirectory() as scratch:
-        produce(Path(scratch), args.extra)
+        produce(Path(scratch), args.extra, args.sim_args.split())
         differing = compare(args.folder, Path(scratch), names, args.rtol)
     tolerance = f" (rtol {args.rtol})" if args.rtol else ""
     print(f"{len(names) - differing} of {len(names)} files identical{tolerance}")
