@@ -1,4 +1,4 @@
-"""Planar geometry: compass wedges, convex polygons and the convex operations growth needs.
+"""Planar geometry: poses, compass wedges, convex polygons and the convex operations the rest needs.
 
 This package imports nothing else of aura-ums but its validation and errors.
 """
@@ -16,6 +16,7 @@ from aura_ums.geometry._convex import (
     simplify_outer,
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
+from aura_ums.geometry._pose import Pose
 from aura_ums.geometry._wedge import ANGLE_TOLERANCE, HeadingWedge
 from aura_ums.geometry._window import UNBOUNDED_PIXELS, ImageWindow
 
@@ -26,6 +27,7 @@ __all__ = [
     "ConvexPolygon",
     "HeadingWedge",
     "ImageWindow",
+    "Pose",
     "angle_difference",
     "clip_halfplane",
     "convex_hull",
