@@ -15,8 +15,9 @@ from aura_ums.expecter._baselines import (
     gaussian_window,
 )
 from aura_ums.expecter._expecter import Expecter
-from aura_ums.expecter._window import DEFAULT_MARGINS, PerceptualStrategy, margin_pixels
+from aura_ums.expecter._window import DEFAULT_MARGINS, margin_pixels
 from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
+from aura_ums.world import PerceptualStrategy
 
 __all__ = [
     "DEFAULT_MARGINS",

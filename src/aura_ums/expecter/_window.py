@@ -1,30 +1,14 @@
-"""Perceptual strategies and the margin each needs; image windows live in geometry."""
+"""The margin each perceptual strategy needs; strategies live in world, image windows in geometry."""
 
 from __future__ import annotations
 
-import enum
 import math
 import types
 from collections.abc import Mapping
 
 from aura_ums._validate import nonnegative_float
 from aura_ums.geometry import ImageWindow
-
-
-class PerceptualStrategy(enum.Enum):
-    """The perceptual algorithm a find-landmark schema runs inside its window.
-
-    The strategy decides how much context (margin) the window needs around the place
-    where the landmark is guaranteed to appear (the paper's Figure 8).
-    """
-
-    #: Fast line finder: fits lines to gradient runs; needs long context on each side.
-    LINE_FINDER = "line_finder"
-    #: Moravec-style interest operator: a small neighbourhood per point suffices.
-    INTEREST_OPERATOR = "interest_operator"
-    #: Region segmenter: needs some surrounding region to compare against.
-    REGION_SEGMENTER = "region_segmenter"
-
+from aura_ums.world import PerceptualStrategy as PerceptualStrategy  # expecter/_expecter.py imports it here
 
 #: Margin (pixels, added on every side) that each perceptual strategy needs around the
 #: guaranteed window. Illustrative figures in the spirit of the paper's Figure 8: a line
