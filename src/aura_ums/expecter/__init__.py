@@ -20,6 +20,7 @@ from aura_ums.expecter._baselines import (
 )
 from aura_ums.expecter._expecter import Expecter
 from aura_ums.expecter._observations import observe_ground_line, observe_point, observe_vertical_line
+from aura_ums.expecter._scenario import Figure4Scenario, figure4_scenario
 from aura_ums.expecter._window import DEFAULT_MARGINS, margin_pixels
 from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
 from aura_ums.world import PerceptualStrategy
@@ -29,10 +30,12 @@ __all__ = [
     "DISK_SIDES",
     "UNBOUNDED_PIXELS",
     "Expecter",
+    "Figure4Scenario",
     "ImageWindow",
     "PerceptualStrategy",
     "disk_model_map",
     "disk_model_window",
+    "figure4_scenario",
     "gaussian_box_map",
     "gaussian_window",
     "margin_pixels",

@@ -31,6 +31,7 @@ from aura_ums.perception._landmarks import (
     evaluate_path_edge,
     evaluate_vertical_line,
     line_intersections,
+    strongest_within,
 )
 from aura_ums.perception._lines import FastLineFinder, LineBackend
 from aura_ums.perception._moravec import MoravecOperator
@@ -59,4 +60,5 @@ __all__ = [
     "sample_points",
     "segment_orientation",
     "segment_recall_precision",
+    "strongest_within",
 ]

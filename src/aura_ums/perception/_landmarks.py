@@ -134,7 +134,33 @@ def evaluate_vertical_line(
 
 
 def strongest_within(lines: LineSegments, orientation: float, tolerance: float) -> LineEvidence:
-    """:func:`evaluate_vertical_line` on checked arguments (a float orientation and tolerance >= 0)."""
+    """Return the strongest line within ``tolerance`` of ``orientation``, arguments unchecked.
+
+    :func:`evaluate_vertical_line` once its arguments are checked, for callers that
+    checked them already (a schema evaluates every frame with the same ones).
+
+    Parameters
+    ----------
+    lines : LineSegments
+        Lines found in the window.
+    orientation : float
+        Expected image direction, radians, finite.
+    tolerance : float
+        Largest difference of direction, radians, >= 0.
+
+    Returns
+    -------
+    LineEvidence
+        As :func:`evaluate_vertical_line`.
+
+    Examples
+    --------
+    >>> lines = LineSegments([[50, 10, 51, 90], [20, 5, 90, 6]], [12.0, 40.0])
+    >>> strongest_within(lines, math.pi / 2, 0.1).column
+    50.5
+    >>> strongest_within(lines, 0.7, 0.1).segment is None   # no line that direction
+    True
+    """
     return _best_line(lines, angle_difference(lines.orientation, orientation) <= tolerance)
 
 
