@@ -37,7 +37,7 @@ from aura_ums.perception._lines import FastLineFinder, LineBackend
 from aura_ums.perception._moravec import MoravecOperator
 from aura_ums.perception._opencv import OpenCvLineFinder
 from aura_ums.perception._regions import Region, RegionSegmenter, otsu_threshold
-from aura_ums.perception._segments import LineSegments, angle_difference, segment_orientation
+from aura_ums.perception._segments import LineSegments, orientation_difference, segment_orientation
 
 __all__ = [
     "CornerEvidence",
@@ -50,11 +50,11 @@ __all__ = [
     "RecallPrecision",
     "Region",
     "RegionSegmenter",
-    "angle_difference",
     "evaluate_corner",
     "evaluate_path_edge",
     "evaluate_vertical_line",
     "line_intersections",
+    "orientation_difference",
     "otsu_threshold",
     "read_gray_image",
     "sample_points",
