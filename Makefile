@@ -35,6 +35,7 @@ figures: $(VENV)/.stamp-install
 lint: $(VENV)/.stamp-dev
 	$(BIN)/ruff check src tests benchmarks setup.py
 	$(BIN)/ruff format --check src tests benchmarks setup.py
+	$(BIN)/lint-imports
 
 typecheck: $(VENV)/.stamp-dev
 	$(BIN)/mypy

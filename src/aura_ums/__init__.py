@@ -20,9 +20,6 @@ from aura_ums.camera import (
     CameraMount,
     load_camera,
     load_opencv_calibration,
-    observe_ground_line,
-    observe_point,
-    observe_vertical_line,
 )
 from aura_ums.errors import (
     AuraUmsError,
@@ -31,7 +28,14 @@ from aura_ums.errors import (
     MissingDependencyError,
     UnknownTerrainError,
 )
-from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy
+from aura_ums.expecter import (
+    Expecter,
+    ImageWindow,
+    PerceptualStrategy,
+    observe_ground_line,
+    observe_point,
+    observe_vertical_line,
+)
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
 from aura_ums.manager import IdentifiedLandmarkBuffer
 from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter

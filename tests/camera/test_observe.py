@@ -1,4 +1,4 @@
-"""Pixels to bounded observations: soundness (Monte Carlo against a true camera) and input errors."""
+"""Pixels to bounded bearings, ranges and ground lines: soundness (Monte Carlo, a true camera), errors."""
 
 from __future__ import annotations
 
@@ -15,19 +15,13 @@ from aura_ums.camera import (
     CameraIntrinsics,
     CameraMount,
     _observe,
-    observe_ground_line,
-    observe_point,
-    observe_vertical_line,
+    bound_ground_line,
+    bound_point,
+    bound_vertical_line,
     undistort_points,
 )
 from aura_ums.errors import InputError
-from aura_ums.geometry import wrap_angle
-from aura_ums.uncertainty import (
-    GroundLineLandmark,
-    PointLandmark,
-    Pose,
-    VerticalLineLandmark,
-)
+from aura_ums.geometry import Pose, wrap_angle
 
 CASES = 2000
 WIDTH, HEIGHT = 640, 480
@@ -213,16 +207,14 @@ def test_bearing_bound_is_sound(rng: np.random.Generator) -> None:
         measured = None if pixel is None else perturbed(rng, pixel, scene.pixel_error)
         if measured is None:
             continue
-        pole = VerticalLineLandmark("pole", point[0], point[1], min(point[2], 0.0), max(point[2], 0.0) + 1.0)
-        obs = observe_vertical_line(
-            scene.nominal, pole, measured, time=1.0, pixel_error=scene.pixel_error, bounds=scene.bounds
+        bearing, error = bound_vertical_line(
+            scene.nominal, measured, pixel_error=scene.pixel_error, bounds=scene.bounds
         )
-        assert obs.sensor_offset == scene.nominal.mount.sensor_offset
         sensor = sensor_xy(scene)
         truth = wrap_angle(math.atan2(point[1] - sensor[1], point[0] - sensor[0]) - scene.pose.heading)
-        miss = wrap_angle(truth - obs.bearing)
-        assert abs(miss) <= obs.bearing_error, (scene, measured, truth, obs)
-        tally.add(miss, obs.bearing_error)
+        miss = wrap_angle(truth - bearing)
+        assert abs(miss) <= error, (scene, measured, truth, bearing, error)
+        tally.add(miss, error)
         tally.checked += 1
     assert tally.worst_ratio <= 1.0
 
@@ -242,13 +234,11 @@ def test_range_bearing_bound_is_sound(rng: np.random.Generator) -> None:
         measured = None if pixel is None else perturbed(rng, pixel, scene.pixel_error)
         if measured is None:
             continue
-        corner = PointLandmark("corner", point[0], point[1], z)
         try:
-            obs = observe_point(
+            bearing, bearing_error, range_min, range_max = bound_point(
                 scene.nominal,
-                corner,
                 measured,
-                time=2.0,
+                z,
                 pixel_error=scene.pixel_error,
                 bounds=scene.bounds,
                 max_range=60.0,
@@ -259,12 +249,12 @@ def test_range_bearing_bound_is_sound(rng: np.random.Generator) -> None:
         sensor = sensor_xy(scene)
         true_bearing = wrap_angle(math.atan2(point[1] - sensor[1], point[0] - sensor[0]) - scene.pose.heading)
         true_range = math.hypot(point[0] - sensor[0], point[1] - sensor[1])
-        miss = wrap_angle(true_bearing - obs.bearing)
-        assert abs(miss) <= obs.bearing_error, (scene, measured, true_bearing, obs)
-        assert obs.range_min <= true_range <= obs.range_max, (scene, measured, true_range, obs)
-        centre = 0.5 * (obs.range_min + obs.range_max)
-        range_tally.add(true_range - centre, 0.5 * (obs.range_max - obs.range_min))
-        tally.add(miss, obs.bearing_error)
+        miss = wrap_angle(true_bearing - bearing)
+        assert abs(miss) <= bearing_error, (scene, measured, true_bearing, bearing, bearing_error)
+        assert range_min <= true_range <= range_max, (scene, measured, true_range, range_min, range_max)
+        centre = 0.5 * (range_min + range_max)
+        range_tally.add(true_range - centre, 0.5 * (range_max - range_min))
+        tally.add(miss, bearing_error)
         tally.checked += 1
     assert len(refusals) < CASES // 10
     assert all("horizon" in message for message in refusals)
@@ -294,30 +284,28 @@ def test_ground_line_bound_is_sound(rng: np.random.Generator) -> None:
         start, end = (a[:2] - 2 * unit, b[:2] + 2 * unit)
         if rng.random() < 0.5:
             start, end, unit = end, start, -unit
-        edge = GroundLineLandmark("edge", start, end)
+        direction = math.atan2(end[1] - start[1], end[0] - start[0])
         sensor = sensor_xy(scene)
-        true_angle = wrap_angle(edge.direction - scene.pose.heading)
+        true_angle = wrap_angle(direction - scene.pose.heading)
         true_offset = float(unit[0] * (sensor[1] - start[1]) - unit[1] * (sensor[0] - start[0]))
         ends = (measured_a, measured_b) if rng.random() < 0.5 else (measured_b, measured_a)
         segment = np.concatenate(ends)
         try:
-            obs = observe_ground_line(
+            offset, offset_error, angle, angle_error = bound_ground_line(
                 scene.nominal,
-                edge,
                 segment,
                 expected_angle=true_angle + rng.uniform(-1.2, 1.2),
-                time=3.0,
                 pixel_error=scene.pixel_error,
                 bounds=scene.bounds,
             )
         except InputError as exc:  # horizon within the bounds, or too short a segment
             refusals.append(str(exc))
             continue
-        miss = wrap_angle(true_angle - obs.angle)
-        assert abs(miss) <= obs.angle_error, (scene, segment, true_angle, obs)
-        assert abs(true_offset - obs.offset) <= obs.offset_error, (scene, segment, true_offset, obs)
-        angle_tally.add(miss, obs.angle_error)
-        offset_tally.add(true_offset - obs.offset, obs.offset_error)
+        miss = wrap_angle(true_angle - angle)
+        assert abs(miss) <= angle_error, (scene, segment, true_angle, angle, angle_error)
+        assert abs(true_offset - offset) <= offset_error, (scene, segment, true_offset, offset, offset_error)
+        angle_tally.add(miss, angle_error)
+        offset_tally.add(true_offset - offset, offset_error)
         angle_tally.checked += 1
     assert len(refusals) < CASES // 5
     assert all("horizon" in message or "long enough" in message for message in refusals)
@@ -328,72 +316,69 @@ def test_ground_line_bound_is_sound(rng: np.random.Generator) -> None:
 # ------------------------------------------------------------------ exactness and tightness
 
 FLAT = Camera(CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480), CameraMount(1.0, forward=0.4, left=0.1))
-POLE = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 3.0)
-CORNER = PointLandmark("corner", 10.0, 0.0, 0.0)
-EDGE = GroundLineLandmark("edge", (0.0, -2.0), (20.0, -2.0))
 
 
 def test_exact_calibration_and_pixel_give_the_true_values() -> None:
     tilted = Camera(FLAT.intrinsics, replace(FLAT.mount, tilt=0.2, pan=0.3))
     pose = Pose(0.0, 0.0, 0.0)
     pixel = tilted.project(pose, [(9.0, 4.0, 0.0)])[0]
-    obs = observe_point(tilted, replace(CORNER, x=9.0, y=4.0), pixel, time=0.0, pixel_error=0.0)
-    assert obs.bearing == pytest.approx(math.atan2(4.0 - 0.1, 9.0 - 0.4), abs=1e-9)
-    assert obs.bearing_error < 1e-8
-    assert obs.range_min == pytest.approx(math.hypot(8.6, 3.9), abs=1e-8)
-    assert obs.range_max - obs.range_min < 1e-8
-    assert obs.sensor_offset == (0.4, 0.1)
+    bearing, bearing_error, range_min, range_max = bound_point(tilted, pixel, 0.0, pixel_error=0.0)
+    assert bearing == pytest.approx(math.atan2(4.0 - 0.1, 9.0 - 0.4), abs=1e-9)
+    assert bearing_error < 1e-8
+    assert range_min == pytest.approx(math.hypot(8.6, 3.9), abs=1e-8)
+    assert range_max - range_min < 1e-8
 
 
 def test_pan_bound_adds_exactly_to_the_bearing_error() -> None:
-    obs = observe_vertical_line(
-        FLAT, POLE, (200.0, 100.0), time=0.0, pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
+    _, bearing_error = bound_vertical_line(
+        FLAT, (200.0, 100.0), pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
     )
-    assert obs.bearing_error == pytest.approx(0.01, rel=1e-5)
+    assert bearing_error == pytest.approx(0.01, rel=1e-5)
     line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
-    ground = observe_ground_line(
-        FLAT, EDGE, line, expected_angle=0.0, time=0.0, pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
+    _, offset_error, _, angle_error = bound_ground_line(
+        FLAT, line, expected_angle=0.0, pixel_error=0.0, bounds=CalibrationBounds(pan=0.01)
     )
-    assert ground.angle_error == pytest.approx(0.01, rel=1e-5)
-    assert ground.offset_error < 1e-8  # a rotation about the sensor keeps the distance to the line
+    assert angle_error == pytest.approx(0.01, rel=1e-5)
+    assert offset_error < 1e-8  # a rotation about the sensor keeps the distance to the line
 
 
 def test_height_bound_scales_the_ground_offset() -> None:
     line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
-    obs = observe_ground_line(
-        FLAT, EDGE, line, expected_angle=0.0, time=0.0, pixel_error=0.0, bounds=CalibrationBounds(height=0.1)
+    offset, offset_error, _, angle_error = bound_ground_line(
+        FLAT, line, expected_angle=0.0, pixel_error=0.0, bounds=CalibrationBounds(height=0.1)
     )
-    assert obs.offset == pytest.approx(2.1, abs=1e-8)  # 2 m from the robot, the sensor 0.1 m to its left
-    assert obs.offset_error == pytest.approx(0.21, rel=1e-5)  # +-10 % of the height
-    assert obs.angle_error < 1e-8
+    assert offset == pytest.approx(2.1, abs=1e-8)  # 2 m from the robot, the sensor 0.1 m to its left
+    assert offset_error == pytest.approx(0.21, rel=1e-5)  # +-10 % of the height
+    assert angle_error < 1e-8
 
 
 def test_ground_line_orientation_follows_the_expected_angle() -> None:
     line = FLAT.project(Pose(0, 0, 0), [(6.0, -2.0, 0.0), (12.0, -2.0, 0.0)]).ravel()
-    forward = observe_ground_line(FLAT, EDGE, line, expected_angle=1.4, time=0.0, pixel_error=0.0)
-    backward = observe_ground_line(FLAT, EDGE, line, expected_angle=1.8, time=0.0, pixel_error=0.0)
-    assert forward.angle == pytest.approx(0.0, abs=1e-6)
-    assert abs(backward.angle) == pytest.approx(math.pi, abs=1e-6)
-    assert backward.offset == pytest.approx(-forward.offset)
-    assert backward.offset_error == pytest.approx(forward.offset_error)
+    forward = bound_ground_line(FLAT, line, expected_angle=1.4, pixel_error=0.0)
+    backward = bound_ground_line(FLAT, line, expected_angle=1.8, pixel_error=0.0)
+    assert forward[2] == pytest.approx(0.0, abs=1e-6)
+    assert abs(backward[2]) == pytest.approx(math.pi, abs=1e-6)
+    assert backward[0] == pytest.approx(-forward[0])
+    assert backward[1] == pytest.approx(forward[1])
 
 
 def test_range_capped_by_max_range_near_the_horizon() -> None:
     pixel = FLAT.project(Pose(0, 0, 0), [(60.0, 0.1, 0.0)])[0]  # 1 m below the horizon at 60 m
     with pytest.raises(InputError, match=r"max_range: expected a bound on the range, .* reach the horizon"):
-        observe_point(FLAT, CORNER, pixel, time=0.0, pixel_error=10.0)
-    obs = observe_point(FLAT, CORNER, pixel, time=0.0, pixel_error=10.0, max_range=80.0)
-    assert obs.range_max == 80.0
-    assert 0.0 < obs.range_min < 60.0
+        bound_point(FLAT, pixel, 0.0, pixel_error=10.0)
+    _, _, range_min, range_max = bound_point(FLAT, pixel, 0.0, pixel_error=10.0, max_range=80.0)
+    assert range_max == 80.0
+    assert 0.0 < range_min < 60.0
 
 
-def test_landmark_above_the_camera() -> None:
-    lamp = PointLandmark("lamp", 10.0, 0.0, 3.0)
+def test_point_above_the_camera() -> None:
     pixel = FLAT.project(Pose(0, 0, 0), [(10.0, 0.0, 3.0)])[0]
-    obs = observe_point(FLAT, lamp, pixel, time=0.0, pixel_error=1.0, bounds=CalibrationBounds(height=0.05))
-    assert obs.range_min <= 9.6 <= obs.range_max
+    _, _, range_min, range_max = bound_point(
+        FLAT, pixel, 3.0, pixel_error=1.0, bounds=CalibrationBounds(height=0.05)
+    )
+    assert range_min <= 9.6 <= range_max
     with pytest.raises(InputError, match=r"expected a pixel above the horizon for a landmark at height 3\.0"):
-        observe_point(FLAT, lamp, (320.0, 400.0), time=0.0)
+        bound_point(FLAT, (320.0, 400.0), 3.0)
 
 
 # ------------------------------------------------------------------ the one-pixel float path
@@ -434,21 +419,19 @@ def test_float_sine_and_cosine_ranges_agree_with_the_interval_ones(rng: np.rando
         assert _observe._cos_range(lo[k], hi[k]) == pytest.approx((cosine.lo[k], cosine.hi[k]), abs=1e-15)
 
 
-def test_pixel_given_as_floats_arrays_or_numpy_scalars_gives_the_same_observation() -> None:
+def test_pixel_given_as_floats_arrays_or_numpy_scalars_gives_the_same_bounds() -> None:
     pixel = FLAT.project(Pose(0, 0, 0), [(9.0, 1.0, 0.0)])[0]
-    observations = [
-        observe_point(FLAT, replace(CORNER, x=9.0, y=1.0), form, time=0.0, pixel_error=0.5)
+    results = [
+        bound_point(FLAT, form, 0.0, pixel_error=0.5)
         for form in (tuple(pixel.tolist()), pixel, (pixel[0], pixel[1]), [pixel.tolist()])
     ]
-    assert all(o == observations[0] for o in observations)
+    assert all(r == results[0] for r in results)
 
 
 # ------------------------------------------------------------------ input errors
 
 GOOD_PIXEL = (320.0, 300.0)
 # wrongly typed arguments, as a caller without a type checker might pass them
-WRONG_CORNER: Any = CORNER
-WRONG_POLE: Any = POLE
 WRONG_CAMERA: Any = "camera"
 WRONG_BOUNDS: Any = 0.1
 GOOD_SEGMENT = (100.0, 400.0, 200.0, 300.0)
@@ -458,136 +441,112 @@ GOOD_SEGMENT = (100.0, 400.0, 200.0, 300.0)
     ("call", "error", "match"),
     [
         (
-            lambda: observe_vertical_line(FLAT, POLE, (640.0, 10.0), time=0.0),
+            lambda: bound_vertical_line(FLAT, (640.0, 10.0)),
             InputError,
             r"pixel: expected a pixel inside the 640x480 image \(\[-0.5, 639.5\]",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, (10.0, -0.6), time=0.0),
+            lambda: bound_vertical_line(FLAT, (10.0, -0.6)),
             InputError,
             "pixel: expected a pixel inside",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, (math.nan, 10.0), time=0.0),
+            lambda: bound_vertical_line(FLAT, (math.nan, 10.0)),
             InputError,
             "pixel: expected finite coordinates",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, (1.0, 2.0, 3.0), time=0.0),
+            lambda: bound_vertical_line(FLAT, (1.0, 2.0, 3.0)),
             InputError,
             "pixel: expected an \\(n, 2\\) array",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, [(1.0, 2.0), (3.0, 4.0)], time=0.0),
+            lambda: bound_vertical_line(FLAT, [(1.0, 2.0), (3.0, 4.0)]),
             InputError,
             r"pixel: expected \(u, v\)",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=0.0, pixel_error=-1.0),
+            lambda: bound_vertical_line(FLAT, GOOD_PIXEL, pixel_error=-1.0),
             InputError,
             "pixel_error: expected a non-negative number",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=math.inf),
-            InputError,
-            "time: expected a finite number",
-        ),
-        (
-            lambda: observe_vertical_line(FLAT, WRONG_CORNER, GOOD_PIXEL, time=0.0),
-            InputError,
-            "landmark: expected VerticalLineLandmark, got PointLandmark",
-        ),
-        (
-            lambda: observe_point(FLAT, WRONG_POLE, GOOD_PIXEL, time=0.0),
-            InputError,
-            "landmark: expected PointLandmark, got VerticalLineLandmark",
-        ),
-        (
-            lambda: observe_ground_line(FLAT, WRONG_POLE, GOOD_SEGMENT, expected_angle=0.0, time=0.0),
-            InputError,
-            "landmark: expected GroundLineLandmark",
-        ),
-        (
-            lambda: observe_vertical_line(WRONG_CAMERA, POLE, GOOD_PIXEL, time=0.0),
+            lambda: bound_vertical_line(WRONG_CAMERA, GOOD_PIXEL),
             InputError,
             "camera: expected Camera, got str",
         ),
         (
-            lambda: observe_vertical_line(FLAT, POLE, GOOD_PIXEL, time=0.0, bounds=WRONG_BOUNDS),
+            lambda: bound_vertical_line(FLAT, GOOD_PIXEL, bounds=WRONG_BOUNDS),
             InputError,
             "bounds: expected CalibrationBounds, got float",
         ),
         (
-            lambda: observe_vertical_line(
-                FLAT, POLE, GOOD_PIXEL, time=0.0, bounds=CalibrationBounds(fy=500.0)
-            ),
+            lambda: bound_vertical_line(FLAT, GOOD_PIXEL, bounds=CalibrationBounds(fy=500.0)),
             InputError,
             r"bounds.fy: expected less than the focal length fy \(500.0\)",
         ),
         (
-            lambda: observe_point(FLAT, CORNER, (320.0, 100.0), time=0.0),
+            lambda: bound_point(FLAT, (320.0, 100.0), 0.0),
             InputError,
             "pixel: expected a pixel below the horizon",
         ),
         (
-            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, bounds=CalibrationBounds(height=1.0)),
+            lambda: bound_point(FLAT, GOOD_PIXEL, 0.0, bounds=CalibrationBounds(height=1.0)),
             InputError,
             "bounds.height: expected the camera height 1.0 .* to exclude",
         ),
         (
-            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, max_range=-1.0),
+            lambda: bound_point(FLAT, GOOD_PIXEL, 0.0, max_range=-1.0),
             InputError,
             "max_range: expected a positive number",
         ),
         (
-            lambda: observe_point(FLAT, CORNER, GOOD_PIXEL, time=0.0, max_range=1.0),
+            lambda: bound_point(FLAT, GOOD_PIXEL, 0.0, max_range=1.0),
             InputError,
             "max_range: expected at least the smallest possible range",
         ),
         (
-            lambda: observe_ground_line(FLAT, EDGE, (1.0, 2.0, 3.0), expected_angle=0.0, time=0.0),
+            lambda: bound_ground_line(FLAT, (1.0, 2.0, 3.0), expected_angle=0.0),
             InputError,
             r"segment: expected \(u1, v1, u2, v2\), got shape \(3,\)",
         ),
         (
-            lambda: observe_ground_line(FLAT, EDGE, (1.0, 2.0, 3.0, 900.0), expected_angle=0.0, time=0.0),
+            lambda: bound_ground_line(FLAT, (1.0, 2.0, 3.0, 900.0), expected_angle=0.0),
             InputError,
             "segment: expected a pixel inside",
         ),
         (
-            lambda: observe_ground_line(FLAT, EDGE, ("a", 1, 2, 3), expected_angle=0.0, time=0.0),
+            lambda: bound_ground_line(FLAT, ("a", 1, 2, 3), expected_angle=0.0),
             InputError,
             "segment: expected",
         ),
         (
-            lambda: observe_ground_line(FLAT, EDGE, GOOD_SEGMENT, expected_angle=math.nan, time=0.0),
+            lambda: bound_ground_line(FLAT, GOOD_SEGMENT, expected_angle=math.nan),
             InputError,
             "expected_angle: expected a finite number",
         ),
         (
-            lambda: observe_ground_line(
-                FLAT, EDGE, (100.0, 400.0, 200.0, 100.0), expected_angle=0.0, time=0.0
-            ),
+            lambda: bound_ground_line(FLAT, (100.0, 400.0, 200.0, 100.0), expected_angle=0.0),
             InputError,
             "segment: expected both ends below the horizon, got end 2",
         ),
         (
-            lambda: observe_ground_line(
-                FLAT, EDGE, (100.0, 400.0, 200.0, 250.0), expected_angle=0.0, time=0.0, pixel_error=20.0
+            lambda: bound_ground_line(
+                FLAT, (100.0, 400.0, 200.0, 250.0), expected_angle=0.0, pixel_error=20.0
             ),
             InputError,
             "segment: expected error bounds that keep both ends below the horizon",
         ),
         (
-            lambda: observe_ground_line(
-                FLAT, EDGE, (100.0, 400.0, 101.0, 401.0), expected_angle=0.0, time=0.0, pixel_error=2.0
+            lambda: bound_ground_line(
+                FLAT, (100.0, 400.0, 101.0, 401.0), expected_angle=0.0, pixel_error=2.0
             ),
             InputError,
             "segment: expected a segment long enough",
         ),
         (
-            lambda: observe_ground_line(
-                FLAT, EDGE, GOOD_SEGMENT, expected_angle=0.0, time=0.0, bounds=CalibrationBounds(height=1.5)
+            lambda: bound_ground_line(
+                FLAT, GOOD_SEGMENT, expected_angle=0.0, bounds=CalibrationBounds(height=1.5)
             ),
             InputError,
             "bounds.height: expected the camera height 1.0 .* to stay above the ground",

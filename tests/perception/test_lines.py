@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from aura_ums.errors import InputError, MissingDependencyError
 from aura_ums.expecter import ImageWindow
-from aura_ums.perception import FastLineFinder, LineBackend, LineSegments, angle_difference
+from aura_ums.perception import FastLineFinder, LineBackend, LineSegments, orientation_difference
 
 VERTICAL = math.pi / 2
 
@@ -69,7 +69,7 @@ def test_tilted_edge_direction_and_position(degrees: float) -> None:
     lines = FastLineFinder(angle, tolerance=math.radians(3)).find_detailed(image)
     assert len(lines) >= 1
     best = lines.select([0])
-    assert angle_difference(best.orientation, angle)[0] < math.radians(1.5)
+    assert orientation_difference(best.orientation, angle)[0] < math.radians(1.5)
     assert best.length[0] > 80.0
     # The midpoint lies on the edge through the image centre.
     mu, mv = best.midpoints[0]
@@ -268,7 +268,7 @@ def test_segments_from_a_window_lie_in_it(u0: int, v0: int) -> None:
     whole = finder.find_detailed(image)
     window_lines = finder.find_detailed(image, ImageWindow(u0, v0, u0 + 99, v0 + 79))
     for midpoint, angle in zip(window_lines.midpoints, window_lines.orientation, strict=True):
-        near = angle_difference(whole.orientation, angle) < math.radians(2)
+        near = orientation_difference(whole.orientation, angle) < math.radians(2)
         a, b = whole.segments[near, :2], whole.segments[near, 2:]
         t = np.clip(np.einsum("ij,ij->i", midpoint - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
         assert np.min(np.hypot(*(a + t[:, None] * (b - a) - midpoint).T)) < 1.0

@@ -10,8 +10,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from aura_ums.expecter import ImageWindow
-from aura_ums.perception import FastLineFinder, LineSegments, angle_difference, evaluate_vertical_line
-from aura_ums.perception._landmarks import strongest_within
+from aura_ums.perception import (
+    FastLineFinder,
+    LineSegments,
+    evaluate_vertical_line,
+    orientation_difference,
+    strongest_within,
+)
 
 
 def clutter(seed: int, height: int = 90, width: int = 120) -> np.ndarray:
@@ -34,7 +39,7 @@ def clutter(seed: int, height: int = 90, width: int = 120) -> np.ndarray:
     st.sampled_from([0.0, 3.0, 12.0]),
     st.booleans(),
 )
-def test_tuned_filter_equals_angle_difference_on_all_lines(
+def test_tuned_filter_equals_orientation_difference_on_all_lines(
     seed: int, orientation: float, tolerance: float, min_contrast: float, windowed: bool
 ) -> None:
     image = clutter(seed)
@@ -43,7 +48,8 @@ def test_tuned_filter_equals_angle_difference_on_all_lines(
         orientation, tolerance=tolerance, min_length=8.0, min_contrast=min_contrast
     ).find_detailed(image, window)
     every = FastLineFinder(orientation, tolerance=math.pi / 2, min_length=8.0).find_detailed(image, window)
-    keep = (angle_difference(every.orientation, orientation) <= tolerance) & (every.contrast >= min_contrast)
+    near = orientation_difference(every.orientation, orientation) <= tolerance
+    keep = near & (every.contrast >= min_contrast)
     assert tuned.segments.tobytes() == every.segments[keep].tobytes()
     assert tuned.contrast.tobytes() == every.contrast[keep].tobytes()
 

@@ -1,18 +1,8 @@
 from __future__ import annotations
 
-import math
-
-import numpy as np
 import pytest
 
-from aura_ums import FOOT, InputError, Pose, TurnAndRun
-
-
-def test_pose_wraps_heading_and_converts() -> None:
-    pose = Pose(1, 2, -3 * math.pi / 2)
-    assert pose.heading == pytest.approx(math.pi / 2)
-    assert pose.as_array().tolist() == pytest.approx([1.0, 2.0, math.pi / 2])
-    assert isinstance(pose.x, float)
+from aura_ums import FOOT, InputError, TurnAndRun
 
 
 def test_foot_is_exact() -> None:
@@ -36,10 +26,3 @@ def test_zero_command_is_valid() -> None:
 def test_bad_commands_are_refused(turn: object, run: object, message: str) -> None:
     with pytest.raises(InputError, match=message):
         TurnAndRun(turn, run)  # type: ignore[arg-type]
-
-
-def test_bad_pose_is_refused() -> None:
-    with pytest.raises(InputError, match=r"Pose.y: expected a finite number, got nan"):
-        Pose(0.0, float("nan"), 0.0)
-    with pytest.raises(ValueError, match=r"Pose.heading"):
-        Pose(0.0, 0.0, np.inf)

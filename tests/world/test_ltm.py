@@ -17,6 +17,8 @@ from aura_ums import (
     TerrainTable,
     UnknownTerrainError,
     VerticalLineLandmark,
+    expecter,
+    world,
 )
 from aura_ums.world import LandmarkRecord, Meadow, MeadowMap, make_grid_world
 
@@ -330,3 +332,9 @@ def test_maps_are_immutable_values() -> None:
         world.meadows = ()  # type: ignore[misc]
     with pytest.raises(TypeError, match="unhashable"):
         hash(world)
+
+
+def test_the_strategy_lives_with_the_records_and_the_expecter_re_exports_it() -> None:
+    assert world.PerceptualStrategy is PerceptualStrategy
+    assert expecter.PerceptualStrategy is PerceptualStrategy
+    assert PerceptualStrategy("region_segmenter") is PerceptualStrategy.REGION_SEGMENTER

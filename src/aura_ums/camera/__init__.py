@@ -1,4 +1,10 @@
-"""The camera: intrinsics, mount, projection, and pixels turned into bounded observations."""
+"""The camera: intrinsics, mount, projection, and pixels turned into bounded measurements.
+
+This package imports nothing else of aura-ums but geometry, validation and errors: it
+bounds bearings, ranges and ground lines in the robot frame, and the observers of
+:mod:`aura_ums.expecter` (:func:`~aura_ums.expecter.observe_vertical_line` and its kin)
+turn them into observations of landmarks.
+"""
 
 from aura_ums.camera._io import (
     camera_to_toml,
@@ -21,9 +27,9 @@ from aura_ums.camera._observe import (
     UNDISTORT_ITERATIONS,
     UNDISTORT_TOLERANCE,
     CalibrationBounds,
-    observe_ground_line,
-    observe_point,
-    observe_vertical_line,
+    bound_ground_line,
+    bound_point,
+    bound_vertical_line,
     undistort_points,
 )
 
@@ -38,14 +44,14 @@ __all__ = [
     "Camera",
     "CameraIntrinsics",
     "CameraMount",
+    "bound_ground_line",
+    "bound_point",
+    "bound_vertical_line",
     "camera_to_toml",
     "distort",
     "load_calibration_bounds",
     "load_camera",
     "load_opencv_calibration",
-    "observe_ground_line",
-    "observe_point",
-    "observe_vertical_line",
     "robot_from_camera_rotation",
     "undistort_points",
 ]

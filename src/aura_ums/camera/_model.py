@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, float_array
 from aura_ums.errors import InputError
-from aura_ums.uncertainty import Pose
+from aura_ums.geometry import Pose
 
 #: Points closer to the camera plane than this (m, along the optical axis) count as behind it.
 NEAR_PLANE = 1e-6

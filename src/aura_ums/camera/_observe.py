@@ -1,10 +1,12 @@
-"""Pixels turned into bounded observations of the three landmark classes.
+"""Pixels turned into bounded measurements of the three landmark classes.
 
-The observer knows a *nominal* camera and, in :class:`CalibrationBounds`, how far each
-calibrated parameter may be off; it knows how far a measured pixel may be off
-(``pixel_error``). Every observation it returns carries an error bound that holds for
-*every* camera and pixel within those bounds (a set-membership bound, not a standard
-deviation), so that the reductions of the spatial uncertainty map stay sound.
+The camera knows a *nominal* calibration and, in :class:`CalibrationBounds`, how far each
+calibrated parameter may be off; it is told how far a measured pixel may be off
+(``pixel_error``). Every bearing, range, offset and angle it returns carries an error
+bound that holds for *every* camera and pixel within those bounds (a set-membership
+bound, not a standard deviation), so that the reductions of the spatial uncertainty map
+stay sound. The observers of :mod:`aura_ums.expecter` attach them to a landmark as
+observations.
 
 Error propagation
 -----------------
@@ -57,14 +59,6 @@ from aura_ums._validate import finite_float, nonnegative_float, points_array
 from aura_ums.camera._model import Camera, CameraIntrinsics, distort
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
-from aura_ums.uncertainty import (
-    BearingObservation,
-    GroundLineLandmark,
-    GroundLineObservation,
-    PointLandmark,
-    RangeBearingObservation,
-    VerticalLineLandmark,
-)
 
 Array = NDArray[np.float64]
 Coefficients = tuple[float, float, float, float, float]
@@ -646,36 +640,26 @@ def _bearing_bound(camera: Camera, bounds: CalibrationBounds, rays: _Rays) -> tu
 # ------------------------------------------------------------------ the three classes
 
 
-def _common_inputs(pixel_error: object, time: object) -> tuple[float, float]:
-    return nonnegative_float(pixel_error, "pixel_error"), finite_float(time, "time")
-
-
-def observe_vertical_line(
+def bound_vertical_line(
     camera: Camera,
-    landmark: VerticalLineLandmark,
     pixel: ArrayLike,
     *,
-    time: float,
     pixel_error: float = 0.5,
     bounds: CalibrationBounds | None = None,
-) -> BearingObservation:
-    """Turn a pixel on the image of a vertical line into a bounded bearing (Class I).
+) -> tuple[float, float]:
+    """Bound the bearing of a vertical line from one pixel of its image (Class I).
 
     The pixel's back-projected ray lies in the vertical plane through the optical centre
     and the line, whatever the tilt, so its horizontal component points at the line: the
     bearing is its azimuth in the robot frame (counter-clockwise from robot forward),
-    measured from the optical centre (``sensor_offset = mount.sensor_offset``).
+    measured from the optical centre (``camera.mount.sensor_offset``).
 
     Parameters
     ----------
     camera : Camera
         The nominal camera.
-    landmark : VerticalLineLandmark
-        The landmark seen (its id names the observation).
     pixel : array_like, shape (2,)
         (u, v) of any point of the line's image, inside the image.
-    time : float
-        Time of the image, seconds.
     pixel_error : float
         Bound on the pixel's error in u and in v, pixels, >= 0.
     bounds : CalibrationBounds, optional
@@ -683,54 +667,49 @@ def observe_vertical_line(
 
     Returns
     -------
-    BearingObservation
-        ``bearing`` is the centre of the guaranteed interval (radians), ``bearing_error``
-        its half-width, pi when the ray may be vertical (no bearing information).
+    bearing, bearing_error : float
+        The centre of the guaranteed interval of bearings and its half-width, radians;
+        the half-width is pi when the ray may be vertical (no bearing information).
 
     Raises
     ------
     InputError
-        For a pixel outside the image or not finite, a negative error, a landmark of
-        another class, or bounds that make a focal length non-positive.
+        For a pixel outside the image or not finite, a negative error, or bounds that
+        make a focal length non-positive.
 
     Examples
     --------
     >>> from aura_ums.camera import CameraMount
     >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, pan=0.5))
-    >>> pole = VerticalLineLandmark("pole", 5.0, 0.0, 0.0, 3.0)
-    >>> obs = observe_vertical_line(camera, pole, (320, 100), time=0.0, pixel_error=0.0)
-    >>> round(obs.bearing, 6), obs.bearing_error < 1e-8    # the optical axis, tilted or not
+    >>> bearing, error = bound_vertical_line(camera, (320, 100), pixel_error=0.0)
+    >>> round(bearing, 6), error < 1e-8    # the optical axis, tilted or not
     (0.5, True)
-    >>> observe_vertical_line(camera, pole, (640, 100), time=0.0)
+    >>> bound_vertical_line(camera, (640, 100))
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: pixel: expected a pixel inside the 640x480 image \
 ([-0.5, 639.5] x [-0.5, 479.5]), got (640.0, 100.0)
     """
     camera, checked = _check_camera(camera, bounds)
-    if not isinstance(landmark, VerticalLineLandmark):
-        raise InputError(f"landmark: expected VerticalLineLandmark, got {type(landmark).__name__}")
-    error, when = _common_inputs(pixel_error, time)
+    error = nonnegative_float(pixel_error, "pixel_error")
     u, v = _one_pixel(camera, pixel)
-    bearing, bearing_error = _pixel_bearing(camera, checked, _pixel_ray(camera, checked, u, v, error))
-    return BearingObservation(landmark.id, when, bearing, bearing_error, camera.mount.sensor_offset)
+    return _pixel_bearing(camera, checked, _pixel_ray(camera, checked, u, v, error))
 
 
-def observe_point(
+def bound_point(
     camera: Camera,
-    landmark: PointLandmark,
     pixel: ArrayLike,
+    z: float,
     *,
-    time: float,
     pixel_error: float = 0.5,
     bounds: CalibrationBounds | None = None,
     max_range: float | None = None,
-) -> RangeBearingObservation:
-    """Turn the pixel of a point landmark of known height into bounded bearing and range (Class II).
+) -> tuple[float, float, float, float]:
+    """Bound the bearing and range of a point of known height from its pixel (Class II).
 
     The range is the horizontal distance from the optical centre to where the
-    back-projected ray meets the horizontal plane at the landmark's height ``z`` (the
-    ground-plane assumption), bounded over every camera and pixel within the bounds.
+    back-projected ray meets the horizontal plane at height ``z`` (the ground-plane
+    assumption), bounded over every camera and pixel within the bounds.
 
     Near the horizon the range grows without bound. A pixel whose nominal ray does not
     meet the plane (at or above the horizon for that height) is an error. When the ray
@@ -743,12 +722,10 @@ def observe_point(
     ----------
     camera : Camera
         The nominal camera.
-    landmark : PointLandmark
-        The landmark seen; its ``z`` is used.
     pixel : array_like, shape (2,)
-        (u, v) of the landmark's image, inside the image.
-    time : float
-        Time of the image, seconds.
+        (u, v) of the point's image, inside the image.
+    z : float
+        Height of the point above the ground, metres.
     pixel_error : float
         Bound on the pixel's error in u and in v, pixels, >= 0.
     bounds : CalibrationBounds, optional
@@ -758,34 +735,32 @@ def observe_point(
 
     Returns
     -------
-    RangeBearingObservation
-        Bearing as in :func:`observe_vertical_line`, ``[range_min, range_max]`` in metres.
+    bearing, bearing_error, range_min, range_max : float
+        Bearing as in :func:`bound_vertical_line` (radians), ``[range_min, range_max]``
+        in metres.
 
     Raises
     ------
     InputError
-        As :func:`observe_vertical_line`; also for a pixel at or above the horizon, error
+        As :func:`bound_vertical_line`; also for a pixel at or above the horizon, error
         bounds reaching the horizon without ``max_range``, a camera height bound that
-        reaches the landmark's height, or a range_min beyond ``max_range``.
+        reaches the point's height, or a range_min beyond ``max_range``.
 
     Examples
     --------
     >>> from aura_ums.camera import CameraMount
     >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, tilt=0.1))
-    >>> corner = PointLandmark("corner", 10.0, 0.0, 0.0)
-    >>> obs = observe_point(camera, corner, (320, 240), time=0.0, pixel_error=0.0)
-    >>> round(obs.range_min, 6), round(obs.range_max, 6)    # 1 m / tan(0.1)
+    >>> _, _, near, far = bound_point(camera, (320, 240), 0.0, pixel_error=0.0)
+    >>> round(near, 6), round(far, 6)    # 1 m / tan(0.1)
     (9.966644, 9.966644)
-    >>> observe_point(camera, corner, (320, 100), time=0.0)
+    >>> bound_point(camera, (320, 100), 0.0)
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: pixel: expected a pixel below the horizon for a landmark at \
 height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that plane
     """
     camera, checked = _check_camera(camera, bounds)
-    if not isinstance(landmark, PointLandmark):
-        raise InputError(f"landmark: expected PointLandmark, got {type(landmark).__name__}")
-    error, when = _common_inputs(pixel_error, time)
+    error = nonnegative_float(pixel_error, "pixel_error")
     cap = math.inf
     if max_range is not None:
         cap = finite_float(max_range, "max_range")
@@ -793,18 +768,18 @@ height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that pl
             raise InputError(f"max_range: expected a positive number, got {cap}")
     u, v = _one_pixel(camera, pixel)
     height = camera.mount.height
-    drop_lo, drop_hi = (height - landmark.z) - checked.height, (height - landmark.z) + checked.height
+    drop_lo, drop_hi = (height - z) - checked.height, (height - z) + checked.height
     if drop_lo <= 0.0 <= drop_hi:
         raise InputError(
             f"bounds.height: expected the camera height {height} +- {checked.height} m to exclude the "
-            f"landmark's height {landmark.z} m, got an interval that reaches it"
+            f"landmark's height {z} m, got an interval that reaches it"
         )
     sign = 1.0 if drop_lo > 0.0 else -1.0
     ray = _pixel_ray(camera, checked, u, v, error)
     if sign * math.sin(ray.psi0) <= 0.0:
         raise InputError(
             f"pixel: expected a pixel {'below' if sign > 0 else 'above'} the horizon for a landmark at "
-            f"height {landmark.z} m (camera at {height} m), got ({u}, {v}) whose ray "
+            f"height {z} m (camera at {height} m), got ({u}, {v}) whose ray "
             "never meets that plane"
         )
     bearing, bearing_error = _pixel_bearing(camera, checked, ray)
@@ -826,34 +801,30 @@ height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that pl
         )
     if range_min > cap:
         raise InputError(f"max_range: expected at least the smallest possible range {range_min} m, got {cap}")
-    return RangeBearingObservation(
-        landmark.id, when, bearing, bearing_error, range_min, min(range_max, cap), camera.mount.sensor_offset
-    )
+    return bearing, bearing_error, range_min, min(range_max, cap)
 
 
 def _ground_boxes(camera: Camera, bounds: CalibrationBounds, uv: Array, pixel_error: float) -> _Rays:
     return _rays(camera, bounds, uv, pixel_error, splits=GROUND_LINE_SPLITS)
 
 
-def observe_ground_line(
+def bound_ground_line(
     camera: Camera,
-    landmark: GroundLineLandmark,
     segment: ArrayLike,
     *,
     expected_angle: float,
-    time: float,
     pixel_error: float = 0.5,
     bounds: CalibrationBounds | None = None,
-) -> GroundLineObservation:
-    """Turn an image segment of a known ground line into bounded offset and angle (Class III).
+) -> tuple[float, float, float, float]:
+    """Bound the offset and angle of a ground line from an image segment of it (Class III).
 
     Both ends are back-projected to the ground plane z = 0, giving the line in the robot
     frame. ``offset`` is the signed distance from the optical centre (the
-    ``sensor_offset``) to the line, positive when it is left of the landmark's start ->
-    end direction; ``angle`` is that direction relative to the heading.
+    ``sensor_offset``) to the line, positive when it is left of the line's direction;
+    ``angle`` is that direction relative to the heading.
 
-    The image does not say which end is ``start``: the line is oriented along whichever
-    of its two directions is closer to ``expected_angle`` (robot frame, radians), e.g.
+    The image does not say which way the line runs: it is oriented along whichever of
+    its two directions is closer to ``expected_angle`` (robot frame, radians), e.g.
     ``landmark.direction - heading`` for a heading estimate; it must be within 90 degrees
     of the truth.
 
@@ -861,15 +832,11 @@ def observe_ground_line(
     ----------
     camera : Camera
         The nominal camera.
-    landmark : GroundLineLandmark
-        The landmark seen.
     segment : array_like, shape (4,) or (2, 2)
         (u1, v1, u2, v2): two image points of the line, inside the image, both below
         the horizon.
     expected_angle : float
-        Roughly expected direction start -> end relative to the heading, radians.
-    time : float
-        Time of the image, seconds.
+        Roughly expected direction of the line relative to the heading, radians.
     pixel_error : float
         Bound on each end's error in u and in v, pixels, >= 0.
     bounds : CalibrationBounds, optional
@@ -877,38 +844,34 @@ def observe_ground_line(
 
     Returns
     -------
-    GroundLineObservation
+    offset, offset_error, angle, angle_error : float
         ``offset`` (m) and ``angle`` (rad, wrapped) at the centres of their guaranteed
         intervals, with the half-widths as errors.
 
     Raises
     ------
     InputError
-        For bad pixels, errors or landmark type as :func:`observe_vertical_line`; an end
-        at or above the horizon, or whose error bounds reach it; a camera height bound
-        that reaches the ground; a segment too short for its error bounds to fix a
-        direction.
+        For bad pixels or errors as :func:`bound_vertical_line`; an end at or above the
+        horizon, or whose error bounds reach it; a camera height bound that reaches the
+        ground; a segment too short for its error bounds to fix a direction.
 
     Examples
     --------
-    >>> from aura_ums import Pose
     >>> from aura_ums.camera import CameraMount
+    >>> from aura_ums.geometry import Pose
     >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, tilt=0.3))
-    >>> edge = GroundLineLandmark("edge", (0.0, -2.0), (10.0, -2.0))
     >>> # the images of the ground points (3, -2) and (6, -2) seen from the origin, heading 0
     >>> uv = camera.project(Pose(0, 0, 0), [(3.0, -2.0, 0.0), (6.0, -2.0, 0.0)])
-    >>> obs = observe_ground_line(camera, edge, uv[::-1], expected_angle=0.0, time=0.0, pixel_error=0.0)
-    >>> round(obs.offset, 6), round(obs.angle, 6) + 0.0      # ends given in either order
+    >>> offset, _, angle, _ = bound_ground_line(camera, uv[::-1], expected_angle=0.0, pixel_error=0.0)
+    >>> round(offset, 6), round(angle, 6) + 0.0      # ends given in either order
     (2.0, 0.0)
-    >>> observe_ground_line(camera, edge, (0, 0, 10, 10), expected_angle=0.0, time=0.0)
+    >>> bound_ground_line(camera, (0, 0, 10, 10), expected_angle=0.0)
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: segment: expected both ends below the horizon, got end 1 at (0.0, 0.0)
     """
     camera, checked = _check_camera(camera, bounds)
-    if not isinstance(landmark, GroundLineLandmark):
-        raise InputError(f"landmark: expected GroundLineLandmark, got {type(landmark).__name__}")
-    error, when = _common_inputs(pixel_error, time)
+    error = nonnegative_float(pixel_error, "pixel_error")
     hint = finite_float(expected_angle, "expected_angle")
     try:
         flat = np.asarray(segment, dtype=np.float64)
@@ -987,12 +950,4 @@ def observe_ground_line(
     offset = unit * height
     angle_error = min(_widen(0.5 * (angle_hi - angle_lo)), math.pi)
     offset_error = _widen(float(offset.rad))
-    return GroundLineObservation(
-        landmark.id,
-        when,
-        float(offset.mid),
-        offset_error,
-        wrap_angle(0.5 * (angle_lo + angle_hi)),
-        angle_error,
-        mount.sensor_offset,
-    )
+    return float(offset.mid), offset_error, wrap_angle(0.5 * (angle_lo + angle_hi)), angle_error

@@ -15,7 +15,7 @@ import typer
 from aura_ums.cli._common import console, fail, print_log_summary
 
 if TYPE_CHECKING:
-    from aura_ums.export._types import ReplayLike
+    from aura_ums.logs import ReplayResult
     from aura_ums.sim import Scenario
 
 
@@ -59,8 +59,7 @@ def rosbag_command(
     Sensor bounds are the log defaults (meta.toml): edit them, or calibrate, before replaying.
     """
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import LogMeta
-    from aura_ums.logs._rosbag import import_rosbag
+    from aura_ums.logs import LogMeta, import_rosbag
 
     try:
         meta = None if name is None else LogMeta(name, source=f"ROS bag {bag.name}")
@@ -109,7 +108,7 @@ def write_simulation_mcap_option(path: Path, scenario: Scenario, seed: int, *, p
     return written
 
 
-def write_replay_mcap_option(path: Path, replay: ReplayLike) -> Path:
+def write_replay_mcap_option(path: Path, replay: ReplayResult) -> Path:
     """Write a replay as MCAP; prints where, or ``error: ...`` and exits with code 2."""
     from aura_ums.errors import AuraUmsError
     from aura_ums.export import write_replay_mcap

@@ -15,9 +15,10 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter._expecter import Expecter
-from aura_ums.expecter._window import PerceptualStrategy, margin_pixels
+from aura_ums.expecter._window import margin_pixels
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, ImageWindow, outer_disk
 from aura_ums.uncertainty import Landmark, Pose, SpatialUncertaintyMap
+from aura_ums.world import PerceptualStrategy
 
 #: Sides of the outer polygon that stands for the disk model's circle.
 DISK_SIDES = 64

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from aura_ums.geometry._angles import TWO_PI
 
+#: An arc of directions ``(lo, width)``, radians (see the module notes).
 Arc = tuple[float, float]
 
 #: The arc of every direction.
@@ -79,6 +80,29 @@ def nearest_on_polygon(
 
     The distance is 0, and the point itself is returned, when it lies in the polygon
     (a point or a segment allowed).
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (n, 2)
+        Convex counter-clockwise polygon, metres, n >= 1.
+    point : ndarray, shape (2,)
+        The point (x, y), metres.
+
+    Returns
+    -------
+    distance : float
+        Metres, >= 0.
+    nearest : ndarray, shape (2,)
+        The polygon's point nearest to ``point``.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    >>> distance, nearest = nearest_on_polygon(square, np.array([5.0, 1.0]))
+    >>> distance, nearest.tolist()
+    (3.0, [2.0, 1.0])
+    >>> nearest_on_polygon(square, np.array([1.0, 1.0]))[0]   # inside: distance 0
+    0.0
     """
     relative = point - vertices
     if len(vertices) == 1:

@@ -79,7 +79,23 @@ def _edges(vertices: Array) -> Array:
 
 
 def cross2(a: Array, b: Array) -> Array:
-    """Return the z component of the cross product of 2-D vectors, row by row."""
+    """Return the z component of the cross product of 2-D vectors, row by row.
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (..., 2)
+        Vectors (x, y), broadcast against each other.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        ``a_x * b_y - a_y * b_x``: positive when ``b`` turns counter-clockwise from ``a``.
+
+    Examples
+    --------
+    >>> cross2(np.array([[1.0, 0.0], [1.0, 0.0]]), np.array([[0.0, 2.0], [3.0, 0.0]])).tolist()
+    [2.0, 0.0]
+    """
     return np.asarray(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0], dtype=np.float64)
 
 
@@ -455,6 +471,28 @@ def points_in_convex(vertices: Array, points: Array, tolerance: float) -> NDArra
     """Tell which points lie in a convex polygon, counting ``tolerance`` metres around it.
 
     Works for degenerate polygons (a point, a segment) by distance.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (n, 2)
+        Convex counter-clockwise polygon, metres, n >= 1.
+    points : ndarray, shape (m, 2)
+        Points (x, y), metres.
+    tolerance : float
+        Distance (m, >= 0) outside the polygon that still counts as inside.
+
+    Returns
+    -------
+    ndarray of bool, shape (m,)
+        True for the points inside (or within ``tolerance`` of) the polygon.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    >>> points_in_convex(square, np.array([[1.0, 1.0], [2.0 + 1e-10, 1.0], [3.0, 1.0]]), 1e-9).tolist()
+    [True, True, False]
+    >>> points_in_convex(np.array([[1.0, 1.0]]), np.array([[1.0, 1.0]]), 0.0).tolist()  # a point
+    [True]
     """
     n = len(vertices)
     if n < 3 or polygon_area(vertices) <= 0.0:

@@ -67,6 +67,25 @@ class ImageWindow:
         if self.v_max < self.v_min:
             raise InputError(f"ImageWindow.v_max: expected >= v_min ({self.v_min}), got {self.v_max}")
 
+    @classmethod
+    def _trusted(cls, u_min: float, v_min: float, u_max: float, v_max: float) -> ImageWindow:
+        """Build a window from bounds computed inside aura-ums, skipping validation.
+
+        For internal paths only (the Expecter and the schemas build one per landmark and
+        frame): the bounds must be Python floats. Bounds that are not finite or out of
+        order go through the validated constructor, which raises; otherwise the result
+        equals ``ImageWindow(u_min, v_min, u_max, v_max)``.
+        """
+        if not (-math.inf < u_min <= u_max < math.inf and -math.inf < v_min <= v_max < math.inf):
+            return cls(u_min, v_min, u_max, v_max)
+        window = object.__new__(cls)
+        setattr_ = object.__setattr__
+        setattr_(window, "u_min", u_min)
+        setattr_(window, "v_min", v_min)
+        setattr_(window, "u_max", u_max)
+        setattr_(window, "v_max", v_max)
+        return window
+
     @property
     def width(self) -> float:
         """Horizontal extent ``u_max - u_min``, pixels (inf when both sides are unbounded)."""

@@ -31,12 +31,13 @@ from aura_ums.perception._landmarks import (
     evaluate_path_edge,
     evaluate_vertical_line,
     line_intersections,
+    strongest_within,
 )
 from aura_ums.perception._lines import FastLineFinder, LineBackend
 from aura_ums.perception._moravec import MoravecOperator
 from aura_ums.perception._opencv import OpenCvLineFinder
 from aura_ums.perception._regions import Region, RegionSegmenter, otsu_threshold
-from aura_ums.perception._segments import LineSegments, angle_difference, segment_orientation
+from aura_ums.perception._segments import LineSegments, orientation_difference, segment_orientation
 
 __all__ = [
     "CornerEvidence",
@@ -49,14 +50,15 @@ __all__ = [
     "RecallPrecision",
     "Region",
     "RegionSegmenter",
-    "angle_difference",
     "evaluate_corner",
     "evaluate_path_edge",
     "evaluate_vertical_line",
     "line_intersections",
+    "orientation_difference",
     "otsu_threshold",
     "read_gray_image",
     "sample_points",
     "segment_orientation",
     "segment_recall_precision",
+    "strongest_within",
 ]

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.perception._segments import angle_difference, segment_orientation
+from aura_ums.perception._segments import orientation_difference, segment_orientation
 
 _CHUNK = 2048
 
@@ -130,7 +130,9 @@ def _matched(
         ex = rel_x - t * d[None, :, 0]
         ey = rel_y - t * d[None, :, 1]
         close = ex * ex + ey * ey <= distance * distance
-        close &= angle_difference(point_angle[lo : lo + _CHUNK, None], seg_angle[None, :]) <= angle_tolerance
+        close &= (
+            orientation_difference(point_angle[lo : lo + _CHUNK, None], seg_angle[None, :]) <= angle_tolerance
+        )
         found += int(close.any(axis=1).sum())
     return found
 

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.perception._segments import LineSegments, angle_difference
+from aura_ums.perception._segments import LineSegments, orientation_difference
 
 #: At most this many of the strongest lines are intersected pairwise by :func:`evaluate_corner`.
 MAX_CORNER_LINES = 64
@@ -134,8 +134,34 @@ def evaluate_vertical_line(
 
 
 def strongest_within(lines: LineSegments, orientation: float, tolerance: float) -> LineEvidence:
-    """:func:`evaluate_vertical_line` on checked arguments (a float orientation and tolerance >= 0)."""
-    return _best_line(lines, angle_difference(lines.orientation, orientation) <= tolerance)
+    """Return the strongest line within ``tolerance`` of ``orientation``, arguments unchecked.
+
+    :func:`evaluate_vertical_line` once its arguments are checked, for callers that
+    checked them already (a schema evaluates every frame with the same ones).
+
+    Parameters
+    ----------
+    lines : LineSegments
+        Lines found in the window.
+    orientation : float
+        Expected image direction, radians, finite.
+    tolerance : float
+        Largest difference of direction, radians, >= 0.
+
+    Returns
+    -------
+    LineEvidence
+        As :func:`evaluate_vertical_line`.
+
+    Examples
+    --------
+    >>> lines = LineSegments([[50, 10, 51, 90], [20, 5, 90, 6]], [12.0, 40.0])
+    >>> strongest_within(lines, math.pi / 2, 0.1).column
+    50.5
+    >>> strongest_within(lines, 0.7, 0.1).segment is None   # no line that direction
+    True
+    """
+    return _best_line(lines, orientation_difference(lines.orientation, orientation) <= tolerance)
 
 
 def evaluate_path_edge(
@@ -176,7 +202,7 @@ def evaluate_path_edge(
     target = finite_float(orientation, "orientation")
     limit = nonnegative_float(tolerance, "tolerance")
     shortest = nonnegative_float(min_length, "min_length")
-    keep = (angle_difference(lines.orientation, target) <= limit) & (lines.length >= shortest)
+    keep = (orientation_difference(lines.orientation, target) <= limit) & (lines.length >= shortest)
     return _best_line(lines, keep)
 
 
@@ -200,7 +226,7 @@ def line_intersections(lines: LineSegments, *, radius: float, min_angle: float) 
         return np.zeros((0, 2))
     i, j = np.triu_indices(n, k=1)
     angles = lines.orientation[order]
-    pairs = angle_difference(angles[i], angles[j]) >= min_angle
+    pairs = orientation_difference(angles[i], angles[j]) >= min_angle
     i, j = i[pairs], j[pairs]
     p, r = seg[i, :2], seg[i, 2:] - seg[i, :2]
     q, s = seg[j, :2], seg[j, 2:] - seg[j, :2]

@@ -41,7 +41,7 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
 from aura_ums.perception._opencv import import_cv2
-from aura_ums.perception._segments import LineSegments
+from aura_ums.perception._segments import LineSegments, orientation_difference
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 
@@ -200,9 +200,11 @@ class FastLineFinder:
         if self.min_contrast > 0.0:  # contrasts are means of magnitudes: never below 0
             keep &= contrast >= self.min_contrast
         if self.orientation is not None:
-            # angle_difference(direction, orientation) <= tolerance, operation for operation.
-            turn = np.mod(np.mod(np.arctan2(dv, du), math.pi) - self.orientation, math.pi)
-            keep &= np.minimum(turn, math.pi - turn) <= self.tolerance
+            # The orientations LineSegments gives these segments, compared as it compares them.
+            keep &= (
+                orientation_difference(np.mod(np.arctan2(dv, du), math.pi), self.orientation)
+                <= self.tolerance
+            )
         kept = np.flatnonzero(keep)
         order = kept[np.argsort(-(length[kept] * contrast[kept]), kind="stable")]
         return LineSegments._trusted(segments[order], contrast[order])

@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums.errors import InputError
+from aura_ums.geometry import angle_difference
 
 
 def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -22,16 +23,32 @@ def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.asarray(np.mod(angle, math.pi), dtype=np.float64)
 
 
-def angle_difference(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
-    """Return the difference of line directions ``a`` and ``b`` modulo pi, in ``[0, pi/2]``.
+def orientation_difference(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Return the difference of line orientations ``a`` and ``b``, in ``[0, pi/2]`` radians.
+
+    A line has no sense: orientations ``t`` and ``t + pi`` are the same line, so the
+    difference is the smaller turn, either way, that brings one line onto the other (the
+    signed difference of directions, :func:`aura_ums.geometry.angle_difference`, folded).
+
+    Parameters
+    ----------
+    a, b : array_like
+        Orientations, radians, broadcast against each other.
+
+    Returns
+    -------
+    ndarray
+        The differences, radians in ``[0, pi/2]``, of the broadcast shape.
 
     Examples
     --------
-    >>> angle_difference([0.1, 3.1], 0.0).round(4).tolist()
+    >>> orientation_difference([0.1, 3.1], 0.0).round(4).tolist()
     [0.1, 0.0416]
+    >>> float(orientation_difference(0.0, np.pi))   # the same line, either way round
+    0.0
     """
-    d = np.mod(np.asarray(a, dtype=np.float64) - np.asarray(b, dtype=np.float64), math.pi)
-    return np.asarray(np.minimum(d, math.pi - d), dtype=np.float64)
+    turn = np.abs(angle_difference(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)))
+    return np.asarray(np.minimum(turn, math.pi - turn), dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True, eq=False, init=False)
@@ -132,4 +149,4 @@ class LineSegments:
 
     def within(self, orientation: float, tolerance: float) -> LineSegments:
         """Return the segments within ``tolerance`` of direction ``orientation`` (radians, mod pi)."""
-        return self.select(angle_difference(self.orientation, orientation) <= tolerance)
+        return self.select(orientation_difference(self.orientation, orientation) <= tolerance)

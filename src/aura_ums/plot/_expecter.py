@@ -11,8 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon as PolygonPatch
 from matplotlib.patches import Rectangle
 
-from aura_ums.expecter import Expecter, ImageWindow, disk_model_map
-from aura_ums.expecter._scenario import figure4_scenario
+from aura_ums.expecter import Expecter, ImageWindow, disk_model_map, figure4_scenario
 from aura_ums.uncertainty import PointLandmark, SpatialUncertaintyMap
 
 _SAMPLES = 600

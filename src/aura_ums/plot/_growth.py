@@ -166,8 +166,7 @@ def draw_all_figures(out: str | Path, *, seed: int = 0) -> list[Path]:
 
 def _figure4_window_rows() -> list[str]:
     """Rows of the report's window table: polygon against disk model, Figure 4 scenario."""
-    from aura_ums.expecter import Expecter, disk_model_map
-    from aura_ums.expecter._scenario import figure4_scenario
+    from aura_ums.expecter import Expecter, disk_model_map, figure4_scenario
 
     scenario = figure4_scenario()
     expecter = Expecter(scenario.camera)

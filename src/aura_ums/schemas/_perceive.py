@@ -31,14 +31,17 @@ from aura_ums.camera import (
     NEAR_PLANE,
     CalibrationBounds,
     Camera,
-    observe_ground_line,
-    observe_point,
-    observe_vertical_line,
     robot_from_camera_rotation,
     undistort_points,
 )
 from aura_ums.errors import InputError
-from aura_ums.expecter import ImageWindow, PerceptualStrategy
+from aura_ums.expecter import (
+    ImageWindow,
+    PerceptualStrategy,
+    observe_ground_line,
+    observe_point,
+    observe_vertical_line,
+)
 from aura_ums.expecter._window import trusted_window
 from aura_ums.perception import (
     FastLineFinder,

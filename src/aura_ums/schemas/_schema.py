@@ -9,7 +9,6 @@ from aura_ums._validate import integer_at_least, nonnegative_float
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
 from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow
-from aura_ums.expecter._window import trusted_window
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._perceive import (
     Detector,
@@ -51,7 +50,7 @@ def _grown_clipped(window: ImageWindow, margin: float, width: int, height: int) 
     u1, v1 = min(window.u_max + margin, width - 0.5), min(window.v_max + margin, height - 0.5)
     if u0 > u1 or v0 > v1:
         return None
-    return trusted_window(u0, v0, u1, v1)
+    return ImageWindow._trusted(u0, v0, u1, v1)
 
 
 def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWindow:
@@ -67,7 +66,7 @@ def widen(window: ImageWindow, scale: float, width: int, height: int) -> ImageWi
     ImageWindow(u_min=-0.5, v_min=-0.5, u_max=639.5, v_max=479.5)
     """
     if math.isinf(scale):
-        return trusted_window(-0.5, -0.5, width - 0.5, height - 0.5)
+        return ImageWindow._trusted(-0.5, -0.5, width - 0.5, height - 0.5)
     du = 0.5 * (scale - 1.0) * (window.u_max - window.u_min)
     dv = 0.5 * (scale - 1.0) * (window.v_max - window.v_min)
     wide = ImageWindow(window.u_min - du, window.v_min - dv, window.u_max + du, window.v_max + dv)
@@ -353,7 +352,7 @@ class FindLandmarkSchema:
         u1, v1 = min(u1, guaranteed.u_max), min(v1, guaranteed.v_max)
         if u0 > u1 or v0 > v1:
             return guaranteed
-        return trusted_window(u0, v0, u1, v1)
+        return ImageWindow._trusted(u0, v0, u1, v1)
 
     def _look(self, frame: Frame, window: ImageWindow) -> tuple[float, Detection | None, Observation | None]:
         """Run the strategy in the window; return the value, and the detection and observation of a hit."""

@@ -3,6 +3,7 @@
 This package imports nothing of aura-ums but geometry, validation and errors.
 """
 
+from aura_ums.geometry import Pose
 from aura_ums.uncertainty._checks import (
     ContainmentResult,
     TightnessResult,
@@ -23,7 +24,7 @@ from aura_ums.uncertainty._landmarks import (
     VerticalLineLandmark,
 )
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._motion import FOOT, Pose, TurnAndRun
+from aura_ums.uncertainty._motion import FOOT, TurnAndRun
 from aura_ums.uncertainty._reduce import Reduction
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 

@@ -216,10 +216,16 @@ def _sensor_offset(value: ArrayLike, name: str) -> tuple[float, float]:
     return (float(offset[0, 0]), float(offset[0, 1]))
 
 
-def _common(obs: object, landmark_id: object, time: object, offset: object) -> None:
-    object.__setattr__(obs, "landmark_id", _identifier(landmark_id, "landmark_id"))
-    object.__setattr__(obs, "time", finite_float(time, "time"))
-    object.__setattr__(obs, "sensor_offset", _sensor_offset(offset, "sensor_offset"))  # type: ignore[arg-type]
+_COMMON = ("landmark_id", "time", "sensor_offset")
+
+
+def _common(landmark_id: object, time: object, offset: ArrayLike) -> tuple[str, float, tuple[float, float]]:
+    """Check the fields every observation has; their values in the order of ``_COMMON``."""
+    return (
+        _identifier(landmark_id, "landmark_id"),
+        finite_float(time, "time"),
+        _sensor_offset(offset, "sensor_offset"),
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -247,7 +253,10 @@ class BearingObservation:
     sensor_offset: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        for name, value in zip(
+            _COMMON, _common(self.landmark_id, self.time, self.sensor_offset), strict=True
+        ):
+            object.__setattr__(self, name, value)
         object.__setattr__(self, "bearing", finite_float(self.bearing, "bearing"))
         object.__setattr__(self, "bearing_error", nonnegative_float(self.bearing_error, "bearing_error"))
 
@@ -273,7 +282,10 @@ class RangeBearingObservation:
     sensor_offset: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        for name, value in zip(
+            _COMMON, _common(self.landmark_id, self.time, self.sensor_offset), strict=True
+        ):
+            object.__setattr__(self, name, value)
         object.__setattr__(self, "bearing", finite_float(self.bearing, "bearing"))
         object.__setattr__(self, "bearing_error", nonnegative_float(self.bearing_error, "bearing_error"))
         object.__setattr__(self, "range_min", nonnegative_float(self.range_min, "range_min"))
@@ -305,7 +317,10 @@ class GroundLineObservation:
     sensor_offset: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _common(self, self.landmark_id, self.time, self.sensor_offset)
+        for name, value in zip(
+            _COMMON, _common(self.landmark_id, self.time, self.sensor_offset), strict=True
+        ):
+            object.__setattr__(self, name, value)
         object.__setattr__(self, "offset", finite_float(self.offset, "offset"))
         object.__setattr__(self, "offset_error", nonnegative_float(self.offset_error, "offset_error"))
         object.__setattr__(self, "angle", finite_float(self.angle, "angle"))

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import float_array, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError
-from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, outer_disk, wrap_angle
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, Pose, outer_disk, wrap_angle
 from aura_ums.uncertainty._growth import (
     DEFAULT_MAX_VERTICES,
     compiled_sequence_kernel,
@@ -21,7 +21,7 @@ from aura_ums.uncertainty._growth import (
     motion_bounds,
 )
 from aura_ums.uncertainty._landmarks import Landmark, Observation
-from aura_ums.uncertainty._motion import Pose, TurnAndRun
+from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._reduce import Reduced, Reduction, reduce_checked, reduce_map
 from aura_ums.uncertainty._terrain import TerrainStats
 

@@ -1,49 +1,14 @@
-"""Poses and turn-and-run motion commands."""
+"""Turn-and-run motion commands (and the pose, which geometry defines)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-from numpy.typing import NDArray
-
 from aura_ums._validate import finite_float, nonnegative_float
-from aura_ums.geometry import wrap_angle
+from aura_ums.geometry import Pose as Pose  # geometry's; uncertainty/_terrain.py imports it from here
 
 #: One foot in metres, for the paper's experiment (which is in feet).
 FOOT = 0.3048
-
-
-@dataclass(frozen=True, slots=True)
-class Pose:
-    """A robot pose in the world frame.
-
-    Parameters
-    ----------
-    x, y : float
-        Position of the robot's reference point, metres (x east, y north).
-    heading : float
-        Radians counter-clockwise from world +x; wrapped to (-pi, pi].
-
-    Examples
-    --------
-    >>> import math
-    >>> Pose(1.0, 2.0, 3 * math.pi).heading == math.pi
-    True
-    """
-
-    x: float
-    y: float
-    heading: float
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "x", finite_float(self.x, "Pose.x"))
-        object.__setattr__(self, "y", finite_float(self.y, "Pose.y"))
-        object.__setattr__(self, "heading", wrap_angle(finite_float(self.heading, "Pose.heading")))
-
-    def as_array(self) -> NDArray[np.float64]:
-        """Return ``[x, y, heading]`` as a float array of shape (3,)."""
-        return np.array([self.x, self.y, self.heading])
 
 
 @dataclass(frozen=True, slots=True)

@@ -54,6 +54,7 @@ from aura_ums.world._ltm import (
     LandmarkRecord,
     Meadow,
     MeadowMap,
+    PerceptualStrategy,
 )
 from aura_ums.world._navigator import (
     RUN_TOLERANCE,
@@ -76,6 +77,7 @@ __all__ = [
     "LandmarkRecord",
     "Meadow",
     "MeadowMap",
+    "PerceptualStrategy",
     "Route",
     "RunPiece",
     "ShortTermMemory",

@@ -16,7 +16,6 @@ from typing import NoReturn
 import numpy as np
 
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -25,7 +24,7 @@ from aura_ums.uncertainty import (
     TerrainTable,
     VerticalLineLandmark,
 )
-from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, _MapError
+from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy, _MapError
 
 _MEADOW_KEYS = ("kind", "id", "terrain", "landmarks")
 _COMMON_LANDMARK_KEYS = (

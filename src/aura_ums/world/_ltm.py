@@ -8,6 +8,7 @@ passes from one to the other through that segment, the *portal*.
 
 from __future__ import annotations
 
+import enum
 import math
 import types
 from collections.abc import Iterable, Mapping, Sequence
@@ -21,7 +22,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, points_array, read_only
 from aura_ums.errors import InputError, UnknownTerrainError
-from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -46,6 +46,21 @@ MIN_PORTAL_WIDTH = 1e-3
 OVERLAP_TOLERANCE = 1e-6
 
 _LANDMARK_TYPES = (VerticalLineLandmark, PointLandmark, GroundLineLandmark)
+
+
+class PerceptualStrategy(enum.Enum):
+    """The perceptual algorithm a find-landmark schema runs inside its window.
+
+    The strategy decides how much context (margin) the window needs around the place
+    where the landmark is guaranteed to appear (the paper's Figure 8).
+    """
+
+    #: Fast line finder: fits lines to gradient runs; needs long context on each side.
+    LINE_FINDER = "line_finder"
+    #: Moravec-style interest operator: a small neighbourhood per point suffices.
+    INTEREST_OPERATOR = "interest_operator"
+    #: Region segmenter: needs some surrounding region to compare against.
+    REGION_SEGMENTER = "region_segmenter"
 
 
 class _MapError(InputError):

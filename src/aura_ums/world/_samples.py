@@ -10,10 +10,9 @@ import numpy as np
 
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
-from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import TerrainTable, VerticalLineLandmark
-from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap
+from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy
 
 #: Names of the sample worlds in ``aura_ums/world/data`` (GeoJSON files).
 SAMPLE_WORLDS = ("indoor_corridor", "paper_sidewalk")

@@ -1,4 +1,4 @@
-"""trusted_window, the Expecter's and schemas' unchecked ImageWindow, against the validated constructor."""
+"""ImageWindow._trusted, the Expecter's and schemas' unchecked window, against the validated constructor."""
 
 from __future__ import annotations
 
@@ -9,8 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from aura_ums.errors import InputError
-from aura_ums.expecter import UNBOUNDED_PIXELS, ImageWindow
-from aura_ums.expecter._window import trusted_window
+from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
 
 bound = st.floats(min_value=-UNBOUNDED_PIXELS, max_value=UNBOUNDED_PIXELS, allow_nan=False)
 
@@ -18,7 +17,7 @@ bound = st.floats(min_value=-UNBOUNDED_PIXELS, max_value=UNBOUNDED_PIXELS, allow
 @given(bound, bound, bound, bound)
 def test_equals_the_validated_window(a: float, b: float, c: float, d: float) -> None:
     u0, u1, v0, v1 = min(a, b), max(a, b), min(c, d), max(c, d)
-    fast, checked = trusted_window(u0, v0, u1, v1), ImageWindow(u0, v0, u1, v1)
+    fast, checked = ImageWindow._trusted(u0, v0, u1, v1), ImageWindow(u0, v0, u1, v1)
     assert fast == checked
     assert repr(fast) == repr(checked)
     assert all(type(getattr(fast, name)) is float for name in ("u_min", "v_min", "u_max", "v_max"))
@@ -38,4 +37,4 @@ def test_bad_bounds_raise_as_the_constructor_does(
     bounds: tuple[float, float, float, float], message: str
 ) -> None:
     with pytest.raises(InputError, match=message):
-        trusted_window(*bounds)
+        ImageWindow._trusted(*bounds)
