@@ -45,7 +45,6 @@ REPLAY = "replay"
 COMPARE = "compare"
 COMPARE_ROW = "compare (per method)"
 STEPS_CSV = "replay --steps-csv"
-WRITERS = (SIMULATE, REPLAY, COMPARE, COMPARE_ROW, STEPS_CSV)
 
 
 @dataclass(frozen=True, slots=True)
