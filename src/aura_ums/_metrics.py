@@ -17,7 +17,7 @@ import os
 import secrets
 import types
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from typing import TypeAlias
 
@@ -366,23 +366,22 @@ class Metrics(Mapping[str, "MetricValue"]):
     aura_ums.errors.InputError: Metrics: expected a key of the metrics table (docs/metrics.md), got 'area'
     """
 
-    figures: Mapping[str, MetricValue]
+    figures: InitVar[Mapping[str, object]]
+    _values: Mapping[str, MetricValue] = field(init=False)
 
-    def __post_init__(self) -> None:
-        if not isinstance(self.figures, Mapping):
-            raise InputError(
-                f"Metrics: expected a mapping of keys to values, got {type(self.figures).__name__}"
-            )
+    def __post_init__(self, figures: Mapping[str, object]) -> None:
+        if not isinstance(figures, Mapping):
+            raise InputError(f"Metrics: expected a mapping of keys to values, got {type(figures).__name__}")
         checked: dict[str, MetricValue] = {}
-        for name, value in self.figures.items():
+        for name, value in figures.items():
             key = _BY_NAME.get(name) if isinstance(name, str) else None
             if key is None:
                 raise InputError(
                     f"Metrics: expected a key of the metrics table (docs/metrics.md), got {name!r}"
                 )
             checked[name] = _checked(key, value)
-        # Validated once here; the dataclass is frozen, so the checked copy replaces the input.
-        object.__setattr__(self, "figures", types.MappingProxyType(checked))
+        # Validated once, here; frozen afterwards.
+        object.__setattr__(self, "_values", types.MappingProxyType(checked))
 
     @staticmethod
     def table() -> tuple[MetricKey, ...]:
@@ -397,16 +396,16 @@ class Metrics(Mapping[str, "MetricValue"]):
         return _TABLE
 
     def __getitem__(self, name: str) -> MetricValue:
-        return self.figures[name]
+        return self._values[name]
 
     def __iter__(self) -> Iterator[str]:
-        return iter(self.figures)
+        return iter(self._values)
 
     def __len__(self) -> int:
-        return len(self.figures)
+        return len(self._values)
 
     def __repr__(self) -> str:
-        return f"Metrics({dict(self.figures)!r})"
+        return f"Metrics({dict(self._values)!r})"
 
     def number(self, name: str) -> float:
         """Return a numeric value as a float; NaN when it is undefined.
@@ -424,7 +423,7 @@ class Metrics(Mapping[str, "MetricValue"]):
         >>> metrics.number("frames"), metrics.number("landmark_detection_rate")
         (8.0, nan)
         """
-        value = self.figures[name]
+        value = self._values[name]
         if _Kind(_BY_NAME[name].kind) not in (_Kind.INTEGER, _Kind.COUNT, _Kind.FRACTION, _Kind.NUMBER):
             raise InputError(f"Metrics.number: expected a numeric key, got {name!r} ({_BY_NAME[name].kind})")
         return float(value) if isinstance(value, (int, float)) else math.nan
@@ -437,7 +436,7 @@ class Metrics(Mapping[str, "MetricValue"]):
         >>> Metrics({"rejected_by_reason": {"stale": 2}}).to_dict()
         {'rejected_by_reason': {'stale': 2}}
         """
-        return {name: _plain(value) for name, value in self.figures.items()}
+        return {name: _plain(value) for name, value in self._values.items()}
 
     def to_json(self) -> str:
         """Return the metrics as strict JSON (undefined values are ``null``), indented, one final newline."""
@@ -482,7 +481,7 @@ class Metrics(Mapping[str, "MetricValue"]):
         containment_rate             n/a
         """
         out: list[str] = []
-        for name, value in self.figures.items():
+        for name, value in self._values.items():
             out.append(f"{name:28s} {_shown(value)}")
             if isinstance(value, tuple):
                 for row in value:
