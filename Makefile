@@ -15,32 +15,35 @@ $(BIN)/python:
 # holds the compatible ranges. After changing a dependency there, run `make lock`.
 UV_VERSION := 0.13.9
 UV := $(BIN)/uv
+UV_STAMP := $(VENV)/.stamp-uv-$(UV_VERSION)
 # --locked: stop if uv.lock no longer matches pyproject.toml. --inexact: keep what another
 # stamp installed (the dev tools under `make docs`). The package itself is rebuilt each time,
 # since its C kernels may have changed.
 SYNC := UV_PROJECT_ENVIRONMENT=$(VENV) $(UV) sync --locked --inexact --reinstall-package aura-ums --quiet
 
-$(UV): | $(BIN)/python
+# Named by its version: a new UV_VERSION installs that uv.
+$(UV_STAMP): | $(BIN)/python
 	$(BIN)/python -m pip install --quiet uv==$(UV_VERSION)
+	@touch $@
 
 # The install also compiles the C kernels: rebuild when their source changes.
 BUILD_INPUTS := pyproject.toml uv.lock setup.py $(wildcard src/aura_ums/geometry/*.c)
 
-$(VENV)/.stamp-install: $(BUILD_INPUTS) | $(UV)
+$(VENV)/.stamp-install: $(BUILD_INPUTS) | $(UV_STAMP)
 	$(SYNC)
 	@touch $@
 
-$(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(UV)
+$(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(UV_STAMP)
 	$(SYNC) --extra dev --extra opencv --extra foxglove --extra ros
 	@touch $@ $(VENV)/.stamp-install
 
-$(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(UV)
+$(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(UV_STAMP)
 	$(SYNC) --extra docs
 	@touch $@ $(VENV)/.stamp-install
 
 # Re-resolve uv.lock after a change of pyproject.toml's dependencies (upgrades nothing else;
 # `make lock LOCK_ARGS=--upgrade` takes the newest versions the ranges allow).
-lock: | $(UV)
+lock: | $(UV_STAMP)
 	$(UV) lock $(LOCK_ARGS)
 
 demo: $(VENV)/.stamp-install
