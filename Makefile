@@ -4,27 +4,47 @@ VENV := .venv
 BIN := $(VENV)/bin
 REPORT ?= report
 
-.PHONY: demo test lint typecheck pytest bench figures docs clean
+.PHONY: demo test lint typecheck pytest bench figures docs lock clean
 
 $(BIN)/python:
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "aura-ums needs Python >= 3.11, got " + sys.version.split()[0])'
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-# The install also compiles the C kernels: rebuild when their source changes.
-BUILD_INPUTS := pyproject.toml setup.py $(wildcard src/aura_ums/geometry/*.c)
+# Every install comes from uv.lock (exact versions and hashes of all packages); pyproject.toml
+# holds the compatible ranges. After changing a dependency there, run `make lock`.
+UV_VERSION := 0.13.9
+UV := $(BIN)/uv
+UV_STAMP := $(VENV)/.stamp-uv-$(UV_VERSION)
+# --locked: stop if uv.lock no longer matches pyproject.toml. --inexact: keep what another
+# stamp installed (the dev tools under `make docs`). The package itself is rebuilt each time,
+# since its C kernels may have changed.
+SYNC := UV_PROJECT_ENVIRONMENT=$(VENV) $(UV) sync --locked --inexact --reinstall-package aura-ums --quiet
 
-$(VENV)/.stamp-install: $(BUILD_INPUTS) | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e .
+# Named by its version: a new UV_VERSION installs that uv.
+$(UV_STAMP): | $(BIN)/python
+	$(BIN)/python -m pip install --quiet uv==$(UV_VERSION)
 	@touch $@
 
-$(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[dev,opencv,foxglove,ros]"
+# The install also compiles the C kernels: rebuild when their source changes.
+BUILD_INPUTS := pyproject.toml uv.lock setup.py $(wildcard src/aura_ums/geometry/*.c)
+
+$(VENV)/.stamp-install: $(BUILD_INPUTS) | $(UV_STAMP)
+	$(SYNC)
+	@touch $@
+
+$(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(UV_STAMP)
+	$(SYNC) --extra dev --extra opencv --extra foxglove --extra ros
 	@touch $@ $(VENV)/.stamp-install
 
-$(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[docs]"
+$(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(UV_STAMP)
+	$(SYNC) --extra docs
 	@touch $@ $(VENV)/.stamp-install
+
+# Re-resolve uv.lock after a change of pyproject.toml's dependencies (upgrades nothing else;
+# `make lock LOCK_ARGS=--upgrade` takes the newest versions the ranges allow).
+lock: | $(UV_STAMP)
+	$(UV) lock $(LOCK_ARGS)
 
 demo: $(VENV)/.stamp-install
 	$(BIN)/aura-ums demo --out $(REPORT)

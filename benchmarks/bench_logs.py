@@ -76,7 +76,7 @@ def main() -> None:
         for method, row in rows.items():
             print(
                 f"{log.meta.name:16s} {label:11s} {method:13s} {row.containment_rate:7.4f} "
-                f"{row.median_area_m2:9.4g} {row.median_heading_width_rad:8.3f} {row.position_rmse_m:7.3f} "
+                f"{row.median_area_m2:9.4g} {row.median_wedge_width_rad:8.3f} {row.position_rmse_m:7.3f} "
                 f"{best[method]:8.1f} {best[method] / ekf:6.2f} {best[method] / filterpy:6.2f}"
             )
 

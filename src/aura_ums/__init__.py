@@ -13,6 +13,7 @@ Examples
 True
 """
 
+from aura_ums._metrics import Metrics
 from aura_ums.camera import (
     CalibrationBounds,
     Camera,
@@ -89,6 +90,7 @@ __all__ = [
     "LandmarkRecord",
     "Meadow",
     "MeadowMap",
+    "Metrics",
     "MissingDependencyError",
     "MoravecOperator",
     "Observation",

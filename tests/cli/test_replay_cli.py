@@ -5,16 +5,29 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from aura_ums import Metrics
 from aura_ums.cli import app
 from aura_ums.logs import synthetic_log, write_log
 from aura_ums.uncertainty import DEFAULT_MAX_VERTICES
 
 runner = CliRunner()
+
+
+def strict_json(text: str) -> Any:
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def written_by(output: str) -> list[str]:
+    return [key.name for key in Metrics.table() if output in key.written_by]
 
 
 @pytest.fixture(scope="module")
@@ -41,10 +54,26 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     )
     for label, extra in runs:
         out = tmp_path / f"{label}.json"
-        result = runner.invoke(app, ["replay", *common, "--classes", "I", *extra, "--metrics-json", str(out)])
+        steps = tmp_path / f"{label}.csv"
+        result = runner.invoke(
+            app,
+            [
+                "replay",
+                *common,
+                "--classes",
+                "I",
+                *extra,
+                "--metrics-json",
+                str(out),
+                "--steps-csv",
+                str(steps),
+            ],
+        )
         assert result.exit_code == 0, result.output
         assert "containment_rate" in result.output
-        metrics[label] = json.loads(out.read_text())
+        metrics[label] = strict_json(out.read_text())
+        assert set(metrics[label]) == set(written_by("replay"))
+        assert steps.read_text().splitlines()[0].split(",") == written_by("replay --steps-csv")
     assert metrics["joint"]["joint_above_rad"] == pytest.approx(math.pi / 2)
     assert metrics["one by one"]["joint_above_rad"] is None
     assert (metrics["joint"]["robust"], metrics["gate only"]["robust"]) == (True, False)
@@ -61,8 +90,11 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     table = tmp_path / "compare.json"
     result = runner.invoke(app, ["compare", *common, "--particles", "50", "--metrics-json", str(table)])
     assert result.exit_code == 0, result.output
-    rows = json.loads(table.read_text())
+    rows = strict_json(table.read_text())
+    assert set(rows) == set(written_by("compare"))
     assert [row["method"] for row in rows["methods"]] == ["aura-ums", "EKF", "PF (50)"]
+    for row in rows["methods"]:
+        assert set(row) == set(written_by("compare (per method)"))
 
 
 def test_replay_names_a_missing_terrain_file(log_folder: Path, tmp_path: Path) -> None:

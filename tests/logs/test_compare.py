@@ -71,16 +71,19 @@ def test_an_estimator_of_ones_own_is_stepped_and_judged_as_the_ekf(log: RobotLog
     assert math.hypot(starts[0].x - x, starts[0].y - y) < 1.0
     ekf, twin_row, blind_row = rows[1], rows[3], rows[4]
     # Same filter, same steps: the same figures, bit for bit (only the timing differs).
-    assert (twin_row.containment_rate, twin_row.median_area_m2, twin_row.median_heading_width_rad) == (
+    assert (twin_row.containment_rate, twin_row.median_area_m2, twin_row.median_wedge_width_rad) == (
         ekf.containment_rate,
         ekf.median_area_m2,
-        ekf.median_heading_width_rad,
+        ekf.median_wedge_width_rad,
     )
-    assert (twin_row.position_rmse_m, twin_row.rejected) == (ekf.position_rmse_m, ekf.rejected)
+    assert (twin_row.position_rmse_m, twin_row.inconsistent_observations) == (
+        ekf.position_rmse_m,
+        ekf.inconsistent_observations,
+    )
     assert twin_row.median_update_us > 0.0
-    assert blind_row.rejected > 0
+    assert blind_row.inconsistent_observations > 0
     assert blind_row.median_area_m2 > ekf.median_area_m2  # never corrected: it only grows
-    assert blind_row.median_heading_width_rad > ekf.median_heading_width_rad
+    assert blind_row.median_wedge_width_rad > ekf.median_wedge_width_rad
 
 
 class _NotAnEstimator:

@@ -45,8 +45,8 @@ def shifted(meadow_map: MeadowMap, ids: set[str], dx: float, dy: float) -> Meado
 def test_containment_over_seeded_runs(paper: Scenario) -> None:
     results = [run_scenario(paper, np.random.default_rng(seed)) for seed in range(30)]
     metrics = summarize_runs(results)
-    assert metrics["containment_rate"] >= 0.99
-    assert metrics["accepted_observations"] > 0
+    assert metrics.number("containment_rate") >= 0.99
+    assert metrics.number("accepted_observations") > 0
     assert all(r.completed and len(r.records) == 4 for r in results)
 
 
@@ -57,8 +57,8 @@ def test_containment_in_the_indoor_corridor_with_look_alike_landmarks() -> None:
     corridor = Scenario.from_toml(SCENARIOS / "indoor_corridor.toml")
     results = [run_scenario(corridor, np.random.default_rng(seed)) for seed in range(3)]
     metrics = summarize_runs(results)
-    assert metrics["containment_rate"] >= 0.99
-    assert metrics["accepted_observations"] > 0
+    assert metrics.number("containment_rate") >= 0.99
+    assert metrics.number("accepted_observations") > 0
 
 
 def test_pruned_maps_are_smaller_than_unpruned(paper: Scenario) -> None:

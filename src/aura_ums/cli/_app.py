@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
 
-from aura_ums.cli._common import fail
+from aura_ums.cli._common import fail, write_metrics_json
 from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._replay import calibrate, compare, replay
@@ -70,6 +68,7 @@ def simulate(
     import numpy as np
     from rich.progress import Progress
 
+    from aura_ums import Metrics
     from aura_ums.errors import AuraUmsError
     from aura_ums.sim import Scenario, run_scenario, summarize_runs
 
@@ -93,22 +92,13 @@ def simulate(
                 progress.advance(task)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    metrics: dict[str, object] = {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune}
-    metrics.update(summarize_runs(results))
-    for key, value in metrics.items():
-        _console.print(f"{key:28s} {value}", highlight=False)
+    metrics = Metrics(
+        {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune, **summarize_runs(results)}
+    )
+    for line in metrics.lines():
+        _console.print(line, highlight=False, markup=False)
     if metrics_json is not None:
-        clean = {
-            k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in metrics.items()
-        }
-        try:
-            metrics_json.parent.mkdir(parents=True, exist_ok=True)
-            metrics_json.write_text(json.dumps(clean, indent=2) + "\n")
-        except OSError as exc:
-            raise fail(
-                f"--metrics-json: expected a writable path, got {metrics_json}: {exc.strerror}"
-            ) from None
-        _console.print(f"wrote {metrics_json}")
+        write_metrics_json(metrics_json, metrics)
     if mcap is not None:
         write_simulation_mcap_option(mcap, loaded, seed, prune=prune)
 

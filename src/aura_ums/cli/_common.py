@@ -1,9 +1,10 @@
-"""What every ``aura-ums`` command shares: the console, the error exit, and a log's summary."""
+"""What every ``aura-ums`` command shares: the console, the error exit, a log's summary, metrics JSON."""
 
 from __future__ import annotations
 
 import math
 from collections import Counter
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
@@ -11,6 +12,7 @@ from rich.console import Console
 from rich.markup import escape
 
 if TYPE_CHECKING:
+    from aura_ums import Metrics
     from aura_ums.logs import RobotLog
 
 console = Console(soft_wrap=True)
@@ -20,6 +22,15 @@ def fail(message: str) -> typer.Exit:
     """Print ``error: <message>`` (markup-safe) and return the exit (code 2) for the caller to raise."""
     console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
     return typer.Exit(code=2)
+
+
+def write_metrics_json(path: Path, metrics: Metrics) -> None:
+    """Write ``--metrics-json`` (strict JSON, atomically) and say so; an unwritable path fails cleanly."""
+    try:
+        metrics.write_json(path)
+    except OSError as exc:
+        raise fail(f"--metrics-json: expected a writable path, got {path}: {exc.strerror}") from None
+    console.print(f"wrote {path}", highlight=False, markup=False)
 
 
 def span(first: float, last: float) -> str:

@@ -2,16 +2,14 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.markup import escape
 from rich.table import Table
 
-from aura_ums.cli._common import console, fail
+from aura_ums.cli._common import console, fail, write_metrics_json
 
 if TYPE_CHECKING:
     from aura_ums.logs import ReplayOptions
@@ -146,13 +144,10 @@ def replay(
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = result.metrics()
-    for key, value in metrics.items():
-        shown = f"{value:.6g}" if isinstance(value, float) else str(value)
-        console.print(f"{key}: {escape(shown)}", highlight=False)
+    for line in metrics.lines():
+        console.print(line, highlight=False, markup=False)
     if metrics_json is not None:
-        metrics_json.parent.mkdir(parents=True, exist_ok=True)
-        metrics_json.write_text(json.dumps(metrics, indent=2, allow_nan=True) + "\n")
-        console.print(f"wrote {metrics_json}")
+        write_metrics_json(metrics_json, metrics)
     if steps_csv is not None:
         steps_csv.parent.mkdir(parents=True, exist_ok=True)
         lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
@@ -197,6 +192,7 @@ def compare(
     """Print our map next to an EKF and a particle filter on the same log (99% regions)."""
     import numpy as np
 
+    from aura_ums import Metrics
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, observation_errors
     from aura_ums.uncertainty import TerrainTable
@@ -230,7 +226,7 @@ def compare(
         "method",
         "truth inside",
         "median area m^2",
-        "median heading width rad",
+        "median wedge width rad",
         "RMSE m",
         "us/step",
         "rejected",
@@ -241,46 +237,20 @@ def compare(
             row.method,
             f"{row.containment_rate:.4f}",
             f"{row.median_area_m2:.4g}",
-            f"{row.median_heading_width_rad:.3f}",
+            f"{row.median_wedge_width_rad:.3f}",
             f"{row.position_rmse_m:.3f}",
             f"{row.median_update_us:.1f}",
-            str(row.rejected),
+            str(row.inconsistent_observations),
         )
     console.print(grid)
     if metrics_json is not None:
-        metrics_json.parent.mkdir(parents=True, exist_ok=True)
-        payload = {
-            "log": log.meta.name,
-            "landmark_class": classes,
-            "bearing_sd": bearing_sd,
-            "range_sd_fraction": range_sd,
-            "methods": [
-                {
-                    k: (None if isinstance(v, float) and math.isnan(v) else v)
-                    for k, v in zip(
-                        (
-                            "method",
-                            "containment_rate",
-                            "median_area_m2",
-                            "median_heading_width_rad",
-                            "position_rmse_m",
-                            "median_update_us",
-                            "rejected",
-                        ),
-                        (
-                            r.method,
-                            r.containment_rate,
-                            r.median_area_m2,
-                            r.median_heading_width_rad,
-                            r.position_rmse_m,
-                            r.median_update_us,
-                            r.rejected,
-                        ),
-                        strict=True,
-                    )
-                }
-                for r in rows
-            ],
-        }
-        metrics_json.write_text(json.dumps(payload, indent=2) + "\n")
-        console.print(f"wrote {metrics_json}")
+        table_metrics = Metrics(
+            {
+                "log": log.meta.name,
+                "landmark_class": classes,
+                "bearing_sd_rad": bearing_sd,
+                "range_sd_fraction": range_sd,
+                "methods": tuple(row.metrics() for row in rows),
+            }
+        )
+        write_metrics_json(metrics_json, table_metrics)

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from aura_ums._metrics import Metrics
 from aura_ums._validate import finite_float
 from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
@@ -31,6 +32,10 @@ from aura_ums.uncertainty import BearingObservation, Pose, RangeBearingObservati
 class MethodSummary:
     """One row of :func:`compare_on_log`'s table.
 
+    Its fields carry the keys of the metrics table (``docs/metrics.md``) that ``simulate``
+    and ``replay`` use for the same figures; :meth:`metrics` returns them as
+    :class:`~aura_ums.Metrics`.
+
     Attributes
     ----------
     method : str
@@ -40,25 +45,46 @@ class MethodSummary:
         the filters' 99% regions).
     median_area_m2 : float
         Median area of the position region, m^2.
-    median_heading_width_rad : float
-        Median width of the heading region, radians.
+    median_wedge_width_rad : float
+        Median width of the heading region (our wedge; the filters' confidence
+        intervals), radians.
     position_rmse_m : float
         Root mean square distance from the region's centre (our map) or the mean (the
         filters) to the true position, metres.
     median_update_us : float
         Median microseconds per step (growth or prediction since the previous step, and
         the step's observations).
-    rejected : int
+    inconsistent_observations : int
         Observations rejected (our gate; the filters' Mahalanobis gates).
+
+    Examples
+    --------
+    >>> row = MethodSummary("EKF", 0.5, 2.0, 0.1, float("nan"), 12.0, 3)
+    >>> row.metrics()["position_rmse_m"] is None, row.metrics()["inconsistent_observations"]
+    (True, 3)
     """
 
     method: str
     containment_rate: float
     median_area_m2: float
-    median_heading_width_rad: float
+    median_wedge_width_rad: float
     position_rmse_m: float
     median_update_us: float
-    rejected: int
+    inconsistent_observations: int
+
+    def metrics(self) -> Metrics:
+        """Return the row as metrics (undefined figures, NaN here, become ``None``)."""
+        return Metrics(
+            {
+                "method": self.method,
+                "containment_rate": self.containment_rate,
+                "median_area_m2": self.median_area_m2,
+                "median_wedge_width_rad": self.median_wedge_width_rad,
+                "position_rmse_m": self.position_rmse_m,
+                "median_update_us": self.median_update_us,
+                "inconsistent_observations": self.inconsistent_observations,
+            }
+        )
 
 
 def _ours(result: ReplayResult) -> MethodSummary:

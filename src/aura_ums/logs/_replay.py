@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from aura_ums._metrics import Metrics
 from aura_ums._validate import finite_float, integer_at_least, positive_float
 from aura_ums.errors import InputError
 from aura_ums.expecter import PerceptualStrategy
@@ -220,29 +221,34 @@ class ReplayResult:
         """Median microseconds per step's update."""
         return float(np.median([s.update_us for s in self.steps])) if self.steps else math.nan
 
-    def metrics(self) -> dict[str, object]:
-        """Return the figures as a JSON-ready dictionary."""
+    def metrics(self) -> Metrics:
+        """Return the options and figures of the replay (keys: ``docs/metrics.md``).
+
+        Undefined figures (no steps, no ground truth, no envelope) are ``None``.
+        """
         envelope = [s.envelope_inside for s in self.steps if s.envelope_inside is not None]
-        return {
-            "log": self.log.meta.name,
-            "landmark_class": self.options.landmark_class.value,
-            "sigmas": self.options.sigmas,
-            "robust": self.options.robust,
-            "joint_above_rad": self.options.joint_above,
-            "max_vertices": self.options.max_vertices,
-            "envelope_max_vertices": self.options.envelope_max_vertices,
-            "steps": len(self.steps),
-            "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
-            "containment_rate": self.containment_rate,
-            "envelope_containment_rate": float(np.mean(envelope)) if envelope else None,
-            "median_area_m2": self.median_area_m2,
-            "median_wedge_width_rad": self.median_wedge_width_rad,
-            "accepted_observations": sum(s.accepted for s in self.steps),
-            "inconsistent_observations": self.inconsistent_observations,
-            "rejected_by_reason": dict(self.rejected_counts),
-            "relocalizations": self.relocalizations,
-            "median_update_us": self.median_update_us,
-        }
+        return Metrics(
+            {
+                "log": self.log.meta.name,
+                "landmark_class": self.options.landmark_class.value,
+                "sigmas": self.options.sigmas,
+                "robust": self.options.robust,
+                "joint_above_rad": self.options.joint_above,
+                "max_vertices": self.options.max_vertices,
+                "envelope_max_vertices": self.options.envelope_max_vertices,
+                "steps": len(self.steps),
+                "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
+                "containment_rate": self.containment_rate,
+                "envelope_containment_rate": float(np.mean(envelope)) if envelope else None,
+                "median_area_m2": self.median_area_m2,
+                "median_wedge_width_rad": self.median_wedge_width_rad,
+                "accepted_observations": sum(s.accepted for s in self.steps),
+                "inconsistent_observations": self.inconsistent_observations,
+                "rejected_by_reason": self.rejected_counts,
+                "relocalizations": self.relocalizations,
+                "median_update_us": self.median_update_us,
+            }
+        )
 
 
 def replay_start(log: RobotLog) -> tuple[float, Pose]:

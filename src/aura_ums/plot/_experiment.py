@@ -11,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
+from aura_ums._metrics import Metrics
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_window
 from aura_ums.plot._draw import draw_map
 from aura_ums.schemas import FindLandmarkSchema
@@ -204,12 +205,18 @@ def figure_track(path: Path, scenario: Scenario, result: RunResult) -> Path:
     return path
 
 
-def _metrics_lines(title: str, metrics: dict[str, float | int]) -> list[str]:
+def _metrics_lines(title: str, metrics: Metrics) -> list[str]:
     lines = [f"| {title} | value |", "| --- | --- |"]
     for key, value in metrics.items():
-        text = f"{value:.4g}" if isinstance(value, float) else str(value)
-        lines.append(f"| {key} | {text} |")
+        lines.append(f"| {key} | {_cell(value)} |")
     return lines
+
+
+def _cell(value: object) -> str:
+    """Return a metric as a report's table shows it (``n/a``: undefined, as ``Metrics.lines``)."""
+    if value is None:
+        return "n/a"
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -> Path:
@@ -285,8 +292,7 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
     for key in keys:
         cells = []
         for _, metrics in mc:
-            value = metrics[key]
-            cells.append(f"{value:.4g}" if isinstance(value, float) else str(value))
+            cells.append(_cell(metrics[key]))
         lines.append(f"| {key} | " + " | ".join(cells) + " |")
     lines.extend(["", "### Other worlds (one seeded run each)", ""])
     for file in OTHERS:
@@ -327,9 +333,9 @@ def _slice(result: RunResult, index: int) -> RunResult:
     )
 
 
-def _class2_changes(class1: dict[str, float | int], class2: dict[str, float | int]) -> list[str]:
-    area1, area2 = float(class1["median_area_m2"]), float(class2["median_area_m2"])
-    wedge1, wedge2 = float(class1["median_wedge_width_rad"]), float(class2["median_wedge_width_rad"])
+def _class2_changes(class1: Metrics, class2: Metrics) -> list[str]:
+    area1, area2 = class1.number("median_area_m2"), class2.number("median_area_m2")
+    wedge1, wedge2 = class1.number("median_wedge_width_rad"), class2.number("median_wedge_width_rad")
     return [
         "What changes with the corner as a Class II landmark (a point of known height): its image",
         "row gives a range as well as a bearing, so a recognition can cut the polygon along the",
@@ -340,6 +346,6 @@ def _class2_changes(class1: dict[str, float | int], class2: dict[str, float | in
         "is not isolated yet. Median over all frames of the Monte Carlo below:",
         f"area {area1:.3f} m² (Class I) vs {area2:.3f} m² (Class II); wedge "
         f"{math.degrees(wedge1):.2f}° vs {math.degrees(wedge2):.2f}°; containment "
-        f"{float(class1['containment_rate']):.3f} vs {float(class2['containment_rate']):.3f}; inconsistent "
+        f"{class1.number('containment_rate'):.3f} vs {class2.number('containment_rate'):.3f}; inconsistent "
         f"observations {class1['inconsistent_observations']} vs {class2['inconsistent_observations']}.",
     ]

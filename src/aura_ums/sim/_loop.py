@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._metrics import Metrics
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
 from aura_ums.manager import Blackboard, ManagerState, PositionReport, UncertaintyMapManager
@@ -595,13 +596,14 @@ def run_scenario(
     )
 
 
-def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> dict[str, float | int]:
+def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
     """Return the Monte Carlo metrics of several runs, over all their frames.
 
-    Keys: ``containment_rate`` (fraction of frames with the true pose inside the map),
-    ``median_area_m2``, ``median_wedge_width_rad``, ``landmark_detection_rate`` (matches
-    per searched window), ``inconsistent_observations`` (observations the manager
-    rejected), ``accepted_observations``, ``median_frame_ms``, ``frames``,
+    Keys (units and meanings: ``docs/metrics.md``): ``containment_rate`` (fraction of
+    frames with the true pose inside the map), ``median_area_m2``,
+    ``median_wedge_width_rad``, ``landmark_detection_rate`` (matches per searched window;
+    None when no window was searched), ``inconsistent_observations`` (observations the
+    manager rejected), ``accepted_observations``, ``median_frame_ms``, ``frames``,
     ``runs_lost`` (runs that declared themselves lost), ``runs_completed``.
 
     Examples
@@ -617,15 +619,17 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> dict[str
         raise InputError("results: expected at least one run with frames, got none")
     predictions = sum(result.predictions for result in results)
     hits = sum(result.hits for result in results)
-    return {
-        "containment_rate": sum(r.inside for r in records) / len(records),
-        "median_area_m2": statistics.median(r.area for r in records),
-        "median_wedge_width_rad": statistics.median(r.wedge_width for r in records),
-        "landmark_detection_rate": hits / predictions if predictions else math.nan,
-        "inconsistent_observations": sum(len(r.rejected) for r in records),
-        "accepted_observations": sum(r.accepted for r in records),
-        "median_frame_ms": statistics.median(r.frame_ms for r in records),
-        "frames": len(records),
-        "runs_lost": sum(result.ever_lost for result in results),
-        "runs_completed": sum(result.completed for result in results),
-    }
+    return Metrics(
+        {
+            "containment_rate": sum(r.inside for r in records) / len(records),
+            "median_area_m2": statistics.median(r.area for r in records),
+            "median_wedge_width_rad": statistics.median(r.wedge_width for r in records),
+            "landmark_detection_rate": hits / predictions if predictions else math.nan,
+            "inconsistent_observations": sum(len(r.rejected) for r in records),
+            "accepted_observations": sum(r.accepted for r in records),
+            "median_frame_ms": statistics.median(r.frame_ms for r in records),
+            "frames": len(records),
+            "runs_lost": sum(result.ever_lost for result in results),
+            "runs_completed": sum(result.completed for result in results),
+        }
+    )
