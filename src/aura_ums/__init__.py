@@ -29,11 +29,12 @@ from aura_ums.errors import (
     FileFormatError,
     InputError,
     MissingDependencyError,
+    UnknownLandmarkError,
     UnknownTerrainError,
 )
 from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
-from aura_ums.manager import IdentifiedLandmarkBuffer
+from aura_ums.manager import IdentifiedLandmarkBuffer, ManagerSettings
 from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
 from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
 from aura_ums.uncertainty import (
@@ -83,6 +84,7 @@ __all__ = [
     "Landmark",
     "LandmarkClass",
     "LandmarkRecord",
+    "ManagerSettings",
     "Meadow",
     "MeadowMap",
     "MissingDependencyError",
@@ -102,6 +104,7 @@ __all__ = [
     "TerrainStats",
     "TerrainTable",
     "TurnAndRun",
+    "UnknownLandmarkError",
     "UnknownTerrainError",
     "VerticalLineLandmark",
     "__version__",
