@@ -8,7 +8,7 @@ model in numpy matrices and the same gate, from benchmarks/filterpy_ekf.py). Use
 ../shared/data when present (calibrated on robot 1), else a synthetic log. Each log is
 run ``REPEATS`` times; a method's figure is the lowest of its per-run medians, so that a
 burst of load on this machine does not land on one method only. Robot 1 is also replayed
-with the map polygon capped at 16 vertices (``ReplayOptions.max_vertices``, default 64):
+with the map polygon capped at 16 vertices (``ManagerSettings.max_vertices``, default 64):
 the speed a coarser polygon buys and the area it costs.
 
     .venv/bin/python benchmarks/bench_logs.py
@@ -32,6 +32,7 @@ from aura_ums.logs import (
     read_mrclam,
     synthetic_log,
 )
+from aura_ums.manager import ManagerSettings
 from aura_ums.uncertainty import LandmarkClass, Pose
 from filterpy_ekf import FilterpyLogEkf
 
@@ -87,11 +88,11 @@ def main() -> None:
 
     def calibrated(landmark_class: LandmarkClass, **settings: Any) -> ReplayOptions:
         return ReplayOptions(
+            settings=ManagerSettings(**settings),
             landmark_class=landmark_class,
             working=calibration.working,
             envelope=calibration.envelope,
             motion=calibration.motion,
-            **settings,
         )
 
     for log in logs:
@@ -99,7 +100,7 @@ def main() -> None:
             run(log, calibrated(landmark_class), landmark_class.value)
     # Without the envelope (the consistency gate alone): one manager instead of two.
     run(logs[-1], calibrated(LandmarkClass.POINT, robust=False), "II gate only")
-    # A coarser polygon (ReplayOptions.max_vertices, replay --max-vertices): speed for area.
+    # A coarser polygon (ManagerSettings.max_vertices, replay --max-vertices): speed for area.
     for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
         run(logs[0], calibrated(landmark_class, max_vertices=16), f"{landmark_class.value} cap 16")
     print(

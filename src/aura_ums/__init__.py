@@ -27,6 +27,7 @@ from aura_ums.errors import (
     FileFormatError,
     InputError,
     MissingDependencyError,
+    UnknownLandmarkError,
     UnknownTerrainError,
 )
 from aura_ums.expecter import (
@@ -38,7 +39,7 @@ from aura_ums.expecter import (
     observe_vertical_line,
 )
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
-from aura_ums.manager import IdentifiedLandmarkBuffer
+from aura_ums.manager import IdentifiedLandmarkBuffer, ManagerSettings
 from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
 from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
 from aura_ums.uncertainty import (
@@ -88,6 +89,7 @@ __all__ = [
     "Landmark",
     "LandmarkClass",
     "LandmarkRecord",
+    "ManagerSettings",
     "Meadow",
     "MeadowMap",
     "Metrics",
@@ -108,6 +110,7 @@ __all__ = [
     "TerrainStats",
     "TerrainTable",
     "TurnAndRun",
+    "UnknownLandmarkError",
     "UnknownTerrainError",
     "VerticalLineLandmark",
     "__version__",

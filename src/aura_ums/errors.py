@@ -14,6 +14,7 @@ __all__ = [
     "InputError",
     "MissingDependencyError",
     "OutsideMapError",
+    "UnknownLandmarkError",
     "UnknownTerrainError",
 ]
 
@@ -56,9 +57,28 @@ class FileFormatError(InputError):
 
 
 class UnknownTerrainError(InputError, KeyError):
-    """A name (a terrain, a landmark) is not in the table it was looked up in.
+    """A name (a terrain, a meadow) is not in the table it was looked up in.
 
     It is a :class:`KeyError` too, so ``Mapping.get`` and ``in`` work as usual.
+    """
+
+    def __str__(self) -> str:
+        # KeyError would quote the message; keep it readable.
+        return str(self.args[0]) if self.args else ""
+
+
+class UnknownLandmarkError(InputError, KeyError):
+    """A landmark id is not in the map (or log) it was looked up in.
+
+    It is a :class:`KeyError` too, so ``Mapping.get`` and ``in`` work as usual.
+
+    Examples
+    --------
+    >>> from aura_ums.world import sample_world
+    >>> sample_world("paper_sidewalk").landmark("lamppost_999")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.UnknownLandmarkError: landmark: expected the id of a landmark ..., got 'lamppost_999'
     """
 
     def __str__(self) -> str:

@@ -113,7 +113,10 @@ def test_a_vertex_cap_below_three_is_refused_by_name(command: str, log_folder: P
     assert "--max-vertices: expected an integer >= 3, got 2" in result.output
 
 
-def test_the_cli_default_cap_is_the_library_default() -> None:
-    from aura_ums.cli import _replay
-
-    assert _replay._MAX_VERTICES == DEFAULT_MAX_VERTICES
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_the_landmark_classes_are_a_choice(command: str, log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text("")
+    result = runner.invoke(app, [command, str(log_folder), "--terrain", str(terrain), "--classes", "III"])
+    assert result.exit_code == 2
+    assert "'III' is not one of 'I', 'II'" in result.output

@@ -21,6 +21,7 @@ from aura_ums.logs import (
     replay_log,
     synthetic_log,
 )
+from aura_ums.manager import ManagerSettings
 from aura_ums.uncertainty import (
     BearingObservation,
     LandmarkClass,
@@ -95,8 +96,10 @@ def test_replay_rejects_bad_arguments(clean_log: RobotLog) -> None:
         replay_log(clean_log, TerrainTable.default())
     with pytest.raises(InputError, match="log: expected a RobotLog"):
         replay_log("log", FLOOR)  # type: ignore[arg-type]
-    with pytest.raises(InputError, match=r"ReplayOptions.sigmas: expected a positive number"):
-        ReplayOptions(sigmas=0.0)
+    with pytest.raises(InputError, match=r"ReplayOptions\.settings: expected ManagerSettings, got dict"):
+        ReplayOptions(settings={"sigmas": 3.0})  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"ReplayOptions\.max_interval: expected a positive number"):
+        ReplayOptions(max_interval=0.0)
     no_start = dataclasses.replace(clean_log, groundtruth=None)
     with pytest.raises(InputError, match=r"expected a \[start\] pose in meta.toml or a groundtruth.csv"):
         replay_log(no_start, FLOOR)
@@ -152,27 +155,15 @@ def test_mrclam_bearing_only_replay_is_sound_and_informative_with_joint_reductio
         assert result.containment_rate >= 0.99, log.meta.name
         assert result.median_area_m2 < 50.0, log.meta.name
         assert result.median_wedge_width_rad < 2.0, log.meta.name
-    alone = dataclasses.replace(options, joint_above=None)
+    alone = dataclasses.replace(options, settings=ManagerSettings(joint_above=None))
     one_by_one = replay_log(robot1, calibration.terrain_table(), alone)
     assert one_by_one.median_area_m2 > 1000.0
     assert one_by_one.metrics()["joint_above_rad"] is None
 
 
-def test_joint_above_is_checked() -> None:
-    assert ReplayOptions().joint_above == pytest.approx(np.pi / 2)
-    with pytest.raises(
-        InputError, match=r"ReplayOptions.joint_above: expected a number >= 0 or None, got -1.0"
-    ):
-        ReplayOptions(joint_above=-1.0)
-    with pytest.raises(InputError, match=r"ReplayOptions\.joint_above: expected a finite number"):
-        ReplayOptions(joint_above=float("nan"))
-
-
-def test_vertex_caps_are_checked_and_reported(clean_log: RobotLog) -> None:
-    with pytest.raises(InputError, match=r"ReplayOptions\.max_vertices: expected an integer >= 3, got 2"):
-        ReplayOptions(max_vertices=2)
-    with pytest.raises(InputError, match=r"ReplayOptions\.envelope_max_vertices: expected an integer >= 3"):
-        ReplayOptions(envelope_max_vertices=1.5)  # type: ignore[arg-type]
-    metrics = replay_log(clean_log, FLOOR, ReplayOptions(max_vertices=8)).metrics()
+def test_the_settings_are_reported(clean_log: RobotLog) -> None:
+    assert ReplayOptions().settings == ManagerSettings()
+    options = ReplayOptions(settings=ManagerSettings(max_vertices=8))
+    metrics = replay_log(clean_log, FLOOR, options).metrics()
     assert (metrics["max_vertices"], metrics["envelope_max_vertices"]) == (8, None)
     assert metrics["containment_rate"] == 1.0

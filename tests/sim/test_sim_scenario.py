@@ -8,11 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
-from aura_ums.sim import LostLimits, Scenario, StartState, waypoints_array
+from aura_ums.errors import FileFormatError, InputError, UnknownLandmarkError
+from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.sim import Scenario, StartState, waypoints_array
 from aura_ums.uncertainty import FOOT, LandmarkClass, TerrainStats, TurnAndRun
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+DEFAULTS = ManagerSettings().to_dict()
 SCENARIO_FILES = sorted(p for p in SCENARIOS.glob("*.toml") if not p.name.endswith("camera.toml"))
 
 GOOD = """\
@@ -30,7 +32,7 @@ heading_halfwidth_deg = 2.0
 [route]
 commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]
 
-[lost]
+[manager]
 area_limit = 20.0
 missed_limit = 2
 """
@@ -99,8 +101,7 @@ def test_frames_every_spacing_and_at_every_stop(folder: Path) -> None:
     legs = scenario.legs()
     assert [leg.run for leg in legs] == pytest.approx([2.0, 2.0, 1.0, 1.0])
     assert [leg.turn for leg in legs] == pytest.approx([0.0, 0.0, 0.0, math.radians(10.0)])
-    assert scenario.lost.area_limit == 20.0
-    assert scenario.lost.missed_limit == 2
+    assert scenario.settings == ManagerSettings(area_limit=20.0, missed_limit=2)
     assert scenario.name == "good"
     assert waypoints_array(scenario)[-1] == pytest.approx(
         [5.0 + math.cos(0.17453292519943295), 0.17364817766693033]
@@ -224,12 +225,28 @@ MALFORMED = [
         r"\[route\] goal",
         "expected a goal reachable",
     ),
-    ("area_limit = 20.0", "area_limit = 0", r"\[lost\] area_limit", "positive"),
-    ("missed_limit = 2", "missed_limit = 1.5", r"\[lost\] missed_limit", "integer >= 1"),
-    ("[lost]", "[render]\nnoise = -1\n[lost]", r"\[render\] noise", "non-negative"),
-    ("[lost]", "[render]\nclutter = 2.5\n[lost]", r"\[render\] clutter", "integer >= 0"),
-    ("[lost]", "[render]\nsparkle = 1\n[lost]", r"\[render\] sparkle", "unknown key"),
-    ("[lost]", "x = = 3\n[lost]", "line 15", "expected TOML"),
+    ("area_limit = 20.0", "area_limit = 0", r"\[manager\] area_limit", "positive number or none, got 0"),
+    ("missed_limit = 2", "missed_limit = 1.5", r"\[manager\] missed_limit", "integer >= 1, got 1.5"),
+    ("missed_limit = 2", "sigma = 2", r"\[manager\] sigma", "unknown key 'sigma'"),
+    ("missed_limit = 2", "relocalize_after = 2", r"\[manager\] relocalize_window", r"relocalize_after \(2\)"),
+    (
+        "missed_limit = 2",
+        "joint_above = 0.5\njoint_above_deg = 30",
+        r"\[manager\] joint_above_deg",
+        "another in",
+    ),
+    ("missed_limit = 2", "joint_sector_deg = 400", r"\[manager\] joint_sector_deg", r"in \(0, 2 pi\]"),
+    ("missed_limit = 2", 'robust = "none"', r"\[manager\] robust", "expected true or false, got 'none'"),
+    (
+        "[manager]",
+        "[lost]\nmissed_limit = 3\n[manager]",
+        r"\[manager\] missed_limit",
+        r"got another in \[lost\]",
+    ),
+    ("[manager]", "[render]\nnoise = -1\n[manager]", r"\[render\] noise", "non-negative"),
+    ("[manager]", "[render]\nclutter = 2.5\n[manager]", r"\[render\] clutter", "integer >= 0"),
+    ("[manager]", "[render]\nsparkle = 1\n[manager]", r"\[render\] sparkle", "unknown key"),
+    ("[manager]", "x = = 3\n[manager]", "line 15", "expected TOML"),
     ("[start]", "[begin]", "begin", "unknown key 'begin'"),
     (
         "[route]\ncommands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]\n",
@@ -277,11 +294,9 @@ def test_values_built_in_code_are_checked() -> None:
     scenario = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")
     with pytest.raises(InputError, match=r"StartState.position_radius: expected a non-negative number"):
         StartState(scenario.start.pose, -1.0, 0.1)
-    with pytest.raises(InputError, match=r"LostLimits.missed_limit: expected an integer >= 1, got 0"):
-        LostLimits(10.0, 0)
-    with pytest.raises(InputError, match=r"LostLimits.area_limit: expected a positive number"):
-        LostLimits(0.0, 2)
-    with pytest.raises(UnknownTerrainError, match="got 'nope'"):
+    with pytest.raises(InputError, match=r"Scenario.settings: expected a ManagerSettings, got dict"):
+        dataclasses.replace(scenario, settings={"area_limit": 10.0})  # type: ignore[arg-type]
+    with pytest.raises(UnknownLandmarkError, match="got 'nope'"):
         dataclasses.replace(scenario, landmark_ids=("nope",))
     with pytest.raises(InputError, match=r"Scenario.frame_spacing: expected a positive number or None"):
         dataclasses.replace(scenario, frame_spacing=0.0)
@@ -292,3 +307,34 @@ def test_frames_are_read_only() -> None:
     frame = next(iter(scenario.simulate(np.random.default_rng(0))))
     with pytest.raises(ValueError, match="read-only"):
         frame.image[0, 0] = 0
+
+
+def test_the_manager_table_knows_every_field(folder: Path) -> None:
+    # A value other than the default for every field of ManagerSettings, by its own name.
+    chosen: dict[str, object] = {}
+    for field in dataclasses.fields(ManagerSettings):
+        info = SettingInfo.of(field)
+        if info.kind is bool:
+            chosen[field.name] = not DEFAULTS[field.name]
+        elif info.kind is int:
+            chosen[field.name] = (DEFAULTS[field.name] or 3) + 2
+        else:
+            chosen[field.name] = (DEFAULTS[field.name] or 1.0) * 1.5
+    lines = [f"{name} = {str(value).lower()}" for name, value in chosen.items()]
+    (folder / "all.toml").write_text(GOOD.split("[manager]")[0] + "[manager]\n" + "\n".join(lines) + "\n")
+    settings = Scenario.from_toml(folder / "all.toml").settings
+    assert settings.to_dict() == chosen
+    assert settings.to_dict() != ManagerSettings().to_dict()
+
+
+def test_the_manager_table_takes_degrees_and_none_and_the_earlier_lost_table(folder: Path) -> None:
+    text = GOOD.replace("missed_limit = 2", 'joint_above = "none"\njoint_sector_deg = 10.0\nrobust = false')
+    (folder / "deg.toml").write_text(text)
+    settings = Scenario.from_toml(folder / "deg.toml").settings
+    assert (settings.joint_above, settings.joint_sector, settings.robust) == (None, math.radians(10.0), False)
+    assert settings.area_limit == 20.0
+    (folder / "earlier.toml").write_text(GOOD.replace("[manager]", "[lost]"))
+    earlier = Scenario.from_toml(folder / "earlier.toml").settings
+    assert earlier == ManagerSettings(area_limit=20.0, missed_limit=2)
+    (folder / "plain.toml").write_text(GOOD.split("[manager]")[0])
+    assert Scenario.from_toml(folder / "plain.toml").settings == ManagerSettings()

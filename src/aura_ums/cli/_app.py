@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
 
-from aura_ums.cli._common import fail, write_metrics_json
+from aura_ums.cli._common import NO_OPTIONS, SettingOptions, fail, manager_options, write_metrics_json
 from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._replay import calibrate, compare, replay
@@ -51,6 +52,7 @@ def demo(
 
 
 @app.command()
+@manager_options(default_from="the scenario's [manager]")
 def simulate(
     scenario: Annotated[Path, typer.Argument(help="Scenario TOML file (see aura_ums.sim).")],
     runs: Annotated[int, typer.Option("--runs", help="Monte Carlo runs, >= 1.")] = 100,
@@ -63,8 +65,12 @@ def simulate(
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
     mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+    settings: SettingOptions = NO_OPTIONS,
 ) -> None:
-    """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics."""
+    """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics.
+
+    The map manager's options override the scenario's [manager] table.
+    """
     import numpy as np
     from rich.progress import Progress
 
@@ -82,6 +88,7 @@ def simulate(
         loaded = Scenario.from_toml(scenario)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
+    loaded = dataclasses.replace(loaded, settings=settings.over(loaded.settings))
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
     try:

@@ -1,21 +1,31 @@
-"""What every ``aura-ums`` command shares: the console, the error exit, a log's summary, metrics JSON."""
+"""What the ``aura-ums`` commands share: console, error exit, manager options, log summaries, metrics JSON."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import inspect
 import math
 from collections import Counter
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 from rich.markup import escape
+
+from aura_ums.manager import ManagerSettings, SettingInfo
 
 if TYPE_CHECKING:
     from aura_ums import Metrics
     from aura_ums.logs import RobotLog
 
 console = Console(soft_wrap=True)
+
+# The parameter name under which a flag that sets a setting to None arrives (``--one-by-one``).
+_OFF = "{}__off"
 
 
 def fail(message: str) -> typer.Exit:
@@ -66,3 +76,106 @@ def print_log_summary(log: RobotLog) -> None:
         rows.append(("ground truth span", span(float(truth.time[0]), float(truth.time[-1]))))
     for key, value in rows:
         console.print(f"{key:18s} {value}", highlight=False, markup=False)
+
+
+def setting_flag(name: str) -> str:
+    """Return the option of a :class:`ManagerSettings` field: ``max_vertices`` -> ``--max-vertices``."""
+    return "--" + name.replace("_", "-")
+
+
+@dataclass(frozen=True, slots=True)
+class SettingOptions:
+    """The :class:`ManagerSettings` options given on the command line (the others were left out).
+
+    Attributes
+    ----------
+    given : Mapping[str, object]
+        Field name to value, for the options given only.
+    """
+
+    given: Mapping[str, object]
+
+    def over(self, base: ManagerSettings | None = None) -> ManagerSettings:
+        """Return ``base`` (default: the defaults) with the options given; a bad value exits, named."""
+        return ManagerSettings.from_dict(self.given, base=base, fail=_fail_setting)
+
+
+#: The ``settings`` parameter's placeholder default in a command's definition (see :func:`manager_options`).
+NO_OPTIONS = SettingOptions({})
+
+
+def _fail_setting(name: str, message: str) -> Exception:
+    return fail(f"{setting_flag(name)}: {message}")
+
+
+def manager_options(default_from: str = "") -> Callable[[Callable[..., None]], Callable[..., None]]:
+    """Give a command one option per :class:`ManagerSettings` field, declared from its :class:`SettingInfo`.
+
+    The command's ``settings`` parameter is replaced by the options (where it stands in
+    the signature); the command receives a :class:`SettingOptions` there. The options are
+    checked against the defaults before the command runs, so a bad value is named before
+    any file is read. ``default_from`` says where a left-out option's value comes from
+    when not from the defaults (shown in ``--help``).
+    """
+
+    def decorate(command: Callable[..., None]) -> Callable[..., None]:
+        signature = inspect.signature(command, eval_str=True)
+        names = [f.name for f in dataclasses.fields(ManagerSettings)]
+        options: list[inspect.Parameter] = []
+        for field in dataclasses.fields(ManagerSettings):
+            options += _parameters(field, default_from)
+        parameters: list[inspect.Parameter] = []
+        for parameter in signature.parameters.values():
+            parameters += options if parameter.name == "settings" else [parameter]
+
+        @functools.wraps(command)
+        def run(**kwargs: Any) -> None:
+            given: dict[str, object] = {}
+            for name in names:
+                value = kwargs.pop(name)
+                if kwargs.pop(_OFF.format(name), False):
+                    if value is not None:
+                        raise fail(f"{setting_flag(name)}: expected it or {_off_flag(name)}, got both")
+                    given[name] = None
+                elif value is not None:
+                    given[name] = value
+            chosen = SettingOptions(given)
+            chosen.over()  # named before any file is read
+            command(**kwargs, settings=chosen)
+
+        run.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+        run.__annotations__ = {p.name: p.annotation for p in parameters}
+        return run
+
+    return decorate
+
+
+def _off_flag(name: str) -> str:
+    return next(SettingInfo.of(f).off_flag for f in dataclasses.fields(ManagerSettings) if f.name == name)
+
+
+def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspect.Parameter]:
+    """Return the typer parameters of a field: its option, and the flag that turns it off if it has one."""
+    info = SettingInfo.of(field)
+    flag = setting_flag(field.name)
+    unit = f", in {info.unit}" if info.unit else ""
+    default = f"{default_from}, else {field.default!r}" if default_from else repr(field.default)
+    keyword = inspect.Parameter.POSITIONAL_OR_KEYWORD
+    if info.kind is bool:
+        option = typer.Option(f"{flag}/{info.off_flag}", help=f"{info.help}.", show_default=default)
+        return [
+            inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[bool | None, option])
+        ]
+    help_text = f"{info.help}{unit}; {info.expected.removesuffix(' or none')}."
+    option = typer.Option(flag, help=help_text, show_default=default)
+    parameters = [
+        inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[info.kind | None, option])
+    ]
+    if info.off_flag:
+        off = typer.Option(info.off_flag, help=f"Set {flag} to none (see there).")
+        parameters.append(
+            inspect.Parameter(
+                _OFF.format(field.name), keyword, default=False, annotation=Annotated[bool, off]
+            )
+        )
+    return parameters

@@ -2,58 +2,52 @@
 
 from __future__ import annotations
 
-import math
+import enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
 
-from aura_ums.cli._common import console, fail, write_metrics_json
+from aura_ums.cli._common import (
+    NO_OPTIONS,
+    SettingOptions,
+    console,
+    fail,
+    manager_options,
+    write_metrics_json,
+)
 
 if TYPE_CHECKING:
     from aura_ums.logs import ReplayOptions
+    from aura_ums.manager import ManagerSettings
 
 
-_CLASSES = {"I": "VERTICAL_LINE", "II": "POINT"}
-_MAX_VERTICES = 64  # aura_ums.uncertainty.DEFAULT_MAX_VERTICES, without importing numpy for --help
-_MaxVertices = Annotated[
-    int,
-    typer.Option("--max-vertices", help="Cap on the map polygon's vertices (>= 3): fewer is faster, looser."),
-]
+class Classes(enum.StrEnum):
+    """The landmark classes a replay reads a log's observations as (``--classes``)."""
+
+    #: Class I: bearings only, to vertical lines.
+    VERTICAL_LINE = "I"
+    #: Class II: range and bearing, to points.
+    POINT = "II"
+
+
+_Classes = Annotated[Classes, typer.Option("--classes", help="I: bearings only; II: range and bearing.")]
 _Terrain = Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")]
 _Sensors = Annotated[
     Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
 ]
 
 
-def _check_cap(max_vertices: int) -> None:
-    # Before any file is read: a bad argument is named first.
-    if max_vertices < 3:
-        raise fail(f"--max-vertices: expected an integer >= 3, got {max_vertices}")
-
-
-def _options(
-    classes: str,
-    sigmas: float,
-    sensors: Path | None,
-    robust: bool,
-    joint: bool = True,
-    max_vertices: int = _MAX_VERTICES,
-) -> ReplayOptions:
+def _options(classes: Classes, sensors: Path | None, settings: ManagerSettings) -> ReplayOptions:
     from aura_ums.logs import ReplayOptions, load_sensors
     from aura_ums.uncertainty import LandmarkClass
 
-    if classes not in _CLASSES:
-        raise fail(f"--classes: expected I or II, got {classes!r}")
     # Without a sensors file, the options' defaults: the log's meta.toml.
     motion, working, envelope = load_sensors(sensors) if sensors is not None else (None, None, None)
     return ReplayOptions(
-        sigmas=sigmas,
-        landmark_class=LandmarkClass[_CLASSES[classes]],
-        robust=robust,
-        joint_above=math.pi / 2 if joint else None,
-        max_vertices=max_vertices,
+        settings=settings,
+        landmark_class=LandmarkClass[classes.name],
         working=working,
         envelope=envelope,
         motion=motion,
@@ -100,25 +94,13 @@ def calibrate(
     console.print(f"wrote {out} and {sensors}")
 
 
+@manager_options()
 def replay(
     log_dir: Annotated[Path, typer.Argument(help="Log folder (docs/log-format.md).")],
     terrain: _Terrain,
     sensors: _Sensors = None,
-    sigmas: Annotated[
-        float, typer.Option("--sigmas", help="Standard deviations bounded by the growth.")
-    ] = 3.0,
-    classes: Annotated[str, typer.Option("--classes", help="I: bearings only; II: range and bearing.")] = "I",
-    robust: Annotated[
-        bool, typer.Option("--robust/--gate-only", help="Re-localize from an envelope map (default).")
-    ] = True,
-    joint: Annotated[
-        bool,
-        typer.Option(
-            "--joint/--one-by-one",
-            help="Reduce by a frame's observations together while the heading is wider than pi/2 (default).",
-        ),
-    ] = True,
-    max_vertices: _MaxVertices = _MAX_VERTICES,
+    classes: _Classes = Classes.VERTICAL_LINE,
+    settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
     ] = None,
@@ -135,11 +117,10 @@ def replay(
     from aura_ums.logs import load_log, replay_log
     from aura_ums.uncertainty import TerrainTable
 
-    _check_cap(max_vertices)
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, sigmas, sensors, robust, joint, max_vertices)
+        options = _options(classes, sensors, settings.over())
         result = replay_log(log, table, options)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
@@ -169,6 +150,7 @@ def replay(
         write_replay_mcap_option(mcap, result)
 
 
+@manager_options()
 def compare(
     log_dir: Annotated[Path, typer.Argument(help="Log folder with groundtruth.csv.")],
     terrain: _Terrain,
@@ -179,12 +161,10 @@ def compare(
             "--noise-from", help="Logs whose observation errors give the filters' noise (default LOG_DIR)."
         ),
     ] = None,
-    classes: Annotated[
-        str, typer.Option("--classes", help="I: bearings only; II: range and bearing.")
-    ] = "II",
+    classes: _Classes = Classes.POINT,
     particles: Annotated[int, typer.Option("--particles", help="Particles of the particle filter.")] = 1000,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
-    max_vertices: _MaxVertices = _MAX_VERTICES,
+    settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
     ] = None,
@@ -199,11 +179,10 @@ def compare(
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
-    _check_cap(max_vertices)
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, 3.0, sensors, True, max_vertices=max_vertices)
+        options = _options(classes, sensors, settings.over())
         noise_logs = [load_log(p) for p in calibration_logs] if calibration_logs else [log]
         bearing, ranges = observation_errors(noise_logs)
         if bearing.size < 2:

@@ -10,11 +10,14 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
   time-stamped :class:`~aura_ums.manager.PositionReport` s the map manager grows by
   (:func:`odometry_to_commands`);
 - :func:`read_mrclam` and :func:`import_mrclam` read the UTIAS MRCLAM dataset
-  (Leung et al., IJRR 2011).
+  (Leung et al., IJRR 2011);
+- :func:`replay_log` feeds a log to the :class:`~aura_ums.manager.UncertaintyMapManager`
+  (the localizer, with its outlier recovery) and records what it did against the ground
+  truth; :func:`compare_on_log` sets it next to an EKF and a particle filter.
 """
 
-# Replay, calibration and robust localization are the lead's (_calibrate, _replay, _robust,
-# _synthetic); the formats and readers are helper-logs' (_io, _log, _mrclam, _odometry).
+# Replay and calibration are the lead's (_calibrate, _replay, _synthetic); the formats
+# and readers are helper-logs' (_io, _log, _mrclam, _odometry).
 # One sorted import block (ruff's isort), so the two are interleaved below.
 from aura_ums.logs._calibrate import (
     Calibration,
@@ -50,7 +53,6 @@ from aura_ums.logs._replay import (
     replay_start,
     with_motion,
 )
-from aura_ums.logs._robust import EnvelopeLocalizer, EnvelopeStep
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import SYNTHETIC_LANDMARKS, synthetic_log
 
@@ -58,8 +60,6 @@ __all__ = [
     "LOG_FILES",
     "SYNTHETIC_LANDMARKS",
     "Calibration",
-    "EnvelopeLocalizer",
-    "EnvelopeStep",
     "GroundTruth",
     "LogLandmark",
     "LogMeta",

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, float_array, integer_at_least, read_only
-from aura_ums.errors import InputError
+from aura_ums.errors import InputError, UnknownLandmarkError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
 from aura_ums.manager import PositionReport
@@ -475,7 +475,7 @@ class RobotLog:
     >>> log.landmark("b")
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: landmark_id: expected one of the log's landmark ids (a), got 'b'
+    aura_ums.errors.UnknownLandmarkError: landmark_id: expected one of the log's landmark ids (a), got 'b'
     """
 
     meta: LogMeta
@@ -551,14 +551,15 @@ class RobotLog:
 
         Raises
         ------
-        InputError
-            Naming the id when the log lists no such landmark.
+        UnknownLandmarkError
+            (an :class:`InputError` and a ``KeyError``) naming the id when the log lists no
+            such landmark.
         """
         try:
             return self._by_id[landmark_id]
         except KeyError:
             known = ", ".join(list(self._by_id)[:20]) + (", ..." if len(self._by_id) > 20 else "")
-            raise InputError(
+            raise UnknownLandmarkError(
                 f"landmark_id: expected one of the log's landmark ids ({known}), got {landmark_id!r}"
             ) from None
 

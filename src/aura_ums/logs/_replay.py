@@ -7,21 +7,26 @@ import math
 import time as _time
 import types
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import finite_float, integer_at_least, positive_float
+from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
-from aura_ums.logs._robust import EnvelopeLocalizer
-from aura_ums.manager import ManagerState, PositionReport
+from aura_ums.manager import (
+    Blackboard,
+    ManagerSettings,
+    ManagerState,
+    PositionReport,
+    RejectReason,
+    UncertaintyMapManager,
+)
 from aura_ums.uncertainty import (
-    DEFAULT_MAX_VERTICES,
     BearingObservation,
     LandmarkClass,
     Observation,
@@ -39,12 +44,14 @@ _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
 
 @dataclass(frozen=True, slots=True)
 class ReplayOptions:
-    """How :func:`replay_log` runs a log.
+    """How :func:`replay_log` runs a log: the manager's settings and how the log is read.
 
     Parameters
     ----------
-    sigmas : float
-        Standard deviations bounded by the growth, > 0.
+    settings : ManagerSettings
+        The map manager's settings (sigmas, joint reduction, vertex caps, outlier
+        recovery, ...); ``settings.envelope_factor`` also widens the working sensor bounds
+        into the envelope's when ``envelope`` is None.
     landmark_class : LandmarkClass
         ``VERTICAL_LINE`` (Class I: bearings only) or ``POINT`` (Class II: range and bearing).
     max_interval : float
@@ -55,72 +62,48 @@ class ReplayOptions:
         row of ``observations.csv`` gives itself take precedence.
     envelope : SensorBounds or None
         Worst-case bounds of the envelope map; None: the working bounds widened by
-        ``envelope_factor``.
-    envelope_factor : float
-        >= 1, see ``envelope``.
-    robust : bool
-        Keep the envelope and re-localize from it (False: the consistency gate alone).
+        ``settings.envelope_factor``.
     motion : MotionCalibration or None
         Delay and scales of the recorded motion; None takes the log's ``meta.toml``.
-    relocalize_after, relocalize_window : int
-        See :class:`EnvelopeLocalizer`.
     arena_margin : float
         Metres, >= 0, by which the one meadow of the replay (the log's terrain) extends
         beyond the landmarks, the start and the ground truth.
-    joint_above : float or None
-        Wedge width (radians, >= 0) above which the observations of one frame reduce the
-        map together (:func:`~aura_ums.uncertainty.reduce_jointly`); None: one by one.
-    max_vertices : int
-        Cap on the working map polygon's vertex count, >= 3: fewer is faster and looser.
-    envelope_max_vertices : int or None
-        The same cap for the envelope map, >= 3; None: ``max_vertices``.
 
     Examples
     --------
     >>> ReplayOptions(landmark_class=LandmarkClass.POINT).landmark_class.value
     'II'
+    >>> ReplayOptions(settings=ManagerSettings(robust=False)).settings.robust
+    False
     >>> ReplayOptions(landmark_class=LandmarkClass.GROUND_LINE)
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: ReplayOptions.landmark_class: expected Class I or II, got GROUND_LINE
     """
 
-    sigmas: float = 3.0
+    settings: ManagerSettings = field(default_factory=ManagerSettings)
     landmark_class: LandmarkClass = LandmarkClass.VERTICAL_LINE
     max_interval: float = 0.25
     working: SensorBounds | None = None
     envelope: SensorBounds | None = None
-    envelope_factor: float = 2.0
-    robust: bool = True
     motion: MotionCalibration | None = None
-    relocalize_after: int = 1
-    relocalize_window: int = 1
     arena_margin: float = 5.0
-    joint_above: float | None = math.pi / 2
-    max_vertices: int = DEFAULT_MAX_VERTICES
-    envelope_max_vertices: int | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.settings, ManagerSettings):
+            raise InputError(
+                f"ReplayOptions.settings: expected ManagerSettings, got {type(self.settings).__name__}"
+            )
         if self.landmark_class not in _REPLAY_CLASSES:
             raise InputError(
                 f"ReplayOptions.landmark_class: expected Class I or II, got {self.landmark_class.name}"
             )
-        for name in ("sigmas", "max_interval"):
-            object.__setattr__(self, name, positive_float(getattr(self, name), f"ReplayOptions.{name}"))
-        factor = finite_float(self.envelope_factor, "ReplayOptions.envelope_factor")
-        if factor < 1.0:
-            raise InputError(f"ReplayOptions.envelope_factor: expected a number >= 1, got {factor!r}")
+        object.__setattr__(
+            self, "max_interval", positive_float(self.max_interval, "ReplayOptions.max_interval")
+        )
         margin = finite_float(self.arena_margin, "ReplayOptions.arena_margin")
         if margin < 0.0:
             raise InputError(f"ReplayOptions.arena_margin: expected a number >= 0, got {margin!r}")
-        if self.joint_above is not None:
-            above = finite_float(self.joint_above, "ReplayOptions.joint_above")
-            if above < 0.0:
-                raise InputError(f"ReplayOptions.joint_above: expected a number >= 0 or None, got {above!r}")
-            object.__setattr__(self, "joint_above", above)
-        integer_at_least(self.max_vertices, "ReplayOptions.max_vertices", 3)
-        if self.envelope_max_vertices is not None:
-            integer_at_least(self.envelope_max_vertices, "ReplayOptions.envelope_max_vertices", 3)
         for name in ("working", "envelope"):
             value = getattr(self, name)
             if value is not None and not isinstance(value, SensorBounds):
@@ -152,7 +135,7 @@ class ReplayStep:
     update_us : float
         Microseconds of the update (growth since the previous frame, and the reductions).
     state : ManagerState
-        The working manager's state.
+        The manager's state.
     relocalized : bool
         Whether the working map was re-seeded from the envelope at this step.
     envelope_inside : bool or None
@@ -183,7 +166,7 @@ class ReplayResult:
         How.
     steps : tuple of ReplayStep
         One per frame, in time order.
-    rejected_counts : Mapping[str, int]
+    rejected_counts : Mapping[RejectReason, int]
         Rejected observations by reason.
     relocalizations : int
         Times the working map was re-seeded from the envelope.
@@ -192,7 +175,7 @@ class ReplayResult:
     log: RobotLog
     options: ReplayOptions
     steps: tuple[ReplayStep, ...]
-    rejected_counts: Mapping[str, int]
+    rejected_counts: Mapping[RejectReason, int]
     relocalizations: int
 
     @property
@@ -231,11 +214,11 @@ class ReplayResult:
             {
                 "log": self.log.meta.name,
                 "landmark_class": self.options.landmark_class.value,
-                "sigmas": self.options.sigmas,
-                "robust": self.options.robust,
-                "joint_above_rad": self.options.joint_above,
-                "max_vertices": self.options.max_vertices,
-                "envelope_max_vertices": self.options.envelope_max_vertices,
+                "sigmas": self.options.settings.sigmas,
+                "robust": self.options.settings.robust,
+                "joint_above_rad": self.options.settings.joint_above,
+                "max_vertices": self.options.settings.max_vertices,
+                "envelope_max_vertices": self.options.settings.envelope_max_vertices,
                 "steps": len(self.steps),
                 "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
                 "containment_rate": self.containment_rate,
@@ -244,7 +227,7 @@ class ReplayResult:
                 "median_wedge_width_rad": self.median_wedge_width_rad,
                 "accepted_observations": sum(s.accepted for s in self.steps),
                 "inconsistent_observations": self.inconsistent_observations,
-                "rejected_by_reason": self.rejected_counts,
+                "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
                 "median_update_us": self.median_update_us,
             }
@@ -350,8 +333,11 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     start uncertainty. The motion becomes position reports cut at every observation time
     and at least every ``max_interval`` seconds (:meth:`RobotLog.position_reports`, with
     the options' :class:`MotionCalibration` when given). Each frame (the observations
-    sharing a time stamp) is one step: the :class:`EnvelopeLocalizer` grows to it, reduces
-    by its observations, and the ground truth at that time is checked against the map.
+    sharing a time stamp) is one step: its observations are posted with the working
+    bounds, and their twins under the envelope bounds are given to
+    :meth:`~aura_ums.manager.UncertaintyMapManager.update`, which grows the map to the
+    frame, reduces it (re-localizing from its envelope when the settings are robust);
+    the ground truth at that time is checked against the map.
 
     Parameters
     ----------
@@ -394,8 +380,9 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
     log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
+    robust = opts.settings.robust
     envelope_bounds = (
-        opts.envelope if opts.envelope is not None else working_bounds.widened(opts.envelope_factor)
+        opts.envelope if opts.envelope is not None else working_bounds.widened(opts.settings.envelope_factor)
     )
 
     start_time, start_pose = replay_start(log)
@@ -403,18 +390,8 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         start_pose, log.meta.start_radius, log.meta.start_heading_halfwidth
     )
     meadow_map = log_meadow_map(log, opts.landmark_class, margin=opts.arena_margin)
-    localizer = EnvelopeLocalizer(
-        initial,
-        meadow_map,
-        table,
-        sigmas=opts.sigmas,
-        envelope=opts.robust,
-        relocalize_after=opts.relocalize_after,
-        relocalize_window=opts.relocalize_window,
-        joint_above=opts.joint_above,
-        max_vertices=opts.max_vertices,
-        envelope_max_vertices=opts.envelope_max_vertices,
-    )
+    manager = UncertaintyMapManager(initial, meadow_map, table, opts.settings)
+    board = Blackboard()
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
@@ -430,19 +407,21 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     for index, frame_time in enumerate(frame_times):
         rows = frames[float(frame_time)]
         working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
-        envelope = [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows]
+        envelope = (
+            [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows] if robust else None
+        )
         began = _time.perf_counter()
         while next_report < len(reports) and reports[next_report].time <= frame_time:
-            localizer.post_report(reports[next_report])
+            board.post_report(reports[next_report])
             next_report += 1
-        for w, e in zip(working, envelope, strict=True):
-            localizer.observe(w, e)
-        step = localizer.update(float(frame_time))
+        for observation in working:
+            board.identified.post(observation)
+        step = manager.update(board, now=float(frame_time), envelope=envelope)
         elapsed = (_time.perf_counter() - began) * 1e6
         x, y, heading = truth_at[index]
         truth = None if math.isnan(x) else Pose(float(x), float(y), float(heading))
         inside = None if truth is None else bool(step.map.contains(truth.x, truth.y, truth.heading))
-        envelope_map = localizer.envelope_map
+        envelope_map = step.envelope_map
         envelope_inside = (
             None
             if truth is None or envelope_map is None
@@ -454,10 +433,10 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
                 step.map,
                 truth,
                 inside,
-                len(step.working.accepted),
-                len(step.working.rejected),
+                len(step.accepted),
+                len(step.rejected),
                 elapsed,
-                step.working.state,
+                step.state,
                 step.relocalized,
                 envelope_inside,
             )
@@ -466,8 +445,8 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         log,
         opts,
         tuple(steps),
-        types.MappingProxyType(dict(localizer.rejected_counts)),
-        localizer.relocalizations,
+        types.MappingProxyType(dict(manager.rejected_counts)),
+        manager.relocalizations,
     )
 
 

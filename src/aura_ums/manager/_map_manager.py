@@ -2,41 +2,37 @@
 
 from __future__ import annotations
 
+import dataclasses
 import enum
-import math
 import types
+from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import shapely
 
-from aura_ums._validate import finite_float, integer_at_least, positive_float
-from aura_ums.errors import InputError, OutsideMapError, UnknownTerrainError
+from aura_ums._validate import finite_float
+from aura_ums.errors import FileFormatError, InputError, OutsideMapError, UnknownLandmarkError
 from aura_ums.manager._blackboard import Blackboard, PositionReport
 from aura_ums.manager._codec import Reader, dump_document, encode_map
+from aura_ums.manager._reasons import RejectReason
+from aura_ums.manager._settings import ManagerSettings
 from aura_ums.uncertainty import (
-    DEFAULT_MAX_VERTICES,
-    DEFAULT_SECTOR,
+    BearingObservation,
+    GroundLineObservation,
     Landmark,
     Observation,
     Pose,
+    RangeBearingObservation,
     SpatialUncertaintyMap,
     TerrainStats,
     TerrainTable,
     TurnAndRun,
     reduce_jointly,
 )
-from aura_ums.uncertainty._joint import check_sector
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
-
-#: Rejection reason: the observation is older than the map (the map was grown past its time).
-REJECT_STALE = "observation older than the map's time"
-#: Rejection reason: the meadow map has no landmark with the observation's id.
-REJECT_UNKNOWN_LANDMARK = "unknown landmark id"
-#: Rejection reason: the observation is not of the class of the landmark it names.
-REJECT_CLASS_MISMATCH = "observation class differs from the landmark's"
 
 
 class ManagerState(enum.Enum):
@@ -58,9 +54,8 @@ class ObservationOutcome:
         The observation taken from the identified landmark buffer.
     accepted : bool
         True when the map was reduced by it (a consistent reduction).
-    reason : str
-        Why it was rejected (a reduction's reason, or one of :data:`REJECT_STALE`,
-        :data:`REJECT_UNKNOWN_LANDMARK`, :data:`REJECT_CLASS_MISMATCH`); ``""`` when accepted.
+    reason : RejectReason or None
+        Why it was rejected; None when accepted.
     area_before, area_after : float
         Area of the map's polygon before and after, square metres (equal when rejected).
     wedge_width_before, wedge_width_after : float
@@ -69,7 +64,7 @@ class ObservationOutcome:
 
     observation: Observation
     accepted: bool
-    reason: str
+    reason: RejectReason | None
     area_before: float
     area_after: float
     wedge_width_before: float
@@ -80,7 +75,7 @@ class ObservationOutcome:
         cls,
         observation: Observation,
         accepted: bool,
-        reason: str,
+        reason: RejectReason | None,
         area_before: float,
         area_after: float,
         wedge_width_before: float,
@@ -114,9 +109,15 @@ class ManagerStep:
     lost_reason : str
         Why the robot is lost (``""`` when :attr:`ManagerState.NOMINAL`).
     outcomes : tuple of ObservationOutcome
-        Every observation taken from the buffer, in time order.
+        Every observation taken from the buffer, in time order (what became of it in the
+        working map).
     grown_reports : int
         Number of position reports the map was grown by in this update.
+    relocalized : bool
+        Whether the map was re-localized from the envelope map in this update (``map`` is
+        then the re-seeded one).
+    envelope_map : SpatialUncertaintyMap or None
+        The envelope map after the update (None without :attr:`ManagerSettings.robust`).
     """
 
     time: float
@@ -125,6 +126,8 @@ class ManagerStep:
     lost_reason: str
     outcomes: tuple[ObservationOutcome, ...]
     grown_reports: int
+    relocalized: bool = False
+    envelope_map: SpatialUncertaintyMap | None = None
 
     @classmethod
     def _new(
@@ -135,6 +138,8 @@ class ManagerStep:
         lost_reason: str,
         outcomes: tuple[ObservationOutcome, ...],
         grown_reports: int,
+        relocalized: bool,
+        envelope_map: SpatialUncertaintyMap | None,
     ) -> ManagerStep:
         # As ObservationOutcome._new: one step per update.
         step = object.__new__(cls)
@@ -144,6 +149,8 @@ class ManagerStep:
         _set_lost_reason(step, lost_reason)
         _set_outcomes(step, outcomes)
         _set_grown_reports(step, grown_reports)
+        _set_relocalized(step, relocalized)
+        _set_envelope_map(step, envelope_map)
         return step
 
     @property
@@ -178,9 +185,27 @@ class ManagerStep:
         "wedge_width_after",
     )
 )
-(_set_time, _set_map, _set_state, _set_lost_reason, _set_outcomes, _set_grown_reports) = (
+(
+    _set_time,
+    _set_map,
+    _set_state,
+    _set_lost_reason,
+    _set_outcomes,
+    _set_grown_reports,
+    _set_relocalized,
+    _set_envelope_map,
+) = (
     ManagerStep.__dict__[name].__set__
-    for name in ("time", "map", "state", "lost_reason", "outcomes", "grown_reports")
+    for name in (
+        "time",
+        "map",
+        "state",
+        "lost_reason",
+        "outcomes",
+        "grown_reports",
+        "relocalized",
+        "envelope_map",
+    )
 )
 
 
@@ -215,6 +240,20 @@ class UncertaintyMapManager:
     reduction's areas and widths in their outcomes. When no heading agrees with all of
     them, they are taken one by one instead, so the consistency gate rejects the odd one.
 
+    Outlier recovery (with :attr:`ManagerSettings.robust`, the default): real sensors
+    are heavy-tailed. Bounds wide enough for every error make the map useless; bounds
+    that hold "only" 99% of the time let the 1% shrink the map onto a wrong region that
+    later observations may still agree with. So the manager keeps two maps over the same
+    motion: the *working* map, reduced by the observations as posted (their typical
+    bounds) -- the one reported and used -- and an *envelope* map, reduced by the same
+    observations under worst-case bounds (``envelope_factor`` times wider, or the twins
+    the caller gives :meth:`update`), which stays sound through outliers at the price of
+    being larger. When ``relocalize_after`` of the last ``relocalize_window`` observations
+    that reached a reduction were inconsistent with the working map, it is presumed
+    wrong (the paper's "a landmark shown to be incorrect", seen from the other side) and
+    re-localized: re-seeded from the envelope map, reduced by the update's observations
+    under their typical bounds. The same code runs in simulation, in replay and live.
+
     Lost detection (the paper: "if no landmarks are recognized even though several have
     been predicted, the robot would declare itself lost, stop, and then start searching
     larger windows"): after an update the state is :attr:`ManagerState.LOST` when the
@@ -229,33 +268,20 @@ class UncertaintyMapManager:
     Parameters
     ----------
     initial_map : SpatialUncertaintyMap
-        Where the robot starts (bootstrapped or known from a previous leg).
+        Where the robot starts (bootstrapped or known from a previous leg); the envelope
+        map starts here too.
     meadow_map : MeadowMap
         Long-term memory: the meadows' terrains and the landmarks' geometry.
     table : TerrainTable
         Statistics of the meadows' terrains.
-    sigmas : float
-        Standard deviations bounded by the growth, > 0.
-    area_limit : float or None
-        Map area (m^2, > 0) above which the robot is lost; None for no limit.
-    missed_limit : int
-        Frames in a row with predicted landmarks and none found that make the robot lost, >= 1.
-    lost_window_scale : float
-        :attr:`window_scale` while lost, >= 1.
-    joint_above : float or None
-        Wedge width (radians, >= 0) above which the observations of one instant reduce the
-        map together; None: always one by one.
-    joint_sector : float
-        Widest heading sector of the joint reduction, radians, in (0, 2 pi].
-    max_vertices : int
-        Cap on the map polygon's vertex count, >= 3: a growth that moves the polygon, and
-        a reduction, keep an outer polygon of at most this many vertices (or of its prior's
-        count, when that is more). Fewer is faster and looser.
+    settings : ManagerSettings or None
+        Sigmas, limits, joint reduction, vertex caps and outlier recovery (see
+        :class:`ManagerSettings`); None: the defaults.
 
     Raises
     ------
     InputError
-        For an argument of the wrong type or out of range.
+        For an argument of the wrong type.
 
     Examples
     --------
@@ -264,17 +290,24 @@ class UncertaintyMapManager:
     >>> from aura_ums.world import make_grid_world
     >>> world = make_grid_world(2, 3)                 # poles at (0, 0), (10, 0), (0, 10), (10, 10)
     >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.2, 0.05)
-    >>> manager = UncertaintyMapManager(start, world, TerrainTable.default(), area_limit=50.0)
+    >>> settings = ManagerSettings(area_limit=50.0)
+    >>> manager = UncertaintyMapManager(start, world, TerrainTable.default(), settings)
     >>> board = Blackboard()
     >>> board.post_report(PositionReport(1.0, TurnAndRun(0.0, 2.0)))
     >>> board.identified.post(BearingObservation("pole_0_2", 1.0, math.atan2(-2.5, 5.5), 0.01))
     >>> board.identified.post(BearingObservation("pole_9_9", 1.0, 0.0, 0.01))     # not in the map
     >>> step = manager.update(board, now=1.0)
-    >>> len(step.accepted), step.rejected[0].reason, step.state.value
+    >>> len(step.accepted), step.rejected[0].reason.value, step.state.value
     (1, 'unknown landmark id', 'nominal')
     >>> seen = step.accepted[0]                       # a small map: the heading narrows
     >>> seen.wedge_width_after < seen.wedge_width_before, seen.area_after <= seen.area_before
     (True, True)
+    >>> board.identified.post(BearingObservation("pole_0_2", 1.0, math.atan2(-2.5, 5.5) + 2.0, 0.01))
+    >>> step = manager.update(board, now=1.0)         # inconsistent: re-localized from the envelope
+    >>> step.rejected[0].reason.name, step.relocalized, manager.relocalizations
+    ('NO_POSITION', True, 1)
+    >>> step.envelope_map.area >= step.map.area
+    True
     >>> manager.update(board, now=2.0, missed_in_a_row=3).state    # predicted, not found: lost
     <ManagerState.LOST: 'lost'>
     >>> manager.should_stop_and_look, manager.window_scale
@@ -285,19 +318,22 @@ class UncertaintyMapManager:
         "_accepted",
         "_area_limit",
         "_consumed",
+        "_envelope",
+        "_envelope_factor",
         "_grown",
         "_joint_above",
         "_joint_sector",
         "_lost_reason",
-        "_lost_window_scale",
         "_map",
         "_map_time",
         "_max_vertices",
         "_meadow_map",
         "_missed_limit",
         "_only_terrain",
+        "_recent",
         "_rejected",
         "_relocalizations",
+        "_settings",
         "_sigmas",
         "_state",
         "_table",
@@ -308,14 +344,7 @@ class UncertaintyMapManager:
         initial_map: SpatialUncertaintyMap,
         meadow_map: MeadowMap,
         table: TerrainTable,
-        *,
-        sigmas: float = 3.0,
-        area_limit: float | None = None,
-        missed_limit: int = 3,
-        lost_window_scale: float = 2.0,
-        joint_above: float | None = math.pi / 2,
-        joint_sector: float = DEFAULT_SECTOR,
-        max_vertices: int = DEFAULT_MAX_VERTICES,
+        settings: ManagerSettings | None = None,
     ) -> None:
         if not isinstance(initial_map, SpatialUncertaintyMap):
             raise InputError(
@@ -325,33 +354,44 @@ class UncertaintyMapManager:
             raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
         if not isinstance(table, TerrainTable):
             raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
+        if settings is None:
+            settings = ManagerSettings()
+        elif not isinstance(settings, ManagerSettings):
+            raise InputError(f"settings: expected ManagerSettings or None, got {type(settings).__name__}")
         self._meadow_map = meadow_map
         self._table = table
         self._only_terrain: TerrainStats | None = None
-        self._sigmas = positive_float(sigmas, "sigmas")
-        self._area_limit = None if area_limit is None else positive_float(area_limit, "area_limit")
-        self._missed_limit = integer_at_least(missed_limit, "missed_limit", 1)
-        scale = finite_float(lost_window_scale, "lost_window_scale")
-        if scale < 1.0:
-            raise InputError(f"lost_window_scale: expected a number >= 1, got {scale!r}")
-        self._lost_window_scale = scale
-        self._joint_above: float | None = None
-        if joint_above is not None:
-            above = finite_float(joint_above, "joint_above")
-            if above < 0.0:
-                raise InputError(f"joint_above: expected a non-negative number or None, got {above!r}")
-            self._joint_above = above
-        self._joint_sector = check_sector(joint_sector, "joint_sector")
-        self._max_vertices = integer_at_least(max_vertices, "max_vertices", 3)
+        self._settings = settings
+        # The settings the hot paths read, as plain attributes.
+        self._sigmas = settings.sigmas
+        self._area_limit = settings.area_limit
+        self._missed_limit = settings.missed_limit
+        self._joint_above = settings.joint_above
+        self._joint_sector = settings.joint_sector
+        self._max_vertices = settings.max_vertices
+        self._envelope_factor = settings.envelope_factor
         self._map = initial_map
         self._map_time: float | None = None
         self._consumed = 0
         self._state = ManagerState.NOMINAL
         self._lost_reason = ""
         self._accepted = 0
-        self._rejected: dict[str, int] = {}
+        self._rejected: dict[RejectReason, int] = {}
         self._grown = 0
         self._relocalizations = 0
+        # Whether each of the latest observations that reached a reduction was inconsistent.
+        self._recent: deque[bool] = deque(maxlen=settings.relocalize_window)
+        self._envelope: UncertaintyMapManager | None = None
+        if settings.robust:
+            cap = settings.envelope_max_vertices
+            # The envelope's own lost state and recovery are never read: limits off, no envelope.
+            envelope_settings = dataclasses.replace(
+                settings,
+                robust=False,
+                area_limit=None,
+                max_vertices=settings.max_vertices if cap is None else cap,
+            )
+            self._envelope = UncertaintyMapManager(initial_map, meadow_map, table, envelope_settings)
 
     # --- what others read --------------------------------------------------------------
 
@@ -378,7 +418,7 @@ class UncertaintyMapManager:
     @property
     def window_scale(self) -> float:
         """Factor by which to widen the Expecter's windows: ``lost_window_scale`` while LOST, else 1."""
-        return self._lost_window_scale if self._state is ManagerState.LOST else 1.0
+        return self._settings.lost_window_scale if self._state is ManagerState.LOST else 1.0
 
     @property
     def map_time(self) -> float | None:
@@ -396,7 +436,7 @@ class UncertaintyMapManager:
         return self._accepted
 
     @property
-    def rejected_counts(self) -> Mapping[str, int]:
+    def rejected_counts(self) -> Mapping[RejectReason, int]:
         """Observations rejected since construction, by reason (a read-only copy)."""
         return types.MappingProxyType(dict(self._rejected))
 
@@ -407,7 +447,7 @@ class UncertaintyMapManager:
 
     @property
     def relocalizations(self) -> int:
-        """Times the map was replaced by :meth:`relocalize`, since construction."""
+        """Times the map was re-localized (from the envelope or by :meth:`relocalize`) since construction."""
         return self._relocalizations
 
     @property
@@ -416,44 +456,38 @@ class UncertaintyMapManager:
         return self._grown
 
     @property
-    def sigmas(self) -> float:
-        """Standard deviations bounded by the growth."""
-        return self._sigmas
+    def inconsistent_count(self) -> int:
+        """Observations rejected by the consistency gate (no pose of the map agrees), since construction."""
+        return sum(n for reason, n in self._rejected.items() if reason.inconsistent)
 
     @property
-    def area_limit(self) -> float | None:
-        """Map area (m^2) above which the robot is lost; None for no limit."""
-        return self._area_limit
+    def settings(self) -> ManagerSettings:
+        """The settings the manager runs with."""
+        return self._settings
 
     @property
-    def joint_above(self) -> float | None:
-        """Wedge width (radians) above which observations of one instant reduce the map together."""
-        return self._joint_above
-
-    @property
-    def joint_sector(self) -> float:
-        """Widest heading sector of the joint reduction, radians."""
-        return self._joint_sector
-
-    @property
-    def max_vertices(self) -> int:
-        """Cap on the map polygon's vertex count."""
-        return self._max_vertices
-
-    @property
-    def missed_limit(self) -> int:
-        """Missed frames in a row that make the robot lost."""
-        return self._missed_limit
+    def envelope_map(self) -> SpatialUncertaintyMap | None:
+        """The envelope map (worst-case bounds); None without :attr:`ManagerSettings.robust`."""
+        return None if self._envelope is None else self._envelope._map
 
     # --- the update --------------------------------------------------------------------
 
-    def update(self, blackboard: Blackboard, *, now: float, missed_in_a_row: int = 0) -> ManagerStep:
+    def update(
+        self,
+        blackboard: Blackboard,
+        *,
+        now: float,
+        missed_in_a_row: int = 0,
+        envelope: Sequence[Observation] | None = None,
+    ) -> ManagerStep:
         """Bring the map up to ``now``: grow to each observation, reduce by it, grow to ``now``.
 
         The identified observations with ``time <= now`` are drained from
         ``blackboard.identified``; the position reports with ``time <= now`` not yet
-        consumed are grown into the map. The update is all or nothing: when it raises,
-        neither the manager nor the blackboard has changed.
+        consumed are grown into the map (and into the envelope map, which is reduced by
+        the same observations under worst-case bounds). When the working map is presumed
+        wrong, it is re-localized from the envelope (see the class notes). The update is
+        all or nothing: when it raises, neither the manager nor the blackboard has changed.
 
         Parameters
         ----------
@@ -464,6 +498,12 @@ class UncertaintyMapManager:
         missed_in_a_row : int
             The schema manager's count of frames in a row in which landmarks were
             predicted and none found, >= 0.
+        envelope : sequence of observations, or None
+            The envelope map's twins of the observations this update drains, in the order
+            drained (time order; posting order within a time): the same sighting, of the
+            same class, landmark and time, under worst-case bounds. None: the drained
+            observations with their bounds widened ``envelope_factor`` times. Unused
+            without :attr:`ManagerSettings.robust`.
 
         Returns
         -------
@@ -473,7 +513,8 @@ class UncertaintyMapManager:
         Raises
         ------
         InputError
-            For a bad argument; for a blackboard that is not the one this manager has been
+            For a bad argument (an ``envelope`` that does not pair with the drained
+            observations); for a blackboard that is not the one this manager has been
             reading (fewer reports than consumed, or a different last consumed report); when
             a run meets no meadow of the meadow map (from :func:`~aura_ums.world.grow_through`).
 
@@ -498,11 +539,50 @@ class UncertaintyMapManager:
             raise InputError(f"missed_in_a_row: expected a non-negative integer, got {missed_in_a_row!r}")
         self._check_blackboard(blackboard)
 
+        identified = blackboard.identified
+        pending = identified._peek_until(time)
+        current, index, map_time, outcomes = self._advance(blackboard, time, pending)
+        outer = self._envelope
+        if outer is not None:
+            twins = self._twins(pending, envelope)
+            wide, wide_index, wide_time, _ = outer._advance(blackboard, time, twins)
+
+        # Commit: nothing above changed the manager or the blackboard.
+        identified._discard(len(pending))  # exactly ``pending``: single-threaded by contract
+        grown = index - self._consumed
+        found = self._commit(current, index, map_time, outcomes)
+        relocalized = False
+        if outer is not None:
+            outer._commit(wide, wide_index, wide_time, [])
+            recent = self._recent
+            for outcome in outcomes:
+                reason = outcome.reason
+                if reason is None or reason.inconsistent:
+                    recent.append(reason is not None)
+            if sum(recent) >= self._settings.relocalize_after:
+                self._map = self._reseed(wide, [o.observation for o in outcomes])
+                self._relocalizations += 1
+                recent.clear()
+                relocalized = True
+        self._update_state(found, missed_in_a_row)
+        return ManagerStep._new(
+            time,
+            self._map,
+            self._state,
+            self._lost_reason,
+            tuple(outcomes),
+            grown,
+            relocalized,
+            None if outer is None else outer._map,
+        )
+
+    def _advance(
+        self, blackboard: Blackboard, time: float, pending: Sequence[Observation]
+    ) -> tuple[SpatialUncertaintyMap, int, float | None, list[ObservationOutcome]]:
+        """Grow and reduce by ``pending`` up to ``time``, changing nothing; return what to commit."""
         current, index, map_time = self._map, self._consumed, self._map_time
         reports = blackboard._reports  # read in place (the manager's own subpackage): no copies
-        identified = blackboard.identified
         outcomes: list[ObservationOutcome] = []
-        pending = identified._peek_until(time)
         first = 0
         while first < len(pending):
             instant = pending[first].time
@@ -523,22 +603,68 @@ class UncertaintyMapManager:
             first = last
         stop = blackboard._report_stop(time, index)
         current, map_time = self._grow(current, reports, index, stop, map_time)
-        index = stop
-        grown = index - self._consumed
+        return current, stop, map_time, outcomes
 
-        # Commit: nothing above changed the manager or the blackboard.
-        identified._discard(len(pending))  # exactly ``pending``: single-threaded by contract
+    def _commit(
+        self,
+        current: SpatialUncertaintyMap,
+        index: int,
+        map_time: float | None,
+        outcomes: Sequence[ObservationOutcome],
+    ) -> bool:
+        """Take what :meth:`_advance` returned; return whether an observation reduced the map."""
+        self._grown += index - self._consumed
         self._map, self._consumed, self._map_time = current, index, map_time
-        self._grown += grown
         found = False
         for outcome in outcomes:
-            if outcome.accepted:
+            reason = outcome.reason
+            if reason is None:
                 self._accepted += 1
                 found = True
             else:
-                self._rejected[outcome.reason] = self._rejected.get(outcome.reason, 0) + 1
-        self._update_state(found, missed_in_a_row)
-        return ManagerStep._new(time, current, self._state, self._lost_reason, tuple(outcomes), grown)
+                self._rejected[reason] = self._rejected.get(reason, 0) + 1
+        return found
+
+    def _twins(
+        self, pending: Sequence[Observation], envelope: Sequence[Observation] | None
+    ) -> list[Observation]:
+        """Return the envelope's observations: ``envelope`` checked against ``pending``, or widened ones."""
+        if envelope is None:
+            factor = self._envelope_factor
+            return [_widened(observation, factor) for observation in pending]
+        if isinstance(envelope, (str, bytes)) or not isinstance(envelope, Sequence):
+            raise InputError(
+                f"envelope: expected a sequence of observations or None, got {type(envelope).__name__}"
+            )
+        if len(envelope) != len(pending):
+            raise InputError(
+                f"envelope: expected one observation per identified observation drained ({len(pending)}), "
+                f"got {len(envelope)}"
+            )
+        for position, (ours, twin) in enumerate(zip(pending, envelope, strict=True)):
+            if type(twin) is not type(ours) or twin.landmark_id != ours.landmark_id or twin.time != ours.time:
+                raise InputError(
+                    f"envelope[{position}]: expected a {type(ours).__name__} of {ours.landmark_id!r} at "
+                    f"t={ours.time!r} (the drained observation's twin), got {twin!r}"
+                )
+        return list(envelope)
+
+    def _reseed(
+        self, envelope_map: SpatialUncertaintyMap, observations: Sequence[Observation]
+    ) -> SpatialUncertaintyMap:
+        """Return the envelope map reduced by the observations with their typical bounds, where consistent."""
+        current = envelope_map
+        for observation in observations:
+            try:
+                landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+            except UnknownLandmarkError:
+                continue
+            if observation.landmark_class is not landmark.landmark_class:
+                continue
+            found = current._reduce_checked(observation, landmark, self._max_vertices)
+            if not isinstance(found, str):
+                current = found[0]
+        return current
 
     def relocalize(self, new_map: SpatialUncertaintyMap) -> None:
         """Replace the map by one re-derived elsewhere (re-localization), keeping the clock.
@@ -546,8 +672,9 @@ class UncertaintyMapManager:
         The map's time and the consumed position reports stay: ``new_map`` must describe
         the robot at :attr:`map_time`. The state returns to :attr:`ManagerState.NOMINAL`
         (the new map is the response to being lost) and :attr:`relocalizations` counts it.
-        Used by :class:`~aura_ums.logs.EnvelopeLocalizer`, whose envelope map, kept under
-        worst-case bounds, re-seeds a working map that outliers have led astray.
+        For a re-localization found by other means (a GPS fix, an operator); with
+        :attr:`ManagerSettings.robust` the manager re-localizes from its envelope map by
+        itself. The envelope map is kept as it is.
 
         Raises
         ------
@@ -573,6 +700,7 @@ class UncertaintyMapManager:
             raise InputError(f"new_map: expected a SpatialUncertaintyMap, got {type(new_map).__name__}")
         self._map = new_map
         self._relocalizations += 1
+        self._recent.clear()  # the inconsistencies were the old map's
         self._state, self._lost_reason = ManagerState.NOMINAL, ""
 
     def _check_blackboard(self, blackboard: Blackboard) -> None:
@@ -662,7 +790,7 @@ class UncertaintyMapManager:
             sightings = [
                 (o, found)
                 for o, found in zip(observations, checked, strict=True)
-                if not isinstance(found, str)
+                if not isinstance(found, RejectReason)
             ]
             if len(sightings) >= 2:
                 joint = reduce_jointly(
@@ -672,14 +800,20 @@ class UncertaintyMapManager:
                     reduced = joint.map
                     area, width = current.area, current.wedge.width
                     for observation, found in zip(observations, checked, strict=True):
-                        if isinstance(found, str):
+                        if isinstance(found, RejectReason):
                             outcomes.append(
                                 ObservationOutcome._new(observation, False, found, area, area, width, width)
                             )
                         else:
                             outcomes.append(
                                 ObservationOutcome._new(
-                                    observation, True, "", area, joint.area_after, width, reduced.wedge.width
+                                    observation,
+                                    True,
+                                    None,
+                                    area,
+                                    joint.area_after,
+                                    width,
+                                    reduced.wedge.width,
                                 )
                             )
                     return reduced
@@ -688,23 +822,23 @@ class UncertaintyMapManager:
             outcomes.append(outcome)
         return current
 
-    def _landmark_for(self, observation: Observation, map_time: float | None) -> Landmark | str:
+    def _landmark_for(self, observation: Observation, map_time: float | None) -> Landmark | RejectReason:
         """Return the landmark an observation names, or why it is rejected before any reduction."""
         if map_time is not None and observation.time < map_time:
-            return REJECT_STALE
+            return RejectReason.STALE
         try:
             landmark = self._meadow_map.landmark(observation.landmark_id).landmark
-        except UnknownTerrainError:
-            return REJECT_UNKNOWN_LANDMARK
+        except UnknownLandmarkError:
+            return RejectReason.UNKNOWN_LANDMARK
         if observation.landmark_class is not landmark.landmark_class:
-            return REJECT_CLASS_MISMATCH
+            return RejectReason.CLASS_MISMATCH
         return landmark
 
     def _reduce(
-        self, current: SpatialUncertaintyMap, observation: Observation, landmark: Landmark | str
+        self, current: SpatialUncertaintyMap, observation: Observation, landmark: Landmark | RejectReason
     ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
         """Reduce by one observation and its landmark (from :meth:`_landmark_for`, or why not)."""
-        if isinstance(landmark, str):
+        if isinstance(landmark, RejectReason):
             reason = landmark
         else:
             # Found by the observation's id, of its class: the pair reduce() would check.
@@ -713,10 +847,11 @@ class UncertaintyMapManager:
                 reduced, area_before, area_after = found
                 width_before, width_after = current.wedge.width, reduced.wedge.width
                 outcome = ObservationOutcome._new(
-                    observation, True, "", area_before, area_after, width_before, width_after
+                    observation, True, None, area_before, area_after, width_before, width_after
                 )
                 return outcome, reduced
-            reason = found
+            # The reductions word their reasons; each is a RejectReason's value.
+            reason = RejectReason(found)
         # Rejected: the map stays, and so do its area and width.
         area, width = current.area, current.wedge.width
         return ObservationOutcome._new(observation, False, reason, area, area, width, width), current
@@ -742,11 +877,13 @@ class UncertaintyMapManager:
     def to_json(self) -> str:
         """Return the manager's whole state as JSON text.
 
-        The map (polygon vertices, centre, wedge) is written with ``repr`` precision, so
-        :meth:`from_json` restores it bit for bit; with it go the state, the counters, the
-        settings and the index and time of the last consumed position report. The meadow
-        map and terrain table are not saved: they are long-term memory, given again on
-        restore. Save the :class:`Blackboard` too (:meth:`Blackboard.to_json`).
+        The maps (polygon vertices, centre, wedge; the working map and the envelope map)
+        are written with ``repr`` precision, so :meth:`from_json` restores them bit for
+        bit; with them go the state, the counters, the settings
+        (:meth:`ManagerSettings.to_dict`), the recent inconsistencies and the index and
+        time of the last consumed position report. The meadow map and terrain table are
+        not saved: they are long-term memory, given again on restore. Save the
+        :class:`Blackboard` too (:meth:`Blackboard.to_json`).
 
         Examples
         --------
@@ -754,11 +891,14 @@ class UncertaintyMapManager:
         >>> from aura_ums.world import make_grid_world
         >>> world, table = make_grid_world(1, 3), TerrainTable.default()
         >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.3), 0.1, 0.01)
-        >>> manager = UncertaintyMapManager(start, world, table, area_limit=40.0)
+        >>> manager = UncertaintyMapManager(start, world, table, ManagerSettings(area_limit=40.0))
         >>> again = UncertaintyMapManager.from_json(manager.to_json(), world, table)
-        >>> again.map.polygon.vertices.tobytes() == start.polygon.vertices.tobytes(), again.area_limit
-        (True, 40.0)
+        >>> again.map.polygon.vertices.tobytes() == start.polygon.vertices.tobytes()
+        True
+        >>> again.settings == manager.settings
+        True
         """
+        outer = self._envelope
         return dump_document(
             _KIND,
             {
@@ -769,19 +909,14 @@ class UncertaintyMapManager:
                 "lost_reason": self._lost_reason,
                 "counters": {
                     "accepted": self._accepted,
-                    "rejected": dict(self._rejected),
+                    "rejected": {reason.value: count for reason, count in self._rejected.items()},
                     "grown_reports": self._grown,
                     "relocalizations": self._relocalizations,
                 },
-                "settings": {
-                    "sigmas": self._sigmas,
-                    "area_limit": self._area_limit,
-                    "missed_limit": self._missed_limit,
-                    "lost_window_scale": self._lost_window_scale,
-                    "joint_above": self._joint_above,
-                    "joint_sector": self._joint_sector,
-                    "max_vertices": self._max_vertices,
-                },
+                "settings": self._settings.to_dict(),
+                "envelope": None
+                if outer is None
+                else {"map": encode_map(outer._map), "recent": list(self._recent)},
             },
         )
 
@@ -795,6 +930,10 @@ class UncertaintyMapManager:
         source: str = "<manager JSON>",
     ) -> UncertaintyMapManager:
         """Restore a manager saved by :meth:`to_json`, with its long-term memory.
+
+        A document saved before a setting existed is restored as it ran: without
+        ``joint_above``, one by one; without ``robust``, with no envelope. Any other
+        setting it lacks takes its default.
 
         Parameters
         ----------
@@ -827,34 +966,16 @@ class UncertaintyMapManager:
             raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
         reader = Reader(source)
         keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
-        data = reader.mapping(reader.document(text, _KIND), "", (*keys, "counters", "settings"))
-        settings = reader.mapping(
-            data["settings"],
-            "settings",
-            ("sigmas", "area_limit", "missed_limit", "lost_window_scale"),
-            # Saved before joint reductions (or the vertex cap) were settings: restored as they ran.
-            optional=("joint_above", "joint_sector", "max_vertices"),
+        data = reader.mapping(
+            reader.document(text, _KIND), "", (*keys, "counters", "settings"), optional=("envelope",)
+        )
+        settings = ManagerSettings.from_dict(
+            reader.mapping(data["settings"], "settings"),
+            base=_BEFORE_SETTINGS,
+            fail=lambda key, message: FileFormatError(source, f"settings.{key}", message),
         )
         uncertainty_map = reader.uncertainty_map(data["map"], "map")
-        try:
-            manager = cls(
-                uncertainty_map,
-                meadow_map,
-                table,
-                sigmas=reader.number(settings["sigmas"], "settings.sigmas"),
-                area_limit=reader.optional_number(settings["area_limit"], "settings.area_limit"),
-                missed_limit=reader.integer(settings["missed_limit"], "settings.missed_limit", 1),
-                lost_window_scale=reader.number(settings["lost_window_scale"], "settings.lost_window_scale"),
-                joint_above=reader.optional_number(settings.get("joint_above"), "settings.joint_above"),
-                joint_sector=reader.number(
-                    settings.get("joint_sector", DEFAULT_SECTOR), "settings.joint_sector"
-                ),
-                max_vertices=reader.integer(
-                    settings.get("max_vertices", DEFAULT_MAX_VERTICES), "settings.max_vertices", 3
-                ),
-            )
-        except InputError as exc:
-            reader.fail("settings", str(exc))
+        manager = cls(uncertainty_map, meadow_map, table, settings)
         manager._map_time = reader.optional_number(data["map_time"], "map_time")
         manager._consumed = reader.integer(data["consumed_reports"], "consumed_reports")
         if (manager._consumed == 0) != (manager._map_time is None):
@@ -872,14 +993,67 @@ class UncertaintyMapManager:
         manager._accepted = reader.integer(counters["accepted"], "counters.accepted")
         manager._grown = reader.integer(counters["grown_reports"], "counters.grown_reports")
         rejected = reader.mapping(counters["rejected"], "counters.rejected")
-        manager._rejected = {
-            reason: reader.integer(count, f"counters.rejected[{reason!r}]")
-            for reason, count in rejected.items()
-        }
+        for key, count in rejected.items():
+            place = f"counters.rejected[{key!r}]"
+            try:
+                reason = RejectReason(key)
+            except ValueError:
+                reader.fail(place, f"expected one of {[r.value for r in RejectReason]}, got {key!r}")
+            manager._rejected[reason] = reader.integer(count, place)
+        manager._restore_envelope(reader, data.get("envelope"))
         return manager
+
+    def _restore_envelope(self, reader: Reader, value: object) -> None:
+        """Restore the envelope map and the recent inconsistencies saved by :meth:`to_json`."""
+        outer = self._envelope
+        if outer is None:
+            if value is not None:
+                reader.fail("envelope", "expected null (settings.robust is false), got a value")
+            return
+        if value is None:
+            reader.fail("envelope", "expected the envelope map (settings.robust is true), got none")
+        data = reader.mapping(value, "envelope", ("map", "recent"))
+        outer._map = reader.uncertainty_map(data["map"], "envelope.map")
+        outer._map_time, outer._consumed = self._map_time, self._consumed
+        recent = reader.array(data["recent"], "envelope.recent")
+        window = self._settings.relocalize_window
+        if len(recent) > window or not all(isinstance(item, bool) for item in recent):
+            reader.fail(
+                "envelope.recent", f"expected at most {window} booleans (relocalize_window), got {recent!r}"
+            )
+        self._recent.extend(recent)
 
     def __repr__(self) -> str:
         return (
             f"UncertaintyMapManager({self._state.value}, area={self._map.area:.4g} m^2, "
             f"reports consumed={self._consumed}, accepted={self._accepted}, rejected={self.rejected_count})"
         )
+
+
+#: What a saved document lacking a setting ran with: one by one before joint reductions,
+#: without an envelope before outlier recovery; the defaults otherwise.
+_BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False)
+
+
+def _widened(observation: Observation, factor: float) -> Observation:
+    """Return ``observation`` with its error bounds ``factor`` (>= 1) times wider, about their centres."""
+    if factor == 1.0:
+        return observation
+    if isinstance(observation, BearingObservation):
+        return dataclasses.replace(observation, bearing_error=observation.bearing_error * factor)
+    if isinstance(observation, RangeBearingObservation):
+        middle = (observation.range_min + observation.range_max) / 2.0
+        half = (observation.range_max - observation.range_min) / 2.0 * factor
+        return dataclasses.replace(
+            observation,
+            bearing_error=observation.bearing_error * factor,
+            range_min=max(0.0, middle - half),
+            range_max=middle + half,
+        )
+    if isinstance(observation, GroundLineObservation):
+        return dataclasses.replace(
+            observation,
+            offset_error=observation.offset_error * factor,
+            angle_error=observation.angle_error * factor,
+        )
+    raise InputError(f"observation: expected an observation of Class I, II or III, got {observation!r}")

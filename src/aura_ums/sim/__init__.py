@@ -23,7 +23,6 @@ from aura_ums.sim._loop import (
 from aura_ums.sim._render import CLIP_NEAR, TEXTURE_FADE, SyntheticCamera, fill_polygon
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scenario import (
-    LostLimits,
     RenderSettings,
     Scenario,
     SimulatedFrame,
@@ -58,7 +57,6 @@ __all__ = [
     "GroundPatch",
     "GroundStripe",
     "LoopState",
-    "LostLimits",
     "PerceptionMode",
     "Pole",
     "RenderSettings",

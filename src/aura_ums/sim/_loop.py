@@ -10,7 +10,11 @@ Each frame of :func:`run_scenario`:
    on the image with that map snapshot (the Expecter's windows, widened by the manager's
    ``window_scale`` while lost; the whole image in :attr:`PerceptionMode.FULL_FRAME`),
    posting their identifications to the identified landmark buffer;
-4. the manager reduces the map by them (``prune=False``: they are dropped; growth only).
+4. the manager reduces the map by them (``prune=False``: they are dropped; growth only),
+   with the scenario's :class:`~aura_ums.manager.ManagerSettings`: with ``robust``, it
+   keeps an envelope map (the identifications' bounds widened by ``envelope_factor``) and
+   re-localizes from it when an identification is inconsistent with the map, as in
+   replay and live use.
 
 Consistency of the synthetic world with the map (:func:`check_render_consistency`): the
 camera renders Class I poles with a radius and Class III strips with a width, and the
@@ -36,7 +40,7 @@ from numpy.typing import NDArray
 from aura_ums._metrics import Metrics
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
-from aura_ums.manager import Blackboard, ManagerState, PositionReport, UncertaintyMapManager
+from aura_ums.manager import Blackboard, ManagerState, PositionReport, RejectReason, UncertaintyMapManager
 from aura_ums.schemas import Frame, Pilot, SchemaManager, SchemaManagerState, StepReport
 from aura_ums.sim._scenario import Scenario, waypoints_array
 from aura_ums.sim._scene import CORNER_MATCH_DISTANCE
@@ -94,7 +98,7 @@ class FrameRecord:
         Ids of the identifications posted to the buffer.
     accepted : int
         Observations that reduced the map.
-    rejected : tuple of str
+    rejected : tuple of RejectReason
         Reasons of the rejected observations.
     state : ManagerState
         The manager's state after the frame.
@@ -119,7 +123,7 @@ class FrameRecord:
     found: tuple[str, ...]
     posted: tuple[str, ...]
     accepted: int
-    rejected: tuple[str, ...]
+    rejected: tuple[RejectReason, ...]
     state: ManagerState
     frame_ms: float
     detections: tuple[tuple[str, tuple[float, float, float, float]], ...] = ()
@@ -338,7 +342,6 @@ class _Loop:
         self.pilot = Pilot(scenario.camera)
         drawn = scenario if world is None else _with_map(scenario, world)
         s = scenario
-        limit = s.lost.area_limit if math.isfinite(s.lost.area_limit) else None
         if resume_from is None:
             start_rng, motion_rng, camera_rng = rng.spawn(3)
             self.scene_state = camera_rng.bit_generator.state
@@ -347,9 +350,7 @@ class _Loop:
             self.motion_rng = motion_rng
             self.camera = drawn.synthetic_camera(camera_rng)
             self.camera_rng = camera_rng
-            self.manager = UncertaintyMapManager(
-                s.initial_map(), s.meadow_map, s.terrain, area_limit=limit, missed_limit=s.lost.missed_limit
-            )
+            self.manager = UncertaintyMapManager(s.initial_map(), s.meadow_map, s.terrain, s.settings)
             self.board = Blackboard()
             self.schemas = SchemaManager(buffer=self.board.identified)
             self.instantiated = 0
@@ -447,7 +448,7 @@ class _Loop:
                 found=report.found,
                 posted=tuple(o.landmark_id for o in report.posted),
                 accepted=len(after.accepted),
-                rejected=tuple(o.reason for o in after.rejected),
+                rejected=tuple(o.reason for o in after.rejected if o.reason is not None),
                 state=after.state,
                 frame_ms=elapsed,
                 detections=_detections(report),

@@ -24,9 +24,12 @@ says ``_deg``, radians otherwise; every other unit SI)::
     # waypoints = [[5.0, 0.0], [5.0, 4.0]]       # straight legs from the start
     # goal = [20.0, 0.0]                         # legs planned with aura_ums.world.plan_route
 
-    [lost]                              # optional: when the manager declares the robot lost
-    area_limit = 25.0                   # m^2 of the position polygon, > 0
-    missed_limit = 3                    # landmarks expected but not found in a row, >= 1
+    [manager]                           # optional: aura_ums.manager.ManagerSettings
+    area_limit = 25.0                   # m^2: the robot is lost above it (default: no limit)
+    missed_limit = 3                    # frames in a row of landmarks predicted, none found
+    robust = true                       # envelope map and re-localization from it
+    # ... any field of ManagerSettings, by its name (its unit, range and default are
+    # there); angles in radians, or in degrees as <name>_deg; "none" for None.
 
     [render]                            # optional: the synthetic camera and scene
     noise = 2.0                         # gray levels (sd); clutter = 0 (ground strips);
@@ -34,25 +37,29 @@ says ``_deg``, radians otherwise; every other unit SI)::
     building_width = 15.0               # building_depth = 10.0; building_base = 0.0
 
 Frames are taken at the start, at the end of every command, and, with a frame spacing,
-every ``frame_spacing`` metres of commanded run along the route.
+every ``frame_spacing`` metres of commanded run along the route. Files that hold
+``area_limit`` and ``missed_limit`` in a ``[lost]`` table (the earlier format) are read
+as before.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import tomllib
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, integer_at_least, nonnegative_float, read_only
+from aura_ums._validate import finite_float, nonnegative_float, read_only
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
+from aura_ums.manager import ManagerSettings, SettingInfo
 from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scene import Scene
@@ -71,6 +78,7 @@ _TOP_KEYS = (
     "speed",
     "start",
     "route",
+    "manager",
     "lost",
     "render",
 )
@@ -126,29 +134,6 @@ class StartState:
             "heading_halfwidth",
             nonnegative_float(self.heading_halfwidth, "StartState.heading_halfwidth"),
         )
-
-
-@dataclass(frozen=True, slots=True)
-class LostLimits:
-    """When the map manager declares the robot lost.
-
-    Parameters
-    ----------
-    area_limit : float
-        Largest area of the position polygon, m^2, > 0 (``inf``: no limit).
-    missed_limit : int
-        Number of expected landmarks not found in a row, >= 1.
-    """
-
-    area_limit: float = math.inf
-    missed_limit: int = 3
-
-    def __post_init__(self) -> None:
-        area = float(self.area_limit) if isinstance(self.area_limit, (int, float)) else math.nan
-        if isinstance(self.area_limit, bool) or not area > 0.0:
-            raise InputError(f"LostLimits.area_limit: expected a positive number, got {self.area_limit!r}")
-        integer_at_least(self.missed_limit, "LostLimits.missed_limit", 1)
-        object.__setattr__(self, "area_limit", area)
 
 
 @dataclass(frozen=True, slots=True)
@@ -317,8 +302,8 @@ class Scenario:
     frame_spacing : float or None
         Metres of commanded run between frames (None: frames at the start and at the end
         of every command only).
-    lost : LostLimits
-        When to declare the robot lost.
+    settings : ManagerSettings
+        The map manager's settings: when to declare the robot lost, outlier recovery, ...
     render : RenderSettings
         Settings of the synthetic scene and camera.
     source : str
@@ -357,7 +342,7 @@ class Scenario:
     commands: tuple[TurnAndRun, ...]
     landmark_ids: tuple[str, ...]
     frame_spacing: float | None = None
-    lost: LostLimits = LostLimits()
+    settings: ManagerSettings = field(default_factory=ManagerSettings)
     render: RenderSettings = RenderSettings()
     source: str = ""
 
@@ -367,7 +352,7 @@ class Scenario:
             ("terrain", TerrainTable),
             ("camera", Camera),
             ("start", StartState),
-            ("lost", LostLimits),
+            ("settings", ManagerSettings),
             ("render", RenderSettings),
         ):
             value = getattr(self, name)
@@ -456,7 +441,7 @@ class Scenario:
         start = _start(reader.table(document, "start", required=True), reader, meadow_map)
         commands = _route(reader.table(document, "route", required=True), reader, meadow_map, start.pose)
         spacing = _frame_spacing(document, reader)
-        lost = _lost(reader.table(document, "lost", required=False), reader)
+        settings = _settings(document, reader)
         render = _render(reader.table(document, "render", required=False), reader)
         return cls(
             name,
@@ -468,7 +453,7 @@ class Scenario:
             commands,
             landmark_ids,
             spacing,
-            lost,
+            settings,
             render,
             reader.source,
         )
@@ -740,11 +725,30 @@ def _frame_spacing(document: Mapping[str, object], reader: _Reader) -> float | N
     return None
 
 
-def _lost(table: Mapping[str, object], reader: _Reader) -> LostLimits:
-    reader.keys(table, ("area_limit", "missed_limit"), "[lost]")
-    area = reader.positive(table["area_limit"], "[lost] area_limit") if "area_limit" in table else math.inf
-    missed = reader.integer(table["missed_limit"], "[lost] missed_limit", 1) if "missed_limit" in table else 3
-    return LostLimits(area, missed)
+def _settings(document: Mapping[str, object], reader: _Reader) -> ManagerSettings:
+    """Read ``[manager]`` (and the earlier ``[lost]``) into :class:`ManagerSettings`."""
+    manager = reader.table(document, "manager", required=False)
+    lost = reader.table(document, "lost", required=False)
+    infos = {f.name: SettingInfo.of(f) for f in dataclasses.fields(ManagerSettings)}
+    angles = tuple(f"{name}_deg" for name, info in infos.items() if info.unit == "rad")
+    reader.keys(manager, (*infos, *angles), "[manager]")
+    reader.keys(lost, ("area_limit", "missed_limit"), "[lost]")
+    values: dict[str, object] = {}
+    places: dict[str, str] = {}
+    for table, name in ((lost, "lost"), (manager, "manager")):
+        for key, value in table.items():
+            setting, degrees = (key[:-4], True) if key in angles else (key, False)
+            where = f"[{name}] {key}"
+            if setting in places:
+                raise reader.fail(where, f"expected one value of {setting}, got another in {places[setting]}")
+            if degrees and isinstance(value, (int, float)) and not isinstance(value, bool):
+                value = math.radians(value)
+            elif value == "none" and infos[setting].nullable:
+                value = None
+            values[setting], places[setting] = value, where
+    return ManagerSettings.from_dict(
+        values, fail=lambda key, message: reader.fail(places.get(key, f"[manager] {key}"), message)
+    )
 
 
 def _render(table: Mapping[str, object], reader: _Reader) -> RenderSettings:

@@ -21,7 +21,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, points_array, read_only
-from aura_ums.errors import InputError, UnknownTerrainError
+from aura_ums.errors import InputError, UnknownLandmarkError, UnknownTerrainError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -538,12 +538,12 @@ expected the id of a landmark feature, got 'pole'
 
         Raises
         ------
-        UnknownTerrainError
+        UnknownLandmarkError
             (a ``KeyError``) when the map has no such landmark.
         """
         index = self._landmark_index.get(landmark_id)
         if index is None:
-            raise UnknownTerrainError(
+            raise UnknownLandmarkError(
                 f"landmark: expected the id of a landmark of this map, got {landmark_id!r}"
             )
         return self.landmarks[index]

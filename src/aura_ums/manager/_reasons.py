@@ -1,0 +1,52 @@
+"""Why the map manager rejects an identified observation: one enum for every reason."""
+
+from __future__ import annotations
+
+import enum
+
+
+class RejectReason(enum.StrEnum):
+    """Why an observation did not reduce the map.
+
+    The first three are checks the manager makes before any reduction; the others are the
+    reductions' own: no pose of the map agrees with the observation (an *inconsistent*
+    observation, most likely a misidentified landmark). Each value is the text the
+    reductions and earlier versions wrote, so counts keyed by reason read the same in
+    JSON and CSV (a ``StrEnum`` member is its value wherever a string is expected).
+
+    Examples
+    --------
+    >>> RejectReason.STALE.inconsistent, RejectReason.NO_POSITION.inconsistent
+    (False, True)
+    >>> RejectReason("unknown landmark id")          # from its value, as saved
+    <RejectReason.UNKNOWN_LANDMARK: 'unknown landmark id'>
+    >>> RejectReason("no such reason")
+    Traceback (most recent call last):
+    ...
+    ValueError: 'no such reason' is not a valid RejectReason
+    """
+
+    #: The observation is older than the map (the map was grown past its time).
+    STALE = "observation older than the map's time"
+    #: The meadow map has no landmark with the observation's id.
+    UNKNOWN_LANDMARK = "unknown landmark id"
+    #: The observation is not of the class of the landmark it names.
+    CLASS_MISMATCH = "observation class differs from the landmark's"
+    #: No position of the map is consistent with the observation (Class I and II).
+    NO_POSITION = "no position of the map is consistent with the observation"
+    #: No sensor position of the map is consistent with it (a camera off the robot's centre).
+    NO_SENSOR_POSITION = "no sensor position of the map is consistent with the observation"
+    #: No heading of the map is consistent with the observed bearing.
+    NO_HEADING_FOR_BEARING = "no heading of the map is consistent with the observed bearing"
+    #: No heading of the map is consistent with the observed angle of a ground line (Class III).
+    NO_HEADING_FOR_LINE = "no heading of the map is consistent with the observed line angle"
+    #: No position of the map is at the observed offset from a ground line (Class III).
+    NO_LINE_OFFSET = "no position of the map is at the observed offset from the line"
+
+    @property
+    def inconsistent(self) -> bool:
+        """Whether it is a reduction's: no pose of the map agrees (the consistency gate)."""
+        return self not in _CHECKS
+
+
+_CHECKS = frozenset({RejectReason.STALE, RejectReason.UNKNOWN_LANDMARK, RejectReason.CLASS_MISMATCH})

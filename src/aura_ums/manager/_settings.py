@@ -1,0 +1,353 @@
+"""The map manager's settings: one frozen type, each field with its unit, range and help.
+
+Every reader of settings -- the ``aura-ums`` options, a scenario's ``[manager]`` table,
+:class:`~aura_ums.logs.ReplayOptions` and the manager's saved JSON -- is built from
+:class:`ManagerSettings` and the :class:`SettingInfo` of its fields: a default, a unit, a
+range or a help text is written here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+import textwrap
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from aura_ums.errors import InputError
+from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, DEFAULT_SECTOR
+
+#: What a setting holds.
+SettingValue = float | int | bool | None
+
+_INFO = "aura_ums.setting"
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class SettingInfo:
+    """What one field of :class:`ManagerSettings` is: its help, unit, type and range.
+
+    Attributes
+    ----------
+    help : str
+        One sentence (no final period) for option help and documentation.
+    unit : str
+        The unit (``"rad"``, ``"m^2"``); ``""`` for counts and factors.
+    kind : type
+        ``float``, ``int`` or ``bool``.
+    low, high : float or None
+        Smallest and largest value allowed (None: unbounded).
+    low_open : bool
+        Whether ``low`` itself is excluded.
+    nullable : bool
+        Whether None is allowed (its meaning is in ``help``).
+    off_flag : str
+        The command-line flag that turns the setting off: for a boolean, the one that
+        sets False (``"--gate-only"``); for a nullable setting whose default is not None,
+        the one that sets None (``"--one-by-one"``). ``""`` when there is none.
+
+    Examples
+    --------
+    >>> info = SettingInfo("Cap on the vertices", "", int, low=3)
+    >>> info.expected, info.problem(2), info.problem(8)
+    ('an integer >= 3', 'expected an integer >= 3, got 2', None)
+    >>> SettingInfo("Scale", "", float, low=1.0, nullable=True).problem(float("nan"))
+    'expected a finite number >= 1 or none, got nan'
+    """
+
+    help: str
+    unit: str
+    kind: type
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    nullable: bool = False
+    off_flag: str = ""
+
+    @property
+    def expected(self) -> str:
+        """What a valid value is, in words (``"a positive number"``, ``"an integer >= 3"``)."""
+        if self.kind is bool:
+            text = "true or false"
+        elif self.kind is int:
+            text = f"an integer >= {_shown(self.low)}" if self.low is not None else "an integer"
+        elif self.high is not None:
+            opening = "(" if self.low_open else "["
+            text = f"a number in {opening}{_shown(self.low)}, {_shown(self.high)}]"
+        elif self.low == 0.0 and self.low_open:
+            text = "a positive number"
+        elif self.low is not None:
+            text = f"a number {'>' if self.low_open else '>='} {_shown(self.low)}"
+        else:
+            text = "a number"
+        return f"{text} or none" if self.nullable else text
+
+    def problem(self, value: object) -> str | None:
+        """Return ``"expected ..., got ..."`` when ``value`` is not valid, else None."""
+        if value is None:
+            return None if self.nullable else f"expected {self.expected}, got None"
+        if self.kind is bool:
+            return None if isinstance(value, bool) else f"expected {self.expected}, got {value!r}"
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            return f"expected {self.expected}, got {value!r}"
+        if self.kind is int:
+            if not isinstance(value, numbers.Integral) or (self.low is not None and value < self.low):
+                return f"expected {self.expected}, got {value!r}"
+            return None
+        number = float(value)
+        if not math.isfinite(number):
+            return f"expected a finite {self.expected.removeprefix('a ')}, got {number!r}"
+        low, high = self.low, self.high
+        if (low is not None and (number < low or (self.low_open and number == low))) or (
+            high is not None and number > high
+        ):
+            return f"expected {self.expected}, got {number!r}"
+        return None
+
+    def normalize(self, value: object) -> SettingValue:
+        """Return a valid ``value`` (see :meth:`problem`) as the setting's type."""
+        if value is None or isinstance(value, bool):
+            return value
+        if self.kind is int and isinstance(value, numbers.Integral):
+            return int(value)
+        if isinstance(value, numbers.Real):
+            return float(value)
+        raise InputError(f"value: expected {self.expected}, got {value!r}")
+
+    @staticmethod
+    def of(field: dataclasses.Field[Any]) -> SettingInfo:
+        """Return the info of a field of :class:`ManagerSettings` (``dataclasses.fields``)."""
+        info = field.metadata.get(_INFO)
+        if not isinstance(info, SettingInfo):
+            raise InputError(f"field: expected a field of ManagerSettings, got {field.name!r}")
+        return info
+
+
+def _shown(value: float | None) -> str:
+    return "2 pi" if value == _TWO_PI else f"{value:g}"
+
+
+def _setting(default: Any, info: SettingInfo) -> Any:
+    return dataclasses.field(default=default, metadata={_INFO: info})
+
+
+def _fail(key: str, message: str) -> Exception:
+    return InputError(f"ManagerSettings.{key}: {message}")
+
+
+@dataclass(frozen=True, slots=True)
+class ManagerSettings:
+    """Every setting of the uncertainty map manager and its localizer, validated once.
+
+    The working map is reduced by observations under their typical bounds and guarded
+    by a consistency gate; with ``robust``, an envelope map under worst-case bounds
+    (``envelope_factor`` wider, unless the caller gives the envelope's observations) runs
+    alongside, and when ``relocalize_after`` of the last ``relocalize_window``
+    observations were inconsistent, the working map is re-localized from it (see
+    :class:`~aura_ums.manager.UncertaintyMapManager`).
+
+    Each field's unit, range and help are its :class:`SettingInfo` (``SettingInfo.of``
+    on ``dataclasses.fields(ManagerSettings)``): the command-line options and the
+    scenario reader are built from them. Errors read ``"ManagerSettings.<field>:
+    expected ..., got ..."`` (or name the option, key or file the value came from).
+
+    Examples
+    --------
+    >>> settings = ManagerSettings(area_limit=25.0, robust=False)
+    >>> settings.sigmas, settings.area_limit, settings.max_vertices
+    (3.0, 25.0, 64)
+    >>> ManagerSettings.from_dict(settings.to_dict()) == settings
+    True
+    >>> ManagerSettings.from_dict({"max_vertices": 24}).max_vertices   # the rest: defaults
+    24
+    >>> ManagerSettings(relocalize_after=2)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: ManagerSettings.relocalize_window: expected an integer >= \
+relocalize_after (2), got 1
+    """
+
+    sigmas: float = _setting(
+        3.0,
+        SettingInfo(
+            "Standard deviations of the motion and terrain model that the growth bounds",
+            "",
+            float,
+            low=0.0,
+            low_open=True,
+        ),
+    )
+    area_limit: float | None = _setting(
+        None,
+        SettingInfo(
+            "Map area above which the robot is lost (none: no limit)",
+            "m^2",
+            float,
+            low=0.0,
+            low_open=True,
+            nullable=True,
+        ),
+    )
+    missed_limit: int = _setting(
+        3,
+        SettingInfo(
+            "Frames in a row with landmarks predicted and none found that make the robot lost", "", int, low=1
+        ),
+    )
+    lost_window_scale: float = _setting(
+        2.0, SettingInfo("Factor by which the Expecter's windows widen while lost", "", float, low=1.0)
+    )
+    joint_above: float | None = _setting(
+        math.pi / 2,
+        SettingInfo(
+            "Heading wedge width above which the observations of one instant reduce the map "
+            "together (none: one by one)",
+            "rad",
+            float,
+            low=0.0,
+            nullable=True,
+            off_flag="--one-by-one",
+        ),
+    )
+    joint_sector: float = _setting(
+        DEFAULT_SECTOR,
+        SettingInfo(
+            "Widest heading sector of the joint reduction", "rad", float, low=0.0, high=_TWO_PI, low_open=True
+        ),
+    )
+    max_vertices: int = _setting(
+        DEFAULT_MAX_VERTICES,
+        SettingInfo("Cap on the map polygon's vertices: fewer is faster and looser", "", int, low=3),
+    )
+    robust: bool = _setting(
+        True,
+        SettingInfo(
+            "Keep an envelope map under worst-case bounds and re-localize from it (off: the "
+            "consistency gate alone)",
+            "",
+            bool,
+            off_flag="--gate-only",
+        ),
+    )
+    envelope_factor: float = _setting(
+        2.0,
+        SettingInfo(
+            "Factor by which the envelope map's bounds are wider than the working ones", "", float, low=1.0
+        ),
+    )
+    envelope_max_vertices: int | None = _setting(
+        None,
+        SettingInfo(
+            "Cap on the envelope map polygon's vertices (none: max_vertices)", "", int, low=3, nullable=True
+        ),
+    )
+    relocalize_after: int = _setting(
+        1,
+        SettingInfo(
+            "Inconsistent observations among the last relocalize_window that re-localize the working map",
+            "",
+            int,
+            low=1,
+        ),
+    )
+    relocalize_window: int = _setting(
+        1, SettingInfo("Observations remembered for relocalize_after", "", int, low=1)
+    )
+
+    def __post_init__(self) -> None:
+        values = _checked({f.name: getattr(self, f.name) for f in _FIELDS}, _fail)
+        for name, value in values.items():
+            object.__setattr__(self, name, value)
+
+    def to_dict(self) -> dict[str, SettingValue]:
+        """Return the settings as a JSON-ready dictionary, field name to value (None for none)."""
+        return {f.name: getattr(self, f.name) for f in _FIELDS}
+
+    @classmethod
+    def from_dict(
+        cls,
+        data: Mapping[str, object],
+        *,
+        base: ManagerSettings | None = None,
+        fail: Callable[[str, str], Exception] | None = None,
+    ) -> ManagerSettings:
+        """Return the settings of ``data`` (field name to value); missing fields are ``base``'s.
+
+        Parameters
+        ----------
+        data : Mapping[str, object]
+            Field names to values, as :meth:`to_dict` writes them.
+        base : ManagerSettings or None
+            Where the fields ``data`` leaves out come from (default: the defaults).
+        fail : callable or None
+            ``fail(field, message)`` returns the exception to raise for a bad field (a
+            reader names its file and key); default: an :class:`InputError` naming
+            ``ManagerSettings.<field>``.
+
+        Raises
+        ------
+        InputError
+            (or what ``fail`` returns) for an unknown field or a bad value.
+
+        Examples
+        --------
+        >>> ManagerSettings.from_dict({"sigma": 2.0})
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: ManagerSettings.sigma: expected a field of ManagerSettings \
+(sigmas, area_limit, missed_limit, lost_window_scale, joint_above, joint_sector, max_vertices, \
+robust, envelope_factor, envelope_max_vertices, relocalize_after, relocalize_window), got 'sigma'
+        """
+        report = _fail if fail is None else fail
+        if not isinstance(data, Mapping):
+            raise report("", f"expected a mapping of field names to values, got {type(data).__name__}")
+        start = ManagerSettings() if base is None else base
+        values: dict[str, object] = dict(start.to_dict())
+        for key, value in data.items():
+            if key not in _INFOS:
+                raise report(
+                    str(key), f"expected a field of ManagerSettings ({', '.join(_INFOS)}), got {key!r}"
+                )
+            values[key] = value
+        changes: dict[str, Any] = _checked(values, report)
+        return dataclasses.replace(start, **changes)
+
+
+_FIELDS = dataclasses.fields(ManagerSettings)
+_INFOS = {f.name: SettingInfo.of(f) for f in _FIELDS}
+
+
+def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]) -> dict[str, SettingValue]:
+    """Check every field of ``values`` and the fields' relations; return them normalized."""
+    checked: dict[str, SettingValue] = {}
+    for name, info in _INFOS.items():
+        value = values[name]
+        problem = info.problem(value)
+        if problem is not None:
+            raise fail(name, problem)
+        checked[name] = info.normalize(value)
+    after, window = checked["relocalize_after"], checked["relocalize_window"]
+    if isinstance(after, int) and isinstance(window, int) and window < after:
+        raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")
+    return checked
+
+
+def _document() -> str:
+    """Return the class docstring with a Parameters section written from the fields' infos."""
+    lines = ["Parameters", "----------"]
+    for field in _FIELDS:
+        info = _INFOS[field.name]
+        unit = f"Unit: {info.unit}. " if info.unit else ""
+        text = f"{info.help}. {unit}Valid: {info.expected}. Default: {field.default!r}."
+        lines.append(f"{field.name} : {info.kind.__name__}" + (" or None" if info.nullable else ""))
+        lines += textwrap.wrap(text, 84, initial_indent="    ", subsequent_indent="    ")
+    doc = ManagerSettings.__doc__ or ""
+    head, examples = doc.split("    Examples\n", 1)
+    section = "".join(f"    {line}\n" for line in lines)
+    return f"{head}{section}\n    Examples\n{examples}"
+
+
+ManagerSettings.__doc__ = _document()

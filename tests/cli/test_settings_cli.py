@@ -1,0 +1,109 @@
+"""The map manager's options: declared once from ManagerSettings, the same on replay, compare and simulate."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from aura_ums.cli import app
+from aura_ums.cli._common import NO_OPTIONS, SettingOptions, manager_options, setting_flag
+from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.sim import Scenario
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+DEFAULTS = ManagerSettings().to_dict()
+FIELDS = dataclasses.fields(ManagerSettings)
+runner = CliRunner()
+
+
+def flags_of(command: str) -> set[str]:
+    group = typer.main.get_command(app)
+    found = group.commands[command]  # type: ignore[attr-defined]
+    return {flag for param in found.params for flag in (*param.opts, *param.secondary_opts)}
+
+
+@pytest.mark.parametrize("command", ["replay", "compare", "simulate"])
+def test_the_commands_know_every_field(command: str) -> None:
+    flags = flags_of(command)
+    for field in FIELDS:
+        assert setting_flag(field.name) in flags, field.name
+        off = SettingInfo.of(field).off_flag
+        assert not off or off in flags, off
+
+
+def recorder() -> tuple[typer.Typer, list[ManagerSettings]]:
+    seen: list[ManagerSettings] = []
+    tool = typer.Typer()
+
+    @tool.command()
+    @manager_options()
+    def run(name: str, settings: SettingOptions = NO_OPTIONS) -> None:
+        seen.append(settings.over())
+
+    return tool, seen
+
+
+def other_than_default(field: dataclasses.Field[Any]) -> tuple[list[str], object]:
+    """The arguments that set a field to a value other than its default, and that value."""
+    info = SettingInfo.of(field)
+    flag = setting_flag(field.name)
+    if info.kind is bool:
+        return ([flag] if not DEFAULTS[field.name] else [info.off_flag]), not DEFAULTS[field.name]
+    if info.kind is int:
+        value: object = (DEFAULTS[field.name] or 3) + 2
+    else:
+        value = (DEFAULTS[field.name] or 1.0) * 1.5
+    return [flag, str(value)], value
+
+
+def test_every_field_reaches_the_command_from_its_option() -> None:
+    tool, seen = recorder()
+    arguments, expected = ["x"], {}
+    for field in FIELDS:
+        given, value = other_than_default(field)
+        arguments += given
+        expected[field.name] = value
+    result = runner.invoke(tool, arguments)
+    assert result.exit_code == 0, result.output
+    assert seen[-1].to_dict() == expected
+    assert runner.invoke(tool, ["x"]).exit_code == 0
+    assert seen[-1] == ManagerSettings()
+
+
+def test_an_off_flag_sets_none_and_bad_values_name_their_option() -> None:
+    tool, seen = recorder()
+    assert runner.invoke(tool, ["x", "--one-by-one", "--gate-only"]).exit_code == 0
+    assert (seen[-1].joint_above, seen[-1].robust) == (None, False)
+    both = runner.invoke(tool, ["x", "--one-by-one", "--joint-above", "1.0"])
+    assert both.exit_code == 2
+    assert "--joint-above: expected it or --one-by-one, got both" in both.output
+    bad = runner.invoke(tool, ["x", "--relocalize-after", "3"])
+    assert bad.exit_code == 2
+    assert "--relocalize-window: expected an integer >= relocalize_after (3), got 1" in bad.output
+
+
+def test_simulate_options_override_the_scenarios_manager_table(monkeypatch: pytest.MonkeyPatch) -> None:
+    import aura_ums.sim
+
+    ran: list[Scenario] = []
+    real = aura_ums.sim.run_scenario
+
+    def spy(scenario: Scenario, *args: Any, **kwargs: Any) -> Any:
+        ran.append(scenario)
+        return real(scenario, *args, **kwargs)
+
+    monkeypatch.setattr(aura_ums.sim, "run_scenario", spy)
+    path = str(SCENARIOS / "paper_sidewalk.toml")
+    result = runner.invoke(app, ["simulate", path, "--runs", "1", "--gate-only", "--missed-limit", "5"])
+    assert result.exit_code == 0, result.output
+    file = Scenario.from_toml(path).settings
+    assert ran[-1].settings == dataclasses.replace(file, robust=False, missed_limit=5)
+    assert ran[-1].settings.area_limit == file.area_limit == 25.0
+    bad = runner.invoke(app, ["simulate", path, "--runs", "1", "--envelope-factor", "0.5"])
+    assert bad.exit_code == 2
+    assert "--envelope-factor: expected a number >= 1, got 0.5" in bad.output

@@ -1,0 +1,122 @@
+"""ManagerSettings: defaults, units and ranges in one place; validation, to_dict and from_dict."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from aura_ums.errors import InputError
+from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, DEFAULT_SECTOR
+
+FIELDS = dataclasses.fields(ManagerSettings)
+
+
+def test_every_field_carries_its_info_and_a_valid_default() -> None:
+    for field in FIELDS:
+        info = SettingInfo.of(field)
+        assert info.help
+        assert not info.help.endswith(".")
+        assert info.kind in (float, int, bool)
+        assert info.problem(field.default) is None, field.name
+        assert field.name in (ManagerSettings.__doc__ or ""), field.name  # documented from the info
+    assert "max_vertices : int\n        Cap on the map polygon" in (ManagerSettings.__doc__ or "")
+
+
+def test_the_defaults_are_the_library_constants() -> None:
+    settings = ManagerSettings()
+    assert (settings.max_vertices, settings.joint_sector) == (DEFAULT_MAX_VERTICES, DEFAULT_SECTOR)
+    assert (settings.sigmas, settings.joint_above, settings.robust) == (3.0, math.pi / 2, True)
+    with pytest.raises(dataclasses.FrozenInstanceError, match="cannot assign to field"):
+        settings.sigmas = 2.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"sigmas": 0.0}, "sigmas: expected a positive number, got 0.0"),
+        ({"sigmas": "3"}, "sigmas: expected a positive number, got '3'"),
+        ({"sigmas": None}, "sigmas: expected a positive number, got None"),
+        ({"area_limit": -1.0}, "area_limit: expected a positive number or none, got -1.0"),
+        ({"area_limit": math.inf}, "area_limit: expected a finite positive number or none, got inf"),
+        ({"missed_limit": 0}, "missed_limit: expected an integer >= 1, got 0"),
+        ({"missed_limit": True}, "missed_limit: expected an integer >= 1, got True"),
+        ({"lost_window_scale": 0.5}, "lost_window_scale: expected a number >= 1, got 0.5"),
+        ({"joint_above": -0.1}, "joint_above: expected a number >= 0 or none, got -0.1"),
+        ({"joint_above": math.nan}, "joint_above: expected a finite number >= 0 or none, got nan"),
+        ({"joint_sector": 0.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 0.0"),
+        ({"joint_sector": 7.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 7.0"),
+        ({"max_vertices": 2}, "max_vertices: expected an integer >= 3, got 2"),
+        ({"max_vertices": 16.0}, "max_vertices: expected an integer >= 3, got 16.0"),
+        ({"robust": 1}, "robust: expected true or false, got 1"),
+        ({"envelope_factor": 0.9}, "envelope_factor: expected a number >= 1, got 0.9"),
+        ({"envelope_max_vertices": 1.5}, "envelope_max_vertices: expected an integer >= 3 or none, got 1.5"),
+        ({"relocalize_after": 0}, "relocalize_after: expected an integer >= 1, got 0"),
+        (
+            {"relocalize_after": 3, "relocalize_window": 2},
+            r"relocalize_window: expected an integer >= relocalize_after \(3\), got 2",
+        ),
+    ],
+)
+def test_bad_settings_are_refused_by_field_name(changes: dict[str, Any], message: str) -> None:
+    with pytest.raises(InputError, match=f"^ManagerSettings.{message}$"):
+        ManagerSettings(**changes)
+    with pytest.raises(InputError, match=f"^ManagerSettings.{message}$"):
+        ManagerSettings.from_dict(changes)
+
+
+def test_numbers_are_normalized_to_the_fields_types() -> None:
+    settings = ManagerSettings(sigmas=np.float32(2.5), max_vertices=np.int64(12), area_limit=4)  # type: ignore[arg-type]
+    assert (type(settings.sigmas), type(settings.max_vertices), type(settings.area_limit)) == (
+        float,
+        int,
+        float,
+    )
+    assert settings == ManagerSettings(sigmas=2.5, max_vertices=12, area_limit=4.0)
+
+
+def test_from_dict_takes_a_base_and_names_places_through_fail() -> None:
+    base = ManagerSettings(area_limit=9.0, robust=False)
+    merged = ManagerSettings.from_dict({"sigmas": 2.0}, base=base)
+    assert (merged.sigmas, merged.area_limit, merged.robust) == (2.0, 9.0, False)
+
+    def fail(key: str, message: str) -> Exception:
+        return KeyError(f"file.toml: [manager] {key}: {message}")
+
+    with pytest.raises(KeyError, match=r"file\.toml: \[manager\] missed_limit: expected an integer >= 1"):
+        ManagerSettings.from_dict({"missed_limit": 0}, fail=fail)
+    with pytest.raises(KeyError, match=r"\[manager\] sigma: expected a field of ManagerSettings"):
+        ManagerSettings.from_dict({"sigma": 3.0}, fail=fail)
+    with pytest.raises(InputError, match="expected a mapping of field names to values, got list"):
+        ManagerSettings.from_dict([("sigmas", 3.0)])  # type: ignore[arg-type]
+
+
+valid = st.builds(
+    ManagerSettings,
+    sigmas=st.floats(0.1, 10.0),
+    area_limit=st.none() | st.floats(0.1, 1e6),
+    missed_limit=st.integers(1, 20),
+    lost_window_scale=st.floats(1.0, 10.0),
+    joint_above=st.none() | st.floats(0.0, 7.0),
+    joint_sector=st.floats(1e-3, 2 * math.pi),
+    max_vertices=st.integers(3, 500),
+    robust=st.booleans(),
+    envelope_factor=st.floats(1.0, 10.0),
+    envelope_max_vertices=st.none() | st.integers(3, 500),
+    relocalize_after=st.just(1),
+    relocalize_window=st.integers(1, 10),
+)
+
+
+@given(valid)
+def test_to_dict_is_strict_json_and_from_dict_restores_it(settings: ManagerSettings) -> None:
+    text = json.dumps(settings.to_dict(), allow_nan=False)
+    assert ManagerSettings.from_dict(json.loads(text)) == settings
+    assert list(settings.to_dict()) == [field.name for field in FIELDS]
