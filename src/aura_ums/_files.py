@@ -215,15 +215,15 @@ def parse_toml(text: str, source: str, *, max_bytes: int | None = None) -> dict[
     try:
         return tomllib.loads(body)
     except tomllib.TOMLDecodeError as exc:
-        match = _TOML_POSITION.match(str(exc))
-        if match is None:
-            raise FileFormatError(source, "", f"expected valid TOML, got {exc}") from None
+        text_of_error = str(exc)
+        match = _TOML_POSITION.match(text_of_error)
+        if match is not None:
+            message, line, column = match["message"], int(match["line"]), int(match["column"])
+        else:  # "... (at end of document)": the place after the last character
+            message = text_of_error.removesuffix(" (at end of document)")
+            line, column = body.count("\n") + 1, len(body) - body.rfind("\n")
         raise FileFormatError(
-            source,
-            "",
-            f"expected valid TOML, got {match['message']}",
-            line=int(match["line"]),
-            column=int(match["column"]),
+            source, "", f"expected valid TOML, got {message}", line=line, column=column
         ) from None
     except RecursionError:
         raise FileFormatError(

@@ -56,7 +56,16 @@ def _write(path: Path, text: str) -> Path:
     ("text", "match"),
     [
         ('format = "aura-ums/sensor-calibration"\n', "expected keys"),
-        ("format = [", "expected TOML"),
+        ("format = [", r"bad\.toml:1:11: expected valid TOML, got Invalid value"),
+        (
+            'format = "aura-ums/sensor-calibration"\nmotion = 1\nworking = 2\nenvelope = 3\n',
+            r"\[motion\]: expected a table, got 1",
+        ),
+        (
+            'format = "aura-ums/sensor-calibration"\n[motion]\ndelay_s = "0"\nrun_scale = 1\nturn_scale = 1\n'
+            "[working]\n[envelope]\n",
+            r"bad\.toml: \[motion\] delay_s: expected a finite number, got '0'",
+        ),
         (
             'format = "x"\n[motion]\n[working]\n[envelope]\n',
             "format: expected 'aura-ums/sensor-calibration'",
@@ -70,7 +79,9 @@ def test_bad_sensor_files_name_the_file(tmp_path: Path, text: str, match: str) -
 
 
 def test_missing_sensor_file_is_named(tmp_path: Path) -> None:
-    with pytest.raises(FileFormatError, match=r"nothere.toml: expected a sensor calibration TOML file"):
+    with pytest.raises(
+        FileFormatError, match=r"nothere.toml: expected an existing sensor calibration TOML file"
+    ):
         load_sensors(tmp_path / "nothere.toml")
 
 
@@ -81,7 +92,9 @@ def test_out_of_range_sensor_value_is_named(tmp_path: Path) -> None:
         .sensors_toml()
         .replace("[working]\nbearing_error = ", "[working]\nbearing_error = -")
     )
-    with pytest.raises(FileFormatError, match=r"SensorBounds.bearing_error: expected a positive number"):
+    with pytest.raises(
+        FileFormatError, match=r"neg\.toml: \[working\] bearing_error: expected a positive number"
+    ):
         load_sensors(_write(tmp_path / "neg.toml", text))
 
 
