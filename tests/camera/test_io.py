@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -403,3 +404,46 @@ def test_yaml_and_json_agree(tmp_path: Path) -> None:
     from_yaml = load_opencv_calibration(write(tmp_path, "a.yml", yaml), MOUNT)
     assert from_json == from_yaml
     np.testing.assert_array_equal(from_json.intrinsics.matrix(), from_yaml.intrinsics.matrix())
+
+
+# -------------------------------------------------------------------- encodings and limits
+
+BOM = b"\xef\xbb\xbf"
+
+
+@pytest.mark.parametrize(("name", "text"), [("c.yml", GOOD_YAML), ("c.json", json.dumps(GOOD_JSON))])
+def test_opencv_files_with_a_byte_order_mark_read_the_same(tmp_path: Path, name: str, text: str) -> None:
+    plain = load_opencv_calibration(write(tmp_path, name, text), MOUNT)
+    (tmp_path / f"bom-{name}").write_bytes(BOM + text.encode())
+    assert load_opencv_calibration(tmp_path / f"bom-{name}", MOUNT) == plain
+
+
+def test_toml_camera_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    (tmp_path / "bom.toml").write_bytes(BOM + GOOD_TOML.encode())
+    assert load_camera(tmp_path / "bom.toml") == load_camera(write(tmp_path, "plain.toml", GOOD_TOML))
+    assert load_calibration_bounds(tmp_path / "bom.toml") == load_calibration_bounds(tmp_path / "plain.toml")
+
+
+@pytest.mark.parametrize("name", ["c.toml", "c.yml", "c.json"])
+def test_latin1_camera_files_are_refused_naming_file_and_byte(tmp_path: Path, name: str) -> None:
+    path = tmp_path / name
+    path.write_bytes('{"note": "f\u00e9",'.encode("latin-1"))
+    loader = load_camera if name.endswith(".toml") else (lambda p: load_opencv_calibration(p, MOUNT))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{path}:1: byte 11: expected UTF-8 text, got the byte 0xe9")
+    ):
+        loader(path)
+
+
+def test_over_size_camera_file_is_refused_stating_the_limit(tmp_path: Path) -> None:
+    path = tmp_path / "huge.yml"
+    with path.open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"huge\.yml: expected a calibration file of at most 64 MiB"):
+        load_opencv_calibration(path, MOUNT)
+
+
+def test_deeply_nested_yaml_is_a_clean_error(tmp_path: Path) -> None:
+    path = write(tmp_path, "deep.yml", "%YAML:1.0\nx: " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(FileFormatError, match=r"deep\.yml: expected YAML, got collections nested too deep"):
+        load_opencv_calibration(path, MOUNT)

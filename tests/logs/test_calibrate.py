@@ -128,3 +128,18 @@ def test_mrclam_calibration_finds_the_command_delay_and_heavy_tails() -> None:
     assert 0.1 <= calibration.motion.delay_s <= 0.3  # commanded velocities lead the robot
     assert calibration.motion.run_scale > 1.0  # the robot sometimes outruns its command
     assert calibration.envelope.bearing_error > 1.5 * calibration.working.bearing_error
+
+
+def test_sensor_file_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    text = calibrate_logs([synthetic_log(np.random.default_rng(1), duration=60.0)]).sensors_toml()
+    plain = load_sensors(_write(tmp_path / "plain.toml", text))
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    assert load_sensors(tmp_path / "bom.toml") == plain
+
+
+def test_latin1_sensor_file_is_refused_naming_it(tmp_path: Path) -> None:
+    (tmp_path / "latin.toml").write_bytes('format = "x"\n# \u00b0\n'.encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=r"latin\.toml:2: byte 15: expected UTF-8 text, got the byte 0xb0"
+    ):
+        load_sensors(tmp_path / "latin.toml")

@@ -384,3 +384,49 @@ def test_bad_meta_toml(tmp_path: Path, text: str, pattern: str) -> None:
     write_files(tmp_path, dict(VALID_FILES, **{"meta.toml": text}))
     with pytest.raises(FileFormatError, match=pattern):
         load_log(tmp_path)
+
+
+# --- encodings and limits (the loading layer) ---------------------------------------------------
+
+
+def test_every_file_with_an_excel_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    plain = load_log(write_files(tmp_path / "plain", VALID_FILES))
+    folder = write_files(tmp_path / "bom", {name: "\ufeff" + text for name, text in VALID_FILES.items()})
+    with_bom = load_log(folder)
+    assert_same_log(with_bom, plain, lines=True)
+    assert with_bom.meta == plain.meta
+
+
+def test_an_excel_csv_with_crlf_and_bom_reads_the_same(tmp_path: Path) -> None:
+    plain = load_log(write_files(tmp_path / "plain", VALID_FILES))
+    folder = write_files(tmp_path / "excel", VALID_FILES)
+    for name in ("landmarks.csv", "observations.csv", "odometry.csv"):
+        (folder / name).write_bytes(b"\xef\xbb\xbf" + VALID_FILES[name].replace("\n", "\r\n").encode())
+    assert_same_log(load_log(folder), plain, lines=True)
+
+
+@pytest.mark.parametrize("name", ["meta.toml", "landmarks.csv", "observations.csv", "odometry.csv"])
+def test_latin1_files_are_refused_naming_file_and_byte(tmp_path: Path, name: str) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    (folder / name).write_bytes(("# r\u00e9sum\u00e9\n" + VALID_FILES[name]).encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{folder / name}:1: byte 3: expected UTF-8 text, got the byte 0xe9")
+    ):
+        load_log(folder)
+
+
+def test_too_many_rows_are_refused_at_the_first_one_over(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    monkeypatch.setattr("aura_ums._files.MAX_ROWS", 2)
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: expected at most 2 data rows, got more"):
+        load_log(folder)
+
+
+def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    with (folder / "odometry.csv").open("ab") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 64 MiB \("):
+        load_log(folder)

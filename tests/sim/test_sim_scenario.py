@@ -309,3 +309,22 @@ def test_frames_are_read_only() -> None:
     frame = next(iter(scenario.simulate(np.random.default_rng(0))))
     with pytest.raises(ValueError, match="read-only"):
         frame.image[0, 0] = 0
+
+
+def test_scenario_with_a_byte_order_mark_reads_the_same(folder: Path) -> None:
+    (folder / "bom.toml").write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
+    plain, with_bom = Scenario.from_toml(folder / "good.toml"), Scenario.from_toml(folder / "bom.toml")
+    assert (with_bom.commands, with_bom.start, with_bom.lost, with_bom.camera) == (
+        plain.commands,
+        plain.start,
+        plain.lost,
+        plain.camera,
+    )
+    assert with_bom.name == "bom"
+
+
+def test_over_size_scenario_is_refused_stating_the_limit(folder: Path) -> None:
+    with (folder / "huge.toml").open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"huge\.toml: expected a scenario file of at most 64 MiB"):
+        Scenario.from_toml(folder / "huge.toml")

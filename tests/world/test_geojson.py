@@ -548,3 +548,40 @@ def test_saved_file_is_a_readable_feature_collection(tmp_path: Path) -> None:
     assert ring[0] == ring[-1]
     assert document["features"][4]["properties"]["strategy"] == "line_finder"
     assert len(path.read_text(encoding="utf-8").splitlines()) == 3 + 8 + 2  # one feature per line
+
+
+# --- encodings and limits (the loading layer) ---------------------------------------------------
+
+
+def test_a_map_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    world = make_grid_world(2, 2)
+    path = tmp_path / "grid.geojson"
+    world.to_geojson(path)
+    (tmp_path / "bom.geojson").write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert MeadowMap.from_geojson(tmp_path / "bom.geojson") == world
+
+
+def test_latin1_map_is_refused_naming_file_line_and_byte(tmp_path: Path) -> None:
+    path = tmp_path / "latin.geojson"
+    path.write_bytes('{"type": "FeatureCollection",\n "name": "Z\u00fcrich"}'.encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{path}:2: byte 41: expected UTF-8 text, got the byte 0xfc")
+    ):
+        MeadowMap.from_geojson(path)
+
+
+def test_over_size_map_is_refused_stating_the_limit(tmp_path: Path) -> None:
+    path = tmp_path / "huge.geojson"
+    with path.open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"huge\.geojson: expected a GeoJSON file of at most 64 MiB"):
+        MeadowMap.from_geojson(path)
+
+
+def test_nan_in_a_coordinate_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "nan.geojson"
+    path.write_text(json.dumps(base_document()).replace("0.0", "NaN", 1))
+    with pytest.raises(
+        FileFormatError, match=r"nan\.geojson: expected valid JSON, got the non-standard number NaN"
+    ):
+        MeadowMap.from_geojson(path)
