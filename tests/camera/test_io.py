@@ -447,3 +447,10 @@ def test_deeply_nested_yaml_is_a_clean_error(tmp_path: Path) -> None:
     path = write(tmp_path, "deep.yml", "%YAML:1.0\nx: " + "[" * 5000 + "]" * 5000 + "\n")
     with pytest.raises(FileFormatError, match=r"deep\.yml: expected YAML, got collections nested too deep"):
         load_opencv_calibration(path, MOUNT)
+
+
+def test_a_flow_sequence_cut_after_a_comma_is_a_clean_error(tmp_path: Path) -> None:
+    # Found by tests/test_files_fuzz.py: the end of the value was taken for a quote.
+    path = write(tmp_path, "cut.yml", "%YAML:1.0\n]: [1,\n")
+    with pytest.raises(FileFormatError, match=r"cut\.yml:2: expected a value, got ''"):
+        load_opencv_calibration(path, MOUNT)

@@ -321,7 +321,7 @@ class _Flow:
             return self._sequence()
         if char == "{":
             return self._mapping()
-        if char in "\"'":
+        if char and char in "\"'":  # "" (the end) is in every string
             return self._quoted()
         start = self.pos
         while self.pos < len(self.text) and self.text[self.pos] not in stops:
@@ -374,7 +374,7 @@ class _Flow:
             self.pos += 1
             return items
         while True:
-            key = self._quoted() if self._peek() in "\"'" else str(self.value(":,}"))
+            key = self._quoted() if self._peek() in ('"', "'") else str(self.value(":,}"))
             if self._peek() != ":":
                 raise self.fail(f"expected ':' after the key {key!r}, got {self._peek() or 'the end'!r}")
             self.pos += 1
