@@ -38,21 +38,44 @@ class MissingDependencyError(AuraUmsError, ImportError):
 class FileFormatError(InputError):
     """A file read by aura-ums is missing, unreadable or malformed.
 
+    The message reads ``file:line: expected ..., got ...`` when the place is a line, and
+    ``file: key path: expected ..., got ...`` when it is a key (a table, a property).
+
     Parameters
     ----------
     path : str
         The file, as the caller named it.
     where : str
-        The place in the file (a table, a key, a line), or ``""`` for the whole file.
+        The place in the file (a table, a key path, a byte offset), or ``""`` for the
+        whole file or a line alone.
     message : str
         What was expected and what was found.
+    line, column : int, optional
+        1-based line (and column) of the place, written after the file name.
+
+    Examples
+    --------
+    >>> str(FileFormatError("log/odometry.csv", "", "expected 3 cells, got 2", line=7))
+    'log/odometry.csv:7: expected 3 cells, got 2'
+    >>> str(FileFormatError("cam.toml", "[mount] height", "expected a finite number, got 'tall'"))
+    "cam.toml: [mount] height: expected a finite number, got 'tall'"
+    >>> str(FileFormatError("map.geojson", "", "expected valid JSON, got Expecting value", line=1, column=9))
+    'map.geojson:1:9: expected valid JSON, got Expecting value'
     """
 
-    def __init__(self, path: str, where: str, message: str) -> None:
+    def __init__(
+        self, path: str, where: str, message: str, *, line: int | None = None, column: int | None = None
+    ) -> None:
         self.path = path
         self.where = where
         self.message = message
-        location = f"{path}: {where}" if where else path
+        self.line = line
+        self.column = column
+        location = path
+        if line is not None:
+            location += f":{line}" if column is None else f":{line}:{column}"
+        if where:
+            location += f": {where}"
         super().__init__(f"{location}: {message}")
 
 

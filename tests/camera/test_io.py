@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +96,7 @@ def edit(old: str, new: str) -> str:
 @pytest.mark.parametrize(
     ("text", "where", "match"),
     [
-        ("[intrinsics\nfx = 1", "line 1", "expected TOML"),
+        ("[intrinsics\nfx = 1", "bad.toml:1:12", "expected valid TOML, got Expected ']'"),
         (
             "[mount]" + GOOD_TOML.split("[mount]")[1],
             "intrinsics",
@@ -105,9 +106,9 @@ def edit(old: str, new: str) -> str:
         (edit("fx = 500.0\n", ""), "intrinsics", r"\[intrinsics\]: expected keys fx, got none"),
         (edit("cx = 320.0", "cx = 320.0\nskew = 0.0"), "skew", r"\[intrinsics\] skew: .*unknown key 'skew'"),
         (GOOD_TOML + "\n[lens]\nmodel = 1\n", "lens", r"lens: expected one of .*unknown key 'lens'"),
-        (edit("width = 640", "width = 640.0"), "width", r"\[intrinsics\] width: expected a positive integer"),
+        (edit("width = 640", "width = 640.0"), "width", r"\[intrinsics\] width: expected an integer >= 1"),
         (edit("fy = 505.0", "fy = nan"), "fy", r"\[intrinsics\] fy: expected a finite number, got nan"),
-        (edit("fy = 505.0", 'fy = "505"'), "fy", r"\[intrinsics\] fy: expected a number, got '505'"),
+        (edit("fy = 505.0", 'fy = "505"'), "fy", r"\[intrinsics\] fy: expected a finite number, got '505'"),
         (edit("fx = 500.0", "fx = -500.0"), "fx", r"\[intrinsics\] fx: expected a positive focal length"),
         (edit("-0.002]", "-0.002, 0.0, 0.0]"), "distortion", "expected 4, 5, 8, 12 or 14 distortion"),
         (edit("-0.002]", "-0.002, 0.0, 0.1, 0.0, 0.0]"), "distortion", "beyond k3 .* to be zero"),
@@ -123,11 +124,16 @@ def test_toml_errors_name_file_and_key(tmp_path: Path, text: str, where: str, ma
     with pytest.raises(FileFormatError, match=match) as caught:
         load_camera(path)
     assert caught.value.path == str(path)
-    assert where in caught.value.where
+    assert where in location(caught.value)
+
+
+def location(error: FileFormatError) -> str:
+    """The place an error names: the file, its line if any, and the key path."""
+    return str(error).removesuffix(f": {error.message}")
 
 
 def test_missing_files_are_named(tmp_path: Path) -> None:
-    with pytest.raises(FileFormatError, match=r"nowhere\.toml: expected an existing TOML file"):
+    with pytest.raises(FileFormatError, match=r"nowhere\.toml: expected an existing camera TOML file"):
         load_camera(tmp_path / "nowhere.toml")
     with pytest.raises(FileFormatError, match=r"nowhere\.yml: expected an existing calibration file"):
         load_opencv_calibration(tmp_path / "nowhere.yml", MOUNT)
@@ -207,10 +213,10 @@ def yaml_edit(old: str, new: str) -> str:
 @pytest.mark.parametrize(
     ("text", "where", "match"),
     [
-        (GOOD_YAML.replace("%YAML:1.0\n", ""), "line 1", "expected the '%YAML:1.0' header"),
+        (GOOD_YAML.replace("%YAML:1.0\n", ""), "calib.yml:1", "expected the '%YAML:1.0' header"),
         (yaml_edit("camera_matrix:", "cam_matrix:"), "camera_matrix", "expected the key camera_matrix"),
         (yaml_edit("image_height: 480\n", ""), "image_height", "expected the key image_height"),
-        (yaml_edit("image_width: 640", "image_width: 640.5"), "image_width", "expected a positive integer"),
+        (yaml_edit("image_width: 640", "image_width: 640.5"), "image_width", "expected an integer >= 1"),
         (
             yaml_edit(" 0., 0., 1. ]", " 0., 0. ]"),
             "camera_matrix.data",
@@ -245,12 +251,12 @@ def yaml_edit(old: str, new: str) -> str:
         ),
         (yaml_edit("   dt: d\n   data: [ 6", "   data: [ 6"), "camera_matrix.dt", "expected this field"),
         (yaml_edit("dt: d", "dt: 3d"), "camera_matrix.dt", "one-channel element type"),
-        (yaml_edit("0., 0., 1. ]", "0., 0., 1. "), "line", "expected balanced brackets"),
-        (yaml_edit("nframes: 20", "nframes 20"), "line 4", "expected 'key: value', got 'nframes 20'"),
-        (yaml_edit("flags: 128", "   flags: 128"), "line 11", "expected indentation 0, got 3"),
-        (yaml_edit("board_width: 9", "image_width: 9"), "line 7", "expected the key 'image_width' once"),
-        (yaml_edit("1, 1 ] }", "1, 1 } }"), "line 31", r"expected ',' or '\]' in a list"),
-        (yaml_edit("{ x:167,", "{ x 167,"), "line 31", r"expected ':' after the key 'x 167'"),
+        (yaml_edit("0., 0., 1. ]", "0., 0., 1. "), "calib.yml:16", "expected balanced brackets"),
+        (yaml_edit("nframes: 20", "nframes 20"), "calib.yml:4", "expected 'key: value', got 'nframes 20'"),
+        (yaml_edit("flags: 128", "   flags: 128"), "calib.yml:11", "expected indentation 0, got 3"),
+        (yaml_edit("board_width: 9", "image_width: 9"), "calib.yml:7", "expected the key 'image_width' once"),
+        (yaml_edit("1, 1 ] }", "1, 1 } }"), "calib.yml:31", r"expected ',' or '\]' in a list"),
+        (yaml_edit("{ x:167,", "{ x 167,"), "calib.yml:31", r"expected ':' after the key 'x 167'"),
         (
             yaml_edit("rows: 5\n   cols: 1", "rows: 1\n   cols: 5")
             .replace("rows: 1\n   cols: 5", "rows: 1\n   cols: 8", 1)
@@ -265,7 +271,7 @@ def test_opencv_yaml_errors(tmp_path: Path, text: str, where: str, match: str) -
     with pytest.raises(FileFormatError, match=match) as caught:
         load_opencv_calibration(path, MOUNT)
     assert caught.value.path == str(path)
-    assert where in caught.value.where
+    assert where in location(caught.value)
 
 
 # -------------------------------------------------------------------- FileStorage JSON
@@ -303,12 +309,17 @@ def test_opencv_json_with_bare_trailing_dots(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "where", "match"),
     [
-        ('{"image_width": 640,', "line 1", "expected JSON"),
-        ("[1, 2]", "", "expected a top-level JSON object, got list"),
+        ('{"image_width": 640,', "calib.json:1:21", "expected valid JSON, got Expecting property name"),
+        ("[1, 2]", "", "expected an object, got an array"),
+        (
+            '{"image_width": 640, "image_width": 640}',
+            "",
+            "expected valid JSON, got the key 'image_width' twice",
+        ),
         (
             json.dumps({**GOOD_JSON, "image_width": -640}),
             "image_width",
-            "expected a positive integer, got -640",
+            "expected an integer >= 1, got -640",
         ),
         (
             json.dumps({k: v for k, v in GOOD_JSON.items() if k != "camera_matrix"}),
@@ -317,8 +328,8 @@ def test_opencv_json_with_bare_trailing_dots(tmp_path: Path) -> None:
         ),
         (
             json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, [math.nan] * 9)}),
-            "camera_matrix.data[0]",
-            "expected a finite number, got nan",
+            "",
+            "expected valid JSON, got the non-standard number NaN",
         ),
         (
             json.dumps(
@@ -340,7 +351,7 @@ def test_opencv_json_with_bare_trailing_dots(tmp_path: Path) -> None:
         (
             json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, ["a"] * 9)}),  # type: ignore[list-item]
             "camera_matrix.data[0]",
-            "expected a number, got 'a'",
+            "expected a finite number, got 'a'",
         ),
         (
             json.dumps({**GOOD_JSON, "cameraMatrix": GOOD_JSON["camera_matrix"]}),
@@ -359,12 +370,14 @@ def test_opencv_json_errors(tmp_path: Path, text: str, where: str, match: str) -
     with pytest.raises(FileFormatError, match=match) as caught:
         load_opencv_calibration(path, MOUNT)
     assert caught.value.path == str(path)
-    assert where in caught.value.where
+    assert where in location(caught.value)
 
 
 def test_opencv_loader_refuses_other_formats(tmp_path: Path) -> None:
     path = write(tmp_path, "calib.xml", '<?xml version="1.0"?>\n<opencv_storage>\n</opencv_storage>\n')
-    with pytest.raises(FileFormatError, match=r"line 1: expected a FileStorage YAML \('%YAML:1.0'\) or JSON"):
+    with pytest.raises(
+        FileFormatError, match=r"calib\.xml:1: expected a FileStorage YAML \('%YAML:1.0'\) or JSON"
+    ):
         load_opencv_calibration(path, MOUNT)
 
 
@@ -391,3 +404,53 @@ def test_yaml_and_json_agree(tmp_path: Path) -> None:
     from_yaml = load_opencv_calibration(write(tmp_path, "a.yml", yaml), MOUNT)
     assert from_json == from_yaml
     np.testing.assert_array_equal(from_json.intrinsics.matrix(), from_yaml.intrinsics.matrix())
+
+
+# -------------------------------------------------------------------- encodings and limits
+
+BOM = b"\xef\xbb\xbf"
+
+
+@pytest.mark.parametrize(("name", "text"), [("c.yml", GOOD_YAML), ("c.json", json.dumps(GOOD_JSON))])
+def test_opencv_files_with_a_byte_order_mark_read_the_same(tmp_path: Path, name: str, text: str) -> None:
+    plain = load_opencv_calibration(write(tmp_path, name, text), MOUNT)
+    (tmp_path / f"bom-{name}").write_bytes(BOM + text.encode())
+    assert load_opencv_calibration(tmp_path / f"bom-{name}", MOUNT) == plain
+
+
+def test_toml_camera_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    (tmp_path / "bom.toml").write_bytes(BOM + GOOD_TOML.encode())
+    assert load_camera(tmp_path / "bom.toml") == load_camera(write(tmp_path, "plain.toml", GOOD_TOML))
+    assert load_calibration_bounds(tmp_path / "bom.toml") == load_calibration_bounds(tmp_path / "plain.toml")
+
+
+@pytest.mark.parametrize("name", ["c.toml", "c.yml", "c.json"])
+def test_latin1_camera_files_are_refused_naming_file_and_byte(tmp_path: Path, name: str) -> None:
+    path = tmp_path / name
+    path.write_bytes('{"note": "f\u00e9",'.encode("latin-1"))
+    loader = load_camera if name.endswith(".toml") else (lambda p: load_opencv_calibration(p, MOUNT))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{path}:1: byte 11: expected UTF-8 text, got the byte 0xe9")
+    ):
+        loader(path)
+
+
+def test_over_size_camera_file_is_refused_stating_the_limit(tmp_path: Path) -> None:
+    path = tmp_path / "huge.yml"
+    with path.open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"huge\.yml: expected a calibration file of at most 64 MiB"):
+        load_opencv_calibration(path, MOUNT)
+
+
+def test_deeply_nested_yaml_is_a_clean_error(tmp_path: Path) -> None:
+    path = write(tmp_path, "deep.yml", "%YAML:1.0\nx: " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(FileFormatError, match=r"deep\.yml: expected YAML, got collections nested too deep"):
+        load_opencv_calibration(path, MOUNT)
+
+
+def test_a_flow_sequence_cut_after_a_comma_is_a_clean_error(tmp_path: Path) -> None:
+    # Found by tests/test_files_fuzz.py: the end of the value was taken for a quote.
+    path = write(tmp_path, "cut.yml", "%YAML:1.0\n]: [1,\n")
+    with pytest.raises(FileFormatError, match=r"cut\.yml:2: expected a value, got ''"):
+        load_opencv_calibration(path, MOUNT)

@@ -92,4 +92,4 @@ def test_malformed_file_is_an_error_naming_file_and_line(
     (dataset / "Robot1_Odometry.dat").write_text(HEADER + "9.0 0.1\n")
     result = runner.invoke(app, ["import", "mrclam", str(dataset), "--robot", "1", str(tmp_path / "out")])
     assert result.exit_code == 2
-    assert "Robot1_Odometry.dat: line 5: expected 3 numbers (time, v, omega), got 2" in result.output
+    assert "Robot1_Odometry.dat:5: expected 3 numbers (time, v, omega), got 2" in result.output

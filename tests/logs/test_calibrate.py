@@ -56,7 +56,16 @@ def _write(path: Path, text: str) -> Path:
     ("text", "match"),
     [
         ('format = "aura-ums/sensor-calibration"\n', "expected keys"),
-        ("format = [", "expected TOML"),
+        ("format = [", r"bad\.toml:1:11: expected valid TOML, got Invalid value"),
+        (
+            'format = "aura-ums/sensor-calibration"\nmotion = 1\nworking = 2\nenvelope = 3\n',
+            r"\[motion\]: expected a table, got 1",
+        ),
+        (
+            'format = "aura-ums/sensor-calibration"\n[motion]\ndelay_s = "0"\nrun_scale = 1\nturn_scale = 1\n'
+            "[working]\n[envelope]\n",
+            r"bad\.toml: \[motion\] delay_s: expected a finite number, got '0'",
+        ),
         (
             'format = "x"\n[motion]\n[working]\n[envelope]\n',
             "format: expected 'aura-ums/sensor-calibration'",
@@ -70,7 +79,9 @@ def test_bad_sensor_files_name_the_file(tmp_path: Path, text: str, match: str) -
 
 
 def test_missing_sensor_file_is_named(tmp_path: Path) -> None:
-    with pytest.raises(FileFormatError, match=r"nothere.toml: expected a sensor calibration TOML file"):
+    with pytest.raises(
+        FileFormatError, match=r"nothere.toml: expected an existing sensor calibration TOML file"
+    ):
         load_sensors(tmp_path / "nothere.toml")
 
 
@@ -81,7 +92,9 @@ def test_out_of_range_sensor_value_is_named(tmp_path: Path) -> None:
         .sensors_toml()
         .replace("[working]\nbearing_error = ", "[working]\nbearing_error = -")
     )
-    with pytest.raises(FileFormatError, match=r"SensorBounds.bearing_error: expected a positive number"):
+    with pytest.raises(
+        FileFormatError, match=r"neg\.toml: \[working\] bearing_error: expected a positive number"
+    ):
         load_sensors(_write(tmp_path / "neg.toml", text))
 
 
@@ -115,3 +128,18 @@ def test_mrclam_calibration_finds_the_command_delay_and_heavy_tails() -> None:
     assert 0.1 <= calibration.motion.delay_s <= 0.3  # commanded velocities lead the robot
     assert calibration.motion.run_scale > 1.0  # the robot sometimes outruns its command
     assert calibration.envelope.bearing_error > 1.5 * calibration.working.bearing_error
+
+
+def test_sensor_file_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    text = calibrate_logs([synthetic_log(np.random.default_rng(1), duration=60.0)]).sensors_toml()
+    plain = load_sensors(_write(tmp_path / "plain.toml", text))
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    assert load_sensors(tmp_path / "bom.toml") == plain
+
+
+def test_latin1_sensor_file_is_refused_naming_it(tmp_path: Path) -> None:
+    (tmp_path / "latin.toml").write_bytes('format = "x"\n# \u00b0\n'.encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=r"latin\.toml:2: byte 15: expected UTF-8 text, got the byte 0xb0"
+    ):
+        load_sensors(tmp_path / "latin.toml")

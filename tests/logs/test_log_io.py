@@ -183,101 +183,101 @@ def test_feet_and_nanoseconds(tmp_path: Path) -> None:
 
 BAD_CSV_CASES = [
     # (file, new text or None to remove, pattern after the file name)
-    ("observations.csv", None, "observations.csv: expected a CSV file, got no such file"),
-    ("landmarks.csv", None, "landmarks.csv: expected a CSV file, got no such file"),
-    ("meta.toml", None, "meta.toml: expected the log's TOML metadata file, got no such file"),
+    ("observations.csv", None, "observations.csv: expected an existing CSV file, got no such file"),
+    ("landmarks.csv", None, "landmarks.csv: expected an existing CSV file, got no such file"),
+    ("meta.toml", None, "meta.toml: expected an existing log metadata TOML file, got no such file"),
     ("observations.csv", "# only a comment\n", "observations.csv: expected a header row naming the columns"),
-    ("observations.csv", "time,landmark_id\n", "observations.csv: line 1: expected a column 'bearing', got"),
+    ("observations.csv", "time,landmark_id\n", "observations.csv:1: expected a column 'bearing', got"),
     (
         "odometry.csv",
         "time,v,omega,speed\n",
-        "odometry.csv: line 1: expected columns from .*unknown column 'speed'",
+        "odometry.csv:1: expected columns from .*unknown column 'speed'",
     ),
-    ("odometry.csv", "time,v,v,omega\n", "odometry.csv: line 1: expected each column once, got 'v' twice"),
+    ("odometry.csv", "time,v,v,omega\n", "odometry.csv:1: expected each column once, got 'v' twice"),
     ("odometry.csv", "time,v,omega\n", "odometry.csv: expected at least one data row, got none"),
     (
         "odometry.csv",
         "time,v,omega\n0,1,0\n# c\n1,abc,0\n",
-        "odometry.csv: line 4: expected a number in column 'v', got 'abc'",
+        "odometry.csv:4: expected a number in column 'v', got 'abc'",
     ),
     (
         "odometry.csv",
         "time,v,omega\n0,1,nan\n",
-        "odometry.csv: line 2: expected a finite number in column 'omega', got 'nan'",
+        "odometry.csv:2: expected a finite number in column 'omega', got 'nan'",
     ),
     (
         "odometry.csv",
         "time,v,omega\n0,1,0\n1,-inf,0\n",
-        "odometry.csv: line 3: expected a finite number in column 'v', got '-inf'",
+        "odometry.csv:3: expected a finite number in column 'v', got '-inf'",
     ),
     (
         "odometry.csv",
         "time,v,omega\n0,1,\n",
-        "odometry.csv: line 2: expected a number in column 'omega', got ''",
+        "odometry.csv:2: expected a number in column 'omega', got ''",
     ),
-    ("odometry.csv", "time,v,omega\n0,1,0,7\n", "odometry.csv: line 2: expected 3 cells, got 4"),
+    ("odometry.csv", "time,v,omega\n0,1,0,7\n", "odometry.csv:2: expected 3 cells, got 4"),
     (
         "odometry.csv",
         "time,v,omega\n0,1,0\n2,1,0\n1,1,0\n",
-        r"odometry.csv: line 4: expected strictly increasing times, got '1' after '2' \(line 3\)",
+        r"odometry.csv:4: expected strictly increasing times, got '1' after '2' \(line 3\)",
     ),
     (
         "odometry.csv",
         "time,v,omega\n0,1,0\n0,1,0\n",
-        "odometry.csv: line 3: expected strictly increasing times, got '0' after '0'",
+        "odometry.csv:3: expected strictly increasing times, got '0' after '0'",
     ),
     (
         "groundtruth.csv",
         "time,x,y,heading\n1,0,0,0\n0.5,0,0,0\n",
-        "groundtruth.csv: line 3: expected strictly increasing times",
+        "groundtruth.csv:3: expected strictly increasing times",
     ),
-    ("groundtruth.csv", "time,x,y\n1,0,0\n", "groundtruth.csv: line 1: expected a column 'heading'"),
+    ("groundtruth.csv", "time,x,y\n1,0,0\n", "groundtruth.csv:1: expected a column 'heading'"),
     (
         "observations.csv",
         "time,landmark_id,bearing\n1.0,A,0\n0.5,A,0\n",
-        "observations.csv: line 3: expected non-decreasing times, got '0.5' after '1.0'",
+        "observations.csv:3: expected non-decreasing times, got '0.5' after '1.0'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing\n" + "0,A,0\n" * 15 + "1,99,0\n",
-        "observations.csv: line 17: expected a landmark id listed in landmarks.csv, got '99'",
+        "observations.csv:17: expected a landmark id listed in landmarks.csv, got '99'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing\n0,,0\n",
-        "observations.csv: line 2: expected a non-empty landmark_id",
+        "observations.csv:2: expected a non-empty landmark_id",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing,range\n0,A,0,-1\n",
-        "observations.csv: line 2: expected a range >= 0, got '-1'",
+        "observations.csv:2: expected a range >= 0, got '-1'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing,bearing_error\n0,A,0,0\n",
-        "observations.csv: line 2: expected a positive bearing_error, got '0'",
+        "observations.csv:2: expected a positive bearing_error, got '0'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing,range_error\n0,A,0,-0.1\n",
-        "observations.csv: line 2: expected a range_error >= 0",
+        "observations.csv:2: expected a range_error >= 0",
     ),
     (
         "landmarks.csv",
         "id,x,y\nA,0,0\nB,1,1\nA,2,2\n",
-        r"landmarks.csv: line 4: expected a unique id, got 'A' again \(first at line 2\)",
+        r"landmarks.csv:4: expected a unique id, got 'A' again \(first at line 2\)",
     ),
     (
         "landmarks.csv",
         "id,x,y,position_uncertainty\nA,0,0,-1\n",
-        "landmarks.csv: line 2: expected a position_uncertainty >= 0",
+        "landmarks.csv:2: expected a position_uncertainty >= 0",
     ),
     (
         "landmarks.csv",
         "id,x,y,z_bottom,z_top\nA,0,0,2,1\n",
-        "landmarks.csv: line 2: expected z_top >= z_bottom",
+        "landmarks.csv:2: expected z_top >= z_bottom",
     ),
-    ("landmarks.csv", "id,x\nA,0\n", "landmarks.csv: line 1: expected a column 'y'"),
+    ("landmarks.csv", "id,x\nA,0\n", "landmarks.csv:1: expected a column 'y'"),
     ("landmarks.csv", 'id,x,y\n"A\nB",0,0\n', "landmarks.csv: expected one row per line"),
 ]
 
@@ -296,14 +296,14 @@ def test_bad_csv_files_are_named_with_their_line(
 def test_negative_run_in_commands(tmp_path: Path) -> None:
     files: dict[str, str | None] = dict(VALID_FILES, **{"odometry.csv": None})
     files["commands.csv"] = "time,turn,run\n1,0.1,0.5\n2,0.0,-0.5\n"
-    with pytest.raises(FileFormatError, match=r"commands\.csv: line 3: expected a run >= 0, got '-0\.5'"):
+    with pytest.raises(FileFormatError, match=r"commands\.csv:3: expected a run >= 0, got '-0\.5'"):
         load_log(write_files(tmp_path, files))
 
 
 def test_commands_times_must_increase(tmp_path: Path) -> None:
     files: dict[str, str | None] = dict(VALID_FILES, **{"odometry.csv": None})
     files["commands.csv"] = "time,turn,run\n1,0.1,0.5\n1,0.0,0.5\n"
-    with pytest.raises(FileFormatError, match=r"commands\.csv: line 3: expected strictly increasing times"):
+    with pytest.raises(FileFormatError, match=r"commands\.csv:3: expected strictly increasing times"):
         load_log(write_files(tmp_path, files))
 
 
@@ -332,16 +332,16 @@ BAD_META_CASES = [
     ('name = "x"\ncolour = "red"\n', r"meta\.toml: colour: expected one of name, terrain, source, \[units\]"),
     (
         "[sensor]\nbearing_eror = 0.1\n",
-        r"meta\.toml: \[sensor\] bearing_eror: expected one of the keys bearing_error",
+        r"meta\.toml: \[sensor\] bearing_eror: expected one of bearing_error",
     ),
     ("[sensors]\nbearing_error = 0.1\n", r"meta\.toml: sensors: expected one of .*got unknown key 'sensors'"),
     (
         '[sensor]\nbearing_error = "big"\n',
-        r"meta\.toml: \[sensor\] bearing_error: expected a number, got 'big'",
+        r"meta\.toml: \[sensor\] bearing_error: expected a finite number, got 'big'",
     ),
     (
         "[sensor]\nbearing_error = true\n",
-        r"meta\.toml: \[sensor\] bearing_error: expected a number, got True",
+        r"meta\.toml: \[sensor\] bearing_error: expected a finite number, got true",
     ),
     (
         "[sensor]\nbearing_error = nan\n",
@@ -372,10 +372,10 @@ BAD_META_CASES = [
         '[units]\nlength = "inch"\n',
         r"meta\.toml: \[units\] length: expected one of 'm', 'cm', 'mm', 'ft', got 'inch'",
     ),
-    ('[units]\nmass = "kg"\n', r"meta\.toml: \[units\] mass: expected one of the keys length, angle, time"),
+    ('[units]\nmass = "kg"\n', r"meta\.toml: \[units\] mass: expected one of length, angle, time"),
     ('units = "m"\n', r"meta\.toml: \[units\]: expected a table, got 'm'"),
     ("sensor = 3\n", r"meta\.toml: \[sensor\]: expected a table, got 3"),
-    ('name = "x\n', r"meta\.toml: expected valid TOML, got"),
+    ('name = "x\n', r"meta\.toml:1:10: expected valid TOML, got Illegal character"),
 ]
 
 
@@ -384,3 +384,49 @@ def test_bad_meta_toml(tmp_path: Path, text: str, pattern: str) -> None:
     write_files(tmp_path, dict(VALID_FILES, **{"meta.toml": text}))
     with pytest.raises(FileFormatError, match=pattern):
         load_log(tmp_path)
+
+
+# --- encodings and limits (the loading layer) ---------------------------------------------------
+
+
+def test_every_file_with_an_excel_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    plain = load_log(write_files(tmp_path / "plain", VALID_FILES))
+    folder = write_files(tmp_path / "bom", {name: "\ufeff" + text for name, text in VALID_FILES.items()})
+    with_bom = load_log(folder)
+    assert_same_log(with_bom, plain, lines=True)
+    assert with_bom.meta == plain.meta
+
+
+def test_an_excel_csv_with_crlf_and_bom_reads_the_same(tmp_path: Path) -> None:
+    plain = load_log(write_files(tmp_path / "plain", VALID_FILES))
+    folder = write_files(tmp_path / "excel", VALID_FILES)
+    for name in ("landmarks.csv", "observations.csv", "odometry.csv"):
+        (folder / name).write_bytes(b"\xef\xbb\xbf" + VALID_FILES[name].replace("\n", "\r\n").encode())
+    assert_same_log(load_log(folder), plain, lines=True)
+
+
+@pytest.mark.parametrize("name", ["meta.toml", "landmarks.csv", "observations.csv", "odometry.csv"])
+def test_latin1_files_are_refused_naming_file_and_byte(tmp_path: Path, name: str) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    (folder / name).write_bytes(("# r\u00e9sum\u00e9\n" + VALID_FILES[name]).encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{folder / name}:1: byte 3: expected UTF-8 text, got the byte 0xe9")
+    ):
+        load_log(folder)
+
+
+def test_too_many_rows_are_refused_at_the_first_one_over(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    monkeypatch.setattr("aura_ums._files.MAX_ROWS", 2)
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: expected at most 2 data rows, got more"):
+        load_log(folder)
+
+
+def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> None:
+    folder = write_files(tmp_path, VALID_FILES)
+    with (folder / "odometry.csv").open("ab") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 64 MiB \("):
+        load_log(folder)

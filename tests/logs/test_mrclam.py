@@ -64,24 +64,24 @@ def test_tiny_dataset(tmp_path: Path) -> None:
     [
         (
             {"Robot1_Odometry.dat": HEADER + "9.0 0.1 0.0\n8.0 0.1 0.0\n"},
-            r"Robot1_Odometry\.dat: line 6: expected non-decreasing times, got 8\.0 after 9\.0",
+            r"Robot1_Odometry\.dat:6: expected non-decreasing times, got 8\.0 after 9\.0",
         ),
         ({"Robot1_Odometry.dat": HEADER}, r"Robot1_Odometry\.dat: expected at least one data row, got none"),
         (
             {"Robot1_Measurement.dat": HEADER + "10.0 63 2.0\n"},
-            r"Robot1_Measurement\.dat: line 5: expected 4 numbers \(time, barcode, range, bearing\), got 3",
+            r"Robot1_Measurement\.dat:5: expected 4 numbers \(time, barcode, range, bearing\), got 3",
         ),
         (
             {"Robot1_Measurement.dat": HEADER + "10.0 63 two 0.5\n"},
-            r"Robot1_Measurement\.dat: line 5: expected numbers",
+            r"Robot1_Measurement\.dat:5: expected numbers",
         ),
         (
             {"Robot1_Measurement.dat": HEADER + "10.0 63 nan 0.5\n"},
-            r"Robot1_Measurement\.dat: line 5: expected finite numbers",
+            r"Robot1_Measurement\.dat:5: expected finite numbers",
         ),
         (
             {"Robot1_Measurement.dat": HEADER + "10.0 63 -2.0 0.5\n"},
-            r"Robot1_Measurement\.dat: line 5: expected a range >= 0, got -2\.0",
+            r"Robot1_Measurement\.dat:5: expected a range >= 0, got -2\.0",
         ),
         (
             {"Robot1_Groundtruth.dat": None},
@@ -90,7 +90,7 @@ def test_tiny_dataset(tmp_path: Path) -> None:
         ({"Barcodes.dat": None}, r"Barcodes\.dat: expected an MRCLAM data file"),
         (
             {"Landmark_Groundtruth.dat": HEADER + "6 0.5 -4.0 -1e400 0.1\n"},
-            r"Landmark_Groundtruth\.dat: line 5: expected finite numbers",
+            r"Landmark_Groundtruth\.dat:5: expected finite numbers",
         ),
     ],
 )

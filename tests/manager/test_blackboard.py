@@ -159,7 +159,7 @@ def edited(change: str, value: object) -> str:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("{", r"<blackboard JSON>: line 1 column 2: expected valid JSON"),
+        ("{", r"<blackboard JSON>:1:2: expected valid JSON"),
         ("[]", r"<blackboard JSON>: expected an object, got an array"),
         (edited("format", "aura-ums/other"), r"format: expected 'aura-ums/blackboard', got 'aura-ums/other'"),
         (edited("version", 7), r"version: expected 1, got 7"),
@@ -168,11 +168,11 @@ def edited(change: str, value: object) -> str:
         (edited("position_reports", {}), r"position_reports: expected an array, got an object"),
         (
             edited("position_reports/1/time", "soon"),
-            r"position_reports\[1\]\.time: expected a number, got str",
+            r"position_reports\[1\]\.time: expected a finite number, got 'soon'",
         ),
         (
             edited("position_reports/1/time", True),
-            r"position_reports\[1\]\.time: expected a number, got a boolean",
+            r"position_reports\[1\]\.time: expected a finite number, got true",
         ),
         (edited("position_reports/3/time", 0.5), r"position_reports\[3\]\.time: expected a time >= 20\.0 "),
         (edited("position_reports/0/command/run", -1.0), r"position_reports\[0\]\.command: .*non-negative"),
@@ -185,11 +185,14 @@ def edited(change: str, value: object) -> str:
         ),
         (
             edited("identified/2/landmark_id", 5),
-            r"identified\[2\]\.landmark_id: expected a string, got int 5",
+            r"identified\[2\]\.landmark_id: expected a string, got 5",
         ),
         (edited("identified/1/range_min", 1.0), r"identified\[1\]: expected only the keys"),
         (edited("commands/1", None), r"commands\[1\]: expected an object, got null"),
-        (full_board().to_json().replace("0.01", "NaN", 1), r"expected finite numbers, got NaN"),
+        (
+            full_board().to_json().replace("0.01", "NaN", 1),
+            r"expected valid JSON, got the non-standard number NaN",
+        ),
     ],
 )
 def test_malformed_json_names_what_is_wrong(text: str, message: str) -> None:
@@ -200,5 +203,5 @@ def test_malformed_json_names_what_is_wrong(text: str, message: str) -> None:
 def test_source_names_the_file_and_non_text_is_refused() -> None:
     with pytest.raises(FileFormatError, match=r"^board\.json: expected JSON text \(str\), got bytes$"):
         Blackboard.from_json(b"{}", source="board.json")  # type: ignore[arg-type]
-    with pytest.raises(InputError, match=r"board\.json: version: expected 1, got None"):
+    with pytest.raises(InputError, match=r"board\.json: version: expected 1, got nothing"):
         Blackboard.from_json('{"format": "aura-ums/blackboard"}', source="board.json")

@@ -176,7 +176,7 @@ def _complete(**overrides: str) -> str:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("[tile\n", r"bad.toml: expected valid TOML, got"),
+        ("[tile\n", r"bad.toml:1:6: expected valid TOML, got Expected ']'"),
         ("", r"bad.toml: expected at least one terrain table, got none"),
         ("tile = 3\n", r"bad.toml: \[tile\]: expected a table of statistics, got 3"),
         (
@@ -193,6 +193,7 @@ def _complete(**overrides: str) -> str:
         ),
         (_complete(drift="nan"), r"bad.toml: \[tile\] drift: expected a finite number, got nan"),
         (_complete(skitter='"much"'), r"bad.toml: \[tile\] skitter: expected a finite number, got 'much'"),
+        (_complete(skitter="[1]"), r"bad.toml: \[tile\] skitter: expected a finite number, got an array"),
         (
             _complete(drift_deg_per_m="1.0"),
             r"bad.toml: \[tile\] drift_deg_per_m: expected drift once, got it twice",
@@ -209,10 +210,37 @@ def test_malformed_toml_names_file_terrain_and_key(tmp_path: Path, text: str, me
 
 
 def test_missing_file_is_a_clear_error(tmp_path: Path) -> None:
-    with pytest.raises(FileFormatError, match=r"nope.toml: expected a readable TOML file, got No such file"):
+    with pytest.raises(
+        FileFormatError, match=r"nope.toml: expected an existing terrain table TOML file, got no such"
+    ):
         TerrainTable.from_toml(tmp_path / "nope.toml")
 
 
 def test_file_errors_are_value_errors_too(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"expected valid TOML"):
         TerrainTable.from_toml(_write(tmp_path, "= 1"))
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path: Path) -> None:
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + TerrainTable.default().to_toml().encode())
+    assert TerrainTable.from_toml(path) == TerrainTable.default()
+
+
+def test_latin1_bytes_are_refused_naming_file_line_and_offset(tmp_path: Path) -> None:
+    path = tmp_path / "latin.toml"
+    path.write_bytes(b"# caf\xe9\n" + TerrainTable.default().to_toml().encode())
+    with pytest.raises(
+        FileFormatError, match=r"latin\.toml:1: byte 5: expected UTF-8 text, got the byte 0xe9"
+    ):
+        TerrainTable.from_toml(path)
+
+
+def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> None:
+    path = tmp_path / "huge.toml"
+    with path.open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(
+        FileFormatError, match=r"huge\.toml: expected a terrain table TOML file of at most 64 MiB"
+    ):
+        TerrainTable.from_toml(path)

@@ -215,7 +215,7 @@ OVERLAPPING = {
 }
 
 BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
-    ("not a collection", whole([1, 2]), "", "expected a GeoJSON object, got a JSON array"),
+    ("not a collection", whole([1, 2]), "", "expected a GeoJSON object, got an array"),
     ("wrong type", whole({"type": "Feature"}), "type", "expected 'FeatureCollection', got 'Feature'"),
     (
         "no features",
@@ -288,7 +288,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "meadow with a 3-d position",
         geometry(0, {"type": "Polygon", "coordinates": [[[0, 0, 5], [4, 0], [4, 2], [0, 0]]]}),
         "features[0] (id 'walk') geometry.coordinates[0][0]",
-        "expected an [x, y] position in metres, got a JSON array",
+        "expected an [x, y] position in metres, got an array",
     ),
     (
         "meadow with a string coordinate",
@@ -330,7 +330,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "unknown meadow property",
         feature(1, terain="grass"),
         "features[1] (id 'lawn') properties.terain",
-        "expected one of the properties kind, id, terrain, landmarks, got unknown 'terain'",
+        "expected one of kind, id, terrain, landmarks, got unknown property 'terain'",
     ),
     (
         "bad class",
@@ -366,7 +366,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "missing z_top",
         drop(2, "z_top"),
         "features[2] (id 'pole') properties.z_top",
-        "expected a number, got nothing",
+        "expected a finite number, got nothing",
     ),
     (
         "z_top below z_bottom",
@@ -378,15 +378,20 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "z on a Class I landmark",
         feature(2, z=3.0),
         "features[2] (id 'pole') properties.z",
-        "expected one of the properties kind, id, class, symbol, position_uncertainty, strategy, parameters, "
-        "activation_range, recognition_threshold, confirm_frames, z_bottom, z_top, got unknown 'z'",
+        "expected one of kind, id, class, symbol, position_uncertainty, strategy, parameters, "
+        "activation_range, recognition_threshold, confirm_frames, z_bottom, z_top, got unknown property 'z'",
     ),
-    ("missing z", drop(3, "z"), "features[3] (id 'corner') properties.z", "expected a number, got nothing"),
+    (
+        "missing z",
+        drop(3, "z"),
+        "features[3] (id 'corner') properties.z",
+        "expected a finite number, got nothing",
+    ),
     (
         "missing activation range",
         drop(2, "activation_range"),
         "features[2] (id 'pole') properties.activation_range",
-        "expected a number, got nothing",
+        "expected a finite number, got nothing",
     ),
     (
         "zero activation range",
@@ -404,7 +409,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "threshold as a boolean",
         feature(2, recognition_threshold=True),
         "features[2] (id 'pole') properties.recognition_threshold",
-        "expected a finite number, got True",
+        "expected a finite number, got true",
     ),
     (
         "negative position uncertainty",
@@ -422,7 +427,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "parameters not an object",
         feature(2, parameters=[1]),
         "features[2] (id 'pole') properties.parameters",
-        "expected an object of numbers, got a JSON array",
+        "expected an object of numbers, got an array",
     ),
     (
         "parameter not a number",
@@ -489,30 +494,32 @@ def test_unknown_terrain_is_refused_when_a_table_is_given(tmp_path: Path) -> Non
 
 
 @pytest.mark.parametrize(
-    ("text", "where", "message"),
+    ("text", "place", "message"),
     [
         (
             '{"type": "FeatureCollection", "features": [',
-            "line 1 column 44",
+            ":1:44",
             "expected valid JSON, got Expecting value",
         ),
-        ('{"type": "FeatureCollection",\n "features": [}', "line 2 column 15", "expected valid JSON"),
+        ('{"type": "FeatureCollection",\n "features": [}', ":2:15", "expected valid JSON"),
         ('{"x": NaN}', "", "expected valid JSON, got the non-standard number NaN"),
-        ("", "line 1 column 1", "expected valid JSON, got Expecting value"),
+        ('{"x": 1e400}', "", "expected valid JSON, got the number '1e400', beyond the largest float"),
+        ('{"type": 1, "type": 2}', "", "expected valid JSON, got the key 'type' twice in one object"),
+        ("", ":1:1", "expected valid JSON, got Expecting value"),
     ],
 )
-def test_malformed_json_is_a_file_format_error(text: str, where: str, message: str, tmp_path: Path) -> None:
+def test_malformed_json_is_a_file_format_error(text: str, place: str, message: str, tmp_path: Path) -> None:
     path = tmp_path / "broken.geojson"
     path.write_text(text, encoding="utf-8")
-    with pytest.raises(
-        FileFormatError, match=re.escape(f"{where}: {message}" if where else message)
-    ) as caught:
+    with pytest.raises(FileFormatError, match="^" + re.escape(f"{path}{place}: {message}")) as caught:
         MeadowMap.from_geojson(path)
-    assert caught.value.where == where
+    assert caught.value.where == ""
 
 
 def test_unreadable_files_are_file_format_errors(tmp_path: Path) -> None:
-    with pytest.raises(FileFormatError, match="expected a readable GeoJSON file, got No such file"):
+    with pytest.raises(
+        FileFormatError, match=r"missing\.geojson: expected an existing GeoJSON file, got no such file"
+    ):
         MeadowMap.from_geojson(tmp_path / "missing.geojson")
     binary = tmp_path / "binary.geojson"
     binary.write_bytes(b"\xff\xfe\x00")
@@ -523,7 +530,7 @@ def test_unreadable_files_are_file_format_errors(tmp_path: Path) -> None:
 
 
 def test_dict_documents_name_their_source() -> None:
-    with pytest.raises(FileFormatError, match=r"^<geojson>: type: expected 'FeatureCollection', got None"):
+    with pytest.raises(FileFormatError, match=r"^<geojson>: type: expected 'FeatureCollection', got nothing"):
         MeadowMap.from_geojson_dict({})
     with pytest.raises(FileFormatError, match=r"^mine: type: "):
         MeadowMap.from_geojson_dict({}, source="mine")
@@ -541,3 +548,40 @@ def test_saved_file_is_a_readable_feature_collection(tmp_path: Path) -> None:
     assert ring[0] == ring[-1]
     assert document["features"][4]["properties"]["strategy"] == "line_finder"
     assert len(path.read_text(encoding="utf-8").splitlines()) == 3 + 8 + 2  # one feature per line
+
+
+# --- encodings and limits (the loading layer) ---------------------------------------------------
+
+
+def test_a_map_with_a_byte_order_mark_reads_the_same(tmp_path: Path) -> None:
+    world = make_grid_world(2, 2)
+    path = tmp_path / "grid.geojson"
+    world.to_geojson(path)
+    (tmp_path / "bom.geojson").write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert MeadowMap.from_geojson(tmp_path / "bom.geojson") == world
+
+
+def test_latin1_map_is_refused_naming_file_line_and_byte(tmp_path: Path) -> None:
+    path = tmp_path / "latin.geojson"
+    path.write_bytes('{"type": "FeatureCollection",\n "name": "Z\u00fcrich"}'.encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=re.escape(f"{path}:2: byte 41: expected UTF-8 text, got the byte 0xfc")
+    ):
+        MeadowMap.from_geojson(path)
+
+
+def test_over_size_map_is_refused_stating_the_limit(tmp_path: Path) -> None:
+    path = tmp_path / "huge.geojson"
+    with path.open("wb") as handle:
+        handle.truncate(64 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"huge\.geojson: expected a GeoJSON file of at most 64 MiB"):
+        MeadowMap.from_geojson(path)
+
+
+def test_nan_in_a_coordinate_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "nan.geojson"
+    path.write_text(json.dumps(base_document()).replace("0.0", "NaN", 1))
+    with pytest.raises(
+        FileFormatError, match=r"nan\.geojson: expected valid JSON, got the non-standard number NaN"
+    ):
+        MeadowMap.from_geojson(path)

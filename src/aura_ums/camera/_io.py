@@ -30,16 +30,15 @@ The TOML camera file::
 
 from __future__ import annotations
 
-import json
 import math
 import re
-import tomllib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import Fields, describe, load_toml, parse_json, read_text
 from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
 from aura_ums.camera._observe import CalibrationBounds
 from aura_ums.errors import FileFormatError, InputError
@@ -56,29 +55,12 @@ _ANGLES = ("pan", "tilt")
 # ------------------------------------------------------------------------------ shared
 
 
-def _read_text(path: str | Path, kind: str) -> str:
-    try:
-        return Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FileFormatError(str(path), "", f"expected an existing {kind} file, got no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) else "bytes that are not UTF-8"
-        raise FileFormatError(str(path), "", f"expected a readable {kind} file, got {reason}") from None
-
-
 def _number(value: object, source: str, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise FileFormatError(source, where, f"expected a number, got {value!r}")
-    result = float(value)
-    if not math.isfinite(result):
-        raise FileFormatError(source, where, f"expected a finite number, got {value!r}")
-    return result
+    return Fields(source).number(value, where)
 
 
 def _integer(value: object, source: str, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-        raise FileFormatError(source, where, f"expected a positive integer, got {value!r}")
-    return value
+    return Fields(source).integer(value, where, minimum=1)
 
 
 def _distortion(values: Array, source: str, where: str) -> tuple[float, float, float, float, float]:
@@ -108,14 +90,11 @@ def _reraise(source: str, where: str, exc: InputError) -> FileFormatError:
 
 
 def _table(document: Mapping[str, object], name: str, source: str, *, required: bool) -> dict[str, object]:
-    table = document.get(name)
-    if table is None:
+    if name not in document:
         if required:
             raise FileFormatError(source, f"[{name}]", "expected this table, got none")
         return {}
-    if not isinstance(table, dict):
-        raise FileFormatError(source, f"[{name}]", f"expected a table, got {table!r}")
-    return table
+    return Fields(source).table(document[name], f"[{name}]")
 
 
 def _angle(table: Mapping[str, object], name: str, source: str, where: str) -> float | None:
@@ -130,25 +109,12 @@ def _angle(table: Mapping[str, object], name: str, source: str, where: str) -> f
 
 
 def _check_keys(table: Mapping[str, object], allowed: tuple[str, ...], source: str, where: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise FileFormatError(
-                source,
-                f"{where} {key}".strip(),
-                f"expected one of {', '.join(allowed)}, got unknown key {key!r}",
-            )
+    Fields(source).keys(table, allowed, where)
 
 
 def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
     source = str(path)
-    text = _read_text(path, "TOML")
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        line = re.search(r"line (\d+)", str(exc))
-        raise FileFormatError(
-            source, f"line {line.group(1)}" if line else "", f"expected TOML, got {exc}"
-        ) from None
+    document = load_toml(path, kind="camera TOML")
     _check_keys(document, ("intrinsics", "mount", "calibration_bounds"), source, "")
 
     table = _table(document, "intrinsics", source, required=True)
@@ -165,7 +131,7 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         raw = table["distortion"]
         if not isinstance(raw, list):
             raise FileFormatError(
-                source, "[intrinsics] distortion", f"expected a list of numbers, got {raw!r}"
+                source, "[intrinsics] distortion", f"expected a list of numbers, got {describe(raw)}"
             )
         numbers = [_number(v, source, f"[intrinsics] distortion[{i}]") for i, v in enumerate(raw)]
         distortion = _distortion(np.array(numbers, dtype=np.float64), source, "[intrinsics] distortion")
@@ -355,14 +321,14 @@ class _Flow:
             return self._sequence()
         if char == "{":
             return self._mapping()
-        if char in "\"'":
+        if char and char in "\"'":  # "" (the end) is in every string
             return self._quoted()
         start = self.pos
         while self.pos < len(self.text) and self.text[self.pos] not in stops:
             self.pos += 1
         plain = self.text[start : self.pos].strip()
         if not plain:
-            raise self.fail(f"expected a value, got {self.text[start : start + 20]!r}")
+            raise self.fail(f"expected a value, got {describe(self.text[start : start + 20])}")
         return _scalar(plain)
 
     def _quoted(self) -> str:
@@ -408,7 +374,7 @@ class _Flow:
             self.pos += 1
             return items
         while True:
-            key = self._quoted() if self._peek() in "\"'" else str(self.value(":,}"))
+            key = self._quoted() if self._peek() in ('"', "'") else str(self.value(":,}"))
             if self._peek() != ":":
                 raise self.fail(f"expected ':' after the key {key!r}, got {self._peek() or 'the end'!r}")
             self.pos += 1
@@ -422,7 +388,7 @@ class _Flow:
 
     def finish(self) -> None:
         if self._peek():
-            raise self.fail(f"expected the end of the value, got {self.text[self.pos :]!r}")
+            raise self.fail(f"expected the end of the value, got {describe(self.text[self.pos :])}")
 
 
 def _strip_comment(line: str) -> str:
@@ -438,8 +404,8 @@ def _strip_comment(line: str) -> str:
     return line.rstrip()
 
 
-def _balance(text: str) -> int:
-    depth, quote = 0, ""
+def _balance(text: str, depth: int = 0, quote: str = "") -> tuple[int, str]:
+    """Bracket depth and open quote after ``text``, from those before it (so lines add up)."""
     for char in text:
         if quote:
             if char == quote:
@@ -450,7 +416,7 @@ def _balance(text: str) -> int:
             depth += 1
         elif char in "]}":
             depth -= 1
-    return depth
+    return depth, quote
 
 
 class _YamlReader:
@@ -461,11 +427,12 @@ class _YamlReader:
         raw = text.splitlines()
         first = next((i for i, line in enumerate(raw) if line.strip()), None)
         if first is None or not re.match(r"%YAML[: ]1\.\d", raw[first].strip()):
-            found = raw[first].strip() if first is not None else "an empty file"
+            found = describe(raw[first].strip()) if first is not None else "an empty file"
             raise FileFormatError(
                 source,
-                "line 1",
-                f"expected the '%YAML:1.0' header of an OpenCV FileStorage file, got {found!r}",
+                "",
+                f"expected the '%YAML:1.0' header of an OpenCV FileStorage file, got {found}",
+                line=1 if first is None else first + 1,
             )
         self.lines: list[tuple[int, int, str]] = []
         i = first + 1
@@ -475,19 +442,23 @@ class _YamlReader:
             if not content.strip() or content.strip() in ("---", "..."):
                 continue
             if "\t" in content[: len(content) - len(content.lstrip())]:
-                raise FileFormatError(source, f"line {number}", "expected spaces for indentation, got a tab")
-            while _balance(content) > 0 and i < len(raw):  # a flow collection over several lines
-                content += " " + _strip_comment(raw[i]).strip()
+                raise FileFormatError(source, "", "expected spaces for indentation, got a tab", line=number)
+            depth, quote = _balance(content)
+            parts = [content]
+            while depth > 0 and i < len(raw):  # a flow collection over several lines
+                parts.append(" " + _strip_comment(raw[i]).strip())
+                depth, quote = _balance(parts[-1], depth, quote)
                 i += 1
-            if _balance(content) != 0:
+            content = "".join(parts)
+            if depth != 0:
                 raise FileFormatError(
-                    source, f"line {number}", "expected balanced brackets, got unbalanced ones"
+                    source, "", "expected balanced brackets, got unbalanced ones", line=number
                 )
             self.lines.append((number, len(content) - len(content.lstrip()), content.strip()))
         self.pos = 0
 
     def fail(self, number: int, message: str) -> FileFormatError:
-        return FileFormatError(self.source, f"line {number}", message)
+        return FileFormatError(self.source, "", message, line=number)
 
     def flow(self, text: str, number: int) -> object:
         reader = _Flow(text, lambda message: self.fail(number, message))
@@ -534,7 +505,7 @@ class _YamlReader:
                 break
             match = re.match(r"""("[^"]*"|'[^']*'|[^:\s][^:]*?)\s*:(\s+|$)""", text)
             if match is None:
-                raise self.fail(number, f"expected 'key: value', got {text!r}")
+                raise self.fail(number, f"expected 'key: value', got {describe(text)}")
             key = match.group(1).strip("\"'")
             rest = text[match.end() :].strip()
             self.pos += 1
@@ -545,10 +516,12 @@ class _YamlReader:
             value = self.flow(rest, number) if rest else self._nested(indent, number)
             if tag == "!!opencv-matrix":
                 if not isinstance(value, dict):
-                    raise self.fail(number, f"expected a mapping under !!opencv-matrix, got {value!r}")
+                    raise self.fail(
+                        number, f"expected a mapping under !!opencv-matrix, got {describe(value)}"
+                    )
                 value = _Matrix(value, type_id="opencv-matrix")
             if key in items:
-                raise self.fail(number, f"expected the key {key!r} once, got it twice")
+                raise self.fail(number, f"expected the key {describe(key)} once, got it twice")
             items[key] = value
         return items
 
@@ -557,10 +530,13 @@ def _parse_yaml(text: str, source: str) -> dict[str, object]:
     reader = _YamlReader(text, source)
     if not reader.lines:
         return {}
-    document = reader.block(reader.lines[0][1])
+    try:
+        document = reader.block(reader.lines[0][1])
+    except RecursionError:
+        raise FileFormatError(source, "", "expected YAML, got collections nested too deep") from None
     if reader.pos < len(reader.lines):
         number, _, found = reader.lines[reader.pos]
-        raise reader.fail(number, f"expected a top-level 'key: value', got {found!r}")
+        raise reader.fail(number, f"expected a top-level 'key: value', got {describe(found)}")
     if not isinstance(document, dict):
         raise FileFormatError(source, "", f"expected a top-level mapping, got {type(document).__name__}")
     return document
@@ -568,17 +544,17 @@ def _parse_yaml(text: str, source: str) -> dict[str, object]:
 
 def _parse_json(text: str, source: str) -> dict[str, object]:
     try:
-        document = json.loads(text)
-    except json.JSONDecodeError as first:
+        document = parse_json(text, source)
+    except FileFormatError as first:
         # OpenCV before 4.x writes reals such as ``1.`` that strict JSON refuses: try once more
         tolerant = re.sub(r"(?<=\d)\.(?=\s*[,\]}\s])", ".0", text)
+        if tolerant == text:
+            raise
         try:
-            document = json.loads(tolerant)
-        except json.JSONDecodeError:
-            raise FileFormatError(source, f"line {first.lineno}", f"expected JSON, got {first.msg}") from None
-    if not isinstance(document, dict):
-        raise FileFormatError(source, "", f"expected a top-level JSON object, got {type(document).__name__}")
-    return document
+            document = parse_json(tolerant, source)
+        except FileFormatError:
+            raise first from None
+    return Fields(source, "json").table(document, "")
 
 
 # --------------------------------------------------------------- FileStorage contents
@@ -610,9 +586,11 @@ def _find(document: Mapping[str, object], label: str, source: str) -> tuple[str,
 
 def _matrix(value: object, source: str, key: str) -> Array:
     if not isinstance(value, dict):
-        raise FileFormatError(source, key, f"expected an opencv-matrix mapping, got {value!r}")
+        raise FileFormatError(source, key, f"expected an opencv-matrix mapping, got {describe(value)}")
     if value.get("type_id") != "opencv-matrix":
-        raise FileFormatError(source, key, f"expected type_id opencv-matrix, got {value.get('type_id')!r}")
+        raise FileFormatError(
+            source, key, f"expected type_id opencv-matrix, got {describe(value.get('type_id'))}"
+        )
     for field in ("rows", "cols", "dt", "data"):
         if field not in value:
             raise FileFormatError(
@@ -623,11 +601,11 @@ def _matrix(value: object, source: str, key: str) -> Array:
     dt = value["dt"]
     if not isinstance(dt, str) or not re.fullmatch(r"[ucswifd]", dt):
         raise FileFormatError(
-            source, f"{key}.dt", f"expected a one-channel element type (d, f, i...), got {dt!r}"
+            source, f"{key}.dt", f"expected a one-channel element type (d, f, i...), got {describe(dt)}"
         )
     data = value["data"]
     if not isinstance(data, list):
-        raise FileFormatError(source, f"{key}.data", f"expected a list of numbers, got {data!r}")
+        raise FileFormatError(source, f"{key}.data", f"expected a list of numbers, got {describe(data)}")
     if len(data) != rows * cols:
         raise FileFormatError(
             source, f"{key}.data", f"expected rows x cols = {rows * cols} numbers, got {len(data)}"
@@ -709,15 +687,15 @@ def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
     if not isinstance(mount, CameraMount):
         raise InputError(f"mount: expected CameraMount, got {type(mount).__name__}")
     source = str(path)
-    text = _read_text(path, "calibration")
+    text = read_text(path, kind="calibration")
     start, suffix = text.lstrip(), Path(path).suffix.lower()
     if start.startswith("%YAML") or (suffix in (".yml", ".yaml") and not start.startswith("{")):
         document = _parse_yaml(text, source)
     elif start.startswith("{") or suffix == ".json":
         document = _parse_json(text, source)
     else:
-        found = start.splitlines()[0][:40] if start else "an empty file"
+        found = describe(start.splitlines()[0][:40]) if start else "an empty file"
         raise FileFormatError(
-            source, "line 1", f"expected a FileStorage YAML ('%YAML:1.0') or JSON ('{{') file, got {found!r}"
+            source, "", f"expected a FileStorage YAML ('%YAML:1.0') or JSON ('{{') file, got {found}", line=1
         )
     return _camera_from_filestorage(document, source, mount)

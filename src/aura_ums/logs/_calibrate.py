@@ -14,22 +14,24 @@ averages out within a second.
 from __future__ import annotations
 
 import math
-import tomllib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import Fields, key_path, load_toml
 from aura_ums._validate import finite_float, positive_float
-from aura_ums.errors import FileFormatError, InputError
+from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import TerrainStats, TerrainTable
 
 _SENSOR_KEYS = ("bearing_error", "range_error", "range_fraction_low", "range_fraction_high")
 _MOTION_KEYS = ("delay_s", "run_scale", "turn_scale")
 _KIND = "aura-ums/sensor-calibration"
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True, slots=True)
@@ -204,39 +206,32 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
         or a value out of range.
     """
     source = str(path)
-    try:
-        with open(path, "rb") as handle:
-            document = tomllib.load(handle)
-    except FileNotFoundError:
-        raise FileFormatError(
-            source, "", "expected a sensor calibration TOML file, got no such file"
-        ) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise FileFormatError(source, "", f"expected TOML, got a syntax error: {exc}") from None
+    document = load_toml(path, kind="sensor calibration TOML")
+    reader = Fields(source)
     expected = {"format", "motion", "working", "envelope"}
     if set(document) != expected:
         missing, extra = sorted(expected - set(document)), sorted(set(document) - expected)
-        raise FileFormatError(
-            source, "", f"expected keys {sorted(expected)}, got missing {missing}, unknown {extra}"
-        )
+        raise reader.error("", f"expected keys {sorted(expected)}, got missing {missing}, unknown {extra}")
     if document["format"] != _KIND:
-        raise FileFormatError(source, "format", f"expected {_KIND!r}, got {document['format']!r}")
+        raise reader.error("format", f"expected {_KIND!r}, got {reader.describe(document['format'])}")
 
     def table(name: str, keys: tuple[str, ...]) -> dict[str, float]:
-        values = document[name]
-        if not isinstance(values, dict) or set(values) != set(keys):
-            found = sorted(values) if isinstance(values, dict) else type(values).__name__
-            raise FileFormatError(source, f"[{name}]", f"expected keys {list(keys)}, got {found}")
-        return values
+        values = reader.table(document[name], f"[{name}]")
+        if set(values) != set(keys):
+            raise reader.error(f"[{name}]", f"expected keys {list(keys)}, got {sorted(values)}")
+        return {key: reader.number(values[key], key_path(f"[{name}]", key)) for key in keys}
 
-    try:
-        motion = MotionCalibration(**table("motion", _MOTION_KEYS))
-        bounds = [SensorBounds(**table(name, _SENSOR_KEYS)) for name in ("working", "envelope")]
-    except InputError as exc:
-        if isinstance(exc, FileFormatError):
-            raise
-        raise FileFormatError(source, "", str(exc)) from None
-    return motion, bounds[0], bounds[1]
+    def build(name: str, keys: tuple[str, ...], make: Callable[..., _T]) -> _T:
+        values = table(name, keys)
+        try:
+            return make(**values)
+        except InputError as exc:  # named "SensorBounds.bearing_error": name the key instead
+            field, _, message = str(exc).partition(": ")
+            raise reader.error(key_path(f"[{name}]", field.rpartition(".")[2]), message) from None
+
+    motion = build("motion", _MOTION_KEYS, MotionCalibration)
+    working = build("working", _SENSOR_KEYS, SensorBounds)
+    return motion, working, build("envelope", _SENSOR_KEYS, SensorBounds)
 
 
 # --- the fit ---------------------------------------------------------------------------

@@ -12,7 +12,6 @@ import io
 import json
 import math
 import os
-import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -21,6 +20,7 @@ from typing import NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import Fields, describe, key_path, load_csv, load_toml
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
 from aura_ums.manager import PositionReport
@@ -124,47 +124,9 @@ class _CsvFile:
     def __init__(self, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> None:
         self.source = str(path)
         self.units = columns
-        if not path.is_file():
-            self.fail("", "expected a CSV file, got no such file")
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            self.fail("", f"expected a readable UTF-8 CSV file, got {exc}")
-        numbers: list[int] = []
-        lines: list[str] = []
-        for number, line in enumerate(text.splitlines(), start=1):
-            stripped = line.strip()
-            if stripped and not stripped.startswith("#"):
-                numbers.append(number)
-                lines.append(line)
-        if not lines:
-            self.fail("", f"expected a header row naming the columns {', '.join(required)}, got none")
-        reader = csv.reader(lines, strict=True)
-        try:
-            parsed = list(reader)
-        except csv.Error as exc:
-            self.fail(f"line {numbers[min(reader.line_num, len(numbers)) - 1]}", f"expected CSV, got {exc}")
-        if len(parsed) != len(lines):  # a quoted cell spanning lines
-            self.fail("", "expected one row per line, got a quoted cell spanning lines")
-        header = [name.strip() for name in parsed[0]]
-        where = f"line {numbers[0]}"
-        for index, name in enumerate(header):
-            if name not in columns:
-                self.fail(where, f"expected columns from {', '.join(columns)}, got unknown column {name!r}")
-            if name in header[:index]:
-                self.fail(where, f"expected each column once, got {name!r} twice")
-        for name in required:
-            if name not in header:
-                self.fail(where, f"expected a column {name!r}, got columns {', '.join(header)}")
-        body = parsed[1:]
-        self.lines = numbers[1:]
-        for number, cells in zip(self.lines, body, strict=True):
-            if len(cells) != len(header):
-                self.fail(f"line {number}", f"expected {len(header)} cells, got {len(cells)}")
-        transposed = list(zip(*body, strict=True)) if body else [() for _ in header]
-        self.cells = {
-            name: [cell.strip() for cell in column] for name, column in zip(header, transposed, strict=True)
-        }
+        table = load_csv(path, columns=tuple(columns), required=required)
+        self.lines = table.lines
+        self.cells = table.columns()
 
     def __len__(self) -> int:
         return len(self.lines)
@@ -173,7 +135,7 @@ class _CsvFile:
         raise FileFormatError(self.source, where, message)
 
     def fail_at(self, row: int, message: str) -> NoReturn:
-        self.fail(f"line {self.lines[row]}", message)
+        raise FileFormatError(self.source, "", message, line=self.lines[row])
 
     def numbers(self, column: str, units: Units, *, optional: bool = False) -> NDArray[np.float64]:
         """Return a column as finite floats in SI; with ``optional``, NaN where absent or empty."""
@@ -188,7 +150,7 @@ class _CsvFile:
                 try:
                     float(cell)
                 except ValueError:
-                    self.fail_at(row, f"expected a number in column {column!r}, got {cell!r}")
+                    self.fail_at(row, f"expected a number in column {column!r}, got {describe(cell)}")
             raise  # pragma: no cover - the loop above finds the cell
         values = values.reshape(-1)
         bad = ~np.isfinite(values)
@@ -196,7 +158,7 @@ class _CsvFile:
             bad &= np.array([cell != "" for cell in cells], dtype=bool)
         if np.any(bad):
             row = int(np.argmax(bad))
-            self.fail_at(row, f"expected a finite number in column {column!r}, got {cells[row]!r}")
+            self.fail_at(row, f"expected a finite number in column {column!r}, got {describe(cells[row])}")
         result: NDArray[np.float64] = values * factor
         return result
 
@@ -214,7 +176,7 @@ class _CsvFile:
         if np.any(bad):
             row = int(np.argmax(bad))
             expected = f"a positive {column}" if positive else f"a {column} >= 0"
-            self.fail_at(row, f"expected {expected}, got {self.cells[column][row]!r}")
+            self.fail_at(row, f"expected {expected}, got {describe(self.cells[column][row])}")
 
     def times(self, units: Units, *, strict: bool) -> NDArray[np.float64]:
         """Return the ``time`` column in seconds, checked increasing (strictly or not)."""
@@ -227,7 +189,7 @@ class _CsvFile:
             order = "strictly increasing" if strict else "non-decreasing"
             self.fail_at(
                 row,
-                f"expected {order} times, got {cells[row]!r} after {cells[row - 1]!r} "
+                f"expected {order} times, got {describe(cells[row])} after {describe(cells[row - 1])} "
                 f"(line {self.lines[row - 1]})",
             )
         return time
@@ -241,41 +203,24 @@ def _given(values: NDArray[np.float64]) -> list[float | None]:
     return [None if math.isnan(value) else value for value in values.tolist()]
 
 
-def _kind(value: object) -> str:
-    return repr(value) if isinstance(value, (str, int, float, bool)) else type(value).__name__
-
-
 class _MetaReader:
     def __init__(self, path: Path) -> None:
         self.source = str(path)
-        if not path.is_file():
-            self.fail("", "expected the log's TOML metadata file, got no such file")
-        try:
-            self.document = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError) as exc:
-            self.fail("", f"expected a readable UTF-8 TOML file, got {exc}")
-        except tomllib.TOMLDecodeError as exc:
-            self.fail("", f"expected valid TOML, got {exc}")
+        self.fields = Fields(self.source)
+        self.document = load_toml(path, kind="log metadata TOML")
 
     def fail(self, where: str, message: str) -> NoReturn:
         raise FileFormatError(self.source, where, message)
 
     def units(self) -> Units:
-        table = self.document.get("units", {})
-        if not isinstance(table, Mapping):
-            self.fail("[units]", f"expected a table, got {_kind(table)}")
+        table = self.fields.table(self.document.get("units", {}), "[units]")
         choices = {"length": LENGTH_UNITS, "angle": ANGLE_UNITS, "time": TIME_UNITS}
+        self.fields.keys(table, tuple(choices), "[units]")
         factors: dict[str, float] = {}
         for key, value in table.items():
-            if key not in choices:
-                self.fail(
-                    f"[units] {key}", f"expected one of the keys length, angle, time, got unknown {key!r}"
-                )
-            if value not in choices[key]:
-                self.fail(
-                    f"[units] {key}",
-                    f"expected one of {', '.join(map(repr, choices[key]))}, got {_kind(value)}",
-                )
+            if not isinstance(value, str) or value not in choices[key]:
+                allowed = ", ".join(map(repr, choices[key]))
+                self.fail(f"[units] {key}", f"expected one of {allowed}, got {self.fields.describe(value)}")
             factors[key] = choices[key][value]
         return Units(**factors)
 
@@ -284,16 +229,14 @@ class _MetaReader:
         values: dict[str, object] = {}
         for key, value in self.document.items():
             if key in _TABLES:
-                if not isinstance(value, Mapping):
-                    self.fail(f"[{key}]", f"expected a table, got {_kind(value)}")
+                table = self.fields.table(value, f"[{key}]")
                 if key != "units":
-                    for inner, item in value.items():
+                    for inner, item in table.items():
                         self.value(key, inner, item, units, values)
             elif key in _META_KEYS[""]:
                 self.value("", key, value, units, values)
             else:
-                known = ", ".join([*_META_KEYS[""], *(f"[{table}]" for table in _TABLES)])
-                self.fail(key, f"expected one of {known}, got unknown key {key!r}")
+                self.fields.keys({key: value}, [*_META_KEYS[""], *(f"[{table}]" for table in _TABLES)])
         pose = {
             axis: values.pop(f"start.{axis}") for axis in ("x", "y", "heading") if f"start.{axis}" in values
         }
@@ -312,21 +255,14 @@ class _MetaReader:
         return meta, units
 
     def value(self, table: str, key: str, value: object, units: Units, values: dict[str, object]) -> None:
-        where = f"[{table}] {key}" if table else key
         keys = _META_KEYS[table]
-        if key not in keys:
-            self.fail(where, f"expected one of the keys {', '.join(keys)}, got unknown {key!r}")
+        self.fields.keys({key: value}, tuple(keys), f"[{table}]" if table else "")
+        where = key_path(f"[{table}]" if table else "", key)
         target, unit = keys[key]
         if unit == "text":
-            if not isinstance(value, str):
-                self.fail(where, f"expected a string, got {_kind(value)}")
-            values[target] = value
+            values[target] = self.fields.string(value, where)
             return
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(where, f"expected a number, got {_kind(value)}")
-        if not math.isfinite(value):
-            self.fail(where, f"expected a finite number, got {value!r}")
-        values[target] = float(value) * units.factor(unit)
+        values[target] = self.fields.number(value, where) * units.factor(unit)
 
 
 def load_log(folder: str | os.PathLike[str]) -> RobotLog:
@@ -366,7 +302,7 @@ def load_log(folder: str | os.PathLike[str]) -> RobotLog:
     >>> load_log(folder)      # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    aura_ums.errors.FileFormatError: .../observations.csv: line 2: expected a landmark id ..., got 'post'
+    aura_ums.errors.FileFormatError: .../observations.csv:2: expected a landmark id ..., got 'post'
     """
     base = Path(folder)
     if not base.is_dir():
@@ -390,9 +326,8 @@ def _read_landmarks(path: Path, units: Units) -> tuple[LogLandmark, ...]:
     first: dict[str, int] = {}
     for row, ident in enumerate(ids):
         if ident in first:
-            table.fail_at(
-                row, f"expected a unique id, got {ident!r} again (first at line {table.lines[first[ident]]})"
-            )
+            earlier = table.lines[first[ident]]
+            table.fail_at(row, f"expected a unique id, got {describe(ident)} again (first at line {earlier})")
         first[ident] = row
     x, y = table.numbers("x", units), table.numbers("y", units)
     uncertainty = table.numbers("position_uncertainty", units, optional=True)
@@ -402,10 +337,8 @@ def _read_landmarks(path: Path, units: Units) -> tuple[LogLandmark, ...]:
     upside_down = top < bottom
     if np.any(upside_down):
         row = int(np.argmax(upside_down))
-        table.fail_at(
-            row,
-            f"expected z_top >= z_bottom ({table.cells['z_bottom'][row]}), got {table.cells['z_top'][row]!r}",
-        )
+        bottom_cell, top_cell = table.cells["z_bottom"][row], table.cells["z_top"][row]
+        table.fail_at(row, f"expected z_top >= z_bottom ({bottom_cell}), got {describe(top_cell)}")
     symbols = table.cells.get("symbol", [""] * len(table))
     result = []
     for row, (ident, u, zb, zt) in enumerate(
@@ -426,7 +359,7 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
     ids = table.texts("landmark_id")
     for row, ident in enumerate(ids):
         if ident not in known:
-            table.fail_at(row, f"expected a landmark id listed in {LANDMARKS}, got {ident!r}")
+            table.fail_at(row, f"expected a landmark id listed in {LANDMARKS}, got {describe(ident)}")
     bearing = table.numbers("bearing", units)
     measured = table.numbers("range", units, optional=True)
     bearing_error = table.numbers("bearing_error", units, optional=True)

@@ -48,16 +48,16 @@ class _DatFile:
             if not cells or cells[0].startswith("#"):
                 continue
             if len(cells) != len(columns):
-                self.fail(
-                    f"line {number}",
+                self.fail_at(
+                    number,
                     f"expected {len(columns)} numbers ({', '.join(columns)}), got {len(cells)}",
                 )
             try:
                 values = [float(cell) for cell in cells]
             except ValueError:
-                self.fail(f"line {number}", f"expected numbers ({', '.join(columns)}), got {line.strip()!r}")
+                self.fail_at(number, f"expected numbers ({', '.join(columns)}), got {line.strip()!r}")
             if not all(math.isfinite(value) for value in values):
-                self.fail(f"line {number}", f"expected finite numbers, got {line.strip()!r}")
+                self.fail_at(number, f"expected finite numbers, got {line.strip()!r}")
             lines.append(number)
             rows.append(values)
         self.lines = np.array(lines, dtype=np.int64)
@@ -65,6 +65,9 @@ class _DatFile:
 
     def fail(self, where: str, message: str) -> NoReturn:
         raise FileFormatError(self.source, where, message)
+
+    def fail_at(self, line: int, message: str) -> NoReturn:
+        raise FileFormatError(self.source, "", message, line=line)
 
     def increasing(self) -> tuple[NDArray[np.float64], int]:
         """Rows with strictly increasing times: an exact repeat of a time keeps the last row.
@@ -77,8 +80,8 @@ class _DatFile:
         steps = np.diff(time)
         if np.any(steps < 0.0):
             row = int(np.argmax(steps < 0.0)) + 1
-            self.fail(
-                f"line {self.lines[row]}",
+            self.fail_at(
+                int(self.lines[row]),
                 f"expected non-decreasing times, got {float(time[row])!r} after {float(time[row - 1])!r}",
             )
         keep = np.concatenate((steps > 0.0, [True]))
@@ -166,7 +169,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
                 LogLandmark(str(int(subject)), x, y, 3.0 * max(abs(x_sd), abs(y_sd)), symbol=LANDMARK_SYMBOL)
             )
         except InputError as exc:
-            landmark_file.fail(f"line {number}", str(exc).partition(": ")[2])
+            landmark_file.fail_at(number, str(exc).partition(": ")[2])
     known = {landmark.id for landmark in landmarks}
 
     measurements = _DatFile(folder / f"{prefix}Measurement.dat", ("time", "barcode", "range", "bearing"))
@@ -181,7 +184,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
         elif subject is None or str(subject) not in known:
             unknown += 1
         elif distance < 0.0:
-            measurements.fail(f"line {number}", f"expected a range >= 0, got {distance!r}")
+            measurements.fail_at(number, f"expected a range >= 0, got {distance!r}")
         else:
             observations.append(LogObservation(time, str(subject), bearing, range=distance, line=int(number)))
     observations.sort(key=lambda item: item.time)  # stable: frames keep their order

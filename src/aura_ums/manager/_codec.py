@@ -17,6 +17,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from aura_ums._files import Fields, describe, parse_json
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
@@ -50,10 +51,11 @@ class Reader:
         What is being read (a file name, or a description such as ``"<manager JSON>"``).
     """
 
-    __slots__ = ("source",)
+    __slots__ = ("fields", "source")
 
     def __init__(self, source: str) -> None:
         self.source = source
+        self.fields = Fields(source, "json")
 
     def fail(self, where: str, message: str) -> NoReturn:
         """Raise the :class:`FileFormatError` for ``where``."""
@@ -63,54 +65,38 @@ class Reader:
         """Parse ``text`` and check that it is a ``kind`` document of a known version."""
         if not isinstance(text, str):
             self.fail("", f"expected JSON text (str), got {type(text).__name__}")
-
-        def refuse_constant(name: str) -> NoReturn:
-            self.fail("", f"expected finite numbers, got {name}")
-
-        try:
-            data = json.loads(text, parse_constant=refuse_constant)
-        except json.JSONDecodeError as exc:
-            self.fail(f"line {exc.lineno} column {exc.colno}", f"expected valid JSON, got {exc.msg}")
-        top = self.mapping(data, "")
+        top = self.mapping(parse_json(text, self.source), "")
         found = top.get("format")
         if found != kind:
-            self.fail("format", f"expected {kind!r}, got {found!r}")
+            self.fail("format", f"expected {kind!r}, got {_found(top, 'format')}")
         version = top.get("version")
         if version != FORMAT_VERSION:
-            self.fail("version", f"expected {FORMAT_VERSION}, got {version!r}")
+            self.fail("version", f"expected {FORMAT_VERSION}, got {_found(top, 'version')}")
         return top
 
     def mapping(
         self, value: object, where: str, keys: Iterable[str] = (), optional: Iterable[str] = ()
     ) -> dict[str, Any]:
         """Return ``value`` as a JSON object; with ``keys``, exactly those (plus ``optional``)."""
-        if not isinstance(value, dict):
-            self.fail(where, f"expected an object, got {_kind(value)}")
+        checked: dict[str, Any] = self.fields.table(value, where)
         required = list(keys)
         if required:
             allowed = {*required, *optional}
             for key in required:
-                if key not in value:
+                if key not in checked:
                     self.fail(where, f"expected a key {key!r}, got none")
-            for key in value:
+            for key in checked:
                 if key not in allowed:
-                    self.fail(where, f"expected only the keys {sorted(allowed)}, got {key!r}")
-        return value
+                    self.fail(where, f"expected only the keys {sorted(allowed)}, got {describe(key)}")
+        return checked
 
     def array(self, value: object, where: str) -> list[Any]:
         """Return ``value`` as a JSON array."""
-        if not isinstance(value, list):
-            self.fail(where, f"expected an array, got {_kind(value)}")
-        return value
+        return self.fields.array(value, where)
 
     def number(self, value: object, where: str) -> float:
         """Return ``value`` as a finite float (a JSON number, not a boolean)."""
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.fail(where, f"expected a number, got {_kind(value)}")
-        result = float(value)
-        if not math.isfinite(result):
-            self.fail(where, f"expected a finite number, got {result!r}")
-        return result
+        return self.fields.number(value, where)
 
     def optional_number(self, value: object, where: str) -> float | None:
         """Return ``value`` as a finite float, or None for JSON ``null``."""
@@ -118,17 +104,11 @@ class Reader:
 
     def integer(self, value: object, where: str, minimum: int = 0) -> int:
         """Return ``value`` as an integer >= ``minimum``."""
-        if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(where, f"expected an integer, got {_kind(value)}")
-        if value < minimum:
-            self.fail(where, f"expected an integer >= {minimum}, got {value}")
-        return value
+        return self.fields.integer(value, where, minimum)
 
     def string(self, value: object, where: str) -> str:
         """Return ``value`` as a string."""
-        if not isinstance(value, str):
-            self.fail(where, f"expected a string, got {_kind(value)}")
-        return value
+        return self.fields.string(value, where)
 
     # --- values of aura-ums ------------------------------------------------------------
 
@@ -148,7 +128,10 @@ class Reader:
         name = data.get("class")
         cls = _OBSERVATION_CLASSES.get(name) if isinstance(name, str) else None
         if cls is None:
-            self.fail(f"{where}.class", f"expected one of {sorted(_OBSERVATION_CLASSES)}, got {name!r}")
+            self.fail(
+                f"{where}.class",
+                f"expected one of {sorted(_OBSERVATION_CLASSES)}, got {self.fields.describe(name)}",
+            )
         names = [field.name for field in dataclasses.fields(cls)]
         self.mapping(data, where, ["class", *names])
         kwargs: dict[str, object] = {}
@@ -249,11 +232,5 @@ def encode_map(uncertainty_map: SpatialUncertaintyMap) -> dict[str, object]:
     }
 
 
-def _kind(value: object) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return f"a boolean ({str(value).lower()})"
-    if isinstance(value, (dict, list)):
-        return "an object" if isinstance(value, dict) else "an array"
-    return f"{type(value).__name__} {value!r}"
+def _found(table: Mapping[str, object], key: str) -> str:
+    return describe(table[key], "json") if key in table else "nothing"

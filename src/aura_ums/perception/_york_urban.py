@@ -58,7 +58,7 @@ def load_york_urban(folder: Path, names: list[str] | None = None) -> list[YorkUr
                         )
                     )
                 except (KeyError, TypeError, ValueError) as exc:
-                    raise FileFormatError(str(table), f"line {line}", f"expected numbers, got {row}") from exc
+                    raise FileFormatError(str(table), "", f"expected numbers, got {row}", line=line) from exc
     except OSError as exc:
         raise FileFormatError(str(table), "", f"expected a readable file, got {exc}") from exc
     result = []

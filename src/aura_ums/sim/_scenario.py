@@ -46,8 +46,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
-import tomllib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -55,6 +53,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import Fields, describe, load_toml
 from aura_ums._validate import finite_float, nonnegative_float, read_only
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
@@ -194,9 +193,10 @@ class _Reader:
 
     def __init__(self, source: str) -> None:
         self.source = source
+        self.fields = Fields(source)
 
     def fail(self, where: str, message: str) -> FileFormatError:
-        return FileFormatError(self.source, where, message)
+        return self.fields.error(where, message)
 
     def table(self, document: Mapping[str, object], name: str, *, required: bool) -> dict[str, object]:
         value = document.get(name)
@@ -204,51 +204,29 @@ class _Reader:
             if required:
                 raise self.fail(f"[{name}]", "expected this table, got none")
             return {}
-        if not isinstance(value, dict):
-            raise self.fail(f"[{name}]", f"expected a table, got {value!r}")
-        return value
+        return self.fields.table(value, f"[{name}]")
 
     def keys(self, table: Mapping[str, object], allowed: tuple[str, ...], where: str, sep: str = " ") -> None:
-        for key in table:
-            if key not in allowed:
-                raise self.fail(
-                    f"{where}{sep}{key}".strip(),
-                    f"expected one of {', '.join(allowed)}, got unknown key {key!r}",
-                )
+        self.fields.keys(table, allowed, where)  # the key path puts " " after a [table], "." elsewhere
 
     def string(self, value: object, where: str) -> str:
-        if not isinstance(value, str) or not value:
-            raise self.fail(where, f"expected a non-empty string, got {value!r}")
-        return value
+        return self.fields.string(value, where, nonempty=True)
 
     def number(self, value: object, where: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.fail(where, f"expected a number, got {value!r}")
-        result = float(value)
-        if not math.isfinite(result):
-            raise self.fail(where, f"expected a finite number, got {value!r}")
-        return result
+        return self.fields.number(value, where)
 
     def positive(self, value: object, where: str) -> float:
-        result = self.number(value, where)
-        if result <= 0.0:
-            raise self.fail(where, f"expected a positive number, got {value!r}")
-        return result
+        return self.fields.positive(value, where)
 
     def nonnegative(self, value: object, where: str) -> float:
-        result = self.number(value, where)
-        if result < 0.0:
-            raise self.fail(where, f"expected a non-negative number, got {value!r}")
-        return result
+        return self.fields.nonnegative(value, where)
 
     def integer(self, value: object, where: str, minimum: int) -> int:
-        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            raise self.fail(where, f"expected an integer >= {minimum}, got {value!r}")
-        return value
+        return self.fields.integer(value, where, minimum)
 
     def point(self, value: object, where: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
-            raise self.fail(where, f"expected [x, y] in metres, got {value!r}")
+            raise self.fail(where, f"expected [x, y] in metres, got {describe(value)}")
         return (self.number(value[0], f"{where}[0]"), self.number(value[1], f"{where}[1]"))
 
     def angle(
@@ -403,20 +381,8 @@ class Scenario:
             missing keys, wrong types or values out of range, and files it names that do
             not load (their own error is quoted).
         """
-        source = str(path)
-        reader = _Reader(source)
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise reader.fail("", "expected an existing scenario file, got no such file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            reason = exc.strerror if isinstance(exc, OSError) else "bytes that are not UTF-8"
-            raise reader.fail("", f"expected a readable scenario file, got {reason}") from None
-        try:
-            document = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            line = re.search(r"line (\d+)", str(exc))
-            raise reader.fail(f"line {line.group(1)}" if line else "", f"expected TOML, got {exc}") from None
+        reader = _Reader(str(path))
+        document = load_toml(path, kind="scenario")
         return cls._from_document(document, reader, Path(path).parent, Path(path).stem)
 
     @classmethod
@@ -427,7 +393,7 @@ class Scenario:
         name = reader.string(document.get("name", stem), "name")
         description = document.get("description", "")
         if not isinstance(description, str):
-            raise reader.fail("description", f"expected a string, got {description!r}")
+            raise reader.fail("description", f"expected a string, got {describe(description)}")
         terrain = _load_terrain(document, reader, base)
         meadow_map = _load_map(document, reader, base, terrain)
         if "camera" not in document:
@@ -617,15 +583,15 @@ def _landmark_ids(document: Mapping[str, object], reader: _Reader, meadow_map: M
         return tuple(record.id for record in meadow_map.landmarks)
     value = document["landmarks"]
     if not isinstance(value, list):
-        raise reader.fail("landmarks", f"expected a list of landmark ids, got {value!r}")
+        raise reader.fail("landmarks", f"expected a list of landmark ids, got {describe(value)}")
     known = {record.id for record in meadow_map.landmarks}
     for index, item in enumerate(value):
         where = f"landmarks[{index}]"
         ident = reader.string(item, where)
         if ident not in known:
-            raise reader.fail(where, f"expected the id of a landmark of the map, got {ident!r}")
+            raise reader.fail(where, f"expected the id of a landmark of the map, got {describe(ident)}")
         if ident in value[:index]:
-            raise reader.fail(where, f"expected each id once, got {ident!r} again")
+            raise reader.fail(where, f"expected each id once, got {describe(ident)} again")
     chosen = set(value)
     return tuple(record.id for record in meadow_map.landmarks if record.id in chosen)
 
@@ -691,7 +657,7 @@ def _route(
             raise reader.fail(where, f"expected a goal away from the start, got {list(goal)}")
         return tuple(_commands_through(route.waypoints[1:], pose, reader, where))
     if not isinstance(value, list) or not value:
-        raise reader.fail(where, f"expected a non-empty list, got {value!r}")
+        raise reader.fail(where, f"expected a non-empty list, got {describe(value)}")
     if key == "waypoints":
         points = np.array([reader.point(item, f"{where}[{i}]") for i, item in enumerate(value)])
         return tuple(_commands_through(points, pose, reader, where))
@@ -699,7 +665,7 @@ def _route(
     for index, item in enumerate(value):
         place = f"{where}[{index}]"
         if not isinstance(item, dict):
-            raise reader.fail(place, f"expected a table {{turn_deg = ..., run = ...}}, got {item!r}")
+            raise reader.fail(place, f"expected a table {{turn_deg = ..., run = ...}}, got {describe(item)}")
         reader.keys(item, ("turn", "turn_deg", "run"), place, ".")
         turn = reader.angle(item, "turn", place, required=False, sep=".")
         if "run" not in item:

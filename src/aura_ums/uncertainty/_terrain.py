@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -12,6 +11,7 @@ from types import MappingProxyType
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from aura_ums._files import Fields, key_path, load_toml
 from aura_ums._validate import finite_float, float_array
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
@@ -231,51 +231,36 @@ class TerrainTable(Mapping[str, TerrainStats]):
             Naming the file, the terrain and the key, for unreadable files, malformed
             TOML, unknown or missing keys and values out of range.
         """
-        source = str(path)
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except OSError as exc:
-            raise FileFormatError(source, "", f"expected a readable TOML file, got {exc.strerror}") from exc
-        try:
-            document = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise FileFormatError(source, "", f"expected valid TOML, got {exc}") from exc
-        return cls.from_mapping(document, source=source)
+        return cls.from_mapping(load_toml(path, kind="terrain table TOML"), source=str(path))
 
     @classmethod
     def from_mapping(cls, document: Mapping[str, object], *, source: str = "<mapping>") -> TerrainTable:
         """Build a table from nested mappings as TOML gives them (see :meth:`from_toml`)."""
         if not document:
             raise FileFormatError(source, "", "expected at least one terrain table, got none")
+        reader = Fields(source)
         names = TerrainStats.field_names()
         entries: dict[str, TerrainStats] = {}
         for terrain, table in document.items():
             where = f"[{terrain}]"
             if not isinstance(table, Mapping):
-                raise FileFormatError(source, where, f"expected a table of statistics, got {table!r}")
+                raise reader.error(where, f"expected a table of statistics, got {reader.describe(table)}")
             values: dict[str, float] = {}
             for key, raw in table.items():
                 target, scale = _ALTERNATE_UNITS.get(key, (key, 1.0))
                 if target not in names:
-                    raise FileFormatError(
-                        source,
-                        f"{where} {key}",
-                        f"expected one of {', '.join(names)}, got unknown key {key!r}",
-                    )
+                    reader.keys({key: raw}, names, where)
                 if target in values:
-                    raise FileFormatError(source, f"{where} {key}", f"expected {target} once, got it twice")
-                try:
-                    values[target] = finite_float(raw, key) * scale
-                except InputError as exc:
-                    raise FileFormatError(source, f"{where} {key}", str(exc).split(": ", 1)[1]) from exc
+                    raise reader.error(key_path(where, key), f"expected {target} once, got it twice")
+                values[target] = reader.number(raw, key_path(where, key)) * scale
             missing = [name for name in names if name not in values]
             if missing:
-                raise FileFormatError(source, where, f"expected keys {', '.join(missing)}, got none for them")
+                raise reader.error(where, f"expected keys {', '.join(missing)}, got none for them")
             try:
                 entries[terrain] = TerrainStats(**values)
             except InputError as exc:
                 key, _, message = str(exc).partition(": ")
-                raise FileFormatError(source, f"{where} {key}", message) from exc
+                raise reader.error(key_path(where, key), message) from exc
         return cls(entries)
 
     def to_toml(self) -> str:

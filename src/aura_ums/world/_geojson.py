@@ -8,13 +8,13 @@ writes them with ``repr`` precision), so a saved map reads back equal.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import NoReturn
 
 import numpy as np
 
+from aura_ums._files import Fields, describe, load_json
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import (
@@ -49,12 +49,13 @@ class _Reader:
 
     def __init__(self, source: str, base: Path, terrain_table: TerrainTable | None) -> None:
         self.source = source
+        self.fields = Fields(source, "json")
         self.base = base
         self.terrain_table = terrain_table
         self.table = terrain_table
 
     def fail(self, where: str, message: str) -> NoReturn:
-        raise FileFormatError(self.source, where, message)
+        self.fields.fail(where, message)
 
     # --- the collection --------------------------------------------------------------------
 
@@ -62,7 +63,7 @@ class _Reader:
         if not isinstance(document, Mapping):
             self.fail("", f"expected a GeoJSON object, got {_kind(document)}")
         if document.get("type") != "FeatureCollection":
-            self.fail("type", f"expected 'FeatureCollection', got {document.get('type')!r}")
+            self.fail("type", f"expected 'FeatureCollection', got {_kind(document.get('type'))}")
         features = document.get("features")
         if not isinstance(features, list):
             self.fail("features", f"expected a list of features, got {_kind(features)}")
@@ -70,7 +71,7 @@ class _Reader:
         table = self.terrain_table
         if table_file is not None:
             if not isinstance(table_file, str) or not table_file:
-                self.fail("terrain_table", f"expected the name of a TOML file, got {table_file!r}")
+                self.fail("terrain_table", f"expected the name of a TOML file, got {_kind(table_file)}")
             if table is None:
                 path = self.base / table_file
                 if not path.is_file():
@@ -92,11 +93,12 @@ class _Reader:
             ident = props.get("id")
             if not isinstance(ident, str) or not ident:
                 self.fail(f"{where} properties.id", f"expected a non-empty string, got {_kind(ident)}")
-            where = f"{where} (id {ident!r})"
+            where = f"{where} (id {describe(ident)})"
             if ident in places:
+                first = places[ident][0]
                 self.fail(
                     f"{where} properties.id",
-                    f"expected a unique id, got {ident!r} again (first at features[{places[ident][0]}])",
+                    f"expected a unique id, got {describe(ident)} again (first at features[{first}])",
                 )
             places[ident] = (index, where)
             kind = props.get("kind")
@@ -115,7 +117,7 @@ class _Reader:
                 if landmark_id not in known:
                     self.fail(
                         f"{where} properties.landmarks[{position}]",
-                        f"expected the id of a landmark feature, got {landmark_id!r}",
+                        f"expected the id of a landmark feature, got {describe(landmark_id)}",
                     )
         try:
             return MeadowMap._create([meadow for _, meadow in meadows], landmarks, table, table_file)
@@ -125,12 +127,7 @@ class _Reader:
     # --- features --------------------------------------------------------------------------
 
     def check_keys(self, where: str, props: Mapping[str, object], allowed: tuple[str, ...]) -> None:
-        for key in props:
-            if key not in allowed:
-                self.fail(
-                    f"{where} properties.{key}",
-                    f"expected one of the properties {', '.join(allowed)}, got unknown {key!r}",
-                )
+        self.fields.keys(props, allowed, f"{where} properties", noun="property")
 
     def meadow(self, where: str, geometry: object, props: Mapping[str, object]) -> Meadow:
         self.check_keys(where, props, _MEADOW_KEYS)
@@ -141,19 +138,21 @@ class _Reader:
         if self.table is not None and terrain not in self.table:
             self.fail(
                 f"{where} properties.terrain",
-                f"expected one of {', '.join(sorted(self.table))}, got {terrain!r}",
+                f"expected one of {', '.join(sorted(self.table))}, got {describe(terrain)}",
             )
         listed = props.get("landmarks", [])
         if not isinstance(listed, list):
             self.fail(
                 f"{where} properties.landmarks", f"expected a list of landmark ids, got {_kind(listed)}"
             )
+        seen: set[str] = set()
         for position, landmark_id in enumerate(listed):
             item = f"{where} properties.landmarks[{position}]"
             if not isinstance(landmark_id, str) or not landmark_id:
                 self.fail(item, f"expected a landmark id (string), got {_kind(landmark_id)}")
-            if landmark_id in listed[:position]:
-                self.fail(item, f"expected each landmark id once, got {landmark_id!r} again")
+            if landmark_id in seen:
+                self.fail(item, f"expected each landmark id once, got {describe(landmark_id)} again")
+            seen.add(landmark_id)
         try:
             polygon = ConvexPolygon(ring)
         except InputError as exc:
@@ -197,9 +196,7 @@ class _Reader:
         return (self.number(where, value[0]), self.number(where, value[1]))
 
     def number(self, where: str, value: object) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(where, f"expected a finite number, got {_kind(value)}")
-        return float(value)
+        return self.fields.number(value, where)
 
     def landmark(self, where: str, geometry: object, props: Mapping[str, object]) -> LandmarkRecord:
         ident = str(props["id"])
@@ -209,9 +206,7 @@ class _Reader:
         self.check_keys(where, props, _COMMON_LANDMARK_KEYS + _CLASS_KEYS[klass])
 
         def required_number(key: str) -> float:
-            if key not in props:
-                self.fail(f"{where} properties.{key}", "expected a number, got nothing")
-            return self.number(f"{where} properties.{key}", props[key])
+            return self.fields.field(props, key, float, f"{where} properties")
 
         symbol = props.get("symbol", "")
         if not isinstance(symbol, str):
@@ -281,22 +276,14 @@ class _Reader:
 
 
 def _kind(value: object) -> str:
-    """Describe a JSON value for an error message."""
-    if value is None:
-        return "nothing"
-    if isinstance(value, (Mapping, list)):
-        return f"a JSON {'object' if isinstance(value, Mapping) else 'array'}"
-    return repr(value)
+    """Describe a JSON value for an error message (absent properties are None: "nothing")."""
+    return "nothing" if value is None else describe(value, "json")
 
 
 def _geometry_kind(geometry: object) -> str:
     if isinstance(geometry, Mapping):
         return repr(geometry.get("type"))
     return _kind(geometry)
-
-
-def _refuse_constant(name: str) -> float:
-    raise ValueError(f"the non-standard number {name}")
 
 
 def parse_geojson(
@@ -308,22 +295,8 @@ def parse_geojson(
 
 def read_geojson(path: str | Path, *, terrain_table: TerrainTable | None) -> MeadowMap:
     """Read and validate a meadow map file (see :meth:`MeadowMap.from_geojson`)."""
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise FileFormatError(source, "", f"expected a readable GeoJSON file, got {exc.strerror}") from exc
-    except UnicodeDecodeError as exc:
-        raise FileFormatError(source, "", f"expected UTF-8 text, got {exc.reason}") from exc
-    try:
-        document = json.loads(text, parse_constant=_refuse_constant)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(
-            source, f"line {exc.lineno} column {exc.colno}", f"expected valid JSON, got {exc.msg}"
-        ) from exc
-    except ValueError as exc:
-        raise FileFormatError(source, "", f"expected valid JSON, got {exc}") from exc
-    return parse_geojson(document, source=source, base=Path(path).parent, terrain_table=terrain_table)
+    document = load_json(path, kind="GeoJSON")
+    return parse_geojson(document, source=str(path), base=Path(path).parent, terrain_table=terrain_table)
 
 
 def _landmark_feature(record: LandmarkRecord) -> dict[str, object]:

@@ -1,0 +1,649 @@
+"""The loading layer: every file aura-ums reads goes through here, and fails one way.
+
+Each reader (terrain tables, cameras, scenarios, sensor calibrations, log folders and
+their ``meta.toml``, saved manager state, meadow maps) reads its file with these steps:
+
+1. bytes, at most :data:`MAX_BYTES` (64 MiB) per file;
+2. UTF-8 text, with or without a byte-order mark (Excel writes one); other bytes are
+   refused naming the line and the byte offset;
+3. parsed as TOML (:mod:`tomllib`), strict JSON (no ``NaN``/``Infinity``, no key twice)
+   or CSV (a header row naming the columns, then at most :data:`MAX_ROWS` data rows;
+   blank lines and ``#`` comments skipped; every row keeps its 1-based line number);
+4. typed values pulled from the parsed tables with :class:`Fields`.
+
+Every failure is a :class:`~aura_ums.errors.FileFormatError` whose message reads
+``file:line: expected ..., got ...`` or ``file: key path: expected ..., got ...``; the
+wording of the common cases (a number, an integer, a string, a table, an unknown key)
+is made here once. Nothing here evaluates what it reads: no pickle, no eval.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import re
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Literal, NoReturn, TypeVar, cast
+
+from aura_ums.errors import FileFormatError
+
+__all__ = [
+    "MAX_BYTES",
+    "MAX_ROWS",
+    "CsvTable",
+    "Fields",
+    "decode",
+    "describe",
+    "key_path",
+    "load_csv",
+    "load_json",
+    "load_toml",
+    "parse_csv",
+    "parse_json",
+    "parse_toml",
+    "read_bytes",
+    "read_text",
+]
+
+#: Largest file read, bytes (64 MiB): far above any aura-ums file, far below memory trouble.
+MAX_BYTES = 64 * 1024 * 1024
+#: Most data rows of a CSV file (two million: hours of 100 Hz odometry).
+MAX_ROWS = 2_000_000
+
+Syntax = Literal["toml", "json"]
+T = TypeVar("T")
+
+_BOM = "\ufeff"
+_OTHER_BOMS = (b"\xff\xfe", b"\xfe\xff")  # UTF-16 and UTF-32 start with one of these
+_DESCRIBED_LENGTH = 60
+_TOML_POSITION = re.compile(r"^(?P<message>.*) \(at line (?P<line>\d+), column (?P<column>\d+)\)$", re.DOTALL)
+
+
+def _size(limit: int) -> str:
+    mebibytes, rest = divmod(limit, 1024 * 1024)
+    return f"{mebibytes} MiB ({limit} bytes)" if mebibytes and not rest else f"{limit} bytes"
+
+
+def _first_clause(exc: Exception) -> str:
+    return str(exc).split(";", 1)[0]
+
+
+def _limit(value: int | None, default: int) -> int:
+    return default if value is None else value
+
+
+# --- bytes and text ------------------------------------------------------------------------
+
+
+def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None = None) -> bytes:
+    r"""Return the bytes of a file of at most ``max_bytes`` (default :data:`MAX_BYTES`).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    kind : str
+        What the file is, for messages (``"TOML"``, ``"scenario"``, ...).
+    max_bytes : int, optional
+        Largest size accepted, bytes.
+
+    Returns
+    -------
+    bytes
+        The whole file.
+
+    Raises
+    ------
+    FileFormatError
+        For a missing, unreadable or larger file; the message states the limit.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "a.toml"
+    >>> _ = path.write_bytes(b"x = 1\n")
+    >>> read_bytes(path, kind="TOML")
+    b'x = 1\n'
+    >>> read_bytes(path, kind="TOML", max_bytes=4)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: .../a.toml: expected a TOML file of at most 4 bytes, got a larger one
+    """
+    limit = _limit(max_bytes, MAX_BYTES)
+    source = str(path)
+    try:
+        with open(path, "rb") as handle:
+            # One byte more than the limit tells a larger file without reading all of it.
+            data = handle.read(limit + 1)
+    except FileNotFoundError:
+        raise FileFormatError(source, "", f"expected an existing {kind} file, got no such file") from None
+    except IsADirectoryError:
+        raise FileFormatError(source, "", f"expected a {kind} file, got a folder") from None
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise FileFormatError(source, "", f"expected a readable {kind} file, got {reason}") from None
+    except ValueError:  # a NUL in the path
+        raise FileFormatError(
+            source, "", f"expected the path of a {kind} file, got an invalid path"
+        ) from None
+    if len(data) > limit:
+        raise FileFormatError(
+            source, "", f"expected a {kind} file of at most {_size(limit)}, got a larger one"
+        )
+    return data
+
+
+def decode(data: bytes, source: str) -> str:
+    r"""Return ``data`` decoded as UTF-8, without its byte-order mark if it has one.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's bytes.
+    source : str
+        The file, for messages.
+
+    Returns
+    -------
+    str
+        The text.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the line and the byte offset of the first byte that is not UTF-8.
+
+    Examples
+    --------
+    >>> decode(b"\xef\xbb\xbftime,v\n", "odometry.csv")
+    'time,v\n'
+    >>> decode(b"name = 'caf\xe9'\n", "meta.toml")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: meta.toml:1: byte 11: expected UTF-8 text, got the byte 0xe9
+    """
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        offset = exc.start
+        if offset < 2 and data.startswith(_OTHER_BOMS):
+            found = "a UTF-16 or UTF-32 byte-order mark"
+        else:
+            found = f"the byte 0x{data[offset]:02x}"
+        line = data.count(b"\n", 0, offset) + 1
+        raise FileFormatError(
+            source, f"byte {offset}", f"expected UTF-8 text, got {found}", line=line
+        ) from None
+    return text.removeprefix(_BOM)
+
+
+def read_text(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None = None) -> str:
+    """Return a file's text: :func:`read_bytes` then :func:`decode`."""
+    return decode(read_bytes(path, kind=kind, max_bytes=max_bytes), str(path))
+
+
+def _text(text: str, source: str, max_bytes: int | None) -> str:
+    """Text given in memory: the same size limit (in characters) and BOM rule as files."""
+    limit = _limit(max_bytes, MAX_BYTES)
+    if len(text) > limit:
+        raise FileFormatError(
+            source, "", f"expected at most {_size(limit)} of text, got {len(text)} characters"
+        )
+    return text.removeprefix(_BOM)
+
+
+# --- TOML and JSON -------------------------------------------------------------------------
+
+
+def parse_toml(text: str, source: str, *, max_bytes: int | None = None) -> dict[str, object]:
+    r"""Parse TOML text; a syntax error names the line and column.
+
+    Examples
+    --------
+    >>> parse_toml("\ufeff[mount]\nheight = 1.2\n", "cam.toml")
+    {'mount': {'height': 1.2}}
+    >>> parse_toml("[mount]\nheight = \n", "cam.toml")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: cam.toml:2:10: expected valid TOML, got Invalid value
+    """
+    body = _text(text, source, max_bytes)
+    try:
+        return tomllib.loads(body)
+    except tomllib.TOMLDecodeError as exc:
+        text_of_error = str(exc)
+        match = _TOML_POSITION.match(text_of_error)
+        if match is not None:
+            message, line, column = match["message"], int(match["line"]), int(match["column"])
+        else:  # "... (at end of document)": the place after the last character
+            message = text_of_error.removesuffix(" (at end of document)")
+            line, column = body.count("\n") + 1, len(body) - body.rfind("\n")
+        raise FileFormatError(
+            source, "", f"expected valid TOML, got {message}", line=line, column=column
+        ) from None
+    except RecursionError:
+        raise FileFormatError(
+            source, "", "expected valid TOML, got arrays or tables nested too deep"
+        ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts
+        raise FileFormatError(source, "", f"expected valid TOML, got {_first_clause(exc)}") from None
+
+
+def _no_constants(name: str) -> NoReturn:
+    raise _RefusedError(f"the non-standard number {name}")
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise _RefusedError(f"the number {describe(text)}, beyond the largest float")
+    return value
+
+
+def _no_repeats(pairs: list[tuple[str, object]]) -> dict[str, object]:
+    result = dict(pairs)
+    if len(result) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise _RefusedError(f"the key {describe(key)} twice in one object")
+            seen.add(key)
+    return result
+
+
+class _RefusedError(Exception):
+    """What strict JSON refuses although :mod:`json` would read it; turned into a FileFormatError."""
+
+
+def parse_json(text: str, source: str, *, max_bytes: int | None = None) -> object:
+    r"""Parse strict JSON text: no ``NaN``/``Infinity`` constants, no key twice in an object.
+
+    Examples
+    --------
+    >>> parse_json('\ufeff{"x": [1, 2.5]}', "state.json")
+    {'x': [1, 2.5]}
+    >>> parse_json('{"x": NaN}', "state.json")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: state.json: expected valid JSON, got the non-standard number NaN
+    """
+    body = _text(text, source, max_bytes)
+    try:
+        return cast(
+            object,
+            json.loads(
+                body, parse_constant=_no_constants, parse_float=_finite_float, object_pairs_hook=_no_repeats
+            ),
+        )
+    except json.JSONDecodeError as exc:
+        raise FileFormatError(
+            source, "", f"expected valid JSON, got {exc.msg}", line=exc.lineno, column=exc.colno
+        ) from None
+    except _RefusedError as exc:
+        raise FileFormatError(source, "", f"expected valid JSON, got {exc}") from None
+    except RecursionError:
+        raise FileFormatError(
+            source, "", "expected valid JSON, got arrays or objects nested too deep"
+        ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts
+        raise FileFormatError(source, "", f"expected valid JSON, got {_first_clause(exc)}") from None
+
+
+def load_toml(
+    path: str | os.PathLike[str], *, kind: str = "TOML", max_bytes: int | None = None
+) -> dict[str, object]:
+    """Read and parse a TOML file (:func:`read_text`, :func:`parse_toml`)."""
+    return parse_toml(read_text(path, kind=kind, max_bytes=max_bytes), str(path), max_bytes=max_bytes)
+
+
+def load_json(path: str | os.PathLike[str], *, kind: str = "JSON", max_bytes: int | None = None) -> object:
+    """Read and parse a strict JSON file (:func:`read_text`, :func:`parse_json`)."""
+    return parse_json(read_text(path, kind=kind, max_bytes=max_bytes), str(path), max_bytes=max_bytes)
+
+
+# --- CSV -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class CsvTable:
+    """A parsed CSV file: the header, the rows of stripped cells and their line numbers.
+
+    Parameters
+    ----------
+    source : str
+        The file, for messages.
+    header : tuple of str
+        The column names, stripped (of spaces and of a byte-order mark).
+    header_line : int
+        1-based line of the header.
+    rows : tuple of tuple of str
+        The data rows, each with one stripped cell per column.
+    lines : tuple of int
+        1-based line of each row.
+    """
+
+    source: str
+    header: tuple[str, ...]
+    header_line: int
+    rows: tuple[tuple[str, ...], ...]
+    lines: tuple[int, ...]
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def columns(self) -> dict[str, list[str]]:
+        """Return the cells column by column, keyed by column name."""
+        transposed = list(zip(*self.rows, strict=True)) if self.rows else [() for _ in self.header]
+        return {name: list(cells) for name, cells in zip(self.header, transposed, strict=True)}
+
+
+def parse_csv(
+    text: str,
+    source: str,
+    *,
+    columns: Sequence[str],
+    required: Sequence[str] = (),
+    max_rows: int | None = None,
+    max_bytes: int | None = None,
+) -> CsvTable:
+    r"""Parse CSV text: a header naming known columns, then rows of as many cells.
+
+    Blank lines and lines starting with ``#`` are skipped; a quoted cell may not span lines.
+
+    Parameters
+    ----------
+    text : str
+        The CSV text.
+    source : str
+        The file, for messages.
+    columns : sequence of str
+        The column names allowed in the header.
+    required : sequence of str
+        The columns the header must have.
+    max_rows : int, optional
+        Most data rows accepted (default :data:`MAX_ROWS`).
+    max_bytes : int, optional
+        Longest text accepted, characters (default :data:`MAX_BYTES`).
+
+    Returns
+    -------
+    CsvTable
+        The header and the rows, with their line numbers.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the line: no header, an unknown, repeated or missing column, a row with
+        the wrong number of cells, too many rows, malformed CSV.
+
+    Examples
+    --------
+    >>> table = parse_csv("\ufefftime, v\n# a comment\n0.5, 1.0\n", "odometry.csv", columns=("time", "v"))
+    >>> table.header, table.rows, table.lines
+    (('time', 'v'), (('0.5', '1.0'),), (3,))
+    >>> parse_csv("time,v\n1,2\n3,4\n", "odometry.csv", columns=("time", "v"), max_rows=1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: odometry.csv:3: expected at most 1 data rows, got more
+    """
+    body = _text(text, source, max_bytes)
+    most = _limit(max_rows, MAX_ROWS)
+    numbers: list[int] = []
+    lines: list[str] = []
+    for number, line in enumerate(body.splitlines(), start=1):
+        stripped = line.strip()
+        if stripped and not stripped.startswith("#"):
+            if len(lines) > most:
+                raise FileFormatError(source, "", f"expected at most {most} data rows, got more", line=number)
+            numbers.append(number)
+            lines.append(line)
+    wanted = ", ".join(required or columns)
+    if not lines:
+        raise FileFormatError(source, "", f"expected a header row naming the columns {wanted}, got none")
+    reader = csv.reader(lines, strict=True)
+    try:
+        parsed = list(reader)
+    except csv.Error as exc:
+        line_number = numbers[min(reader.line_num, len(numbers)) - 1]
+        raise FileFormatError(source, "", f"expected CSV, got {exc}", line=line_number) from None
+    if len(parsed) != len(lines):
+        raise FileFormatError(source, "", "expected one row per line, got a quoted cell spanning lines")
+    header = tuple(name.strip().removeprefix(_BOM).strip() for name in parsed[0])
+    for index, name in enumerate(header):
+        if name not in columns:
+            raise FileFormatError(
+                source,
+                "",
+                f"expected columns from {', '.join(columns)}, got unknown column {describe(name)}",
+                line=numbers[0],
+            )
+        if name in header[:index]:
+            raise FileFormatError(
+                source, "", f"expected each column once, got {describe(name)} twice", line=numbers[0]
+            )
+    for name in required:
+        if name not in header:
+            raise FileFormatError(
+                source, "", f"expected a column {name!r}, got columns {', '.join(header)}", line=numbers[0]
+            )
+    rows: list[tuple[str, ...]] = []
+    for number, cells in zip(numbers[1:], parsed[1:], strict=True):
+        if len(cells) != len(header):
+            raise FileFormatError(source, "", f"expected {len(header)} cells, got {len(cells)}", line=number)
+        rows.append(tuple(cell.strip() for cell in cells))
+    return CsvTable(source, header, numbers[0], tuple(rows), tuple(numbers[1:]))
+
+
+def load_csv(
+    path: str | os.PathLike[str],
+    *,
+    columns: Sequence[str],
+    required: Sequence[str] = (),
+    max_rows: int | None = None,
+    max_bytes: int | None = None,
+) -> CsvTable:
+    """Read and parse a CSV file (:func:`read_text`, :func:`parse_csv`)."""
+    text = read_text(path, kind="CSV", max_bytes=max_bytes)
+    return parse_csv(
+        text, str(path), columns=columns, required=required, max_rows=max_rows, max_bytes=max_bytes
+    )
+
+
+# --- typed values --------------------------------------------------------------------------
+
+
+def describe(value: object, syntax: Syntax = "toml") -> str:
+    """Name a parsed value in a message: scalars by their (shortened) repr, containers by kind.
+
+    Containers are never printed: a message stays short, whatever the file holds.
+
+    Examples
+    --------
+    >>> describe("much"), describe(True), describe([1, 2]), describe({}, "json"), describe(None, "json")
+    ("'much'", 'true', 'an array', 'an object', 'null')
+    >>> describe("x" * 100)
+    "'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx..."
+    """
+    if value is None:
+        return "null" if syntax == "json" else "nothing"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, Mapping):
+        return "an object" if syntax == "json" else "a table"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, (str, int, float)):
+        text = repr(value) if not isinstance(value, int) or value.bit_length() < 200 else "a huge integer"
+    else:  # TOML dates and times
+        text = f"a {type(value).__name__} {value}"
+    return text if len(text) <= _DESCRIBED_LENGTH else text[: _DESCRIBED_LENGTH - 3] + "..."
+
+
+def key_path(where: str, key: str) -> str:
+    """Return the place of ``key`` inside the table at ``where``.
+
+    A TOML table header is followed by a space, any other place by a dot.
+
+    Examples
+    --------
+    >>> key_path("[start]", "x"), key_path("[route] commands[0]", "run"), key_path("", "map")
+    ('[start] x', '[route] commands[0].run', 'map')
+    """
+    if not where:
+        return key
+    if where.startswith("[") and where.endswith("]") and "]" not in where[:-1]:
+        return f"{where} {key}"
+    return f"{where}.{key}"
+
+
+@dataclass(frozen=True, slots=True)
+class Fields:
+    """Typed values pulled from a parsed document; every failure names the file and the place.
+
+    Parameters
+    ----------
+    source : str
+        The file (or a description such as ``"<manager JSON>"``), for messages.
+    syntax : {"toml", "json"}
+        How containers and null are named in messages ("a table" or "an object").
+
+    Examples
+    --------
+    >>> fields = Fields("terrain.toml")
+    >>> fields.field({"drift": 0.01}, "drift", float, "[grass]")
+    0.01
+    >>> fields.field({"drift": "much"}, "drift", float, "[grass]")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: terrain.toml: [grass] drift: expected a finite number, got 'much'
+    >>> fields.field({}, "drift", float, "[grass]")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: terrain.toml: [grass] drift: expected a finite number, got nothing
+    """
+
+    source: str
+    syntax: Syntax = "toml"
+
+    def error(self, where: str, message: str, *, line: int | None = None) -> FileFormatError:
+        """Return the error for ``where`` (raise it)."""
+        return FileFormatError(self.source, where, message, line=line)
+
+    def fail(self, where: str, message: str, *, line: int | None = None) -> NoReturn:
+        """Raise the error for ``where``."""
+        raise self.error(where, message, line=line)
+
+    def describe(self, value: object) -> str:
+        """Name ``value`` in a message (see :func:`describe`)."""
+        return describe(value, self.syntax)
+
+    def table(self, value: object, where: str) -> dict[str, object]:
+        """Return ``value`` as a table (a JSON object)."""
+        if not isinstance(value, dict):
+            self.fail(where, f"expected {self.describe({})}, got {self.describe(value)}")
+        return cast(dict[str, object], value)
+
+    def array(self, value: object, where: str) -> list[object]:
+        """Return ``value`` as an array."""
+        if not isinstance(value, list):
+            self.fail(where, f"expected an array, got {self.describe(value)}")
+        return cast(list[object], value)
+
+    def number(self, value: object, where: str) -> float:
+        """Return ``value`` as a finite float (an integer or a float, not a boolean)."""
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            try:
+                result = float(value)
+            except OverflowError:  # an integer beyond the largest float
+                result = math.inf
+            if math.isfinite(result):
+                return result
+        self.fail(where, f"expected a finite number, got {self.describe(value)}")
+
+    def positive(self, value: object, where: str) -> float:
+        """Return ``value`` as a finite float > 0."""
+        result = self.number(value, where)
+        if result <= 0.0:
+            self.fail(where, f"expected a positive number, got {self.describe(value)}")
+        return result
+
+    def nonnegative(self, value: object, where: str) -> float:
+        """Return ``value`` as a finite float >= 0."""
+        result = self.number(value, where)
+        if result < 0.0:
+            self.fail(where, f"expected a non-negative number, got {self.describe(value)}")
+        return result
+
+    def integer(self, value: object, where: str, minimum: int | None = None) -> int:
+        """Return ``value`` as an integer (not a boolean), >= ``minimum`` when given."""
+        expected = "an integer" if minimum is None else f"an integer >= {minimum}"
+        if isinstance(value, bool) or not isinstance(value, int) or (minimum is not None and value < minimum):
+            self.fail(where, f"expected {expected}, got {self.describe(value)}")
+        return value
+
+    def string(self, value: object, where: str, *, nonempty: bool = False) -> str:
+        """Return ``value`` as a string, non-empty with ``nonempty``."""
+        if not isinstance(value, str) or (nonempty and not value):
+            self.fail(
+                where, f"expected {'a non-empty' if nonempty else 'a'} string, got {self.describe(value)}"
+            )
+        return value
+
+    def boolean(self, value: object, where: str) -> bool:
+        """Return ``value`` as a boolean."""
+        if not isinstance(value, bool):
+            self.fail(where, f"expected true or false, got {self.describe(value)}")
+        return value
+
+    def keys(
+        self, table: Mapping[str, object], allowed: Sequence[str], where: str = "", *, noun: str = "key"
+    ) -> None:
+        """Refuse any key of ``table`` not in ``allowed``, naming the allowed ones."""
+        for key in table:
+            if key not in allowed:
+                self.fail(
+                    key_path(where, key),
+                    f"expected one of {', '.join(allowed)}, got unknown {noun} {describe(key)}",
+                )
+
+    def field(
+        self, table: Mapping[str, object], key: str, kind: type[T], where: str = "", default: T | None = None
+    ) -> T:
+        """Return ``table[key]`` checked as ``kind``, or ``default`` when absent (None: required).
+
+        ``kind`` is one of ``float`` (a finite number; integers accepted), ``int``,
+        ``str``, ``bool``, ``dict`` (a table) and ``list`` (an array).
+        """
+        place = key_path(where, key)
+        if key not in table:
+            if default is not None:
+                return default
+            expected = self.describe({}) if kind is dict else _EXPECTED[kind]
+            self.fail(place, f"expected {expected}, got nothing")
+        value = table[key]
+        if kind is float:
+            return cast(T, self.number(value, place))
+        if kind is int:
+            return cast(T, self.integer(value, place))
+        if kind is str:
+            return cast(T, self.string(value, place))
+        if kind is bool:
+            return cast(T, self.boolean(value, place))
+        if kind is dict:
+            return cast(T, self.table(value, place))
+        if kind is list:
+            return cast(T, self.array(value, place))
+        raise TypeError(f"kind: expected float, int, str, bool, dict or list, got {kind!r}")
+
+
+_EXPECTED: dict[type, str] = {
+    float: "a finite number",
+    int: "an integer",
+    str: "a string",
+    bool: "true or false",
+    list: "an array",
+}
