@@ -11,12 +11,11 @@ heading interval) for side-by-side figures.
 This package imports only geometry, uncertainty, validation and errors.
 """
 
-from aura_ums.baselines._ekf import MIN_LANDMARK_DISTANCE, ExtendedKalmanFilter
+from aura_ums.baselines._ekf import ExtendedKalmanFilter
 from aura_ums.baselines._moments import MotionMoments, clipped_normal_moments, motion_moments
-from aura_ums.baselines._particle import DEFAULT_PARTICLES, ParticleFilter, systematic_resample
+from aura_ums.baselines._particle import ParticleFilter, systematic_resample
 from aura_ums.baselines._protocol import Estimator
 from aura_ums.baselines._region import (
-    ELLIPSE_SIDES,
     ConfidenceRegion,
     chi2_quantile,
     ellipse_polygon,
@@ -25,9 +24,6 @@ from aura_ums.baselines._region import (
 )
 
 __all__ = [
-    "DEFAULT_PARTICLES",
-    "ELLIPSE_SIDES",
-    "MIN_LANDMARK_DISTANCE",
     "ConfidenceRegion",
     "Estimator",
     "ExtendedKalmanFilter",

@@ -26,11 +26,6 @@ Examples
 
 from aura_ums.export._mcap import mcap_channels, write_replay_mcap, write_simulation_mcap
 from aura_ums.export._scene import (
-    ARC_STEP,
-    OTHER_TERRAIN_COLOR,
-    TERRAIN_COLORS,
-    WEDGE_MIN_RADIUS,
-    WEDGE_REACH,
     seconds_to_nanoseconds,
     terrain_color,
     wedge_fan,
@@ -40,11 +35,6 @@ from aura_ums.export._scene import (
 )
 
 __all__ = [
-    "ARC_STEP",
-    "OTHER_TERRAIN_COLOR",
-    "TERRAIN_COLORS",
-    "WEDGE_MIN_RADIUS",
-    "WEDGE_REACH",
     "mcap_channels",
     "seconds_to_nanoseconds",
     "terrain_color",
