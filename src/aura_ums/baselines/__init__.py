@@ -12,16 +12,10 @@ This package imports only geometry, uncertainty, validation and errors.
 """
 
 from aura_ums.baselines._ekf import ExtendedKalmanFilter
-from aura_ums.baselines._moments import MotionMoments, clipped_normal_moments, motion_moments
-from aura_ums.baselines._particle import ParticleFilter, systematic_resample
+from aura_ums.baselines._moments import MotionMoments, motion_moments
+from aura_ums.baselines._particle import ParticleFilter
 from aura_ums.baselines._protocol import Estimator
-from aura_ums.baselines._region import (
-    ConfidenceRegion,
-    chi2_quantile,
-    ellipse_polygon,
-    mahalanobis_core,
-    shortest_arc,
-)
+from aura_ums.baselines._region import ConfidenceRegion, chi2_quantile, ellipse_polygon
 
 __all__ = [
     "ConfidenceRegion",
@@ -30,10 +24,6 @@ __all__ = [
     "MotionMoments",
     "ParticleFilter",
     "chi2_quantile",
-    "clipped_normal_moments",
     "ellipse_polygon",
-    "mahalanobis_core",
     "motion_moments",
-    "shortest_arc",
-    "systematic_resample",
 ]

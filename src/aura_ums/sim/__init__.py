@@ -17,7 +17,7 @@ from aura_ums.sim._loop import (
     run_scenario,
     summarize_runs,
 )
-from aura_ums.sim._render import SyntheticCamera, fill_polygon
+from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scenario import (
     RenderSettings,
@@ -54,7 +54,6 @@ __all__ = [
     "StartState",
     "SyntheticCamera",
     "check_render_consistency",
-    "fill_polygon",
     "ground_texture",
     "landmark_points",
     "random_clutter",
