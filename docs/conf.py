@@ -43,12 +43,17 @@ nitpick_ignore = [
     # External: no intersphinx inventory (the build is offline). perception/_lines.py LineBackend.
     ("py:func", "scipy.ndimage.label"),
     # Unqualified names of another subpackage that aura_ums does not export at the top:
-    # schemas/_schema.py FindLandmarkSchema -> ~aura_ums.expecter.DEFAULT_MARGINS;
     # sim/_loop.py LoopState -> ~aura_ums.manager.UncertaintyMapManager.to_json and
     # ~aura_ums.manager.Blackboard.to_json.
-    ("py:data", "DEFAULT_MARGINS"),
     ("py:meth", "UncertaintyMapManager.to_json"),
     ("py:meth", "Blackboard.to_json"),
+    # Constants that are no longer public, named in docstrings of modules being rewritten:
+    # expecter/_expecter.py Expecter.bounds -> ~aura_ums.geometry.UNBOUNDED_PIXELS and
+    # Expecter.window -> DEFAULT_MARGINS (private: ~aura_ums.expecter.margin_pixels);
+    # uncertainty/_joint.py reduce_jointly -> JOINT_INCONSISTENT (private: its reason text).
+    ("py:data", "UNBOUNDED_PIXELS"),
+    ("py:data", "DEFAULT_MARGINS"),
+    ("py:data", "JOINT_INCONSISTENT"),
     # A private module is not documented: baselines/_ekf.py ExtendedKalmanFilter.region
     # -> :class:`ConfidenceRegion` (or :func:`ellipse_polygon`).
     ("py:mod", "aura_ums.baselines._region"),

@@ -39,7 +39,13 @@ from aura_ums.expecter import (
     observe_vertical_line,
 )
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, wrap_angle
-from aura_ums.manager import IdentifiedLandmarkBuffer, ManagerSettings
+from aura_ums.manager import (
+    Blackboard,
+    IdentifiedLandmarkBuffer,
+    ManagerSettings,
+    PositionReport,
+    UncertaintyMapManager,
+)
 from aura_ums.perception import FastLineFinder, MoravecOperator, RegionSegmenter
 from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
 from aura_ums.uncertainty import (
@@ -59,8 +65,6 @@ from aura_ums.uncertainty import (
     TerrainTable,
     TurnAndRun,
     VerticalLineLandmark,
-    growth_tightness,
-    simulate_containment,
 )
 from aura_ums.world import LandmarkRecord, Meadow, MeadowMap, ShortTermMemory, plan_route, sample_world
 
@@ -70,6 +74,7 @@ __all__ = [
     "FOOT",
     "AuraUmsError",
     "BearingObservation",
+    "Blackboard",
     "CalibrationBounds",
     "Camera",
     "CameraIntrinsics",
@@ -100,6 +105,7 @@ __all__ = [
     "Pilot",
     "PointLandmark",
     "Pose",
+    "PositionReport",
     "RangeBearingObservation",
     "Reduction",
     "RegionSegmenter",
@@ -110,11 +116,11 @@ __all__ = [
     "TerrainStats",
     "TerrainTable",
     "TurnAndRun",
+    "UncertaintyMapManager",
     "UnknownLandmarkError",
     "UnknownTerrainError",
     "VerticalLineLandmark",
     "__version__",
-    "growth_tightness",
     "load_camera",
     "load_opencv_calibration",
     "observe_ground_line",
@@ -122,6 +128,5 @@ __all__ = [
     "observe_vertical_line",
     "plan_route",
     "sample_world",
-    "simulate_containment",
     "wrap_angle",
 ]

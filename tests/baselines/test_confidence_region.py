@@ -10,15 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from aura_ums.baselines import (
-    ConfidenceRegion,
-    ExtendedKalmanFilter,
-    chi2_quantile,
-    ellipse_polygon,
-    mahalanobis_core,
-    shortest_arc,
-)
-from aura_ums.baselines._region import convex_hull_polygon
+from aura_ums.baselines import ConfidenceRegion, ExtendedKalmanFilter, chi2_quantile, ellipse_polygon
+from aura_ums.baselines._region import convex_hull_polygon, mahalanobis_core, shortest_arc
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import Pose, TerrainTable, TurnAndRun
@@ -39,6 +32,16 @@ def test_contains_wraps_around_pi() -> None:
     assert isinstance(inside, np.ndarray)
     assert inside.shape == (2, 2)
     assert inside.tolist() == [[True, True], [False, False]]
+
+
+@pytest.mark.parametrize(("beyond", "inside"), [(0.5e-9, True), (2e-9, False)])
+def test_a_heading_just_past_the_edge_counts_as_a_wedge_counts_it(beyond: float, inside: bool) -> None:
+    # The region writes the wedge's angular tolerance again (it may not import geometry's
+    # private constant): here the two are held equal.
+    region = ConfidenceRegion(SQUARE, 0.0, 0.1, 0.99)
+    for heading in (0.1 + beyond, -0.1 - beyond):
+        assert region.contains(0.0, 0.0, heading) is inside
+        assert region.wedge.contains(heading) is inside
 
 
 def test_centre_is_wrapped_and_wide_interval_is_the_full_circle() -> None:

@@ -16,7 +16,8 @@ from baselines_helpers import (
 from filterpy.kalman import ExtendedKalmanFilter as FilterpyEkf
 from numpy.typing import NDArray
 
-from aura_ums.baselines import Estimator, ExtendedKalmanFilter, clipped_normal_moments, motion_moments
+from aura_ums.baselines import Estimator, ExtendedKalmanFilter, motion_moments
+from aura_ums.baselines._moments import clipped_normal_moments
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     BearingObservation,

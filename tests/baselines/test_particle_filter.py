@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from baselines_helpers import START_HEADING_SD, START_POSITION_SD, run_drive, simulate_drive
 
-from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter, systematic_resample
+from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter
+from aura_ums.baselines._particle import systematic_resample
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     BearingObservation,

@@ -11,10 +11,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from aura_ums import Metrics
+from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
 from aura_ums.logs import synthetic_log, write_log
-from aura_ums.uncertainty import DEFAULT_MAX_VERTICES
 
 runner = CliRunner()
 
@@ -77,7 +76,8 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     assert metrics["joint"]["joint_above_rad"] == pytest.approx(math.pi / 2)
     assert metrics["one by one"]["joint_above_rad"] is None
     assert (metrics["joint"]["robust"], metrics["gate only"]["robust"]) == (True, False)
-    assert (metrics["joint"]["max_vertices"], metrics["coarse"]["max_vertices"]) == (DEFAULT_MAX_VERTICES, 8)
+    default = ManagerSettings().max_vertices
+    assert (metrics["joint"]["max_vertices"], metrics["coarse"]["max_vertices"]) == (default, 8)
     # A coarser polygon: looser on this log.
     coarse, fine = metrics["coarse"]["median_area_m2"], metrics["joint"]["median_area_m2"]
     assert isinstance(coarse, float)

@@ -10,14 +10,9 @@ from expecter_helpers import CAMERAS, extreme_poses, landmark_points, visible_pi
 
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
-from aura_ums.expecter import (
-    DEFAULT_MARGINS,
-    UNBOUNDED_PIXELS,
-    Expecter,
-    ImageWindow,
-    PerceptualStrategy,
-)
-from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy
+from aura_ums.expecter._window import DEFAULT_MARGINS
+from aura_ums.geometry import UNBOUNDED_PIXELS, ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
     GroundLineLandmark,
     Landmark,

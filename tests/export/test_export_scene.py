@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from aura_ums.errors import InputError
-from aura_ums.export import (
+from aura_ums.export._scene import (
     ARC_STEP,
     WEDGE_MIN_RADIUS,
     seconds_to_nanoseconds,

@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from aura_ums.errors import InputError
 from aura_ums.manager import ManagerSettings, SettingInfo
-from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, DEFAULT_SECTOR
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
+from aura_ums.uncertainty._joint import DEFAULT_SECTOR
 
 FIELDS = dataclasses.fields(ManagerSettings)
 
@@ -30,7 +31,9 @@ def test_every_field_carries_its_info_and_a_valid_default() -> None:
     assert "max_vertices : int\n        Cap on the map polygon" in (ManagerSettings.__doc__ or "")
 
 
-def test_the_defaults_are_the_library_constants() -> None:
+def test_the_defaults_are_the_library_defaults() -> None:
+    # Written twice (the manager cannot import the uncertainty layer's private defaults):
+    # here they are held equal.
     settings = ManagerSettings()
     assert (settings.max_vertices, settings.joint_sector) == (DEFAULT_MAX_VERTICES, DEFAULT_SECTOR)
     assert (settings.sigmas, settings.joint_above, settings.robust) == (3.0, math.pi / 2, True)

@@ -26,8 +26,6 @@ from aura_ums.manager import (
     UncertaintyMapManager,
 )
 from aura_ums.uncertainty import (
-    DEFAULT_MAX_VERTICES,
-    DEFAULT_SECTOR,
     BearingObservation,
     GroundLineLandmark,
     GroundLineObservation,
@@ -811,13 +809,13 @@ def test_joint_settings_are_saved_and_an_older_document_restores_without_them() 
     assert (again.settings.joint_above, again.settings.joint_sector) == (1.0, 0.2)
     assert (manager_for().settings.joint_above, manager_for().settings.joint_sector) == (
         math.pi / 2,
-        DEFAULT_SECTOR,
+        ManagerSettings().joint_sector,
     )
     document = json.loads(manager.to_json())
     del document["settings"]["joint_above"], document["settings"]["joint_sector"]
     older = UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
     # As such a manager ran: one by one.
-    assert (older.settings.joint_above, older.settings.joint_sector) == (None, DEFAULT_SECTOR)
+    assert (older.settings.joint_above, older.settings.joint_sector) == (None, ManagerSettings().joint_sector)
 
 
 def test_the_vertex_cap_is_saved_and_an_older_document_restores_the_default() -> None:
@@ -826,7 +824,8 @@ def test_the_vertex_cap_is_saved_and_an_older_document_restores_the_default() ->
     document = json.loads(manager.to_json())
     del document["settings"]["max_vertices"]
     older = UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
-    assert older.settings.max_vertices == DEFAULT_MAX_VERTICES == manager_for().settings.max_vertices
+    default = ManagerSettings().max_vertices
+    assert older.settings.max_vertices == default == manager_for().settings.max_vertices
     document["settings"]["max_vertices"] = 2
     with pytest.raises(FileFormatError, match=r"settings\.max_vertices: expected an integer >= 3, got 2"):
         UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)

@@ -12,12 +12,12 @@ import aura_ums
 from aura_ums.errors import InputError, UnknownLandmarkError, UnknownTerrainError
 from aura_ums.manager import Blackboard, RejectReason, UncertaintyMapManager
 from aura_ums.uncertainty import (
-    JOINT_INCONSISTENT,
     BearingObservation,
     Pose,
     SpatialUncertaintyMap,
     TerrainTable,
 )
+from aura_ums.uncertainty._joint import JOINT_INCONSISTENT
 from aura_ums.world import sample_world
 
 SOURCE = Path(aura_ums.__file__).parent

@@ -11,7 +11,7 @@ from schema_scenes import CAMERA, map_around, pole_record
 
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
-from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow, PerceptualStrategy
+from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy, margin_pixels
 from aura_ums.perception import FastLineFinder, LineSegments, MoravecOperator, RegionSegmenter
 from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaStatus
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, Pose, VerticalLineLandmark
@@ -73,7 +73,7 @@ def test_line_finder_is_tuned_from_the_record() -> None:
     assert schema.detector == FastLineFinder(
         orientation=1.5, tolerance=0.1, min_length=25.0, min_gradient=6.0, buckets=16
     )
-    assert schema.margin == DEFAULT_MARGINS[PerceptualStrategy.LINE_FINDER]
+    assert schema.margin == margin_pixels(PerceptualStrategy.LINE_FINDER)
     assert (schema.confirm_frames, schema.recognition_threshold, schema.activation_range) == (4, 400.0, 20.0)
     assert schema.landmark_id == "pole"
     default = FindLandmarkSchema(
@@ -99,7 +99,7 @@ def test_interest_operator_and_region_segmenter_are_parameterized() -> None:
     )
     schema = FindLandmarkSchema(region, EXPECTER)
     assert schema.detector == RegionSegmenter(threshold=120.0, min_area=30)
-    assert schema.margin == DEFAULT_MARGINS[PerceptualStrategy.REGION_SEGMENTER]
+    assert schema.margin == margin_pixels(PerceptualStrategy.REGION_SEGMENTER)
 
 
 @pytest.mark.parametrize(

@@ -10,7 +10,7 @@ from schema_scenes import CAMERA
 
 from aura_ums.camera import CalibrationBounds, Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
-from aura_ums.expecter import DEFAULT_MARGINS, Expecter, PerceptualStrategy
+from aura_ums.expecter import Expecter, PerceptualStrategy, margin_pixels
 from aura_ums.manager import IdentifiedLandmarkBuffer
 from aura_ums.perception import FastLineFinder, MoravecOperator
 from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
@@ -37,7 +37,7 @@ def test_pilot_builds_one_schema_per_stm_landmark(sidewalk_stm: ShortTermMemory)
         assert schema.confirm_frames == record.confirm_frames
         assert schema.recognition_threshold == record.recognition_threshold
         assert schema.activation_range == record.activation_range
-        assert schema.margin == DEFAULT_MARGINS[record.strategy]
+        assert schema.margin == margin_pixels(record.strategy)
         params = record.parameters
         if record.landmark_class is LandmarkClass.VERTICAL_LINE:
             assert record.strategy is PerceptualStrategy.LINE_FINDER

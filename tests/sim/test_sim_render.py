@@ -10,7 +10,8 @@ from numpy.typing import NDArray
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
 from aura_ums.perception import FastLineFinder, evaluate_vertical_line
-from aura_ums.sim import Building, GroundStripe, Pole, Scene, SyntheticCamera, fill_polygon
+from aura_ums.sim import Building, GroundStripe, Pole, Scene, SyntheticCamera
+from aura_ums.sim._render import fill_polygon
 from aura_ums.uncertainty import PointLandmark, Pose
 from aura_ums.world import sample_world
 

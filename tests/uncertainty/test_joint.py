@@ -14,7 +14,6 @@ from test_reduce import map_inside, wedge_inside
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
-    JOINT_INCONSISTENT,
     BearingObservation,
     Landmark,
     Observation,
@@ -25,6 +24,7 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
     reduce_jointly,
 )
+from aura_ums.uncertainty._joint import JOINT_INCONSISTENT
 
 Array = NDArray[np.float64]
 Sighting = tuple[Observation, Landmark]

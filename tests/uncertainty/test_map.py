@@ -20,7 +20,8 @@ from aura_ums import (
 )
 from aura_ums.geometry import angle_difference, regular_polygon
 from aura_ums.geometry._convex import convexity_defect
-from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, growth_tightness, simulate_containment
+from aura_ums.uncertainty import growth_tightness, simulate_containment
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 
 TERRAINS = TerrainTable.default()
 NAMES = sorted(TERRAINS)

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from aura_ums import FileFormatError, TerrainTable
-from aura_ums.world import SAMPLE_WORLDS, MeadowMap, make_grid_world, sample_world
+from aura_ums.world import MeadowMap, make_grid_world, sample_world
+from aura_ums.world._samples import SAMPLE_WORLDS
 
 Document = dict[str, Any]
 

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import inspect
 import itertools
 import math
 import time
@@ -213,6 +214,15 @@ def test_growing_through_commands_equals_growing_piecewise(terrains: TerrainTabl
     # Splitting is conservative: the split map holds the one-step map's mean position.
     single = start.grow(command, terrains["concrete"])
     assert through.polygon.contains(single.center)[0]
+
+
+def test_grow_through_defaults_are_the_maps() -> None:
+    # The world layer writes the map's defaults again (it may not import the uncertainty
+    # layer's private constants): here the two are held equal.
+    ours = inspect.signature(grow_through).parameters
+    theirs = inspect.signature(SpatialUncertaintyMap.grow).parameters
+    for name in ("sigmas", "max_vertices"):
+        assert ours[name].default == theirs[name].default, name
 
 
 def test_a_turn_only_command_uses_the_start_meadow(terrains: TerrainTable) -> None:

@@ -16,7 +16,8 @@ from aura_ums import (
     TerrainTable,
     VerticalLineLandmark,
 )
-from aura_ums.world import SAMPLE_WORLDS, MeadowMap, make_grid_world, plan_route, sample_world
+from aura_ums.world import MeadowMap, make_grid_world, plan_route, sample_world
+from aura_ums.world._samples import SAMPLE_WORLDS
 
 
 @pytest.mark.parametrize("name", SAMPLE_WORLDS)

@@ -11,33 +11,19 @@ heading interval) for side-by-side figures.
 This package imports only geometry, uncertainty, validation and errors.
 """
 
-from aura_ums.baselines._ekf import MIN_LANDMARK_DISTANCE, ExtendedKalmanFilter
-from aura_ums.baselines._moments import MotionMoments, clipped_normal_moments, motion_moments
-from aura_ums.baselines._particle import DEFAULT_PARTICLES, ParticleFilter, systematic_resample
+from aura_ums.baselines._ekf import ExtendedKalmanFilter
+from aura_ums.baselines._moments import MotionMoments, motion_moments
+from aura_ums.baselines._particle import ParticleFilter
 from aura_ums.baselines._protocol import Estimator
-from aura_ums.baselines._region import (
-    ELLIPSE_SIDES,
-    ConfidenceRegion,
-    chi2_quantile,
-    ellipse_polygon,
-    mahalanobis_core,
-    shortest_arc,
-)
+from aura_ums.baselines._region import ConfidenceRegion, chi2_quantile, ellipse_polygon
 
 __all__ = [
-    "DEFAULT_PARTICLES",
-    "ELLIPSE_SIDES",
-    "MIN_LANDMARK_DISTANCE",
     "ConfidenceRegion",
     "Estimator",
     "ExtendedKalmanFilter",
     "MotionMoments",
     "ParticleFilter",
     "chi2_quantile",
-    "clipped_normal_moments",
     "ellipse_polygon",
-    "mahalanobis_core",
     "motion_moments",
-    "shortest_arc",
-    "systematic_resample",
 ]

@@ -56,7 +56,7 @@ _TWO_PI = 2.0 * math.pi
 _ZERO3 = (0.0, 0.0, 0.0)
 
 #: Landmarks closer than this (m) to the predicted sensor position give no usable direction.
-MIN_LANDMARK_DISTANCE = 1e-9
+_MIN_LANDMARK_DISTANCE = 1e-9
 
 
 def _wrap(angle: float) -> float:
@@ -287,7 +287,7 @@ class ExtendedKalmanFilter:
         dx = lx - self._x - ox
         dy = ly - self._y - oy
         q = dx * dx + dy * dy
-        if q <= MIN_LANDMARK_DISTANCE * MIN_LANDMARK_DISTANCE:
+        if q <= _MIN_LANDMARK_DISTANCE * _MIN_LANDMARK_DISTANCE:
             self._rejected += 1
             return False
         bearing_innovation = _wrap(obs.bearing - (math.atan2(dy, dx) - h))

@@ -45,7 +45,7 @@ Array = NDArray[np.float64]
 _TWO_PI = 2.0 * math.pi
 
 #: Default number of particles.
-DEFAULT_PARTICLES = 1000
+_DEFAULT_PARTICLES = 1000
 
 
 def systematic_resample(weights: Array, rng: np.random.Generator) -> NDArray[np.intp]:
@@ -165,7 +165,7 @@ class ParticleFilter:
         initial: Pose,
         rng: np.random.Generator,
         *,
-        particles: int = DEFAULT_PARTICLES,
+        particles: int = _DEFAULT_PARTICLES,
         position_sd: float,
         heading_sd: float,
         bearing_sd: float,

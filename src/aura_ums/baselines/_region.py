@@ -27,14 +27,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, float_array
 from aura_ums.errors import InputError
-from aura_ums.geometry import ANGLE_TOLERANCE, POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, wrap_angle
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, wrap_angle
 
 Array = NDArray[np.float64]
 
 #: Vertices of the outer polygon that stands for a Gaussian confidence ellipse.
-ELLIPSE_SIDES = 64
+_ELLIPSE_SIDES = 64
 
 _TWO_PI = 2.0 * math.pi
+
+# Headings within this many radians of a region's interval count as inside it, as they do
+# for a HeadingWedge (tests/baselines/test_confidence_region.py holds the two equal), so that the
+# baselines and the map judge a pose on a boundary alike.
+_HEADING_TOLERANCE = 1e-9
 
 # A covariance whose eigenvalue ratio is below this is treated as rank one (collinear points).
 _RANK_TOLERANCE = 1e-12
@@ -99,7 +104,7 @@ def ellipse_polygon(
     center: tuple[float, float],
     covariance: tuple[float, float, float],
     scale: float,
-    sides: int = ELLIPSE_SIDES,
+    sides: int = _ELLIPSE_SIDES,
 ) -> Array:
     """Return the vertices of a polygon circumscribing the ellipse ``d' C^-1 d <= scale``.
 
@@ -440,7 +445,8 @@ class ConfidenceRegion:
         -------
         bool or ndarray of bool
             A bool for scalar input, else an array of the inputs' common shape. Boundaries
-            count as inside, within ``POSITION_TOLERANCE`` m and ``ANGLE_TOLERANCE`` rad.
+            count as inside, within :data:`~aura_ums.geometry.POSITION_TOLERANCE` m and
+            1e-9 rad.
         """
         xs, ys, hs = float_array(x, "x"), float_array(y, "y"), float_array(heading, "heading")
         if not (xs.shape == ys.shape == hs.shape):
@@ -450,7 +456,7 @@ class ConfidenceRegion:
         points = np.column_stack([xs.reshape(-1), ys.reshape(-1)])
         inside = self.polygon.contains(points, tolerance=POSITION_TOLERANCE)
         offset = np.abs(wrap_angle(hs.reshape(-1) - self.heading_center))
-        inside &= offset <= self.heading_halfwidth + ANGLE_TOLERANCE
+        inside &= offset <= self.heading_halfwidth + _HEADING_TOLERANCE
         if xs.ndim == 0:
             return bool(inside[0])
         return np.asarray(inside.reshape(xs.shape), dtype=np.bool_)
@@ -462,7 +468,7 @@ def gaussian_region(
     """:meth:`ConfidenceRegion.gaussian` on checked numbers: mean (m, m, rad) and covariance entries."""
     p = check_probability(probability)
     q = marginal_probability(p)
-    vertices = ellipse_polygon((x, y), (xx, xy, yy), chi2_quantile(q, 2), ELLIPSE_SIDES)
+    vertices = ellipse_polygon((x, y), (xx, xy, yy), chi2_quantile(q, 2), _ELLIPSE_SIDES)
     try:
         polygon = ConvexPolygon(vertices)
     except InputError:  # a (nearly) singular ellipse: its hull is a segment or a point

@@ -21,11 +21,6 @@ from aura_ums.camera._model import (
     robot_from_camera_rotation,
 )
 from aura_ums.camera._observe import (
-    GROUND_LINE_SPLITS,
-    SAFETY_ABSOLUTE,
-    SAFETY_RELATIVE,
-    UNDISTORT_ITERATIONS,
-    UNDISTORT_TOLERANCE,
     CalibrationBounds,
     bound_ground_line,
     bound_point,
@@ -34,12 +29,7 @@ from aura_ums.camera._observe import (
 )
 
 __all__ = [
-    "GROUND_LINE_SPLITS",
     "NEAR_PLANE",
-    "SAFETY_ABSOLUTE",
-    "SAFETY_RELATIVE",
-    "UNDISTORT_ITERATIONS",
-    "UNDISTORT_TOLERANCE",
     "CalibrationBounds",
     "Camera",
     "CameraIntrinsics",

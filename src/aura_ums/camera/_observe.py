@@ -36,8 +36,8 @@ every step is either exact or an outer enclosure:
    on the line's offset (an exact test for boxes of points).
 
 Floating-point rounding is not directed; it is covered by a documented safety margin:
-every error bound is multiplied by ``1 + SAFETY_RELATIVE`` and increased by
-``SAFETY_ABSOLUTE`` (radians or metres), and intermediate boxes are padded by ``1e-12``.
+every error bound is multiplied by ``1 + _SAFETY_RELATIVE`` and increased by
+``_SAFETY_ABSOLUTE`` (radians or metres), and intermediate boxes are padded by ``1e-12``.
 
 Assumptions: the distortion model is one-to-one over the image (true of any usable
 calibration; OpenCV's iterative undistortion assumes the same); the distortion
@@ -63,16 +63,16 @@ from aura_ums.geometry import wrap_angle
 Array = NDArray[np.float64]
 Coefficients = tuple[float, float, float, float, float]
 
-#: Every error bound is multiplied by ``1 + SAFETY_RELATIVE`` ...
-SAFETY_RELATIVE = 1e-6
-#: ... and increased by ``SAFETY_ABSOLUTE`` (rad or m) to cover floating-point rounding.
-SAFETY_ABSOLUTE = 1e-9
+#: Every error bound is multiplied by ``1 + _SAFETY_RELATIVE`` ...
+_SAFETY_RELATIVE = 1e-6
+#: ... and increased by ``_SAFETY_ABSOLUTE`` (rad or m) to cover floating-point rounding.
+_SAFETY_ABSOLUTE = 1e-9
 #: Fixed-point iterations of the undistortion (as cv::undistortPoints' default criteria).
-UNDISTORT_ITERATIONS = 20
+_UNDISTORT_ITERATIONS = 20
 #: Largest accepted residual of the undistortion, normalized image units (about 1e-7 px).
-UNDISTORT_TOLERANCE = 1e-10
+_UNDISTORT_TOLERANCE = 1e-10
 #: Splits per shared calibration parameter when bounding a ground line.
-GROUND_LINE_SPLITS = 3
+_GROUND_LINE_SPLITS = 3
 _ANGLE_PIECES = 12
 _NEWTON_STEPS = 8
 _KRAWCZYK_STEPS = 12
@@ -239,19 +239,19 @@ def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int
             x_next, y_next = (xd - dx) * icdist, (yd - dy) * icdist
             step = np.max(np.abs(x_next - x) + np.abs(y_next - y), initial=0.0)
             x, y = x_next, y_next
-            if not step > 1e-3 * UNDISTORT_TOLERANCE:  # converged (or NaN: left to the check below)
+            if not step > 1e-3 * _UNDISTORT_TOLERANCE:  # converged (or NaN: left to the check below)
                 break
         fx, fy = distort(x, y, k)
         for _ in range(_NEWTON_STEPS):  # polish: Newton converges quadratically near the solution
             ex, ey = fx - xd, fy - yd
-            if not np.any(np.hypot(ex, ey) > 1e-3 * UNDISTORT_TOLERANCE):
+            if not np.any(np.hypot(ex, ey) > 1e-3 * _UNDISTORT_TOLERANCE):
                 break
             j00, j01, j10, j11 = _point_jacobian(x, y, k)
             det = j00 * j11 - j01 * j10
             x, y = x - (j11 * ex - j01 * ey) / det, y - (j00 * ey - j10 * ex) / det
             fx, fy = distort(x, y, k)
         j00, j01, j10, j11 = _point_jacobian(x, y, k)
-        good = (np.hypot(fx - xd, fy - yd) <= UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
+        good = (np.hypot(fx - xd, fy - yd) <= _UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
     return np.where(good, x, np.nan), np.where(good, y, np.nan)
 
 
@@ -260,7 +260,7 @@ def undistort_points(intrinsics: CameraIntrinsics, pixels: ArrayLike, *, iterati
 
     The iterative inverse of OpenCV's radial-tangential model, as ``cv::undistortPoints``
     (``iterations`` fixed-point steps), polished by Newton steps and checked: a pixel
-    whose residual exceeds :data:`UNDISTORT_TOLERANCE`, or that lies beyond the fold of
+    whose residual exceeds 1e-10 (normalized units), or that lies beyond the fold of
     the distortion polynomial, gives NaN.
 
     Parameters
@@ -303,7 +303,7 @@ def _undistort_box(xd: _Interval, yd: _Interval, k: Coefficients | None) -> tupl
     """Enclose every undistorted point whose distorted image lies in the boxes ``xd x yd``."""
     if k is None:
         return xd, yd
-    mx, my = _undistort_normalized(xd.mid, yd.mid, k, UNDISTORT_ITERATIONS)
+    mx, my = _undistort_normalized(xd.mid, yd.mid, k, _UNDISTORT_ITERATIONS)
     if not (np.all(np.isfinite(mx)) and np.all(np.isfinite(my))):
         raise InputError("pixel: expected a pixel the distortion model can invert, got one beyond its fold")
     j00, j01, j10, j11 = _point_jacobian(mx, my, k)
@@ -619,7 +619,7 @@ def _one_pixel(camera: Camera, pixel: ArrayLike) -> tuple[float, float]:
 
 
 def _widen(error: float) -> float:
-    return error * (1.0 + SAFETY_RELATIVE) + SAFETY_ABSOLUTE
+    return error * (1.0 + _SAFETY_RELATIVE) + _SAFETY_ABSOLUTE
 
 
 def _bearing_bound(camera: Camera, bounds: CalibrationBounds, rays: _Rays) -> tuple[float, float]:
@@ -805,7 +805,7 @@ height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that pl
 
 
 def _ground_boxes(camera: Camera, bounds: CalibrationBounds, uv: Array, pixel_error: float) -> _Rays:
-    return _rays(camera, bounds, uv, pixel_error, splits=GROUND_LINE_SPLITS)
+    return _rays(camera, bounds, uv, pixel_error, splits=_GROUND_LINE_SPLITS)
 
 
 def bound_ground_line(

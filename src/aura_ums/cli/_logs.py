@@ -33,11 +33,11 @@ def mrclam(
     source text); ranges stay in metres; sensor bounds are placeholders to calibrate.
     """
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import LOG_FILES, import_mrclam
+    from aura_ums.logs import import_mrclam, log_files_in
 
     if not dataset_dir.is_dir():
         raise fail(f"{dataset_dir}: expected a UTIAS MRCLAM dataset folder, got no such folder")
-    existing = [name for name in LOG_FILES if (out_dir / name).exists()]
+    existing = log_files_in(out_dir)
     if existing and not overwrite:
         raise fail(
             f"{out_dir}: expected a folder without a log, got one holding {', '.join(existing)} "

@@ -11,24 +11,15 @@ The other way round, the observers (:func:`observe_vertical_line`, :func:`observ
 observation of it, from the camera's bounds on what those pixels measure.
 """
 
-from aura_ums.expecter._baselines import (
-    DISK_SIDES,
-    disk_model_map,
-    disk_model_window,
-    gaussian_box_map,
-    gaussian_window,
-)
+from aura_ums.expecter._baselines import disk_model_map, disk_model_window, gaussian_box_map, gaussian_window
 from aura_ums.expecter._expecter import Expecter
 from aura_ums.expecter._observations import observe_ground_line, observe_point, observe_vertical_line
 from aura_ums.expecter._scenario import Figure4Scenario, figure4_scenario
-from aura_ums.expecter._window import DEFAULT_MARGINS, margin_pixels
-from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
+from aura_ums.expecter._window import margin_pixels
+from aura_ums.geometry import ImageWindow
 from aura_ums.world import PerceptualStrategy
 
 __all__ = [
-    "DEFAULT_MARGINS",
-    "DISK_SIDES",
-    "UNBOUNDED_PIXELS",
     "Expecter",
     "Figure4Scenario",
     "ImageWindow",

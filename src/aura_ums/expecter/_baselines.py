@@ -21,10 +21,10 @@ from aura_ums.uncertainty import Landmark, Pose, SpatialUncertaintyMap
 from aura_ums.world import PerceptualStrategy
 
 #: Sides of the outer polygon that stands for the disk model's circle.
-DISK_SIDES = 64
+_DISK_SIDES = 64
 
 
-def disk_model_map(map: SpatialUncertaintyMap, *, sides: int = DISK_SIDES) -> SpatialUncertaintyMap:
+def disk_model_map(map: SpatialUncertaintyMap, *, sides: int = _DISK_SIDES) -> SpatialUncertaintyMap:
     """Return the paper's disk model of a map: a circle around its centre enclosing its polygon.
 
     The circle is centred on ``map.center`` with the radius (m) of the polygon's farthest

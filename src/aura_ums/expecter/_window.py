@@ -28,10 +28,21 @@ DEFAULT_MARGINS: Mapping[PerceptualStrategy, float] = types.MappingProxyType(
 def margin_pixels(margin: float | PerceptualStrategy) -> float:
     """Return a margin in pixels from a number (>= 0) or a :class:`PerceptualStrategy`.
 
+    A strategy's margin is the context it needs on every side of the guaranteed window: a
+    line finder the most (to fit lines to the edges that meet at a feature), a region
+    segmenter less (to contrast the region with its surroundings), an interest operator
+    the least (its support is a few pixels).
+
     Examples
     --------
-    >>> margin_pixels(PerceptualStrategy.INTEREST_OPERATOR), margin_pixels(7)
-    (4.0, 7.0)
+    >>> {strategy.name: margin_pixels(strategy) for strategy in PerceptualStrategy}
+    {'LINE_FINDER': 24.0, 'INTEREST_OPERATOR': 4.0, 'REGION_SEGMENTER': 12.0}
+    >>> margin_pixels(7)
+    7.0
+    >>> margin_pixels(-1.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: margin: expected a non-negative number, got -1.0
     """
     if isinstance(margin, PerceptualStrategy):
         return DEFAULT_MARGINS[margin]

@@ -25,33 +25,9 @@ Examples
 """
 
 from aura_ums.export._mcap import mcap_channels, write_replay_mcap, write_simulation_mcap
-from aura_ums.export._scene import (
-    ARC_STEP,
-    OTHER_TERRAIN_COLOR,
-    TERRAIN_COLORS,
-    WEDGE_MIN_RADIUS,
-    WEDGE_REACH,
-    seconds_to_nanoseconds,
-    terrain_color,
-    wedge_fan,
-    wedge_radius,
-    window_rectangle,
-    yaw_quaternion,
-)
 
 __all__ = [
-    "ARC_STEP",
-    "OTHER_TERRAIN_COLOR",
-    "TERRAIN_COLORS",
-    "WEDGE_MIN_RADIUS",
-    "WEDGE_REACH",
     "mcap_channels",
-    "seconds_to_nanoseconds",
-    "terrain_color",
-    "wedge_fan",
-    "wedge_radius",
-    "window_rectangle",
     "write_replay_mcap",
     "write_simulation_mcap",
-    "yaw_quaternion",
 ]

@@ -20,13 +20,13 @@ from aura_ums.geometry import HeadingWedge, ImageWindow
 #: Shortest ray (m) of the drawn heading wedge.
 WEDGE_MIN_RADIUS = 1.0
 #: Metres the drawn wedge's rays reach beyond the polygon's farthest vertex from the centre.
-WEDGE_REACH = 0.5
+_WEDGE_REACH = 0.5
 #: Largest angle (rad) between two consecutive points of a drawn arc.
 ARC_STEP = math.radians(5.0)
 
 #: RGBA (each in [0, 1]) of the meadow fill per terrain name; other terrains use
-#: :data:`OTHER_TERRAIN_COLOR`. Read-only.
-TERRAIN_COLORS: Mapping[str, tuple[float, float, float, float]] = MappingProxyType(
+#: ``_OTHER_TERRAIN_COLOR``. Read-only.
+_TERRAIN_COLORS: Mapping[str, tuple[float, float, float, float]] = MappingProxyType(
     {
         "tile": (0.80, 0.80, 0.75, 0.35),
         "floor": (0.80, 0.80, 0.75, 0.35),
@@ -35,8 +35,8 @@ TERRAIN_COLORS: Mapping[str, tuple[float, float, float, float]] = MappingProxyTy
         "grass": (0.30, 0.65, 0.25, 0.35),
     }
 )
-#: RGBA of a meadow whose terrain is not in :data:`TERRAIN_COLORS`.
-OTHER_TERRAIN_COLOR = (0.55, 0.45, 0.70, 0.35)
+#: RGBA of a meadow whose terrain is not in ``_TERRAIN_COLORS``.
+_OTHER_TERRAIN_COLOR = (0.55, 0.45, 0.70, 0.35)
 
 
 def terrain_color(terrain: str) -> tuple[float, float, float, float]:
@@ -46,10 +46,10 @@ def terrain_color(terrain: str) -> tuple[float, float, float, float]:
     --------
     >>> terrain_color("grass")
     (0.3, 0.65, 0.25, 0.35)
-    >>> terrain_color("moon dust") == OTHER_TERRAIN_COLOR      # not in the table
+    >>> terrain_color("moon dust") == _OTHER_TERRAIN_COLOR      # not in the table
     True
     """
-    return TERRAIN_COLORS.get(terrain, OTHER_TERRAIN_COLOR)
+    return _TERRAIN_COLORS.get(terrain, _OTHER_TERRAIN_COLOR)
 
 
 def yaw_quaternion(heading: float) -> tuple[float, float, float, float]:
@@ -69,7 +69,7 @@ def yaw_quaternion(heading: float) -> tuple[float, float, float, float]:
 def wedge_radius(center: ArrayLike, vertices: ArrayLike) -> float:
     """Return the length (m) of the drawn wedge's rays for a map.
 
-    ``max(WEDGE_MIN_RADIUS, farthest vertex distance from the centre + WEDGE_REACH)``: the
+    ``max(WEDGE_MIN_RADIUS, farthest vertex distance from the centre + _WEDGE_REACH)``: the
     rays always reach past the polygon, so the wedge stays visible over it.
 
     Examples
@@ -82,14 +82,14 @@ def wedge_radius(center: ArrayLike, vertices: ArrayLike) -> float:
     c = points_array(center, "center", min_rows=1)[0]
     v = points_array(vertices, "vertices")
     far = float(np.max(np.hypot(*(v - c).T))) if len(v) else 0.0
-    return max(WEDGE_MIN_RADIUS, far + WEDGE_REACH)
+    return max(WEDGE_MIN_RADIUS, far + _WEDGE_REACH)
 
 
 def wedge_fan(center: ArrayLike, wedge: HeadingWedge, radius: float) -> NDArray[np.float64]:
     """Return the closed outline ``(n, 2)`` (m) of a heading wedge drawn as a fan.
 
     The fan starts at ``center``, runs along the clockwise bound (``wedge.center - cw``) to
-    ``radius``, follows the arc counter-clockwise (a point every :data:`ARC_STEP` at most)
+    ``radius``, follows the arc counter-clockwise (a point every ``ARC_STEP`` at most)
     to the counter-clockwise bound, and is closed back to the centre by the line loop that
     draws it. A full-circle wedge is a circle of that radius (no centre point).
 

@@ -28,7 +28,7 @@ from aura_ums.logs._calibrate import (
     observation_errors,
 )
 from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
-from aura_ums.logs._io import LOG_FILES, load_log, write_log
+from aura_ums.logs._io import load_log, log_files_in, write_log
 from aura_ums.logs._log import (
     GroundTruth,
     LogLandmark,
@@ -44,21 +44,14 @@ from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
     ReplayStep,
-    frames_after,
     log_meadow_map,
-    meta_bounds,
     observation_for,
-    position_reports_for,
     replay_log,
-    replay_start,
-    with_motion,
 )
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
-from aura_ums.logs._synthetic import SYNTHETIC_LANDMARKS, synthetic_log
+from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
-    "LOG_FILES",
-    "SYNTHETIC_LANDMARKS",
     "Calibration",
     "GroundTruth",
     "LogLandmark",
@@ -77,22 +70,18 @@ __all__ = [
     "calibrate_logs",
     "compare_on_log",
     "filter_settings",
-    "frames_after",
     "import_mrclam",
     "import_rosbag",
     "load_log",
     "load_sensors",
+    "log_files_in",
     "log_meadow_map",
-    "meta_bounds",
     "observation_errors",
     "observation_for",
     "odometry_to_commands",
-    "position_reports_for",
     "read_mrclam",
     "read_rosbag",
     "replay_log",
-    "replay_start",
     "synthetic_log",
-    "with_motion",
     "write_log",
 ]

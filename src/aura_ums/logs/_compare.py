@@ -142,7 +142,7 @@ def compare_on_log(
 ) -> tuple[MethodSummary, ...]:
     """Run our map, an EKF and a particle filter over the same log and judge each against ground truth.
 
-    All three see the same position reports (:func:`position_reports_for`), the same
+    All three see the same position reports (those :func:`replay_log` grows by), the same
     terrain statistics and the same observations, step by step. The filters start from
     the same pose with standard deviations of a third of our start bounds, use
     ``bearing_sd`` (rad) and ``range_sd_fraction`` (of the range) as their measurement

@@ -484,6 +484,35 @@ def _floats(array: np.ndarray) -> list[float]:
     return [float(value) for value in array]
 
 
+def log_files_in(folder: str | os.PathLike[str]) -> tuple[str, ...]:
+    """Return the names of the log files that ``folder`` holds, in the format's order.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        Any path; a missing folder (or a file) holds no log files.
+
+    Returns
+    -------
+    tuple of str
+        Among ``meta.toml``, ``odometry.csv``, ``commands.csv``, ``observations.csv``,
+        ``landmarks.csv`` and ``groundtruth.csv``, those present; empty when none is.
+        :func:`write_log` refuses such a folder unless told to overwrite.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> log_files_in(folder), log_files_in(folder / "missing")
+    ((), ())
+    >>> _ = (folder / "landmarks.csv").write_text(""), (folder / "meta.toml").write_text("")
+    >>> log_files_in(folder)
+    ('meta.toml', 'landmarks.csv')
+    """
+    base = Path(folder)
+    return tuple(name for name in LOG_FILES if (base / name).exists())
+
+
 def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
     """Write ``log`` as a log folder (SI units, ``repr`` floats) that :func:`load_log` reads back equal.
 
@@ -529,7 +558,7 @@ def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool 
     base = Path(folder)
     if base.exists() and not base.is_dir():
         raise InputError(f"folder: expected a folder, got the file {base}")
-    existing = [name for name in LOG_FILES if (base / name).exists()]
+    existing = log_files_in(base)
     if existing and not overwrite:
         raise InputError(
             f"folder: expected a folder without a log, got {base} holding {', '.join(existing)} "

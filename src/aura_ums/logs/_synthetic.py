@@ -13,7 +13,7 @@ from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TerrainStats, TerrainTable, TurnAndRun
 
 #: The eight landmarks of :func:`synthetic_log`, around a 10 m x 10 m arena centred on the origin.
-SYNTHETIC_LANDMARKS: tuple[tuple[str, float, float], ...] = (
+_SYNTHETIC_LANDMARKS: tuple[tuple[str, float, float], ...] = (
     ("L1", -6.0, -6.0),
     ("L2", 0.0, -6.5),
     ("L3", 6.0, -6.0),
@@ -75,7 +75,8 @@ def synthetic_log(
     -------
     RobotLog
         Named ``"synthetic"`` on terrain ``"floor"``, with commands, observations of the
-        :data:`SYNTHETIC_LANDMARKS` and ground truth at every command.
+        eight poles ``L1`` to ``L8`` around a 10 m x 10 m arena centred on the origin, and
+        ground truth at every command.
 
     Raises
     ------
@@ -124,7 +125,7 @@ def synthetic_log(
     times, xs, ys, headings = [0.0], [pose.x], [pose.y], [pose.heading]
     reports: list[PositionReport] = []
     observations: list[LogObservation] = []
-    landmarks = tuple(LogLandmark(name, x, y, 0.01, 0.0, 2.0, "pole") for name, x, y in SYNTHETIC_LANDMARKS)
+    landmarks = tuple(LogLandmark(name, x, y, 0.01, 0.0, 2.0, "pole") for name, x, y in _SYNTHETIC_LANDMARKS)
     for step in range(1, steps + 1):
         time = round(step * dt, 9)
         if math.hypot(pose.x, pose.y) > 3.0:

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from aura_ums.errors import InputError
-from aura_ums.uncertainty import DEFAULT_MAX_VERTICES, DEFAULT_SECTOR
 
 #: What a setting holds.
 SettingValue = float | int | bool | None
@@ -212,14 +211,16 @@ relocalize_after (2), got 1
             off_flag="--one-by-one",
         ),
     )
+    # joint_sector and max_vertices default to what reduce_jointly and the map's grow and
+    # reduce take when not told (tests/manager/test_manager_settings.py holds them equal).
     joint_sector: float = _setting(
-        DEFAULT_SECTOR,
+        math.radians(5.0),
         SettingInfo(
             "Widest heading sector of the joint reduction", "rad", float, low=0.0, high=_TWO_PI, low_open=True
         ),
     )
     max_vertices: int = _setting(
-        DEFAULT_MAX_VERTICES,
+        64,
         SettingInfo("Cap on the map polygon's vertices: fewer is faster and looser", "", int, low=3),
     )
     robust: bool = _setting(

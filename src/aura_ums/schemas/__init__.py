@@ -26,15 +26,11 @@ pixels); a record's ``recognition_threshold`` is compared with them directly.
 
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._manager import SchemaManager, SchemaManagerState, StepReport
-from aura_ums.schemas._perceive import DEFAULT_MIN_ASPECT
 from aura_ums.schemas._pilot import Pilot
-from aura_ums.schemas._schema import DEFAULT_LOST_FRAMES, TRACKING_MARGIN, FindLandmarkSchema
+from aura_ums.schemas._schema import FindLandmarkSchema
 from aura_ums.schemas._state import Detection, SchemaReport, SchemaState, SchemaStatus
 
 __all__ = [
-    "DEFAULT_LOST_FRAMES",
-    "DEFAULT_MIN_ASPECT",
-    "TRACKING_MARGIN",
     "Detection",
     "FindLandmarkSchema",
     "Frame",

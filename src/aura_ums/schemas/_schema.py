@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from aura_ums._validate import integer_at_least, nonnegative_float
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
-from aura_ums.expecter import DEFAULT_MARGINS, Expecter, ImageWindow
+from aura_ums.expecter import Expecter, ImageWindow, margin_pixels
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._perceive import (
     Detector,
@@ -147,7 +147,8 @@ class FindLandmarkSchema:
         The perceptual strategy, parameterized from the record (a line finder's buckets
         tuned to the record's ``orientation``).
     margin : float
-        Pixels the Expecter adds to its window for this strategy (:data:`DEFAULT_MARGINS`).
+        Pixels the Expecter adds to its window for this strategy
+        (:func:`~aura_ums.expecter.margin_pixels` of the record's strategy).
 
     Raises
     ------
@@ -201,7 +202,7 @@ class FindLandmarkSchema:
         object.__setattr__(self, "tracking_margin", margin)
         object.__setattr__(self, "pixel_error", error)
         object.__setattr__(self, "detector", build_detector(self.record))
-        object.__setattr__(self, "margin", DEFAULT_MARGINS[self.record.strategy])
+        object.__setattr__(self, "margin", margin_pixels(self.record.strategy))
 
     @property
     def landmark_id(self) -> str:

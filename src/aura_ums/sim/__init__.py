@@ -9,9 +9,6 @@ and returns a :class:`RunResult`.
 """
 
 from aura_ums.sim._loop import (
-    FRAME_PERIOD,
-    LOOK_TURN,
-    MAX_LOOK_FRAMES,
     FrameRecord,
     LoopState,
     PerceptionMode,
@@ -20,7 +17,7 @@ from aura_ums.sim._loop import (
     run_scenario,
     summarize_runs,
 )
-from aura_ums.sim._render import CLIP_NEAR, TEXTURE_FADE, SyntheticCamera, fill_polygon
+from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scenario import (
     RenderSettings,
@@ -30,9 +27,6 @@ from aura_ums.sim._scenario import (
     waypoints_array,
 )
 from aura_ums.sim._scene import (
-    CORNER_MATCH_DISTANCE,
-    DEFAULT_GROUND_SHADE,
-    TERRAIN_SHADES,
     Building,
     GroundPatch,
     GroundStripe,
@@ -44,14 +38,6 @@ from aura_ums.sim._scene import (
 )
 
 __all__ = [
-    "CLIP_NEAR",
-    "CORNER_MATCH_DISTANCE",
-    "DEFAULT_GROUND_SHADE",
-    "FRAME_PERIOD",
-    "LOOK_TURN",
-    "MAX_LOOK_FRAMES",
-    "TERRAIN_SHADES",
-    "TEXTURE_FADE",
     "Building",
     "FrameRecord",
     "GroundPatch",
@@ -68,7 +54,6 @@ __all__ = [
     "StartState",
     "SyntheticCamera",
     "check_render_consistency",
-    "fill_polygon",
     "ground_texture",
     "landmark_points",
     "random_clutter",

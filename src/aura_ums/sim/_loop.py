@@ -55,11 +55,11 @@ from aura_ums.uncertainty import (
 from aura_ums.world import MeadowMap, ShortTermMemory
 
 #: Seconds between frames (the loop's clock).
-FRAME_PERIOD = 1.0
+_FRAME_PERIOD = 1.0
 #: Radians of each look-around turn while lost (the turns go +a, -2a, +a: back to the start).
-LOOK_TURN = math.radians(15.0)
+_LOOK_TURN = math.radians(15.0)
 #: Frames in a row spent looking around while lost before the run gives up.
-MAX_LOOK_FRAMES = 12
+_MAX_LOOK_FRAMES = 12
 _LOOK_PATTERN = (1.0, -2.0, 1.0)
 
 
@@ -395,17 +395,17 @@ class _Loop:
 
     @property
     def done(self) -> bool:
-        return self.next_index > 0 and (self.leg >= len(self.legs) or self.look_frames >= MAX_LOOK_FRAMES)
+        return self.next_index > 0 and (self.leg >= len(self.legs) or self.look_frames >= _MAX_LOOK_FRAMES)
 
     def step(self, keep: list[NDArray[np.uint8]] | None) -> None:
         index = self.next_index
-        now = index * FRAME_PERIOD
+        now = index * _FRAME_PERIOD
         command: TurnAndRun | None = None
         moved = True
         looking = self.prune and self.manager.should_stop_and_look
         if index > 0:
             if looking:
-                command = TurnAndRun(LOOK_TURN * _LOOK_PATTERN[self.look_frames % len(_LOOK_PATTERN)], 0.0)
+                command = TurnAndRun(_LOOK_TURN * _LOOK_PATTERN[self.look_frames % len(_LOOK_PATTERN)], 0.0)
                 self.look_frames += 1
                 moved = False
             else:

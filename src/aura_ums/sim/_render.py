@@ -33,10 +33,10 @@ from aura_ums.uncertainty import Pose
 Array = NDArray[np.float64]
 
 #: Geometry closer to the camera than this (m, along the optical axis) is clipped away.
-CLIP_NEAR = 0.05
+_CLIP_NEAR = 0.05
 
 #: Distance (m) within which the ground texture shows at full contrast; it fades as d0/d beyond.
-TEXTURE_FADE = 4.0
+_TEXTURE_FADE = 4.0
 
 #: Ground farther than this (m) gets the texture of this distance (it has faded to ~nothing).
 TEXTURE_HORIZON = 500.0
@@ -223,7 +223,7 @@ class SyntheticCamera:
         # float32 texture coordinates keep sub-cell precision.
         shrink = np.minimum(1.0, TEXTURE_HORIZON / np.maximum(distance, 1e-6))
         ground_x, ground_y = ground_x * shrink, ground_y * shrink
-        weight = np.minimum(1.0, TEXTURE_FADE / np.maximum(distance, 1e-6)) * self._scene.texture_contrast
+        weight = np.minimum(1.0, _TEXTURE_FADE / np.maximum(distance, 1e-6)) * self._scene.texture_contrast
         scale = 1.0 / self._scene.texture_cell
         self._ground_span = (lo, hi)
         size = 1 if self._scene.texture is None else self._scene.texture.shape[0]
@@ -244,7 +244,7 @@ class SyntheticCamera:
         return self._scene
 
     def _project_polygon(self, points_camera: Array) -> Array:
-        clipped = _clip_near(points_camera, CLIP_NEAR)
+        clipped = _clip_near(points_camera, _CLIP_NEAR)
         if len(clipped) < 3:
             return clipped[:, :2]
         if self._camera.intrinsics.distortion is not None:
@@ -265,8 +265,8 @@ class SyntheticCamera:
         k = self._camera.intrinsics
         starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.intp)
         z = camera_points[:, 2]
-        front = np.maximum.reduceat(z, starts) >= CLIP_NEAR
-        whole = np.minimum.reduceat(z, starts) >= CLIP_NEAR
+        front = np.maximum.reduceat(z, starts) >= _CLIP_NEAR
+        whole = np.minimum.reduceat(z, starts) >= _CLIP_NEAR
         if k.distortion is None:
             pixels = self._camera.project_camera_frame(camera_points)
             with np.errstate(invalid="ignore"):

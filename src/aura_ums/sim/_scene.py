@@ -36,10 +36,10 @@ from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, VerticalLine
 from aura_ums.world import MeadowMap
 
 #: Gray level of bare ground (outside every patch, or of a terrain without a shade).
-DEFAULT_GROUND_SHADE = 120.0
+_DEFAULT_GROUND_SHADE = 120.0
 
-#: Gray levels of the default terrains' ground (other terrains get DEFAULT_GROUND_SHADE).
-TERRAIN_SHADES: Mapping[str, float] = MappingProxyType(
+#: Gray levels of the default terrains' ground (other terrains get _DEFAULT_GROUND_SHADE).
+_TERRAIN_SHADES: Mapping[str, float] = MappingProxyType(
     {"tile": 185.0, "concrete": 160.0, "gravel": 130.0, "grass": 95.0}
 )
 
@@ -377,7 +377,7 @@ class Scene:
     texture: NDArray[np.float32] | None = None
     texture_cell: float = 0.03
     texture_contrast: float = 8.0
-    ground_shade: float = DEFAULT_GROUND_SHADE
+    ground_shade: float = _DEFAULT_GROUND_SHADE
     sky_shades: tuple[float, float] = field(default=(215.0, 175.0))
 
     def __post_init__(self) -> None:
@@ -426,17 +426,17 @@ class Scene:
         stripe_shade: float = 220.0,
         building_size: tuple[float, float] = (15.0, 10.0),
         building_base: float = 0.0,
-        terrain_shades: Mapping[str, float] = TERRAIN_SHADES,
+        terrain_shades: Mapping[str, float] = _TERRAIN_SHADES,
         clutter: int = 0,
         extra: Iterable[GroundStripe] = (),
     ) -> Scene:
         """Build the scene of a meadow map from its landmark records and meadows.
 
         - Meadows become ground patches shaded by terrain (``terrain_shades``; others get
-          :data:`DEFAULT_GROUND_SHADE`).
+          the default ``ground_shade`` of a :class:`Scene`).
         - Class I landmarks (:class:`~aura_ums.uncertainty.VerticalLineLandmark`) become
           poles of ``pole_radius`` between ``z_bottom`` and ``z_top``, unless one stands
-          within :data:`CORNER_MATCH_DISTANCE` of a Class II landmark: it is then that
+          within 5 cm (horizontally) of a Class II landmark: it is then that
           building's vertical corner edge.
         - Class II landmarks (:class:`~aura_ums.uncertainty.PointLandmark`) become boxes
           of ``building_size`` (width along x, depth along y, metres) from ``building_base``
@@ -507,7 +507,7 @@ class Scene:
         patches = tuple(
             GroundPatch(
                 meadow.polygon.vertices,
-                terrain_shades.get(meadow.terrain, DEFAULT_GROUND_SHADE),
+                terrain_shades.get(meadow.terrain, _DEFAULT_GROUND_SHADE),
             )
             for meadow in meadow_map.meadows
         )

@@ -10,8 +10,8 @@ from aura_ums.uncertainty._checks import (
     growth_tightness,
     simulate_containment,
 )
-from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, MotionBounds, motion_bounds
-from aura_ums.uncertainty._joint import DEFAULT_SECTOR, JOINT_INCONSISTENT, reduce_jointly
+from aura_ums.uncertainty._growth import MotionBounds, motion_bounds
+from aura_ums.uncertainty._joint import reduce_jointly
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -29,10 +29,7 @@ from aura_ums.uncertainty._reduce import Reduction
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 
 __all__ = [
-    "DEFAULT_MAX_VERTICES",
-    "DEFAULT_SECTOR",
     "FOOT",
-    "JOINT_INCONSISTENT",
     "BearingObservation",
     "ContainmentResult",
     "GroundLineLandmark",

@@ -47,15 +47,7 @@ Examples
 ('sidewalk_west', 'sidewalk_middle', 'sidewalk_east')
 """
 
-from aura_ums.world._ltm import (
-    ADJACENCY_TOLERANCE,
-    MIN_PORTAL_WIDTH,
-    OVERLAP_TOLERANCE,
-    LandmarkRecord,
-    Meadow,
-    MeadowMap,
-    PerceptualStrategy,
-)
+from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy
 from aura_ums.world._navigator import (
     RUN_TOLERANCE,
     Route,
@@ -65,15 +57,11 @@ from aura_ums.world._navigator import (
     plan_route,
     split_run,
 )
-from aura_ums.world._samples import SAMPLE_WORLDS, make_grid_world, sample_world
+from aura_ums.world._samples import make_grid_world, sample_world
 from aura_ums.world._stm import ShortTermMemory
 
 __all__ = [
-    "ADJACENCY_TOLERANCE",
-    "MIN_PORTAL_WIDTH",
-    "OVERLAP_TOLERANCE",
     "RUN_TOLERANCE",
-    "SAMPLE_WORLDS",
     "LandmarkRecord",
     "Meadow",
     "MeadowMap",

@@ -37,13 +37,13 @@ if TYPE_CHECKING:
     from shapely.geometry.base import BaseGeometry
 
 #: Gaps between meadows up to this many metres still make them adjacent (rounding in files).
-ADJACENCY_TOLERANCE = 1e-6
+_ADJACENCY_TOLERANCE = 1e-6
 
 #: A portal narrower than this (m) does not make two meadows adjacent: they touch at a corner.
-MIN_PORTAL_WIDTH = 1e-3
+_MIN_PORTAL_WIDTH = 1e-3
 
 #: Meadows whose interiors overlap by more than this area (m^2) are refused.
-OVERLAP_TOLERANCE = 1e-6
+_OVERLAP_TOLERANCE = 1e-6
 
 _LANDMARK_TYPES = (VerticalLineLandmark, PointLandmark, GroundLineLandmark)
 
@@ -267,14 +267,14 @@ class MeadowMap:
 
     Coordinates are metres in the world frame (x east, y north). The map is validated
     once, on construction; it then answers spatial queries through a shapely ``STRtree``
-    and knows which meadows are adjacent (share a boundary segment at least
-    :data:`MIN_PORTAL_WIDTH` long, gaps up to :data:`ADJACENCY_TOLERANCE` closed).
+    and knows which meadows are adjacent (share a boundary segment at least 1 mm long,
+    gaps up to 1e-6 m closed).
 
     Parameters
     ----------
     meadows : iterable of Meadow
-        At least one; unique ids; interiors must not overlap (more than
-        :data:`OVERLAP_TOLERANCE` m^2): the meadows partition free space.
+        At least one; unique ids; interiors must not overlap (more than 1e-6 m^2): the
+        meadows partition free space.
     landmarks : iterable of LandmarkRecord
         The landmark records; unique ids, distinct from the meadow ids. Every id in a
         meadow's ``landmark_ids`` must be among them.
@@ -683,7 +683,7 @@ def _adjacency(
     meadows: Sequence[Meadow], shapes: Sequence[Polygon], tree: shapely.STRtree
 ) -> tuple[dict[tuple[str, str], NDArray[np.float64]], dict[str, tuple[str, ...]]]:
     """Find the portals between meadows; refuse overlapping meadows."""
-    pairs = tree.query(list(shapes), predicate="dwithin", distance=ADJACENCY_TOLERANCE)
+    pairs = tree.query(list(shapes), predicate="dwithin", distance=_ADJACENCY_TOLERANCE)
     keep = pairs[0] < pairs[1]
     first, second = pairs[0][keep], pairs[1][keep]
     a_shapes = np.array(shapes, dtype=object)[first]
@@ -691,7 +691,7 @@ def _adjacency(
     exact = shapely.intersection(a_shapes, b_shapes)
     overlap = shapely.area(exact)
     for i, j, area in zip(first, second, overlap, strict=True):
-        if area > OVERLAP_TOLERANCE:
+        if area > _OVERLAP_TOLERANCE:
             raise _MapError(
                 (meadows[int(i)].id, meadows[int(j)].id),
                 "polygon",
@@ -703,7 +703,7 @@ def _adjacency(
     retry = np.flatnonzero([segment is None for segment in segments])
     if len(retry):
         near = shapely.intersection(
-            shapely.boundary(a_shapes[retry]), shapely.buffer(b_shapes[retry], ADJACENCY_TOLERANCE)
+            shapely.boundary(a_shapes[retry]), shapely.buffer(b_shapes[retry], _ADJACENCY_TOLERANCE)
         )
         for k, close in zip(retry, near, strict=True):
             segments[int(k)] = _portal_segment(close)
@@ -722,12 +722,12 @@ def _adjacency(
 
 def _portal_segment(geometry: BaseGeometry) -> NDArray[np.float64] | None:
     """Return the ends of the (near-)straight shared boundary piece, or None when too short."""
-    if geometry.is_empty or shapely.length(geometry) < MIN_PORTAL_WIDTH:
+    if geometry.is_empty or shapely.length(geometry) < _MIN_PORTAL_WIDTH:
         return None
     coordinates = shapely.get_coordinates(geometry)
     start = coordinates[np.argmax(np.hypot(*(coordinates - coordinates[0]).T))]
     end = coordinates[np.argmax(np.hypot(*(coordinates - start).T))]
-    if math.hypot(*(end - start)) < MIN_PORTAL_WIDTH:
+    if math.hypot(*(end - start)) < _MIN_PORTAL_WIDTH:
         return None
     # Store the portal in a canonical direction (lexicographic), so that it does not
     # depend on the vertex order of the polygons.

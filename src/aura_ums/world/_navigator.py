@@ -21,14 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError, OutsideMapError
-from aura_ums.uncertainty import (
-    DEFAULT_MAX_VERTICES,
-    Pose,
-    SpatialUncertaintyMap,
-    TerrainStats,
-    TerrainTable,
-    TurnAndRun,
-)
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
 from aura_ums.world._ltm import MeadowMap
 
 #: Stretches of a run shorter than this (m) are rounding, not a meadow crossed.
@@ -451,13 +444,13 @@ def grow_through(
     table: TerrainTable,
     *,
     sigmas: float = 3.0,
-    max_vertices: int = DEFAULT_MAX_VERTICES,
+    max_vertices: int = 64,
 ) -> SpatialUncertaintyMap:
     """Grow a spatial uncertainty map by a command, meadow by meadow (:func:`commands_for`).
 
     The run is split from the map's most probable pose; each piece grows as
     :meth:`~aura_ums.uncertainty.SpatialUncertaintyMap.grow` with ``sigmas`` and
-    ``max_vertices``.
+    ``max_vertices`` (whose defaults are that method's).
 
     Examples
     --------

@@ -31,7 +31,7 @@ def sample_world(name: str) -> MeadowMap:
     Parameters
     ----------
     name : str
-        One of :data:`SAMPLE_WORLDS`.
+        ``"paper_sidewalk"`` or ``"indoor_corridor"``.
 
     Raises
     ------

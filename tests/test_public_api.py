@@ -1,0 +1,64 @@
+"""The public API stays small: what ``import aura_ums`` offers, and the constants it shows."""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from types import ModuleType
+
+import pytest
+
+import aura_ums
+
+#: Every public module of the package (subpackages and ``errors``), found, not listed, so
+#: that a new one is checked too.
+PUBLIC = sorted(
+    f"aura_ums.{info.name}" for info in pkgutil.iter_modules(aura_ums.__path__) if info.name[0] != "_"
+)
+
+#: Most names the top level may export, and most ALL-CAPS names all public modules together.
+TOP_LEVEL_LIMIT = 60
+CONSTANT_LIMIT = 5
+
+
+def public_all(name: str) -> list[str]:
+    module = importlib.import_module(name)
+    names = getattr(module, "__all__", None)
+    assert isinstance(names, list), f"{name}: expected an __all__ list"
+    return names
+
+
+def test_the_public_modules_are_found() -> None:
+    assert {"aura_ums.geometry", "aura_ums.uncertainty", "aura_ums.manager", "aura_ums.errors"} <= set(PUBLIC)
+    assert all(not part.startswith("_") for name in PUBLIC for part in name.split("."))
+
+
+def test_the_top_level_is_small_and_every_name_resolves() -> None:
+    names = public_all("aura_ums")
+    assert len(names) <= TOP_LEVEL_LIMIT, f"expected at most {TOP_LEVEL_LIMIT} names, got {len(names)}"
+    assert len(set(names)) == len(names)
+    missing = [name for name in names if not hasattr(aura_ums, name)]
+    assert not missing, f"aura_ums.__all__ names what the package lacks: {missing}"
+    # What a user of `import aura_ums as ums` reaches first.
+    for name in ("FOOT", "SpatialUncertaintyMap", "UncertaintyMapManager", "ManagerSettings", "Expecter"):
+        assert name in names, name
+
+
+@pytest.mark.parametrize("name", PUBLIC)
+def test_every_name_of_a_public_module_resolves(name: str) -> None:
+    module: ModuleType = importlib.import_module(name)
+    names = public_all(name)
+    assert len(set(names)) == len(names), f"{name}.__all__ repeats a name"
+    missing = [item for item in names if not hasattr(module, item)]
+    assert not missing, f"{name}.__all__ names what the module lacks: {missing}"
+
+
+def test_few_constants_are_public_and_foot_is_one() -> None:
+    # Each (module, name) counts: a constant re-exported elsewhere counts again, except
+    # FOOT, the unit of the paper's figures, which the top level re-exports.
+    shown = [(name, item) for name in ("aura_ums", *PUBLIC) for item in public_all(name) if item.isupper()]
+    constants = [pair for pair in shown if pair[1] != "FOOT"]
+    count = len(constants) + any(item == "FOOT" for _, item in shown)
+    assert ("aura_ums", "FOOT") in shown
+    assert ("aura_ums.uncertainty", "FOOT") in shown
+    assert count <= CONSTANT_LIMIT, f"expected at most {CONSTANT_LIMIT} constants, got {count}: {shown}"
