@@ -4,8 +4,8 @@ Runs the ``aura-ums`` command of this environment over the real logs in
 ``../shared/data`` (MRCLAM Dataset 6 robots 1-2 and Dataset 7 robots 1-5, Class I and II,
 all calibrated on Dataset 6 robot 1) and over ``scenarios/paper_sidewalk.toml`` (20 runs,
 seed 1), and keeps every metrics JSON and per-step CSV. Timings (``update_us``,
-``median_update_us`` and any key ending in ``_us``) are dropped; ``NaN`` and ``null`` are
-the same undefined value. Everything else must match to the last digit, or, with
+``median_update_us``, ``median_frame_ms``: any key ending in ``_us`` or ``_ms``) are dropped;
+``NaN`` and ``null`` are the same undefined value. Everything else must match to the last digit, or, with
 ``--rtol``, within that relative tolerance (for the numpy reference against the C kernels:
 ``AURA_UMS_NATIVE=0``).
 
@@ -87,7 +87,7 @@ def produce(out: Path, extra: list[str], sim_extra: list[str]) -> list[str]:
 
 
 def _is_timing(key: str) -> bool:
-    return key.endswith("_us")
+    return key.endswith(("_us", "_ms"))
 
 
 def _flatten(value: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
