@@ -4,7 +4,7 @@ This package imports nothing else of aura-ums but its validation and errors.
 """
 
 from aura_ums.geometry._angles import angle_difference, wrap_angle
-from aura_ums.geometry._arcs import intersect_arcs, subtended_arc
+from aura_ums.geometry._arcs import intersect_arcs, nearest_on_polygon, subtended_arc
 from aura_ums.geometry._convex import (
     clip_halfplane,
     convex_hull,
@@ -12,6 +12,7 @@ from aura_ums.geometry._convex import (
     outer_annular_sector,
     outer_arc,
     outer_disk,
+    points_in_convex,
     polygon_area,
     simplify_outer,
 )
@@ -31,9 +32,11 @@ __all__ = [
     "convex_hull",
     "intersect_arcs",
     "minkowski_sum",
+    "nearest_on_polygon",
     "outer_annular_sector",
     "outer_arc",
     "outer_disk",
+    "points_in_convex",
     "polygon_area",
     "regular_polygon",
     "simplify_outer",

@@ -22,11 +22,11 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
-import shapely
 
+from aura_ums import _native
 from aura_ums.camera import (
     NEAR_PLANE,
     CalibrationBounds,
@@ -61,12 +61,6 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord
-
-_polygon_distance: Callable[..., float] | None
-try:  # the compiled kernel, when the build had a C compiler
-    from aura_ums.geometry._kernels import polygon_distance as _polygon_distance
-except ImportError:  # pragma: no cover - exercised on machines without a compiler
-    _polygon_distance = None
 
 #: A perceptual strategy, parameterized.
 Detector = FastLineFinder | MoravecOperator | RegionSegmenter
@@ -147,28 +141,15 @@ def build_detector(record: LandmarkRecord) -> Detector:
 
 def may_be_within(map: SpatialUncertaintyMap, landmark: Landmark, reach: float) -> bool:
     """Whether some position of the map is within ``reach`` metres of where the landmark may be."""
-    return (
-        map_gap(map, landmark, compiled=_polygon_distance is not None) - landmark.position_uncertainty
-        <= reach
-    )
+    return map_gap(map, landmark) - landmark.position_uncertainty <= reach
 
 
-def map_gap(map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool) -> float:
-    """Distance (m) from the map's polygon (edges included) to the landmark's point or segment.
-
-    ``compiled`` picks the C kernel (when built); otherwise shapely, the reference.
-    """
-    if compiled and _polygon_distance is not None:
-        if isinstance(landmark, GroundLineLandmark):
-            (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
-            return _polygon_distance(map.polygon.vertices, ax, ay, bx, by)
-        return _polygon_distance(map.polygon.vertices, landmark.x, landmark.y, landmark.x, landmark.y)
-    geometry: shapely.Geometry
+def map_gap(map: SpatialUncertaintyMap, landmark: Landmark) -> float:
+    """Distance (m) from the map's polygon (edges included) to the landmark's point or segment."""
     if isinstance(landmark, GroundLineLandmark):
-        geometry = shapely.LineString([landmark.start, landmark.end])
-    else:
-        geometry = shapely.Point(landmark.x, landmark.y)
-    return float(shapely.distance(map.polygon.to_shapely(), geometry))
+        (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
+        return _native.polygon_distance(map.polygon.vertices, ax, ay, bx, by)
+    return _native.polygon_distance(map.polygon.vertices, landmark.x, landmark.y, landmark.x, landmark.y)
 
 
 def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: Pose) -> float | None:
