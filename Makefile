@@ -27,7 +27,7 @@ $(UV_STAMP): | $(BIN)/python
 	@touch $@
 
 # The install also compiles the C kernels: rebuild when their source changes.
-BUILD_INPUTS := pyproject.toml uv.lock setup.py $(wildcard src/aura_ums/geometry/*.c)
+BUILD_INPUTS := pyproject.toml uv.lock setup.py $(wildcard src/aura_ums/_native/*.c src/aura_ums/_native/*.h)
 
 $(VENV)/.stamp-install: $(BUILD_INPUTS) | $(UV_STAMP)
 	$(SYNC)
@@ -60,8 +60,14 @@ lint: $(VENV)/.stamp-dev
 typecheck: $(VENV)/.stamp-dev
 	$(BIN)/mypy
 
+# The numeric core once more on the numpy reference (AURA_UMS_NATIVE=0: an install without a
+# C compiler), with tests/_native's real-log replay against the compiled kernels.
+NUMERIC_CORE := tests/geometry tests/uncertainty tests/expecter tests/manager tests/_native \
+	src/aura_ums/_native src/aura_ums/geometry src/aura_ums/uncertainty src/aura_ums/expecter src/aura_ums/manager
+
 pytest: $(VENV)/.stamp-dev
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	AURA_UMS_NATIVE=0 MPLBACKEND=Agg $(BIN)/python -m pytest -q $(NUMERIC_CORE)
 
 test: lint typecheck pytest
 

@@ -19,6 +19,8 @@ import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import NDArray
 
+from aura_ums import _native
+from aura_ums._native import _reduce as native_reduce
 from aura_ums.geometry import HeadingWedge, regular_polygon
 from aura_ums.uncertainty import (
     BearingObservation,
@@ -28,7 +30,6 @@ from aura_ums.uncertainty import (
     RangeBearingObservation,
     SpatialUncertaintyMap,
     VerticalLineLandmark,
-    _reduce,
 )
 
 REPEATS = 2000
@@ -113,22 +114,24 @@ def numpy_only(call: Callable[[], object]) -> Callable[[], object]:
     """Return ``call`` run with the compiled reduction kernels switched off (the numpy reference)."""
 
     def run() -> object:
-        saved = _reduce._compiled_reduce_cone, _reduce._compiled_reduce_strip
-        _reduce._compiled_reduce_cone = _reduce._compiled_reduce_strip = None
+        # The kernels the package bound (AURA_UMS_NATIVE=0 binds these for a whole process).
+        saved = _native.reduce_cone, _native.reduce_strip
+        _native.reduce_cone = native_reduce.reduce_cone_reference
+        _native.reduce_strip = native_reduce.reduce_strip_reference
         try:
             return call()
         finally:
-            _reduce._compiled_reduce_cone, _reduce._compiled_reduce_strip = saved
+            _native.reduce_cone, _native.reduce_strip = saved
 
     return run
 
 
 def main() -> None:
     ekf = median_microseconds(ekf_update_call())
-    compiled = _reduce.compiled_kernels() is not None
+    compiled = _native.NATIVE
     print(f"filterpy ExtendedKalmanFilter.update (range-bearing, 3 states): {ekf:8.1f} us")
     if not compiled:
-        print("(the C extension was not built: the compiled columns repeat the numpy reference)")
+        print("(the C kernels are not in use: the compiled columns repeat the numpy reference)")
     print()
     print(
         f"{'reduction':<12}{'vertices':>9}{'compiled us':>13}{'vs EKF':>8}{'numpy us':>10}{'vs EKF':>8}"

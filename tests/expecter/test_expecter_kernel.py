@@ -1,8 +1,12 @@
-"""The compiled Expecter kernel against the numpy reference, the fallback, and the kernel's bad input."""
+"""The compiled Expecter against its numpy reference on windows, and the reference's soundness.
+
+The kernel's own input (and its bad input): tests/_native.
+"""
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 import pytest
@@ -15,9 +19,9 @@ from expecter_helpers import (
     visible_pixels,
 )
 
+from aura_ums import _native
+from aura_ums._native import _expecter as native_expecter
 from aura_ums.expecter import Expecter, ImageWindow
-from aura_ums.expecter import _expecter as expecter_module
-from aura_ums.expecter._expecter import _bounds
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -27,8 +31,28 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 
-KERNEL = expecter_module._compiled_expecter_points
-compiled = pytest.mark.skipif(KERNEL is None, reason="the C kernels were not built (no compiler)")
+T = TypeVar("T")
+
+compiled = pytest.mark.skipif(
+    not _native.NATIVE, reason="the C kernels are not in use (not built, or AURA_UMS_NATIVE=0)"
+)
+
+
+def on_reference(call: Callable[..., T], *args: object) -> T:
+    """Return ``call(*args)`` run on the numpy reference (the one switch turned off for it)."""
+    saved, _native.expecter_points = _native.expecter_points, native_expecter.expecter_points_reference
+    try:
+        return call(*args)
+    finally:
+        _native.expecter_points = saved
+
+
+def both(
+    expecter: Expecter, the_map: SpatialUncertaintyMap, landmark: Landmark
+) -> tuple[ImageWindow | None, ImageWindow | None]:
+    """The window by the compiled kernel and by the numpy reference."""
+    return expecter.bounds(the_map, landmark), on_reference(expecter.bounds, the_map, landmark)
+
 
 #: Window sides far off the image (under distortion near the camera plane) come from a
 #: branch and bound stopped after a fixed number of rounds: both paths are sound there, but
@@ -66,8 +90,7 @@ def test_compiled_kernel_agrees_with_the_numpy_reference(rng: np.random.Generato
     for index in range(600):
         name, the_map, landmark = random_case(rng, index)
         expecter = Expecter(CAMERAS[name])
-        ours = _bounds(expecter, the_map, landmark, compiled=True)
-        reference = _bounds(expecter, the_map, landmark, compiled=False)
+        ours, reference = both(expecter, the_map, landmark)
         assert_agree(ours, reference, f"case {index} ({name})")
         nones += ours is None
     assert 0 < nones < 300  # both outcomes were exercised
@@ -94,80 +117,22 @@ def test_degenerate_and_cut_cases_agree(landmark: Landmark) -> None:
         for wedge in (HeadingWedge(0.0, 0.0, 0.0), HeadingWedge(0.2, 0.3, 0.1), HeadingWedge.full_circle()):
             the_map = SpatialUncertaintyMap(polygon, center, wedge)
             assert_agree(
-                _bounds(expecter, the_map, landmark, compiled=True),
-                _bounds(expecter, the_map, landmark, compiled=False),
-                f"{landmark.id}, {polygon.vertex_count} vertices, {wedge}",
+                *both(expecter, the_map, landmark), f"{landmark.id}, {polygon.vertex_count} vertices, {wedge}"
             )
 
 
 @pytest.mark.parametrize("kind", ["I", "II", "III"])
-def test_numpy_fallback_is_sound(kind: str, rng: np.random.Generator) -> None:
-    # The fallback is what runs without a compiler: the soundness tests cover the kernel.
+def test_numpy_reference_is_sound(kind: str, rng: np.random.Generator) -> None:
+    # The reference is what runs without a compiler; the soundness tests cover whichever runs.
     for name, camera in CAMERAS.items():
         expecter = Expecter(camera)
         the_map = random_map(rng, wide_wedge=name == "distorted")
         landmark = random_landmark(rng, kind, the_map.center)
         poses = np.vstack([the_map.sample_poses(500, rng), extreme_poses(the_map)])
         pixels = visible_pixels(camera, poses, landmark_points(landmark, rng))
-        window = _bounds(expecter, the_map, landmark, compiled=False)
+        window = on_reference(expecter.bounds, the_map, landmark)
         if window is None:
             assert len(pixels) == 0
             continue
         assert np.all((pixels[:, 0] >= window.u_min) & (pixels[:, 0] <= window.u_max)), name
         assert np.all((pixels[:, 1] >= window.v_min) & (pixels[:, 1] <= window.v_max)), name
-
-
-def test_bounds_falls_back_when_the_extension_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
-    expecter = Expecter(CAMERAS["plain"])
-    the_map = SpatialUncertaintyMap.from_polygon(
-        ConvexPolygon([(-0.3, -0.1), (0.3, -0.1), (0.3, 0.1), (-0.3, 0.1)]),
-        (0.0, 0.0),
-        HeadingWedge(0, 0.05, 0.05),
-    )
-    pole = VerticalLineLandmark("pole", 9.0, 0.5, 0.0, 4.0, position_uncertainty=0.1)
-    monkeypatch.setattr(expecter_module, "_compiled_expecter_points", None)
-    window = expecter.bounds(the_map, pole)
-    assert window == _bounds(expecter, the_map, pole, compiled=False)
-    assert window is not None
-    assert window.width > 0.0
-
-
-@compiled
-@pytest.mark.parametrize(
-    ("change", "error", "match"),
-    [
-        ({"vertices": np.zeros((3, 3))}, ValueError, r"vertices: expected a C-contiguous \(n, 2\) float64"),
-        ({"vertices": np.zeros((3, 2), dtype=np.float32)}, ValueError, "got format 'f'"),
-        ({"vertices": "abc"}, TypeError, "vertices: expected"),
-        ({"base_count": 3}, ValueError, r"base_count: expected an integer in \[1, 2\], got 3"),
-        ({"level_count": 0}, ValueError, r"level_count: expected an integer in \[1, 2\], got 0"),
-        ({"radius": math.nan}, ValueError, "radius: expected a finite number"),
-        ({"radius": -1.0}, ValueError, "expected radius >= 0"),
-        ({"arc_step": 0.0}, ValueError, "arc_step > 0"),
-        ({"forward": "x"}, TypeError, "forward: expected a real number, got str"),
-    ],
-)
-def test_kernel_refuses_bad_arguments(change: dict[str, object], error: type[Exception], match: str) -> None:
-    arguments: dict[str, object] = {
-        "vertices": np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
-        "base_count": 1,
-        "disk_sides": 64,
-        "full_circle": 0,
-        "level_count": 2,
-        "base_ax": 5.0,
-        "base_ay": 0.0,
-        "base_bx": 5.0,
-        "base_by": 0.0,
-        "radius": 0.1,
-        "heading_lo": -0.1,
-        "heading_width": 0.2,
-        "arc_step": math.pi / 64,
-    }
-    names = [f"r{i}{j}" for i in range(3) for j in range(3)]
-    rotation = dict(zip(names, Expecter(CAMERAS["plain"])._rotation, strict=True))
-    arguments |= rotation | {"forward": 0.0, "left": 0.0, "dz_lo": -1.0, "dz_hi": 2.0, "cut_plane": 5e-7}
-    assert KERNEL is not None
-    assert KERNEL(*arguments.values()) is not None  # the unchanged call works
-    arguments |= change
-    with pytest.raises(error, match=match):
-        KERNEL(*arguments.values())

@@ -11,7 +11,6 @@ import shapely
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount, undistort_points
 from aura_ums.expecter import ImageWindow
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
-from aura_ums.schemas import _perceive
 from aura_ums.schemas._perceive import _project, _rotation, map_gap, may_be_within, predicted_shift
 from aura_ums.schemas._state import Detection
 from aura_ums.uncertainty import (
@@ -22,8 +21,6 @@ from aura_ums.uncertainty import (
     SpatialUncertaintyMap,
     VerticalLineLandmark,
 )
-
-compiled = pytest.mark.skipif(_perceive._polygon_distance is None, reason="the C kernels were not built")
 
 CAMERAS = [
     Camera(CameraIntrinsics(500.0, 500.0, 320.0, 240.0, 640, 480), CameraMount(height=1.0)),
@@ -51,20 +48,7 @@ def random_landmark(rng: np.random.Generator, index: int) -> Landmark:
     return GroundLineLandmark("edge", place, place + rng.normal(size=2) * rng.uniform(0.01, 6.0))
 
 
-@compiled
-def test_compiled_distance_agrees_with_shapely(rng: np.random.Generator) -> None:
-    touching = 0
-    for index in range(3000):
-        the_map, landmark = random_polygon_map(rng), random_landmark(rng, index)
-        ours = map_gap(the_map, landmark, compiled=True)
-        reference = map_gap(the_map, landmark, compiled=False)
-        assert ours == pytest.approx(reference, abs=1e-12), (the_map.polygon.vertices, landmark)
-        touching += reference == 0.0
-    assert 100 < touching < 2900  # inside, crossing and apart were all exercised
-
-
-@compiled
-def test_compiled_distance_edge_cases() -> None:
+def test_distance_edge_cases() -> None:
     square = SpatialUncertaintyMap.from_polygon(
         ConvexPolygon([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]), (0.5, 0.5), HeadingWedge(0, 0, 0)
     )
@@ -72,22 +56,24 @@ def test_compiled_distance_edge_cases() -> None:
     corner_touch = GroundLineLandmark("touch", (1.0, 1.0), (2.0, 3.0))
     beside = GroundLineLandmark("beside", (2.0, -1.0), (2.0, 2.0))
     for landmark, gap in ((crossing, 0.0), (corner_touch, 0.0), (beside, 1.0)):
-        assert map_gap(square, landmark, compiled=True) == pytest.approx(gap, abs=1e-15)
-    kernel = _perceive._polygon_distance
-    assert kernel is not None
-    with pytest.raises(ValueError, match=r"ax: expected a finite number"):
-        kernel(square.polygon.vertices, math.nan, 0.0, 1.0, 1.0)
-    with pytest.raises(TypeError, match=r"vertices: expected a C-contiguous \(n, 2\) float64 buffer"):
-        kernel(None, 0.0, 0.0, 1.0, 1.0)
+        assert map_gap(square, landmark) == pytest.approx(gap, abs=1e-15)
 
 
-def test_activation_falls_back_to_shapely(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_activation_is_the_distance_within_reach(rng: np.random.Generator) -> None:
     the_map = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 0.5, 0.1)
     pole = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 3.0, position_uncertainty=0.2)
-    monkeypatch.setattr(_perceive, "_polygon_distance", None)
     gap = float(shapely.distance(the_map.polygon.to_shapely(), shapely.Point(10.0, 0.0)))
     assert may_be_within(the_map, pole, gap - 0.2 + 1e-9)
     assert not may_be_within(the_map, pole, gap - 0.2 - 1e-9)
+    for index in range(300):
+        other, landmark = random_polygon_map(rng), random_landmark(rng, index)
+        geometry: shapely.Geometry
+        if isinstance(landmark, GroundLineLandmark):
+            geometry = shapely.LineString([landmark.start, landmark.end])
+        else:
+            geometry = shapely.Point(landmark.x, landmark.y)
+        expected = float(shapely.distance(other.polygon.to_shapely(), geometry))
+        assert map_gap(other, landmark) == pytest.approx(expected, abs=1e-12)
 
 
 # --- motion prediction and projection -------------------------------------------------

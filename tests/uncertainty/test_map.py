@@ -55,19 +55,7 @@ def random_moves(rng: np.random.Generator) -> list[tuple[TurnAndRun, TerrainStat
 # --- acceptance: soundness, calibration, tightness -------------------------------------------------
 
 
-@pytest.fixture(params=["compiled", "numpy"])
-def growth_kernel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    """Run a test with the compiled growth kernel and again with the numpy reference."""
-    from aura_ums.uncertainty import _growth
-
-    if request.param == "compiled" and _growth.compiled_kernel() is None:
-        pytest.skip("the C growth kernel was not built (no compiler)")
-    if request.param == "numpy":
-        monkeypatch.setattr(_growth, "_compiled_grow_polygon", None)
-    return str(request.param)
-
-
-def test_soundness_every_truncated_outcome_is_inside(growth_kernel: str) -> None:
+def test_soundness_every_truncated_outcome_is_inside() -> None:
     """>= 300 random sequences of 1-20 moves, all terrains, >= 20,000 true poses: 100 % inside."""
     rng = np.random.default_rng(2026)
     inside = total = 0

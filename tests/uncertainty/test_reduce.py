@@ -11,6 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
+from aura_ums._native._reduce import cap_inside, cos_range
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, intersect_arcs, regular_polygon
 from aura_ums.geometry._angles import TWO_PI
@@ -27,7 +28,7 @@ from aura_ums.uncertainty import (
     SpatialUncertaintyMap,
     VerticalLineLandmark,
 )
-from aura_ums.uncertainty._reduce import arc_wedge, cap_inside, cos_range
+from aura_ums.uncertainty._reduce import arc_wedge
 
 Array = NDArray[np.float64]
 
@@ -199,23 +200,10 @@ def class_three_cases(rng: np.random.Generator, prior: SpatialUncertaintyMap, po
 # --- 1. soundness per class ---------------------------------------------------------
 
 
-@pytest.fixture(params=["compiled", "numpy"])
-def reduce_kernel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    """Run a test with the compiled reduction kernels and again with the numpy reference."""
-    from aura_ums.uncertainty import _reduce
-
-    if request.param == "compiled" and _reduce.compiled_kernels() is None:
-        pytest.skip("the C reduction kernels were not built (no compiler)")
-    if request.param == "numpy":
-        monkeypatch.setattr(_reduce, "_compiled_reduce_cone", None)
-        monkeypatch.setattr(_reduce, "_compiled_reduce_strip", None)
-    return str(request.param)
-
-
 @pytest.mark.parametrize(
     "make_cases", [class_one_cases, class_two_cases, class_three_cases], ids=["I", "II", "III"]
 )
-def test_every_true_pose_is_kept(rng: np.random.Generator, make_cases: MakeCase, reduce_kernel: str) -> None:
+def test_every_true_pose_is_kept(rng: np.random.Generator, make_cases: MakeCase) -> None:
     priors, per_prior = 250, 40
     kept = total = shrunk = 0
     for _ in range(priors):
@@ -242,7 +230,7 @@ def _pole(x: float = 20.0, y: float = 0.0, uncertainty: float = 0.0) -> Vertical
     return VerticalLineLandmark("pole", x, y, 0.0, 6.0, "lamppost", uncertainty)
 
 
-def test_class_one_position_shrinks_when_heading_is_nearly_known(reduce_kernel: str) -> None:
+def test_class_one_position_shrinks_when_heading_is_nearly_known() -> None:
     # Positional uncertainty greater than angular: the cone cuts the polygon.
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 3.0, math.radians(0.5))
     reduction = prior.reduce(BearingObservation("pole", 0.0, 0.0, math.radians(0.5)), _pole())
@@ -252,7 +240,7 @@ def test_class_one_position_shrinks_when_heading_is_nearly_known(reduce_kernel: 
     assert reduction.map.contains(Pose(0.0, 0.0, 0.0))
 
 
-def test_class_one_heading_shrinks_when_position_is_nearly_known(reduce_kernel: str) -> None:
+def test_class_one_heading_shrinks_when_position_is_nearly_known() -> None:
     # Angular uncertainty greater than positional: the bearing fixes the heading.
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.3), 0.05, math.radians(30))
     bearing = -0.3  # the pole straight along +x, seen from heading 0.3
@@ -264,7 +252,7 @@ def test_class_one_heading_shrinks_when_position_is_nearly_known(reduce_kernel: 
     assert not reduction.map.contains(Pose(0.0, 0.0, 0.0))
 
 
-def test_class_one_both_shrink_when_one_direction_dominates(reduce_kernel: str) -> None:
+def test_class_one_both_shrink_when_one_direction_dominates() -> None:
     # The cone's headings run past the polygon's side: positions and headings both go.
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, math.radians(10))
     pole = _pole(10.0, 0.0)
@@ -315,9 +303,7 @@ def observations(draw: st.DrawFn) -> Case:
 
 @settings(suppress_health_check=[HealthCheck.function_scoped_fixture])  # the fixture picks a path only
 @given(priors(), observations())
-def test_reduced_map_is_inside_prior_and_holds_its_centre(
-    reduce_kernel: str, prior: SpatialUncertaintyMap, case: Case
-) -> None:
+def test_reduced_map_is_inside_prior_and_holds_its_centre(prior: SpatialUncertaintyMap, case: Case) -> None:
     observation, landmark = case
     reduction = prior.reduce(observation, landmark)
     if reduction.consistent:
@@ -359,7 +345,7 @@ def test_cos_range_bounds_the_arc(lo: float, width: float, where: float) -> None
 # --- 4. edge cases ------------------------------------------------------------------
 
 
-def test_empty_intersection_returns_prior_unchanged(reduce_kernel: str) -> None:
+def test_empty_intersection_returns_prior_unchanged() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
     cases: list[Case] = [
         (BearingObservation("pole", 0.0, math.pi, 0.1), _pole()),  # the pole is ahead, not behind
@@ -377,7 +363,7 @@ def test_empty_intersection_returns_prior_unchanged(reduce_kernel: str) -> None:
         assert "no " in reduction.reason
 
 
-def test_the_managers_unchecked_reduction_gives_what_reduce_does(reduce_kernel: str) -> None:
+def test_the_managers_unchecked_reduction_gives_what_reduce_does() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.2), 2.0, 0.3)
     edge = GroundLineLandmark("e", (-10.0, -1.0), (10.0, -1.0), "path edge", 0.1)
     cases: list[Case] = [
@@ -402,7 +388,7 @@ def test_the_managers_unchecked_reduction_gives_what_reduce_does(reduce_kernel: 
         assert reduced.area < prior.area or reduced.wedge.width < prior.wedge.width
 
 
-def test_landmark_inside_polygon(rng: np.random.Generator, reduce_kernel: str) -> None:
+def test_landmark_inside_polygon(rng: np.random.Generator) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, 0.3)
     poses = prior.sample_poses(300, rng)
     for pose in poses:
@@ -413,7 +399,7 @@ def test_landmark_inside_polygon(rng: np.random.Generator, reduce_kernel: str) -
         assert map_inside(reduction.map, prior)
 
 
-def test_full_circle_wedge_is_narrowed_by_a_bearing(reduce_kernel: str) -> None:
+def test_full_circle_wedge_is_narrowed_by_a_bearing() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 2.0), 0.5, math.pi)
     assert prior.wedge.is_full_circle
     reduction = prior.reduce(BearingObservation("pole", 0.0, -2.0, 0.02), _pole())
@@ -424,7 +410,7 @@ def test_full_circle_wedge_is_narrowed_by_a_bearing(reduce_kernel: str) -> None:
     assert reduction.map.contains(Pose(0.3, 0.3, 2.0 + math.atan2(-0.3, 19.7)))
 
 
-def test_zero_errors_keep_the_true_pose(rng: np.random.Generator, reduce_kernel: str) -> None:
+def test_zero_errors_keep_the_true_pose(rng: np.random.Generator) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(1.0, -2.0, 0.7), 1.5, 0.4)
     poses = prior.sample_poses(200, rng)
     corner = PointLandmark("c", 12.0, 5.0, 3.0)
@@ -445,7 +431,7 @@ def test_zero_errors_keep_the_true_pose(rng: np.random.Generator, reduce_kernel:
             assert reduction.area_after < 0.5 * reduction.area_before or reduction.wedge_after.width < 0.4
 
 
-def test_class_two_shrinks_along_the_line_of_sight(reduce_kernel: str) -> None:
+def test_class_two_shrinks_along_the_line_of_sight() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 3.0, math.radians(1))
     corner = PointLandmark("c", 20.0, 0.0, 4.0)
     bearing_only = prior.reduce(BearingObservation("pole", 0.0, 0.0, 0.01), _pole())
@@ -455,7 +441,7 @@ def test_class_two_shrinks_along_the_line_of_sight(reduce_kernel: str) -> None:
     assert (x_min, x_max) == pytest.approx((-0.5, 0.5), abs=0.05)
 
 
-def test_class_three_strip_and_heading(reduce_kernel: str) -> None:
+def test_class_three_strip_and_heading() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, 0.3)
     edge = GroundLineLandmark("e", (-10.0, -1.0), (10.0, -1.0), "path edge", 0.1)
     reduction = prior.reduce(GroundLineObservation("e", 0.0, 1.0, 0.2, 0.05, 0.02), edge)
@@ -465,7 +451,7 @@ def test_class_three_strip_and_heading(reduce_kernel: str) -> None:
     assert reduction.wedge_after.hi == pytest.approx(-0.03)
 
 
-def test_centre_moves_into_the_reduced_map(reduce_kernel: str) -> None:
+def test_centre_moves_into_the_reduced_map() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, 0.3)
     edge = GroundLineLandmark("e", (-10.0, -1.0), (10.0, -1.0))
     reduction = prior.reduce(GroundLineObservation("e", 0.0, 2.5, 0.2, -0.2, 0.05), edge)
@@ -475,7 +461,7 @@ def test_centre_moves_into_the_reduced_map(reduce_kernel: str) -> None:
     assert reduction.map.heading == pytest.approx(0.15)
 
 
-def test_vertex_cap_keeps_the_map_inside_prior(reduce_kernel: str) -> None:
+def test_vertex_cap_keeps_the_map_inside_prior() -> None:
     polygon = regular_polygon((0.0, 0.0), 2.0, 16)
     prior = SpatialUncertaintyMap.from_polygon(polygon, (0.0, 0.0), HeadingWedge(0.0, 0.1, 0.1))
     edge = GroundLineLandmark("e", (0.0, -1.0), (1.0, -1.0))
@@ -494,7 +480,7 @@ def test_cap_inside_stops_when_nothing_can_go() -> None:
     assert cap_inside(square, square, 3).tolist() == square.tolist()
 
 
-def test_reduction_is_a_frozen_value(reduce_kernel: str) -> None:
+def test_reduction_is_a_frozen_value() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.01)
     reduction = prior.reduce(BearingObservation("pole", 0.0, 0.0, 0.001), _pole())
     assert isinstance(reduction, Reduction)
@@ -527,7 +513,7 @@ def test_reduction_is_a_frozen_value(reduce_kernel: str) -> None:
     ],
 )
 def test_mismatched_observation_and_landmark_are_refused(
-    observation: object, landmark: object, message: str | None, reduce_kernel: str
+    observation: object, landmark: object, message: str | None
 ) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
     if message is None:
@@ -537,13 +523,13 @@ def test_mismatched_observation_and_landmark_are_refused(
         prior.reduce(observation, landmark)  # type: ignore[arg-type]
 
 
-def test_bad_vertex_cap_is_refused(reduce_kernel: str) -> None:
+def test_bad_vertex_cap_is_refused() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
     with pytest.raises(InputError, match="max_vertices: expected at least 3, got 2"):
         prior.reduce(BearingObservation("pole", 0.0, 0.0, 0.1), _pole(), max_vertices=2)
 
 
-def test_sensor_offset_on_a_point_map_is_exact_enough(reduce_kernel: str) -> None:
+def test_sensor_offset_on_a_point_map_is_exact_enough() -> None:
     # Robot known exactly at the origin facing +x, camera 1 m ahead: the pole at (20, 0)
     # is straight ahead of the camera; a reference-point bearing would be the same, but
     # a camera 1 m to the left sees it 1/19 rad to the right.

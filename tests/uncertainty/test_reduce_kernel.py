@@ -1,9 +1,10 @@
-"""The compiled reduction kernels against the numpy reference, and their handling of bad input."""
+"""The compiled reductions against their numpy reference, on maps (the kernels' own input: tests/_native)."""
 
 from __future__ import annotations
 
 import math
-import tracemalloc
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 import pytest
@@ -22,6 +23,8 @@ from test_reduce import (
     random_prior,
 )
 
+from aura_ums import _native
+from aura_ums._native import _reduce as native_reduce
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, regular_polygon
 from aura_ums.geometry._angles import TWO_PI
 from aura_ums.geometry._convex import convexity_defect
@@ -29,20 +32,41 @@ from aura_ums.uncertainty import (
     BearingObservation,
     GroundLineLandmark,
     GroundLineObservation,
+    Landmark,
+    Observation,
     PointLandmark,
     Pose,
     RangeBearingObservation,
     Reduction,
     SpatialUncertaintyMap,
     VerticalLineLandmark,
-    _reduce,
 )
-from aura_ums.uncertainty._reduce import reduce_map, reduce_map_reference
+from aura_ums.uncertainty._reduce import reduce_map
 
 Array = NDArray[np.float64]
+T = TypeVar("T")
 
-KERNELS = _reduce.compiled_kernels()
-compiled = pytest.mark.skipif(KERNELS is None, reason="the C reduction kernels were not built (no compiler)")
+compiled = pytest.mark.skipif(
+    not _native.NATIVE, reason="the C kernels are not in use (not built, or AURA_UMS_NATIVE=0)"
+)
+
+
+def on_reference(call: Callable[..., T], *args: object) -> T:
+    """Return ``call(*args)`` run on the numpy reference (the one switch turned off for it)."""
+    saved = _native.reduce_cone, _native.reduce_strip
+    _native.reduce_cone = native_reduce.reduce_cone_reference
+    _native.reduce_strip = native_reduce.reduce_strip_reference
+    try:
+        return call(*args)
+    finally:
+        _native.reduce_cone, _native.reduce_strip = saved
+
+
+def reduce_map_reference(
+    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+) -> Reduction:
+    return on_reference(reduce_map, prior, observation, landmark, max_vertices)
+
 
 MAKERS: list[MakeCase] = [class_one_cases, class_two_cases, class_three_cases]
 
@@ -207,144 +231,10 @@ def test_special_observations_agree() -> None:
         compare(full, case, 3)
 
 
-# --- the kernels themselves ---------------------------------------------------------
-
-_SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-_CONE_ARGS = (0.5, 0.5, 0.0, 0.01, 0.01, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.001, 0.0, math.inf, 2.0)
-_STRIP_ARGS = (0.5, 0.5, 0.0, 0.1, 0.1, 0.0, 0.0, 0.0, -1.0, 1.0, -1.0, 0.0, 1.5, 0.5, 0.0, 0.1)
-
-
-@compiled
-def test_kernels_return_the_reduction_or_a_reason() -> None:
-    assert KERNELS is not None
-    cone, strip = KERNELS
-    found = cone(_SQUARE, *_CONE_ARGS, 16)
-    assert isinstance(found, tuple)
-    raw, lo, width, x, y, area_before, area_after = found
-    assert np.frombuffer(raw).reshape(-1, 2).shape[1] == 2
-    # The cone keeps |y| <~ 0.22: the centre moves down to its (slightly sloping) edge.
-    assert width <= 0.02
-    assert (x, y) == pytest.approx((0.5, 0.22), abs=0.01)
-    assert area_before == 1.0
-    assert area_after == pytest.approx(y, rel=0.01)
-    assert isinstance(lo, float)
-    behind = list(_CONE_ARGS)
-    behind[10] = math.pi  # the bearing
-    assert cone(_SQUARE, *behind, 16) == 0  # no position sees it there
-    assert isinstance(strip(_SQUARE, *_STRIP_ARGS, 16), tuple)
-    away = list(_STRIP_ARGS)
-    away[12] = 9.0  # the offset
-    assert strip(_SQUARE, *away, 16) == 4
-    assert _reduce._REASONS[0] == "no position of the map is consistent with the observation"
-    assert _reduce._REASONS[4] == "no position of the map is at the observed offset from the line"
-
-
-@compiled
-@pytest.mark.parametrize(
-    ("vertices", "error", "message"),
-    [
-        (b"abcdefghabcdefgh", ValueError, r"expected a C-contiguous \(n, 2\) float64 buffer, got format 'B'"),
-        (np.zeros((3, 2), dtype=np.float32), ValueError, "got format 'f' with 4-byte items"),
-        (np.zeros((3, 3)), ValueError, "got 2 dimensions with 3 in the last"),
-        (np.zeros((0, 2)), ValueError, "got 0 bytes"),
-        (np.zeros(3), ValueError, "got 24 bytes"),
-        (np.zeros((4, 4))[:, :2], ValueError, "got a non-contiguous numpy.ndarray"),
-        ([[0.0, 0.0]], TypeError, "got list"),
-    ],
-)
-def test_kernels_refuse_a_malformed_buffer(vertices: object, error: type[Exception], message: str) -> None:
-    assert KERNELS is not None
-    cone, strip = KERNELS
-    with pytest.raises(error, match=message):
-        cone(vertices, *_CONE_ARGS, 16)
-    with pytest.raises(error, match=message):
-        strip(vertices, *_STRIP_ARGS, 16)
-
-
-@compiled
-def test_kernels_refuse_bad_numbers() -> None:
-    assert KERNELS is not None
-    cone, strip = KERNELS
-    with pytest.raises(TypeError, match="reduce_cone: expected 17 arguments, got 16"):
-        cone(_SQUARE, *_CONE_ARGS)
-    with pytest.raises(TypeError, match="reduce_strip: expected 18 arguments, got 2"):
-        strip(_SQUARE, 16)
-    with pytest.raises(TypeError, match="bearing: expected a real number, got str"):
-        cone(_SQUARE, *_CONE_ARGS[:10], "north", *_CONE_ARGS[11:], 16)
-    bad = list(_CONE_ARGS)
-    bad[10] = math.nan
-    with pytest.raises(ValueError, match="bearing: expected a finite number, got nan"):
-        cone(_SQUARE, *bad, 16)
-    bad[10], bad[13] = 0.0, -math.inf
-    with pytest.raises(ValueError, match="range_max: expected a finite number or inf, got -inf"):
-        cone(_SQUARE, *bad, 16)
-    bad = list(_STRIP_ARGS)
-    bad[12] = -math.inf
-    with pytest.raises(ValueError, match="offset: expected a finite number, got -inf"):
-        strip(_SQUARE, *bad, 16)
-    bad = list(_CONE_ARGS)
-    bad[14] = 0.0
-    with pytest.raises(ValueError, match=r"piece: expected a positive angle, got 0\.0"):
-        cone(_SQUARE, *bad, 16)
-    with pytest.raises(ValueError, match="max_vertices: expected at least 3, got 2"):
-        cone(_SQUARE, *_CONE_ARGS, 2)
-    with pytest.raises(TypeError):
-        strip(_SQUARE, *_STRIP_ARGS, 16.5)
-
-
-@compiled
-def test_kernels_release_the_buffer_and_free_their_memory() -> None:
-    assert KERNELS is not None
-    cone, strip = KERNELS
-    view = memoryview(bytearray(_SQUARE.tobytes())).cast("d")
-    assert isinstance(cone(view, *_CONE_ARGS, 16), tuple)
-    assert isinstance(strip(view, *_STRIP_ARGS, 3), tuple)
-    view.release()  # raises BufferError if a kernel kept its export
-    raw = bytearray(b"x" * 16)
-    with pytest.raises(ValueError, match="format 'B'"):
-        cone(raw, *_CONE_ARGS, 16)
-    raw.extend(b"y")  # a bytearray with exports cannot be resized
-    prior = SpatialUncertaintyMap.from_polygon(
-        regular_polygon((0.0, 0.0), 2.0, 40), (0.0, 0.0), HeadingWedge(0.0, 0.5, 0.5)
-    )
-    cases: list[Case] = [
-        (BearingObservation("p", 0.0, 0.2, 0.05, (0.3, 0.1)), VerticalLineLandmark("p", 9.0, 3.0, 0.0, 1.0)),
-        (
-            RangeBearingObservation("c", 0.0, 0.2, 0.05, 8.0, 11.0, (0.3, 0.1)),
-            PointLandmark("c", 9.0, 3.0, 1.0),
-        ),
-        (
-            GroundLineObservation("e", 0.0, 1.0, 0.5, 0.1, 0.05, (0.3, 0.1)),
-            GroundLineLandmark("e", (0, -1), (9, -1)),
-        ),
-        (BearingObservation("p", 0.0, 3.0, 0.05), VerticalLineLandmark("p", 9.0, 3.0, 0.0, 1.0)),  # empty
-    ]
-
-    def run() -> None:
-        for observation, landmark in cases:
-            prior.reduce(observation, landmark, max_vertices=6)
-        with pytest.raises(ValueError, match="expected a finite"):
-            cone(_SQUARE, *_CONE_ARGS[:-1], math.nan, 16)
-
-    run()
-    tracemalloc.start()
-    try:
-        run()
-        before = tracemalloc.get_traced_memory()[0]
-        for _ in range(300):
-            run()
-        grown = tracemalloc.get_traced_memory()[0] - before
-    finally:
-        tracemalloc.stop()
-    assert grown < 50_000  # 1,500 calls: a leak of even one small buffer per call would show
-
-
-def test_dispatch_falls_back_to_numpy(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(_reduce, "_compiled_reduce_cone", None)
-    assert _reduce.compiled_kernels() is None
+def test_the_reference_kernel_reduces_maps_alike(monkeypatch: pytest.MonkeyPatch) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
-    reduction = prior.reduce(BearingObservation("p", 0.0, 0.0, 0.01), VerticalLineLandmark("p", 9, 0, 0, 1))
-    expected = reduce_map_reference(
-        prior, BearingObservation("p", 0.0, 0.0, 0.01), VerticalLineLandmark("p", 9, 0, 0, 1), 64
-    )
+    case = (BearingObservation("p", 0.0, 0.0, 0.01), VerticalLineLandmark("p", 9, 0, 0, 1))
+    expected = reduce_map_reference(prior, *case, 64)
+    monkeypatch.setattr(_native, "reduce_cone", native_reduce.reduce_cone_reference)
+    reduction = prior.reduce(*case)
     assert np.array_equal(reduction.map.polygon.vertices, expected.map.polygon.vertices)

@@ -34,26 +34,26 @@ the extremes of a projection over a convex set are attained at its extreme point
 those are actual poses (a vertex of the map with an end of the wedge, or a point of the
 landmark's own set).
 
-Speed: when the C extension ``aura_ums.geometry._kernels`` was built, one call of its
-``expecter_points`` runs every step from the map's vertices to the normalized points and
-their box (the three Minkowski operands merged in one pass); the numpy functions below
-stay the reference implementation and the fallback.
+The geometry, from the map's vertices to the normalized points and their box, is one
+kernel of ``aura_ums._native`` (:func:`~aura_ums._native.expecter_points`, compiled when the
+C extension was built, its numpy reference otherwise); here the landmark and the mount
+become its numbers and its box becomes pixels.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums import _native
 from aura_ums.camera import NEAR_PLANE, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter._distortion import distorted_range
-from aura_ums.expecter._window import PerceptualStrategy, margin_pixels, trusted_window
-from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow, convex_hull, minkowski_sum, outer_disk
+from aura_ums.expecter._window import margin_pixels
+from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
 from aura_ums.uncertainty import (
     GroundLineLandmark,
     Landmark,
@@ -61,15 +61,9 @@ from aura_ums.uncertainty import (
     SpatialUncertaintyMap,
     VerticalLineLandmark,
 )
+from aura_ums.world import PerceptualStrategy
 
 Array = NDArray[np.float64]
-
-_CompiledPoints = Callable[..., tuple[bytes, float, float, float, float] | None]
-_compiled_expecter_points: _CompiledPoints | None
-try:  # the compiled kernel, when the build had a C compiler
-    from aura_ums.geometry._kernels import expecter_points as _compiled_expecter_points
-except ImportError:  # pragma: no cover - exercised on machines without a compiler
-    _compiled_expecter_points = None
 
 #: Angular step (rad) of the outer polygons of swept arcs: 0.03 % outside the arc.
 _ARC_STEP = math.pi / 64
@@ -151,7 +145,7 @@ class Expecter:
         InputError
             When ``map`` or ``landmark`` is of the wrong type.
         """
-        return _bounds(self, map, landmark, compiled=_compiled_expecter_points is not None)
+        return _bounds(self, map, landmark)
 
     def window(
         self,
@@ -192,36 +186,35 @@ class Expecter:
         return guaranteed.expanded(pixels).clipped(k.width, k.height)
 
 
-def _bounds(
-    expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool
-) -> ImageWindow | None:
-    """:meth:`Expecter.bounds` by the compiled kernel or by the numpy reference."""
+def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) -> ImageWindow | None:
+    """:meth:`Expecter.bounds`: the kernel's points, then pixels (with the lens's distortion)."""
     _check_map(map)
+    ends, heights = _landmark_geometry(landmark)
     camera = expecter.camera
-    k = camera.intrinsics
-    normalized: Array | None = None
-    if compiled:
-        result = _compiled_points(expecter, map, landmark)
-        if result is None:
-            return None
-        raw, x_lo, y_lo, x_hi, y_hi = result
-        if k.distortion is None:
-            return _pixel_window(k.fx, k.fy, k.cx, k.cy, x_lo, y_lo, x_hi, y_hi)
-        normalized = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
-    else:
-        ground, levels = _landmark_geometry(landmark)
-        relative = _relative_ground(map, ground)
-        camera_points = _clip_to_front(camera, relative, levels)
-        if camera_points is None:
-            return None
-        normalized = camera_points[:, :2] / camera_points[:, 2:3]
-        if k.distortion is None:
-            lower, upper = normalized.min(axis=0), normalized.max(axis=0)
-            return _pixel_window(
-                k.fx, k.fy, k.cx, k.cy, float(lower[0]), float(lower[1]), float(upper[0]), float(upper[1])
-            )
+    mount, k = camera.mount, camera.intrinsics
+    wedge = map.wedge
+    full = wedge.is_full_circle
+    found = _native.expecter_points(
+        map.polygon.vertices,
+        ends,
+        landmark.position_uncertainty,
+        _DISK_SIDES,
+        full,
+        0.0 if full else wedge.center - wedge.cw,
+        0.0 if full else wedge.width,
+        _ARC_STEP,
+        expecter._rotation,
+        mount.forward,
+        mount.left,
+        tuple(height - mount.height for height in heights),
+        _CUT_PLANE,
+    )
+    if found is None:
+        return None
+    if k.distortion is None:
+        return _pixel_window(k.fx, k.fy, k.cx, k.cy, found.x_min, found.y_min, found.x_max, found.y_max)
     tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
-    lower, upper = distorted_range(normalized, k.distortion, tolerance)
+    lower, upper = distorted_range(found.points, k.distortion, tolerance)
     with np.errstate(over="ignore", invalid="ignore"):
         u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
         v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
@@ -237,60 +230,11 @@ def _pixel_window(
     fx: float, fy: float, cx: float, cy: float, x_lo: float, y_lo: float, x_hi: float, y_hi: float
 ) -> ImageWindow:
     """Pixels of a box of normalized coordinates (fx, fy > 0: monotone), pushed outward."""
-    return trusted_window(
+    return ImageWindow._trusted(
         _outward(fx * x_lo + cx, -1.0),
         _outward(fy * y_lo + cy, -1.0),
         _outward(fx * x_hi + cx, 1.0),
         _outward(fy * y_hi + cy, 1.0),
-    )
-
-
-def _compiled_points(
-    expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark
-) -> tuple[bytes, float, float, float, float] | None:
-    """Run the compiled kernel: (bytes of the normalized points, their box), or None when behind."""
-    assert _compiled_expecter_points is not None  # the caller checked
-    if isinstance(landmark, VerticalLineLandmark):
-        count, ax, ay = 1, landmark.x, landmark.y
-        bx, by = ax, ay
-        bottom, top = landmark.z_bottom, landmark.z_top
-        levels = 1 if top == bottom else 2
-    elif isinstance(landmark, PointLandmark):
-        count, ax, ay = 1, landmark.x, landmark.y
-        bx, by = ax, ay
-        bottom = top = landmark.z
-        levels = 1
-    elif isinstance(landmark, GroundLineLandmark):
-        count = 2
-        (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
-        bottom = top = 0.0
-        levels = 1
-    else:
-        _landmark_geometry(landmark)  # raises the InputError naming the type
-        raise AssertionError("unreachable")  # pragma: no cover
-    mount = expecter.camera.mount
-    wedge = map.wedge
-    full = wedge.is_full_circle
-    return _compiled_expecter_points(
-        map.polygon.vertices,
-        count,
-        _DISK_SIDES,
-        1 if full else 0,
-        levels,
-        ax,
-        ay,
-        bx,
-        by,
-        landmark.position_uncertainty,
-        0.0 if full else wedge.center - wedge.cw,
-        0.0 if full else wedge.width,
-        _ARC_STEP,
-        *expecter._rotation,
-        mount.forward,
-        mount.left,
-        bottom - mount.height,
-        top - mount.height,
-        _CUT_PLANE,
     )
 
 
@@ -299,103 +243,21 @@ def _check_map(map: object) -> None:
         raise InputError(f"map: expected a SpatialUncertaintyMap, got {type(map).__name__}")
 
 
-def _landmark_geometry(landmark: object) -> tuple[Array, tuple[float, ...]]:
-    """Return the landmark's ground set (convex CCW vertices, m) and its heights (m)."""
+def _landmark_geometry(landmark: object) -> tuple[tuple[tuple[float, float], ...], tuple[float, ...]]:
+    """Return the landmark's ground point or segment ends (m) and its one or two heights (m, ascending)."""
     if isinstance(landmark, VerticalLineLandmark):
-        levels: tuple[float, ...] = (landmark.z_bottom, landmark.z_top)
         if landmark.z_top == landmark.z_bottom:
-            levels = (landmark.z_bottom,)
-        base = landmark.position.reshape(1, 2)
-    elif isinstance(landmark, PointLandmark):
-        levels = (landmark.z,)
-        base = landmark.position.reshape(1, 2)
-    elif isinstance(landmark, GroundLineLandmark):
-        levels = (0.0,)
-        base = np.vstack([landmark.start, landmark.end])
-    else:
-        raise InputError(
-            "landmark: expected a VerticalLineLandmark, PointLandmark or GroundLineLandmark, "
-            f"got {type(landmark).__name__}"
-        )
-    radius = landmark.position_uncertainty
-    if radius > 0.0:
-        base = minkowski_sum(base, outer_disk(np.zeros(2), radius, _DISK_SIDES))
-    return np.asarray(base, dtype=np.float64), levels
-
-
-def _relative_ground(map: SpatialUncertaintyMap, ground: Array) -> Array:
-    """Return robot-frame points (m) whose convex hull holds R(-h)(q - p) for all q, p, h."""
-    difference = minkowski_sum(ground, -np.asarray(map.polygon.vertices))
-    wedge = map.wedge
-    if wedge.is_full_circle:
-        reach = float(np.max(np.hypot(difference[:, 0], difference[:, 1])))
-        return outer_disk(np.zeros(2), reach, math.ceil(2.0 * math.pi / _ARC_STEP))
-    h_lo = wedge.center - wedge.cw
-    h_hi = h_lo + wedge.width
-    ends = [_rotate(difference, -h_lo)]
-    if wedge.width > 0.0:
-        ends.append(_rotate(difference, -h_hi))
-        count = max(1, math.ceil(wedge.width / _ARC_STEP))
-        half = wedge.width / (2 * count)
-        radius = np.hypot(difference[:, 0], difference[:, 1]) / math.cos(half)
-        phase = np.arctan2(difference[:, 1], difference[:, 0])
-        # Rotating by -h for h in [h_lo, h_hi] sweeps phase - h_hi .. phase - h_lo.
-        middle = (phase - h_hi)[:, None] + ((2 * np.arange(count) + 1) * half)[None, :]
-        ends.append(
-            np.column_stack(
-                [(radius[:, None] * np.cos(middle)).ravel(), (radius[:, None] * np.sin(middle)).ravel()]
-            )
-        )
-    return np.concatenate(ends)
-
-
-def _rotate(points: Array, angle: float) -> Array:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.column_stack([c * points[:, 0] - s * points[:, 1], s * points[:, 0] + c * points[:, 1]])
-
-
-def _clip_to_front(camera: Camera, ground: Array, levels: tuple[float, ...]) -> Array | None:
-    """Return camera-frame points (m) spanning the polytope's part in front of the cut plane."""
-    mount = camera.mount
-    rotation = mount.rotation()  # robot vector @ rotation -> camera vector
-    planar = np.column_stack([ground[:, 0] - mount.forward, ground[:, 1] - mount.left, np.zeros(len(ground))])
-    base = planar @ rotation
-    up = rotation[2]
-    depth_lo = base[:, 2] + min(level - mount.height for level in levels) * up[2]
-    depth_hi = base[:, 2] + max(level - mount.height for level in levels) * up[2]
-    nearest = np.minimum(depth_lo, depth_hi)
-    farthest = np.maximum(depth_lo, depth_hi)
-    if float(farthest.max()) <= _CUT_PLANE:
-        return None
-    if float(nearest.min()) >= _CUT_PLANE:
-        return np.concatenate([base + (level - mount.height) * up for level in levels])
-    # Part of the polytope is behind: cut it, using its known edges (a prism over the hull).
-    hull = convex_hull(ground)
-    planar = np.column_stack([hull[:, 0] - mount.forward, hull[:, 1] - mount.left, np.zeros(len(hull))])
-    base = planar @ rotation
-    layers = [base + (level - mount.height) * up for level in levels]
-    starts: list[Array] = []
-    stops: list[Array] = []
-    if len(hull) >= 2:
-        for layer in layers:
-            starts.append(layer)
-            stops.append(np.roll(layer, -1, axis=0))
-    if len(layers) == 2:
-        starts.append(layers[0])
-        stops.append(layers[1])
-    vertices = np.concatenate(layers)
-    front = vertices[vertices[:, 2] >= _CUT_PLANE]
-    if not starts:
-        return front if len(front) else None
-    a = np.concatenate(starts)
-    b = np.concatenate(stops)
-    crossing = (a[:, 2] - _CUT_PLANE) * (b[:, 2] - _CUT_PLANE) < 0.0
-    a, b = a[crossing], b[crossing]
-    t = (_CUT_PLANE - a[:, 2]) / (b[:, 2] - a[:, 2])
-    cut = a + t[:, None] * (b - a)
-    cut[:, 2] = _CUT_PLANE
-    points = np.concatenate([front, cut])
-    return points if len(points) else None
+            return ((landmark.x, landmark.y),), (landmark.z_bottom,)
+        return ((landmark.x, landmark.y),), (landmark.z_bottom, landmark.z_top)
+    if isinstance(landmark, PointLandmark):
+        return ((landmark.x, landmark.y),), (landmark.z,)
+    if isinstance(landmark, GroundLineLandmark):
+        (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
+        return ((ax, ay), (bx, by)), (0.0,)
+    raise InputError(
+        "landmark: expected a VerticalLineLandmark, PointLandmark or GroundLineLandmark, "
+        f"got {type(landmark).__name__}"
+    )
 
 
 def _outward(value: float, direction: float) -> float:

@@ -6,8 +6,7 @@ import types
 from collections.abc import Mapping
 
 from aura_ums._validate import nonnegative_float
-from aura_ums.geometry import ImageWindow
-from aura_ums.world import PerceptualStrategy as PerceptualStrategy  # expecter/_expecter.py imports it here
+from aura_ums.world import PerceptualStrategy
 
 #: Margin (pixels, added on every side) that each perceptual strategy needs around the
 #: guaranteed window. Illustrative figures in the spirit of the paper's Figure 8: a line
@@ -51,4 +50,3 @@ def margin_pixels(margin: float | PerceptualStrategy) -> float:
 
 #: :meth:`ImageWindow._trusted`, under the name expecter/_expecter.py and schemas/_perceive.py
 #: import it by.
-trusted_window = ImageWindow._trusted

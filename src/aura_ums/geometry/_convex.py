@@ -45,6 +45,13 @@ _TINY_ANGLE = 1e-12
 # Vertices closer than this fraction of the polygon's extent are merged.
 _MERGE_EPS = 1e-12
 
+#: Sides of the outer polygon of a full-circle annular sector (a disk).
+FULL_DISK_SIDES = 32
+
+# Outward margin of a support polygon's half-planes, relative to the larger of the
+# polygon's extent and its distance from the origin: above their rounding.
+_SUPPORT_MARGIN = 1e-12
+
 # Point sets larger than this are thinned by GEOS (shapely) before the exact monotone chain.
 _PREFILTER = 200
 
@@ -392,8 +399,8 @@ def outer_annular_sector(
     width = stop - start
     if outer <= 0.0:
         return np.zeros((1, 2))
-    if width >= TWO_PI:
-        return outer_disk(np.zeros(2), outer, sides=32)
+    if not width < TWO_PI:  # NaN too, from infinite bounds: the disk
+        return outer_disk(np.zeros(2), outer, sides=FULL_DISK_SIDES)
     if width <= _TINY_ANGLE:
         # Narrower than rounding can resolve at any sensible radius: a single ray.
         direction = np.array([math.cos(start), math.sin(start)])
@@ -412,13 +419,24 @@ def outer_annular_sector(
 
 
 def simplify_outer(vertices: Array, max_vertices: int) -> Array:
-    """Return a convex polygon with at most ``max_vertices`` vertices that contains ``vertices``.
+    """Return a convex polygon with at most ``max(max_vertices, 3)`` vertices that contains ``vertices``.
 
     Removes the edges whose removal (extending both neighbouring edges until they
     meet) adds the least area, greedily and never two adjacent edges in one pass.
-    An edge whose neighbours would meet more than 10 extents of the polygon away is
-    never removed, so a polygon may keep more vertices than asked for (a triangle
-    always does) rather than gain a far-off vertex.
+    An edge whose neighbours would meet more than 10 extents of the polygon away, or
+    whose neighbours are too short for their directions to be reliable, is never
+    removed. When no edge can go and there are still too many, the support polygon
+    (:func:`_support_polygon`) of ``max(max_vertices, 3)`` directions replaces the
+    polygon: coarser, but the cap always holds.
+
+    Examples
+    --------
+    >>> circle = outer_disk(np.zeros(2), 1.0, 64)
+    >>> len(simplify_outer(circle, 16)), len(simplify_outer(circle, 3))
+    (16, 3)
+    >>> square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> len(simplify_outer(square, 3))   # parallel sides never meet: the support triangle
+    3
     """
     while len(vertices) > max(max_vertices, 3):
         n = len(vertices)
@@ -464,7 +482,46 @@ def simplify_outer(vertices: Array, max_vertices: int) -> Array:
         keep = np.ones(n, dtype=bool)
         keep[(picked + 1) % n] = False
         vertices = result[keep]
+    if len(vertices) > max(max_vertices, 3):
+        vertices = _support_polygon(vertices, max(max_vertices, 3))
     return vertices
+
+
+def _support_polygon(vertices: Array, count: int) -> Array:
+    """Return an outer polygon of at most ``count`` (< n) vertices: support lines in even directions.
+
+    The half-planes that support the polygon in ``count`` directions evenly spaced from
+    its longest edge's outward normal (pushed out by a margin above rounding) hold it
+    whatever their directions' rounding, since each offset is the largest projection of a
+    vertex; consecutive lines meet at the result's corners. The longest edge stays as it
+    is, and with an even ``count`` the side opposite to it too.
+    """
+    lower, upper = vertices.min(axis=0), vertices.max(axis=0)
+    center = 0.5 * (lower + upper)
+    span = float(max(upper[0] - lower[0], upper[1] - lower[1]))
+    margin = _SUPPORT_MARGIN * max(span, abs(float(center[0])), abs(float(center[1])))
+    edge = _edges(vertices)
+    longest = int(np.argmax(np.hypot(edge[:, 0], edge[:, 1])))
+    start = math.atan2(-float(edge[longest, 0]), float(edge[longest, 1]))
+    angles = start + np.arange(count) * (TWO_PI / count)
+    nx, ny = np.cos(angles), np.sin(angles)
+    relative = vertices - center
+    reach = (relative[:, 0, None] * nx[None, :] + relative[:, 1, None] * ny[None, :]).max(axis=0) + margin
+    # Corner j joins the lines of directions j and j + 1.
+    mx, my, mreach = _following(nx), _following(ny), _following(reach)
+    det = nx * my - ny * mx
+    corners = np.column_stack(
+        [(reach * my - mreach * ny) / det + center[0], (nx * mreach - mx * reach) / det + center[1]]
+    )
+    # Lines that touch the polygon where their neighbours meet give repeated corners.
+    close = _MERGE_EPS * span
+    kept: list[list[float]] = []
+    for x, y in corners.tolist():
+        if not kept or max(abs(x - kept[-1][0]), abs(y - kept[-1][1])) > close:
+            kept.append([x, y])
+    while len(kept) > 1 and max(abs(kept[-1][0] - kept[0][0]), abs(kept[-1][1] - kept[0][1])) <= close:
+        kept.pop()
+    return np.array(kept)
 
 
 def points_in_convex(vertices: Array, points: Array, tolerance: float) -> NDArray[np.bool_]:

@@ -22,11 +22,11 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
-import shapely
 
+from aura_ums import _native
 from aura_ums.camera import (
     NEAR_PLANE,
     CalibrationBounds,
@@ -42,15 +42,14 @@ from aura_ums.expecter import (
     observe_point,
     observe_vertical_line,
 )
-from aura_ums.expecter._window import trusted_window
 from aura_ums.perception import (
     FastLineFinder,
     MoravecOperator,
     RegionSegmenter,
     evaluate_corner,
     evaluate_path_edge,
+    strongest_within,
 )
-from aura_ums.perception._landmarks import strongest_within
 from aura_ums.schemas._frame import Frame
 from aura_ums.schemas._state import Detection
 from aura_ums.uncertainty import (
@@ -64,12 +63,6 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord
-
-_polygon_distance: Callable[..., float] | None
-try:  # the compiled kernel, when the build had a C compiler
-    from aura_ums.geometry._kernels import polygon_distance as _polygon_distance
-except ImportError:  # pragma: no cover - exercised on machines without a compiler
-    _polygon_distance = None
 
 #: A perceptual strategy, parameterized.
 Detector = FastLineFinder | MoravecOperator | RegionSegmenter
@@ -150,28 +143,15 @@ def build_detector(record: LandmarkRecord) -> Detector:
 
 def may_be_within(map: SpatialUncertaintyMap, landmark: Landmark, reach: float) -> bool:
     """Whether some position of the map is within ``reach`` metres of where the landmark may be."""
-    return (
-        map_gap(map, landmark, compiled=_polygon_distance is not None) - landmark.position_uncertainty
-        <= reach
-    )
+    return map_gap(map, landmark) - landmark.position_uncertainty <= reach
 
 
-def map_gap(map: SpatialUncertaintyMap, landmark: Landmark, *, compiled: bool) -> float:
-    """Distance (m) from the map's polygon (edges included) to the landmark's point or segment.
-
-    ``compiled`` picks the C kernel (when built); otherwise shapely, the reference.
-    """
-    if compiled and _polygon_distance is not None:
-        if isinstance(landmark, GroundLineLandmark):
-            (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
-            return _polygon_distance(map.polygon.vertices, ax, ay, bx, by)
-        return _polygon_distance(map.polygon.vertices, landmark.x, landmark.y, landmark.x, landmark.y)
-    geometry: shapely.Geometry
+def map_gap(map: SpatialUncertaintyMap, landmark: Landmark) -> float:
+    """Distance (m) from the map's polygon (edges included) to the landmark's point or segment."""
     if isinstance(landmark, GroundLineLandmark):
-        geometry = shapely.LineString([landmark.start, landmark.end])
-    else:
-        geometry = shapely.Point(landmark.x, landmark.y)
-    return float(shapely.distance(map.polygon.to_shapely(), geometry))
+        (ax, ay), (bx, by) = landmark.start.tolist(), landmark.end.tolist()
+        return _native.polygon_distance(map.polygon.vertices, ax, ay, bx, by)
+    return _native.polygon_distance(map.polygon.vertices, landmark.x, landmark.y, landmark.x, landmark.y)
 
 
 def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: Pose) -> float | None:
@@ -194,7 +174,7 @@ def ground_line_orientation(camera: Camera, landmark: GroundLineLandmark, pose: 
 
 
 def _box(u1: float, v1: float, u2: float, v2: float) -> ImageWindow:
-    return trusted_window(min(u1, u2), min(v1, v2), max(u1, u2), max(v1, v2))
+    return ImageWindow._trusted(min(u1, u2), min(v1, v2), max(u1, u2), max(v1, v2))
 
 
 def detect(

@@ -20,22 +20,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from aura_ums._native import TOLERANCE, cap_inside
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
-from aura_ums.geometry import ConvexPolygon, HeadingWedge, intersect_arcs
-from aura_ums.geometry._arcs import Arc
-from aura_ums.geometry._convex import convex_hull
+from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._reduce import (
-    TOLERANCE,
-    Reduction,
-    arc_wedge,
-    cap_inside,
-    check_pair,
-    reduce_checked,
-)
+from aura_ums.uncertainty._reduce import Reduction, arc_wedge, check_pair, reduce_checked
 
 #: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
 DEFAULT_SECTOR = math.radians(5.0)

@@ -10,16 +10,11 @@ from typing import overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from aura_ums import _native
 from aura_ums._validate import float_array, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, Pose, outer_disk, wrap_angle
-from aura_ums.uncertainty._growth import (
-    DEFAULT_MAX_VERTICES,
-    compiled_sequence_kernel,
-    grow_polygon,
-    grow_wedge,
-    motion_bounds,
-)
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._reduce import Reduced, Reduction, reduce_checked, reduce_map
@@ -176,20 +171,7 @@ class SpatialUncertaintyMap:
             raise InputError(f"sigmas: expected a positive finite number, got {sigmas!r}")
         if max_vertices < 3:
             raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
-        bounds = motion_bounds(terrain, command, float(sigmas))
-        wedge = self.wedge
-        heading, cw, ccw = wedge.center, wedge.cw, wedge.ccw
-        heading_lo = heading - cw
-        vertices = grow_polygon(
-            self.polygon.vertices, heading_lo, heading_lo + cw + ccw, bounds, max_vertices
-        )
-        heading, cw, ccw = grow_wedge(heading, cw, ccw, bounds)
-        x, y = self.center.tolist()
-        run = bounds.run_mean
-        center = np.array([x + run * math.cos(heading), y + run * math.sin(heading)])
-        return SpatialUncertaintyMap._trusted(
-            ConvexPolygon._trusted(vertices), center, HeadingWedge._trusted(heading, cw, ccw)
-        )
+        return self._grow_many((command,), terrain, float(sigmas), max_vertices)
 
     def _grow_many(
         self,
@@ -200,45 +182,31 @@ class SpatialUncertaintyMap:
     ) -> SpatialUncertaintyMap:
         """Grow by each command in turn on one terrain: bit for bit a loop of :meth:`grow`.
 
-        For callers that validated their arguments (the manager's position reports):
-        one compiled call instead of a Python loop, when the kernel was built.
+        For callers that validated their arguments (the manager's position reports): one
+        call of the growth kernel for the whole run.
         """
-        kernel = compiled_sequence_kernel()
-        if kernel is None or not commands:
-            current = self
-            for command in commands:
-                current = current.grow(command, terrain, sigmas=sigmas, max_vertices=max_vertices)
-            return current
+        if not commands:
+            return self
         values: list[float] = []
         for command in commands:
             values += (command.turn, command.run)
-        vertices = self.polygon.vertices
-        if not vertices.flags.c_contiguous:  # polygons hold C-contiguous float64 arrays already
-            vertices = np.ascontiguousarray(vertices, dtype=np.float64)
         wedge, (x, y) = self.wedge, self.center.tolist()
-        raw, x, y, heading, cw, ccw = kernel(
-            vertices,
+        grown = _native.grow_commands(
+            self.polygon.vertices,
             x,
             y,
             wedge.center,
             wedge.cw,
             wedge.ccw,
-            terrain.rotation_loss,
-            terrain.rotation_sd,
-            terrain.translation_loss,
-            terrain.translation_sd,
-            terrain.translation_inertial_loss,
-            terrain.drift,
-            terrain.skitter,
-            terrain.skitter_sd,
+            terrain,
             sigmas,
             values,
             max_vertices,
         )
-        # Bytes are immutable, so the array is read-only as map values must be.
-        grown = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
         return SpatialUncertaintyMap._trusted(
-            ConvexPolygon._trusted(grown), np.array([x, y]), HeadingWedge._trusted(heading, cw, ccw)
+            ConvexPolygon._trusted(grown.vertices),
+            np.array([grown.x, grown.y]),
+            HeadingWedge._trusted(grown.heading, grown.cw, grown.ccw),
         )
 
     def reduce(

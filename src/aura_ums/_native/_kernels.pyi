@@ -1,22 +1,55 @@
 from collections.abc import Sequence
 
+import numpy as np
+from numpy.typing import NDArray
 from typing_extensions import Buffer
 
-def grow_polygon(
-    vertices: Buffer,
-    heading_lo: float,
-    heading_hi: float,
-    turn_min: float,
-    turn_max: float,
-    drift_max: float,
-    chord_min: float,
-    run_max: float,
-    skitter_radius: float,
+# Vertices: a C-contiguous (n, 2) float64 buffer, usually an array.
+Vertices = NDArray[np.float64] | Buffer
+
+ARC_STEP: float
+TINY_ANGLE: float
+PARALLEL_EPS: float
+NOISE_EDGE: float
+FARTHEST_MERGE: float
+EXTENDABLE: float
+SUPPORT_MARGIN: float
+SAME_POINT: float
+MERGE_EPS: float
+COLLINEAR_EPS: float
+TOLERANCE: float
+TANGENT_STEP: float
+FULL_DISK_SIDES: int
+SKITTER_SIDES: int
+SENSOR_ARC_SIDES: int
+NO_POSITION: int
+NO_SENSOR_POSITION: int
+NO_BEARING_HEADING: int
+NO_LINE_HEADING: int
+NO_OFFSET_POSITION: int
+
+def grow_commands(
+    vertices: Vertices,
+    center_x: float,
+    center_y: float,
+    wedge_center: float,
+    wedge_cw: float,
+    wedge_ccw: float,
+    rotation_loss: float,
+    rotation_sd: float,
+    translation_loss: float,
+    translation_sd: float,
+    translation_inertial_loss: float,
+    drift: float,
+    skitter: float,
+    skitter_sd: float,
+    sigmas: float,
+    commands: Sequence[float],
     max_vertices: int,
     /,
-) -> bytes: ...
+) -> tuple[bytes, float, float, float, float, float]: ...
 def reduce_cone(
-    vertices: Buffer,
+    vertices: Vertices,
     center_x: float,
     center_y: float,
     wedge_center: float,
@@ -36,7 +69,7 @@ def reduce_cone(
     /,
 ) -> tuple[bytes, float, float, float, float, float, float] | int: ...
 def reduce_strip(
-    vertices: Buffer,
+    vertices: Vertices,
     center_x: float,
     center_y: float,
     wedge_center: float,
@@ -57,7 +90,7 @@ def reduce_strip(
     /,
 ) -> tuple[bytes, float, float, float, float, float, float] | int: ...
 def expecter_points(
-    vertices: Buffer,
+    vertices: Vertices,
     base_count: int,
     disk_sides: int,
     full_circle: int,
@@ -86,24 +119,4 @@ def expecter_points(
     cut_plane: float,
     /,
 ) -> tuple[bytes, float, float, float, float] | None: ...
-def polygon_distance(vertices: Buffer, ax: float, ay: float, bx: float, by: float, /) -> float: ...
-def grow_commands(
-    vertices: Buffer,
-    center_x: float,
-    center_y: float,
-    wedge_center: float,
-    wedge_cw: float,
-    wedge_ccw: float,
-    rotation_loss: float,
-    rotation_sd: float,
-    translation_loss: float,
-    translation_sd: float,
-    translation_inertial_loss: float,
-    drift: float,
-    skitter: float,
-    skitter_sd: float,
-    sigmas: float,
-    commands: Sequence[float],
-    max_vertices: int,
-    /,
-) -> tuple[bytes, float, float, float, float, float]: ...
+def polygon_distance(vertices: Vertices, ax: float, ay: float, bx: float, by: float, /) -> float: ...

@@ -1,0 +1,60 @@
+"""The compiled kernels, one wrapper per concept, each with its numpy reference (private).
+
+Each kernel has exactly two implementations: a numpy reference, the specification, and a
+C one (``*.c`` here, one extension module ``aura_ums._native._kernels``) that repeats it
+operation for operation for speed. This is the one place that picks between them, once,
+when aura-ums is imported: the C one when the extension was built, unless the environment
+sets ``AURA_UMS_NATIVE=0``; the numpy reference otherwise (:data:`NATIVE`).
+
+Only the layer that owns a kernel calls it, as ``_native.<kernel>``: ``uncertainty`` the
+growth and the reductions, ``expecter`` its points, ``schemas`` the polygon distance. This
+package imports nothing of aura-ums but ``geometry``.
+"""
+
+import os
+
+from aura_ums._native import _distance, _expecter, _growth, _reduce
+from aura_ums._native._expecter import ExpectedPoints
+from aura_ums._native._extension import BUILT
+from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bounds
+from aura_ums._native._reduce import (
+    CONE_PIECE,
+    SECTOR_PIECE,
+    TOLERANCE,
+    ConeKernel,
+    EmptyReason,
+    RawReduction,
+    StripKernel,
+    cap_inside,
+)
+
+#: Whether the kernels run compiled: the extension was built, and ``AURA_UMS_NATIVE=0`` was
+#: not set when aura-ums was imported.
+NATIVE = BUILT and os.environ.get("AURA_UMS_NATIVE", "").strip() != "0"
+
+grow_commands = _growth.grow_commands_compiled if NATIVE else _growth.grow_commands_reference
+reduce_cone: ConeKernel = _reduce.reduce_cone_compiled if NATIVE else _reduce.reduce_cone_reference
+reduce_strip: StripKernel = _reduce.reduce_strip_compiled if NATIVE else _reduce.reduce_strip_reference
+expecter_points = _expecter.expecter_points_compiled if NATIVE else _expecter.expecter_points_reference
+polygon_distance = _distance.polygon_distance_compiled if NATIVE else _distance.polygon_distance_reference
+
+__all__ = [
+    "BUILT",
+    "CONE_PIECE",
+    "NATIVE",
+    "SECTOR_PIECE",
+    "TOLERANCE",
+    "EmptyReason",
+    "ExpectedPoints",
+    "Grown",
+    "MotionBounds",
+    "MotionModel",
+    "RawReduction",
+    "cap_inside",
+    "expecter_points",
+    "grow_commands",
+    "motion_bounds",
+    "polygon_distance",
+    "reduce_cone",
+    "reduce_strip",
+]

@@ -1,0 +1,67 @@
+/*
+ * Compiled kernel of the find-landmark schemas' activation test: the distance between a
+ * convex polygon (a point or a segment when degenerate) and a segment (a point when both
+ * ends agree). Its reference is shapely's distance (_distance.polygon_distance_reference
+ * beside this file).
+ */
+#include "kernels.h"
+
+/* Distance from the point p to the segment [a, b] (a point when a == b). */
+static double point_to_segment(double px, double py, double ax, double ay, double bx, double by) {
+    double ex = bx - ax, ey = by - ay, rx = px - ax, ry = py - ay;
+    double t = segment_parameter(rx, ry, ex, ey);
+    return hypot(rx - t * ex, ry - t * ey);
+}
+
+/* Distance between the segments [a, b] and [c, d]: 0 when they cross. */
+static double segment_to_segment(double ax, double ay, double bx, double by, double cx, double cy, double dx,
+                                 double dy) {
+    double o1 = cross(bx - ax, by - ay, cx - ax, cy - ay), o2 = cross(bx - ax, by - ay, dx - ax, dy - ay);
+    double o3 = cross(dx - cx, dy - cy, ax - cx, ay - cy), o4 = cross(dx - cx, dy - cy, bx - cx, by - cy);
+    if (((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) && ((o3 > 0.0 && o4 < 0.0) || (o3 < 0.0 && o4 > 0.0)))
+        return 0.0;
+    double best = point_to_segment(ax, ay, cx, cy, dx, dy);
+    best = lesser(best, point_to_segment(bx, by, cx, cy, dx, dy));
+    best = lesser(best, point_to_segment(cx, cy, ax, ay, bx, by));
+    return lesser(best, point_to_segment(dx, dy, ax, ay, bx, by));
+}
+
+static int inside_convex(const double *v, Py_ssize_t n, double x, double y) {
+    for (Py_ssize_t i = 0; i < n; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        if (cross(v[2 * j] - v[2 * i], v[2 * j + 1] - v[2 * i + 1], x - v[2 * i], y - v[2 * i + 1]) < 0.0) return 0;
+    }
+    return 1;
+}
+
+PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"ax", "ay", "bx", "by"};
+    double a[4];
+    Py_ssize_t n;
+    if (nargs != 5) {
+        PyErr_Format(PyExc_TypeError, "polygon_distance: expected 5 arguments, got %zd", nargs);
+        return NULL;
+    }
+    if (parse_doubles(args + 1, 4, names, a) < 0) return NULL;
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    const double *v = (const double *)view.buf;
+    double best;
+    if (n >= 3 && polygon_area(v, n) > 0.0 &&
+        (inside_convex(v, n, a[0], a[1]) || inside_convex(v, n, a[2], a[3]))) {
+        best = 0.0;
+    } else if (n == 1) {
+        best = point_to_segment(v[0], v[1], a[0], a[1], a[2], a[3]);
+    } else {
+        best = HUGE_VAL;
+        Py_ssize_t edges = n == 2 ? 1 : n;
+        for (Py_ssize_t i = 0; i < edges && best > 0.0; i++) {
+            Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+            best = lesser(best, segment_to_segment(a[0], a[1], a[2], a[3], v[2 * i], v[2 * i + 1], v[2 * j],
+                                                   v[2 * j + 1]));
+        }
+    }
+    PyBuffer_Release(&view);
+    return PyFloat_FromDouble(best);
+}

@@ -1,0 +1,386 @@
+/*
+ * Compiled kernels of the three landmark reductions. They mirror, operation for
+ * operation, the numpy reference in _reduce.py beside this file (sector_halfplanes,
+ * clip_to_sector, sensor_arc, cos_range, cap_inside, the cone and strip reductions and
+ * the tail of reduce_cone_reference / reduce_strip_reference), on the polygon primitives
+ * of polygon.c. One call runs a whole reduction: from the prior's vertices to the reduced
+ * vertices, heading arc, centre and areas. Every buffer's capacity is computed from the
+ * sizes of its inputs.
+ */
+#include "kernels.h"
+
+/* Number of tangents of a sector's outer arc (see _reduce.sector_halfplanes). */
+static Py_ssize_t tangent_count(double width) {
+    double count = ceil(width / TANGENT_STEP);
+    return count > 1.0 ? (Py_ssize_t)count : 1;
+}
+
+static void add_plane(double *planes, Py_ssize_t *k, double nx, double ny, double reach, double ax, double ay,
+                      double margin) {
+    planes[3 * *k] = nx;
+    planes[3 * *k + 1] = ny;
+    planes[3 * *k + 2] = nx * ax + ny * ay + reach + margin;
+    (*k)++;
+}
+
+/* See _reduce.sector_halfplanes; `planes` holds 3 + (tangent_count(width) + 1) triples. */
+static Py_ssize_t sector_halfplanes(double ax, double ay, double lo, double width, double widen, double r_min,
+                                    double r_max, double *planes) {
+    double hi = lo + width, middle = lo + width / 2.0, margin = widen + TOLERANCE;
+    Py_ssize_t k = 0;
+    add_plane(planes, &k, sin(lo), -cos(lo), 0.0, ax, ay, margin);
+    add_plane(planes, &k, -sin(hi), cos(hi), 0.0, ax, ay, margin);
+    add_plane(planes, &k, -cos(middle), -sin(middle), -r_min * cos(width / 2.0), ax, ay, margin);
+    if (isfinite(r_max)) {
+        /* np.linspace(lo, hi, count + 1): k * step + lo, the last one exactly hi. */
+        Py_ssize_t count = tangent_count(width);
+        double step = (hi - lo) / (double)count;
+        for (Py_ssize_t j = 0; j <= count; j++) {
+            double angle = j == count ? hi : (double)j * step + lo;
+            add_plane(planes, &k, cos(angle), sin(angle), r_max, ax, ay, margin);
+        }
+    }
+    return k;
+}
+
+/* See _reduce.clip_to_sector; `v` and `out` must not be w->part or w->parts. */
+static int clip_to_sector(const double *v, Py_ssize_t n, double ax, double ay, double lo, double width,
+                          double widen, double r_min, double r_max, double piece, Poly *out, Work *w) {
+    double span = TWO_PI < width ? TWO_PI : width;
+    double pieces = ceil(span / piece);
+    Py_ssize_t count = pieces > 1.0 ? (Py_ssize_t)pieces : 1;
+    double step = span / (double)count;
+    double *planes = scratch(&w->planes, 3 * (4 + tangent_count(step)), sizeof(double));
+    if (!planes) return -1;
+    Py_ssize_t kept = 0;
+    w->parts.n = 0;
+    for (Py_ssize_t j = 0; j < count; j++) {
+        Py_ssize_t k = sector_halfplanes(ax, ay, lo + (double)j * step, step, widen, r_min, r_max, planes);
+        if (clip_halfplanes(v, n, planes, k, &w->part, w) < 0) return -1;
+        if (w->part.n == 0) continue;
+        if (reserve(&w->parts, w->parts.n + w->part.n) < 0) return -1;
+        memcpy(w->parts.v + 2 * w->parts.n, w->part.v, 2 * sizeof(double) * (size_t)w->part.n);
+        w->parts.n += w->part.n;
+        kept++;
+    }
+    if (kept == 0) {
+        out->n = 0;
+        return 0;
+    }
+    if (kept == 1) return copy_into(out, w->parts.v, w->parts.n);
+    return convex_hull(w->parts.v, w->parts.n, out, w);
+}
+
+/* See _reduce.sensor_arc: 0 when the sensor is at the reference point, 1 with the polygon
+   in `out`, -1 on error. */
+static int sensor_arc(double forward, double left, double lo, double width, Poly *out, Work *w) {
+    double radius = hypot(forward, left);
+    if (radius == 0.0) return 0;
+    lo += atan2(left, forward);
+    if (width >= TWO_PI) {
+        if (reserve(out, SENSOR_ARC_SIDES) < 0) return -1;
+        out->n = outer_disk(radius, SENSOR_ARC_SIDES, out->v);
+        return 1;
+    }
+    if (width <= 0.0) {
+        if (reserve(out, 1) < 0) return -1;
+        out->v[0] = radius * cos(lo);
+        out->v[1] = radius * sin(lo);
+        out->n = 1;
+        return 1;
+    }
+    double stop = lo + width;
+    if (reserve(&w->arc_points, arc_pieces(stop - lo, ARC_STEP) + 2) < 0) return -1;
+    w->arc_points.n = outer_arc(radius, lo, stop, w->arc_points.v);
+    return convex_hull(w->arc_points.v, w->arc_points.n, out, w) < 0 ? -1 : 1;
+}
+
+/* See _reduce.cos_range. */
+static void cos_range(double lo, double width, double *lowest, double *highest) {
+    if (width >= TWO_PI) {
+        *lowest = -1.0;
+        *highest = 1.0;
+        return;
+    }
+    double a = cos(lo), b = cos(lo + width);
+    *highest = floor_mod(-lo, TWO_PI) <= width ? 1.0 : greater(a, b);
+    *lowest = floor_mod(M_PI - lo, TWO_PI) <= width ? -1.0 : lesser(a, b);
+}
+
+/* See _reduce.cap_inside; works in place. -1 with MemoryError set on failure. */
+static int cap_inside(Poly *p, const double *prior, Py_ssize_t prior_n, Py_ssize_t max_vertices) {
+    Py_ssize_t floor_count = max_vertices > 3 ? max_vertices : 3;
+    if (p->n <= floor_count) return 0;
+    double *lengths = NULL;
+    if (prior_n >= 3 && polygon_area(prior, prior_n) > 0.0) {
+        lengths = PyMem_Malloc(sizeof(double) * (size_t)prior_n);
+        if (!lengths) {
+            PyErr_NoMemory();
+            return -1;
+        }
+        for (Py_ssize_t i = 0; i < prior_n; i++) {
+            Py_ssize_t j = i + 1 < prior_n ? i + 1 : 0;
+            lengths[i] = hypot(prior[2 * j] - prior[2 * i], prior[2 * j + 1] - prior[2 * i + 1]);
+        }
+    }
+    while (p->n > floor_count) {
+        Py_ssize_t n = p->n, best = 0;
+        double *v = p->v, best_cost = HUGE_VAL, best_x = 0.0, best_y = 0.0;
+        int any = 0;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
+            Py_ssize_t after = next + 1 < n ? next + 1 : 0;
+            double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
+            double ex = v[2 * next] - v[2 * i], ey = v[2 * next + 1] - v[2 * i + 1];
+            double fx = v[2 * after] - v[2 * next], fy = v[2 * after + 1] - v[2 * next + 1];
+            double denominator = px * fy - py * fx;
+            int removable = denominator > 1e-12 * hypot(px, py) * hypot(fx, fy);
+            double t = removable ? (ex * fy - ey * fx) / denominator : 0.0;
+            double x = v[2 * i] + t * px, y = v[2 * i + 1] + t * py;
+            removable = removable && point_in_convex(prior, prior_n, lengths, x, y, TOLERANCE);
+            double cost = removable ? 0.5 * t * (px * ey - py * ex) : HUGE_VAL;
+            any |= removable;
+            /* np.argmin: the first of the cheapest. */
+            if (i == 0 || cost < best_cost) {
+                best = i;
+                best_cost = cost;
+                best_x = x;
+                best_y = y;
+            }
+        }
+        if (!any) break;
+        v[2 * best] = best_x;
+        v[2 * best + 1] = best_y;
+        Py_ssize_t gone = best + 1 < n ? best + 1 : 0;
+        memmove(v + 2 * gone, v + 2 * gone + 2, 2 * sizeof(double) * (size_t)(n - gone - 1));
+        p->n = n - 1;
+    }
+    PyMem_Free(lengths);
+    return 0;
+}
+
+/* The bearing-cone constraint of _reduce._cone_reduction on one polygon. */
+typedef struct {
+    double landmark_x, landmark_y, widen, cone_lo, cone_width, r_min, r_max, piece;
+} Cone;
+
+static int constrain(const Cone *cone, const double *v, Py_ssize_t n, Poly *out, Work *w) {
+    if (cone->cone_width >= TWO_PI && !isfinite(cone->r_max)) return copy_into(out, v, n);
+    return clip_to_sector(v, n, cone->landmark_x, cone->landmark_y, cone->cone_lo, cone->cone_width, cone->widen,
+                          cone->r_min, cone->r_max, cone->piece, out, w);
+}
+
+/* See _reduce._cone_reduction (with _sensor_constrained and _bearing_headings). Returns -1 on
+   error, else 0 with *reason -1 and the positions in *positions, or *reason a code. */
+static int cone_reduction(const double *prior, Py_ssize_t n, double heading_lo, double heading_width,
+                          double forward, double left, double bearing, double error, const Cone *cone, Work *w,
+                          int *reason, Poly **positions, double *arc_lo, double *arc_width) {
+    int has_arc = sensor_arc(forward, left, heading_lo, heading_width, &w->arc, w);
+    if (has_arc < 0) return -1;
+    Poly *sensors;
+    if (!has_arc) {
+        if (constrain(cone, prior, n, &w->sensors, w) < 0) return -1;
+        if (w->sensors.n == 0) {
+            *reason = NO_POSITION;
+            return 0;
+        }
+        *positions = sensors = &w->sensors;
+    } else {
+        if (minkowski_pair(prior, n, w->arc.v, w->arc.n, &w->sum, w) < 0) return -1;
+        if (constrain(cone, w->sum.v, w->sum.n, &w->sensors, w) < 0) return -1;
+        if (w->sensors.n == 0) {
+            *reason = NO_SENSOR_POSITION;
+            return 0;
+        }
+        /* p = s - R(h) o: an outer bound is the sensor region summed with the mirrored arc. */
+        if (reserve(&w->mirrored, w->arc.n) < 0) return -1;
+        for (Py_ssize_t i = 0; i < 2 * w->arc.n; i++) w->mirrored.v[i] = -w->arc.v[i];
+        w->mirrored.n = w->arc.n;
+        if (minkowski_pair(w->sensors.v, w->sensors.n, w->mirrored.v, w->mirrored.n, &w->sum, w) < 0) return -1;
+        if (clip_convex(prior, n, w->sum.v, w->sum.n, TOLERANCE, &w->positions, w) < 0) return -1;
+        if (w->positions.n == 0) {
+            *reason = NO_POSITION;
+            return 0;
+        }
+        *positions = &w->positions;
+        /* Sensors must also be reachable from the remaining positions. */
+        if (minkowski_pair(w->positions.v, w->positions.n, w->arc.v, w->arc.n, &w->sum, w) < 0) return -1;
+        if (clip_convex(w->sensors.v, w->sensors.n, w->sum.v, w->sum.n, TOLERANCE, &w->narrowed, w) < 0) return -1;
+        sensors = w->narrowed.n ? &w->narrowed : &w->sensors;
+    }
+    double seen_lo, seen_width;
+    subtended_arc(sensors->v, sensors->n, cone->landmark_x, cone->landmark_y, cone->widen, &seen_lo, &seen_width);
+    if (seen_width >= TWO_PI) {
+        seen_width = TWO_PI;
+    } else {
+        /* Directions from the sensors towards the landmark are those from it, turned by pi. */
+        double margin = error + TOLERANCE;
+        seen_lo = seen_lo + M_PI - bearing - margin;
+        seen_width = seen_width + 2.0 * margin;
+    }
+    if (!intersect_arcs(heading_lo, heading_width, seen_lo, seen_width, arc_lo, arc_width)) {
+        *reason = NO_BEARING_HEADING;
+        return 0;
+    }
+    *reason = -1;
+    return 0;
+}
+
+/* See _reduce.reduce_ground_line. */
+static int strip_reduction(const double *prior, Py_ssize_t n, double heading_lo, double heading_width,
+                           double forward, double left, double start_x, double start_y, double end_x, double end_y,
+                           double uncertainty, double offset, double offset_error, double angle, double angle_error,
+                           Poly *out, Work *w, int *reason, double *arc_lo, double *arc_width) {
+    double direction = atan2(end_y - start_y, end_x - start_x);
+    /* angle = direction - heading, so the heading is direction - angle. */
+    double margin = angle_error + TOLERANCE;
+    if (!intersect_arcs(heading_lo, heading_width, direction - angle - margin, 0.0 + 2.0 * margin, arc_lo,
+                        arc_width)) {
+        *reason = NO_LINE_HEADING;
+        return 0;
+    }
+    double nx = -sin(direction), ny = cos(direction);
+    double base = nx * start_x + ny * start_y;
+    double spread = offset_error + uncertainty;
+    double lo = base + offset - spread, hi = base + offset + spread;
+    double radius = hypot(forward, left);
+    if (radius > 0.0) {
+        /* normal . R(h) o = |o| cos(h + atan2(left, forward) - direction - pi/2). */
+        double shift = atan2(left, forward) - direction - M_PI / 2.0, lowest, highest;
+        cos_range(*arc_lo + shift, *arc_width, &lowest, &highest);
+        lo -= radius * highest;
+        hi -= radius * lowest;
+    }
+    double planes[6] = {nx, ny, hi + TOLERANCE, -nx, -ny, -lo + TOLERANCE};
+    if (clip_halfplanes(prior, n, planes, 2, out, w) < 0) return -1;
+    *reason = out->n ? -1 : NO_OFFSET_POSITION;
+    return 0;
+}
+
+/* --- results -------------------------------------------------------------------------- */
+
+/* The tail of _reduce.reduce_cone_reference and reduce_strip_reference: the vertex cap, the
+   centre update and both areas; returns
+   (vertex bytes, arc lo, arc width, centre x, centre y, area before, area after). */
+static PyObject *finish(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices,
+                        double center_x, double center_y, double arc_lo, double arc_width) {
+    if (positions->n > max_vertices) {
+        if (cap_inside(positions, prior, n, max_vertices) < 0) return NULL;
+        /* Merging stopped above max(max_vertices, n) (rounding can block the undoing of a
+           cut): the prior, which holds the positions, is the outer bound with few enough. */
+        if (positions->n > max_vertices && positions->n > n && copy_into(positions, prior, n) < 0) return NULL;
+    }
+    double distance, x, y;
+    nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, &x, &y);
+    double values[6] = {arc_lo, arc_width, x, y, polygon_area(prior, n), polygon_area(positions->v, positions->n)};
+    PyObject *result = PyTuple_New(7);
+    if (!result) return NULL;
+    PyObject *raw = PyBytes_FromStringAndSize((const char *)positions->v,
+                                              (Py_ssize_t)(2 * sizeof(double) * (size_t)positions->n));
+    if (!raw) {
+        Py_DECREF(result);
+        return NULL;
+    }
+    PyTuple_SET_ITEM(result, 0, raw);
+    for (int k = 0; k < 6; k++) {
+        PyObject *value = PyFloat_FromDouble(values[k]);
+        if (!value) {
+            Py_DECREF(result);
+            return NULL;
+        }
+        PyTuple_SET_ITEM(result, k + 1, value);
+    }
+    return result;
+}
+
+/* Heading arc (lo, width) of a wedge: see _reduce.wedge_arc. */
+static void wedge_arc(double center, double cw, double ccw, double *lo, double *width) {
+    double sum = cw + ccw;
+    *lo = center - cw;
+    *width = TWO_PI < sum ? TWO_PI : sum;
+}
+
+PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"center_x", "center_y",   "wedge_center", "wedge_cw", "wedge_ccw",
+                                        "forward",  "left",       "landmark_x",   "landmark_y", "widen",
+                                        "bearing",  "bearing_error", "range_min",  "range_max", "piece"};
+    enum { DOUBLES = sizeof(names) / sizeof(names[0]) };
+    double a[DOUBLES];
+    if (nargs != DOUBLES + 2) {
+        PyErr_Format(PyExc_TypeError, "reduce_cone: expected %d arguments, got %zd", DOUBLES + 2, nargs);
+        return NULL;
+    }
+    Py_ssize_t max_vertices, n;
+    if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 1], &max_vertices) < 0)
+        return NULL;
+    /* At most a million pieces: each costs a clip. */
+    if (!(a[14] > 0.0) || TWO_PI / a[14] > 1e6) {
+        PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R", args[15]);
+        return NULL;
+    }
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    const double *prior = (const double *)view.buf;
+    Work w;
+    memset(&w, 0, sizeof(w));
+    PyObject *result = NULL;
+    double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+    wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
+    /* The landmark is seen towards h + bearing, so the sensor lies from the landmark
+       towards h + bearing + pi, for some heading h of the wedge and bearing error. */
+    double margin = a[11] + TOLERANCE;
+    Cone cone = {a[7], a[8], a[9], heading_lo + a[10] + M_PI - margin, heading_width + 2.0 * margin,
+                 a[12], a[13], a[14]};
+    int reason = -1;
+    Poly *positions = NULL;
+    if (cone_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[10], a[11], &cone, &w, &reason,
+                       &positions, &arc_lo, &arc_width) < 0)
+        goto done;
+    if (reason >= 0)
+        result = PyLong_FromLong(reason);
+    else
+        result = finish(positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
+done:
+    work_free(&w);
+    PyBuffer_Release(&view);
+    return result;
+}
+
+PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"center_x", "center_y", "wedge_center", "wedge_cw",    "wedge_ccw",
+                                        "forward",  "left",     "start_x",      "start_y",     "end_x",
+                                        "end_y",    "position_uncertainty", "offset", "offset_error", "angle",
+                                        "angle_error"};
+    enum { DOUBLES = sizeof(names) / sizeof(names[0]) };
+    double a[DOUBLES];
+    if (nargs != DOUBLES + 2) {
+        PyErr_Format(PyExc_TypeError, "reduce_strip: expected %d arguments, got %zd", DOUBLES + 2, nargs);
+        return NULL;
+    }
+    Py_ssize_t max_vertices, n;
+    if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 1], &max_vertices) < 0)
+        return NULL;
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    const double *prior = (const double *)view.buf;
+    Work w;
+    memset(&w, 0, sizeof(w));
+    PyObject *result = NULL;
+    double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+    wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
+    int reason = -1;
+    if (strip_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[7], a[8], a[9], a[10], a[11], a[12],
+                        a[13], a[14], a[15], &w.positions, &w, &reason, &arc_lo, &arc_width) < 0)
+        goto done;
+    if (reason >= 0)
+        result = PyLong_FromLong(reason);
+    else
+        result = finish(&w.positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
+done:
+    work_free(&w);
+    PyBuffer_Release(&view);
+    return result;
+}
+
