@@ -70,29 +70,6 @@ class ObservationOutcome:
     wedge_width_before: float
     wedge_width_after: float
 
-    @classmethod
-    def _new(
-        cls,
-        observation: Observation,
-        accepted: bool,
-        reason: RejectReason | None,
-        area_before: float,
-        area_after: float,
-        wedge_width_before: float,
-        wedge_width_after: float,
-    ) -> ObservationOutcome:
-        # The slots' own setters: the frozen __init__'s object.__setattr__ per field costs
-        # about twice as much, and the manager records an outcome for every observation.
-        outcome = object.__new__(cls)
-        _set_observation(outcome, observation)
-        _set_accepted(outcome, accepted)
-        _set_reason(outcome, reason)
-        _set_area_before(outcome, area_before)
-        _set_area_after(outcome, area_after)
-        _set_width_before(outcome, wedge_width_before)
-        _set_width_after(outcome, wedge_width_after)
-        return outcome
-
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ManagerStep:
@@ -129,30 +106,6 @@ class ManagerStep:
     relocalized: bool = False
     envelope_map: SpatialUncertaintyMap | None = None
 
-    @classmethod
-    def _new(
-        cls,
-        time: float,
-        uncertainty_map: SpatialUncertaintyMap,
-        state: ManagerState,
-        lost_reason: str,
-        outcomes: tuple[ObservationOutcome, ...],
-        grown_reports: int,
-        relocalized: bool,
-        envelope_map: SpatialUncertaintyMap | None,
-    ) -> ManagerStep:
-        # As ObservationOutcome._new: one step per update.
-        step = object.__new__(cls)
-        _set_time(step, time)
-        _set_map(step, uncertainty_map)
-        _set_state(step, state)
-        _set_lost_reason(step, lost_reason)
-        _set_outcomes(step, outcomes)
-        _set_grown_reports(step, grown_reports)
-        _set_relocalized(step, relocalized)
-        _set_envelope_map(step, envelope_map)
-        return step
-
     @property
     def accepted(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that reduced the map."""
@@ -162,51 +115,6 @@ class ManagerStep:
     def rejected(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that were rejected, with their reasons."""
         return tuple(o for o in self.outcomes if not o.accepted)
-
-
-# Setters of the records' slots (frozen: the dataclasses' own __setattr__ refuses).
-(
-    _set_observation,
-    _set_accepted,
-    _set_reason,
-    _set_area_before,
-    _set_area_after,
-    _set_width_before,
-    _set_width_after,
-) = (
-    ObservationOutcome.__dict__[name].__set__
-    for name in (
-        "observation",
-        "accepted",
-        "reason",
-        "area_before",
-        "area_after",
-        "wedge_width_before",
-        "wedge_width_after",
-    )
-)
-(
-    _set_time,
-    _set_map,
-    _set_state,
-    _set_lost_reason,
-    _set_outcomes,
-    _set_grown_reports,
-    _set_relocalized,
-    _set_envelope_map,
-) = (
-    ManagerStep.__dict__[name].__set__
-    for name in (
-        "time",
-        "map",
-        "state",
-        "lost_reason",
-        "outcomes",
-        "grown_reports",
-        "relocalized",
-        "envelope_map",
-    )
-)
 
 
 class UncertaintyMapManager:
@@ -565,7 +473,7 @@ class UncertaintyMapManager:
                 recent.clear()
                 relocalized = True
         self._update_state(found, missed_in_a_row)
-        return ManagerStep._new(
+        return ManagerStep(
             time,
             self._map,
             self._state,
@@ -802,11 +710,11 @@ class UncertaintyMapManager:
                     for observation, found in zip(observations, checked, strict=True):
                         if isinstance(found, RejectReason):
                             outcomes.append(
-                                ObservationOutcome._new(observation, False, found, area, area, width, width)
+                                ObservationOutcome(observation, False, found, area, area, width, width)
                             )
                         else:
                             outcomes.append(
-                                ObservationOutcome._new(
+                                ObservationOutcome(
                                     observation,
                                     True,
                                     None,
@@ -846,7 +754,7 @@ class UncertaintyMapManager:
             if not isinstance(found, str):
                 reduced, area_before, area_after = found
                 width_before, width_after = current.wedge.width, reduced.wedge.width
-                outcome = ObservationOutcome._new(
+                outcome = ObservationOutcome(
                     observation, True, None, area_before, area_after, width_before, width_after
                 )
                 return outcome, reduced
@@ -854,7 +762,7 @@ class UncertaintyMapManager:
             reason = RejectReason(found)
         # Rejected: the map stays, and so do its area and width.
         area, width = current.area, current.wedge.width
-        return ObservationOutcome._new(observation, False, reason, area, area, width, width), current
+        return ObservationOutcome(observation, False, reason, area, area, width, width), current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:
         reasons: list[str] = []
