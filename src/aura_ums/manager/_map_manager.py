@@ -448,7 +448,7 @@ class UncertaintyMapManager:
         self._check_blackboard(blackboard)
 
         identified = blackboard.identified
-        pending = identified._peek_until(time)
+        pending = identified.peek(time)
         current, index, map_time, outcomes = self._advance(blackboard, time, pending)
         outer = self._envelope
         if outer is not None:
@@ -456,7 +456,7 @@ class UncertaintyMapManager:
             wide, wide_index, wide_time, _ = outer._advance(blackboard, time, twins)
 
         # Commit: nothing above changed the manager or the blackboard.
-        identified._discard(len(pending))  # exactly ``pending``: single-threaded by contract
+        identified.drain(time)  # exactly ``pending``: single-threaded by contract
         grown = index - self._consumed
         found = self._commit(current, index, map_time, outcomes)
         relocalized = False
@@ -488,8 +488,10 @@ class UncertaintyMapManager:
         self, blackboard: Blackboard, time: float, pending: Sequence[Observation]
     ) -> tuple[SpatialUncertaintyMap, int, float | None, list[ObservationOutcome]]:
         """Grow and reduce by ``pending`` up to ``time``, changing nothing; return what to commit."""
-        current, index, map_time = self._map, self._consumed, self._map_time
-        reports = blackboard._reports  # read in place (the manager's own subpackage): no copies
+        current, map_time = self._map, self._map_time
+        # Only the reports this update consumes, once; each instant takes its share of them.
+        reports = blackboard.reports_until(time, start=self._consumed)
+        index = 0
         outcomes: list[ObservationOutcome] = []
         first = 0
         while first < len(pending):
@@ -497,7 +499,10 @@ class UncertaintyMapManager:
             last = first + 1
             while last < len(pending) and pending[last].time == instant:
                 last += 1
-            stop = blackboard._report_stop(instant, index)
+            # A scan, not a bisection: every report it passes is grown right after.
+            stop = index
+            while stop < len(reports) and reports[stop].time <= instant:
+                stop += 1
             current, map_time = self._grow(current, reports, index, stop, map_time)
             index = stop
             if last - first == 1:
@@ -509,9 +514,8 @@ class UncertaintyMapManager:
             else:
                 current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
             first = last
-        stop = blackboard._report_stop(time, index)
-        current, map_time = self._grow(current, reports, index, stop, map_time)
-        return current, stop, map_time, outcomes
+        current, map_time = self._grow(current, reports, index, len(reports), map_time)
+        return current, self._consumed + len(reports), map_time, outcomes
 
     def _commit(
         self,
@@ -619,7 +623,7 @@ class UncertaintyMapManager:
                 f"position reports (consumed so far), got {count}"
             )
         if self._consumed:
-            last = blackboard._reports[self._consumed - 1].time  # one report, not a copy of all
+            last = blackboard.report(self._consumed - 1).time
             if last != self._map_time:
                 raise InputError(
                     f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
