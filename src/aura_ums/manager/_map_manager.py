@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import enum
+import operator
 import types
 from collections import deque
 from collections.abc import Mapping, Sequence
@@ -33,6 +35,8 @@ from aura_ums.uncertainty import (
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
+
+_report_time = operator.attrgetter("time")
 
 
 class ManagerState(enum.Enum):
@@ -449,19 +453,25 @@ class UncertaintyMapManager:
 
         identified = blackboard.identified
         pending = identified.peek(time)
-        current, index, map_time, outcomes = self._advance(blackboard, time, pending)
+        # The reports this update consumes (the envelope map has consumed as many).
+        reports = blackboard.reports_until(time, start=self._consumed)
+        index = self._consumed + len(reports)
+        outcomes: list[ObservationOutcome] = []
+        current, map_time = self._advance(reports, pending, outcomes)
         outer = self._envelope
         if outer is not None:
             twins = self._twins(pending, envelope)
-            wide, wide_index, wide_time, _ = outer._advance(blackboard, time, twins)
+            # The envelope's outcomes are never reported: not recording them saves a record
+            # (and a rejected map's area) per observation.
+            wide, wide_time = outer._advance(reports, twins, None)
 
         # Commit: nothing above changed the manager or the blackboard.
         identified.drain(time)  # exactly ``pending``: single-threaded by contract
-        grown = index - self._consumed
+        grown = len(reports)
         found = self._commit(current, index, map_time, outcomes)
         relocalized = False
         if outer is not None:
-            outer._commit(wide, wide_index, wide_time, [])
+            outer._commit(wide, index, wide_time, ())
             recent = self._recent
             for outcome in outcomes:
                 reason = outcome.reason
@@ -485,37 +495,36 @@ class UncertaintyMapManager:
         )
 
     def _advance(
-        self, blackboard: Blackboard, time: float, pending: Sequence[Observation]
-    ) -> tuple[SpatialUncertaintyMap, int, float | None, list[ObservationOutcome]]:
-        """Grow and reduce by ``pending`` up to ``time``, changing nothing; return what to commit."""
+        self,
+        reports: Sequence[PositionReport],
+        pending: Sequence[Observation],
+        outcomes: list[ObservationOutcome] | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None]:
+        """Grow by ``reports`` and reduce by ``pending`` in time order, changing nothing.
+
+        Returns the map and its time, to commit. What became of each observation is
+        appended to ``outcomes`` (None: not recorded).
+        """
         current, map_time = self._map, self._map_time
-        # Only the reports this update consumes, once; each instant takes its share of them.
-        reports = blackboard.reports_until(time, start=self._consumed)
         index = 0
-        outcomes: list[ObservationOutcome] = []
         first = 0
         while first < len(pending):
             instant = pending[first].time
             last = first + 1
             while last < len(pending) and pending[last].time == instant:
                 last += 1
-            # A scan, not a bisection: every report it passes is grown right after.
-            stop = index
-            while stop < len(reports) and reports[stop].time <= instant:
-                stop += 1
+            stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
             current, map_time = self._grow(current, reports, index, stop, map_time)
             index = stop
             if last - first == 1:
                 observation = pending[first]
-                outcome, current = self._reduce(
-                    current, observation, self._landmark_for(observation, map_time)
+                current = self._reduce(
+                    current, observation, self._landmark_for(observation, map_time), outcomes
                 )
-                outcomes.append(outcome)
             else:
                 current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
             first = last
-        current, map_time = self._grow(current, reports, index, len(reports), map_time)
-        return current, self._consumed + len(reports), map_time, outcomes
+        return self._grow(current, reports, index, len(reports), map_time)
 
     def _commit(
         self,
@@ -693,7 +702,7 @@ class UncertaintyMapManager:
         current: SpatialUncertaintyMap,
         observations: Sequence[Observation],
         map_time: float | None,
-        outcomes: list[ObservationOutcome],
+        outcomes: list[ObservationOutcome] | None,
     ) -> SpatialUncertaintyMap:
         """Reduce by observations of one instant: jointly when the wedge is wide, else one by one."""
         # One map time for the instant: each observation's landmark (or rejection) holds for both ways.
@@ -710,6 +719,8 @@ class UncertaintyMapManager:
                 )
                 if joint.consistent:
                     reduced = joint.map
+                    if outcomes is None:
+                        return reduced
                     area, width = current.area, current.wedge.width
                     for observation, found in zip(observations, checked, strict=True):
                         if isinstance(found, RejectReason):
@@ -730,8 +741,7 @@ class UncertaintyMapManager:
                             )
                     return reduced
         for observation, found in zip(observations, checked, strict=True):
-            outcome, current = self._reduce(current, observation, found)
-            outcomes.append(outcome)
+            current = self._reduce(current, observation, found, outcomes)
         return current
 
     def _landmark_for(self, observation: Observation, map_time: float | None) -> Landmark | RejectReason:
@@ -747,8 +757,12 @@ class UncertaintyMapManager:
         return landmark
 
     def _reduce(
-        self, current: SpatialUncertaintyMap, observation: Observation, landmark: Landmark | RejectReason
-    ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
+        self,
+        current: SpatialUncertaintyMap,
+        observation: Observation,
+        landmark: Landmark | RejectReason,
+        outcomes: list[ObservationOutcome] | None,
+    ) -> SpatialUncertaintyMap:
         """Reduce by one observation and its landmark (from :meth:`_landmark_for`, or why not)."""
         if isinstance(landmark, RejectReason):
             reason = landmark
@@ -757,16 +771,21 @@ class UncertaintyMapManager:
             found = current._reduce_checked(observation, landmark, self._max_vertices)
             if not isinstance(found, str):
                 reduced, area_before, area_after = found
-                width_before, width_after = current.wedge.width, reduced.wedge.width
-                outcome = ObservationOutcome(
-                    observation, True, None, area_before, area_after, width_before, width_after
-                )
-                return outcome, reduced
+                if outcomes is not None:
+                    width_before, width_after = current.wedge.width, reduced.wedge.width
+                    outcomes.append(
+                        ObservationOutcome(
+                            observation, True, None, area_before, area_after, width_before, width_after
+                        )
+                    )
+                return reduced
             # The reductions word their reasons; each is a RejectReason's value.
             reason = RejectReason(found)
-        # Rejected: the map stays, and so do its area and width.
-        area, width = current.area, current.wedge.width
-        return ObservationOutcome(observation, False, reason, area, area, width, width), current
+        if outcomes is not None:
+            # Rejected: the map stays, and so do its area and width.
+            area, width = current.area, current.wedge.width
+            outcomes.append(ObservationOutcome(observation, False, reason, area, area, width, width))
+        return current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:
         reasons: list[str] = []
