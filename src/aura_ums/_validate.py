@@ -17,6 +17,8 @@ from aura_ums.errors import InputError
 
 def finite_float(value: object, name: str) -> float:
     """Return ``value`` as a finite float, or raise naming ``name``."""
+    if type(value) is float and math.isfinite(value):
+        return value  # what float(value) returns; a third of the cost (tens of calls per map update)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InputError(f"{name}: expected a finite number, got {value!r}")
     result = float(value)

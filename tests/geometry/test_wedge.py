@@ -121,3 +121,28 @@ def test_trusted_wraps_the_centre_as_wrap_angle_does(center: float) -> None:
     wedge = HeadingWedge._trusted(center, 0.25, 0.5)
     assert wedge == HeadingWedge(center, 0.25, 0.5)
     assert math.copysign(1.0, wedge.center) == math.copysign(1.0, wrap_angle(center))
+
+
+def test_restored_keeps_the_centre_bit_for_bit_where_wrapping_would_move_it() -> None:
+    center = next(h for h in np.linspace(0.01, 0.5, 1000).tolist() if wrap_angle(h) != h)
+    wedge = HeadingWedge._restored(center, 0.25, 0.5)
+    assert (wedge.center, wedge.cw, wedge.ccw) == (center, 0.25, 0.5)
+    assert HeadingWedge(center, 0.25, 0.5).center != center  # the constructor would move it
+    assert HeadingWedge._restored(math.pi, 0.0, 0.0) == HeadingWedge(math.pi, 0.0, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("center", "cw", "ccw", "message"),
+    [
+        (-math.pi, 0.1, 0.1, r"HeadingWedge\.center: expected radians in \(-pi, pi\], got -3\.14159"),
+        (4.0, 0.1, 0.1, r"HeadingWedge\.center: expected radians in \(-pi, pi\], got 4\.0"),
+        (math.nan, 0.1, 0.1, r"HeadingWedge\.center: expected a finite number, got nan"),
+        (0.0, -0.1, 0.1, r"HeadingWedge\.cw: expected a non-negative number, got -0\.1"),
+        (0.0, 0.1, math.inf, r"HeadingWedge\.ccw: expected a finite number, got inf"),
+    ],
+)
+def test_restored_validates_as_the_constructor_does(
+    center: float, cw: float, ccw: float, message: str
+) -> None:
+    with pytest.raises(InputError, match=message):
+        HeadingWedge._restored(center, cw, ccw)

@@ -68,6 +68,18 @@ def test_reports_until_takes_from_start_up_to_until_inclusive() -> None:
         board.reports_until(math.inf)
 
 
+def test_report_reads_one_report_by_index() -> None:
+    board = Blackboard()
+    board.post_reports(report(t) for t in (1.0, 2.0, 3.0))
+    assert [board.report(k).time for k in range(3)] == [1.0, 2.0, 3.0]
+    assert board.report(1) is board.position_reports[1]
+    for bad in (3, -1, True, 1.0):
+        with pytest.raises(InputError, match=rf"index: expected an integer in \[0, 3\), got {bad!r}"):
+            board.report(bad)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"index: expected an integer in \[0, 0\), got 0"):
+        Blackboard().report(0)
+
+
 # --- command buffer and identified buffer ------------------------------------------------
 
 

@@ -526,6 +526,20 @@ def test_a_wedge_centre_that_rewrapping_would_move_is_restored_exactly() -> None
     assert json.loads(again.to_json())["map"]["wedge"]["center"] == heading
 
 
+def test_a_polygon_with_collinear_vertices_is_restored_exactly() -> None:
+    # A vertex on an edge: the public constructor would drop it, the saved map kept it.
+    rows = [[1.0, -1.0], [2.0, -1.0], [3.0, -1.0], [3.0, 1.0], [1.0, 1.0]]
+    assert len(ConvexPolygon(rows).vertices) == 4
+    data = json.loads(manager_for().to_json())
+    data["map"]["vertices"] = rows
+    again = UncertaintyMapManager.from_json(json.dumps(data), WORLD, TABLE)
+    assert again.map.polygon.vertices.tolist() == rows
+    assert not again.map.polygon.vertices.flags.writeable
+    assert json.loads(again.to_json())["map"] == data["map"]
+    step = again.update(board_with((1.0, STRIDE)), now=1.0)  # and it goes on from there
+    assert step.grown_reports == 1
+
+
 def test_a_run_shorter_than_the_split_tolerance_grows_on_the_start_meadow() -> None:
     for run in (0.0, 5e-324, 1e-12, RUN_TOLERANCE):
         command = TurnAndRun(0.2, run)

@@ -72,6 +72,23 @@ class HeadingWedge:
         return wedge
 
     @classmethod
+    def _restored(cls, center: float, cw: float, ccw: float) -> HeadingWedge:
+        """Rebuild a saved wedge, validated as the constructor does but with the centre kept bit for bit.
+
+        The centre must already be in (-pi, pi]: wrapping it again (the constructor does)
+        can move it by one unit in the last place, and a restored manager must go on
+        exactly as the saved one would have.
+        """
+        heading = finite_float(center, "HeadingWedge.center")
+        if not -math.pi < heading <= math.pi:
+            raise InputError(f"HeadingWedge.center: expected radians in (-pi, pi], got {heading!r}")
+        wedge = object.__new__(cls)
+        _set_center(wedge, heading)
+        _set_cw(wedge, nonnegative_float(cw, "HeadingWedge.cw"))
+        _set_ccw(wedge, nonnegative_float(ccw, "HeadingWedge.ccw"))
+        return wedge
+
+    @classmethod
     def full_circle(cls, center: float = 0.0) -> HeadingWedge:
         """Return the wedge of every heading, with the given most probable heading."""
         return cls(center, math.pi, math.pi)

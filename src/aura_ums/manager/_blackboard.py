@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import bisect
+import operator
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -55,8 +56,8 @@ class PositionReport:
             )
 
 
-def _report_time(report: PositionReport) -> float:
-    return report.time
+# The sort key of the reports: attrgetter runs in C, cheaper than a function per comparison.
+_report_time = operator.attrgetter("time")
 
 
 class Blackboard:
@@ -156,8 +157,35 @@ class Blackboard:
         """Time of the newest position report, seconds; None when there is none."""
         return self._reports[-1].time if self._reports else None
 
+    def report(self, index: int) -> PositionReport:
+        """Return the position report at ``index`` (0 is the oldest), without copying the others.
+
+        Raises
+        ------
+        InputError
+            For an index that is not an integer in ``[0, report_count)``.
+
+        Examples
+        --------
+        >>> board = Blackboard()
+        >>> board.post_report(PositionReport(1.0, TurnAndRun(0.1, 0.5)))
+        >>> board.report(0).time
+        1.0
+        >>> board.report(1)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: index: expected an integer in [0, 1), got 1
+        """
+        count = len(self._reports)
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < count:
+            raise InputError(f"index: expected an integer in [0, {count}), got {index!r}")
+        return self._reports[index]
+
     def reports_until(self, until: float, *, start: int = 0) -> tuple[PositionReport, ...]:
         """Return the reports from index ``start`` on whose time is ``<= until``, oldest first.
+
+        Only those reports are copied: the map manager takes the reports it has not yet
+        consumed (``start``) up to the time it updates to, at every update.
 
         Parameters
         ----------
@@ -169,15 +197,9 @@ class Blackboard:
         limit = finite_float(until, "until")
         if isinstance(start, bool) or not isinstance(start, int) or start < 0:
             raise InputError(f"start: expected a non-negative integer, got {start!r}")
-        stop = bisect.bisect_right(self._reports, limit, lo=min(start, len(self._reports)), key=_report_time)
-        return tuple(self._reports[start:stop])
-
-    def _report_stop(self, until: float, start: int) -> int:
-        """Index after the last report from ``start`` on with ``time <= until`` (arguments trusted).
-
-        :meth:`reports_until` without its checks and its copy, for the manager's update.
-        """
-        return bisect.bisect_right(self._reports, until, lo=start, key=_report_time)
+        reports = self._reports
+        stop = bisect.bisect_right(reports, limit, lo=min(start, len(reports)), key=_report_time)
+        return tuple(reports[start:stop])
 
     # --- command buffer ----------------------------------------------------------------
 

@@ -157,9 +157,10 @@ class Reader:
     def uncertainty_map(self, value: object, where: str) -> SpatialUncertaintyMap:
         """Decode a map written by :func:`encode_map`, bit for bit.
 
-        The values are validated by the public constructors; the exact saved numbers are
-        then kept even where a constructor would normalize them (re-wrapping a wedge
-        centre that is already in (-pi, pi] can move it by one unit in the last place).
+        The values are validated as the public constructors validate them, and the exact
+        saved numbers are kept where a constructor would normalize them: the polygon's
+        collinear vertices stay, and the wedge centre is not wrapped again (re-wrapping a
+        centre already in (-pi, pi] can move it by one unit in the last place).
         """
         data = self.mapping(value, where, ("vertices", "center", "wedge"))
         rows = self.array(data["vertices"], f"{where}.vertices")
@@ -174,13 +175,10 @@ class Reader:
             points.append((self.number(pair[0], f"{place}[0]"), self.number(pair[1], f"{place}[1]")))
         vertices = np.array(points, dtype=np.float64)
         try:
-            polygon = ConvexPolygon(vertices)
+            ConvexPolygon(vertices)  # validates; it would drop collinear vertices the map kept
         except InputError as exc:
             self.fail(f"{where}.vertices", str(exc))
-        if not np.array_equal(polygon.vertices, vertices):
-            exact = vertices.copy()
-            exact.setflags(write=False)
-            object.__setattr__(polygon, "vertices", exact)
+        polygon = ConvexPolygon._trusted(vertices)
         center_list = self.array(data["center"], f"{where}.center")
         if len(center_list) != 2:
             self.fail(f"{where}.center", f"expected [x, y], got {len(center_list)} numbers")
@@ -193,15 +191,13 @@ class Reader:
         if not -math.pi < heading <= math.pi:
             self.fail(f"{where}.wedge.center", f"expected a heading in (-pi, pi], got {heading!r}")
         try:
-            wedge = HeadingWedge(
+            wedge = HeadingWedge._restored(
                 heading,
                 self.number(wedge_data["cw"], f"{where}.wedge.cw"),
                 self.number(wedge_data["ccw"], f"{where}.wedge.ccw"),
             )
         except InputError as exc:
             self.fail(f"{where}.wedge", str(exc))
-        if wedge.center != heading:
-            object.__setattr__(wedge, "center", heading)
         try:
             return SpatialUncertaintyMap.from_polygon(polygon, center, wedge)
         except InputError as exc:

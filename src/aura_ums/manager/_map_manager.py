@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import enum
+import operator
 import types
 from collections import deque
 from collections.abc import Mapping, Sequence
@@ -33,6 +35,8 @@ from aura_ums.uncertainty import (
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
 _KIND = "aura-ums/uncertainty-map-manager"
+
+_report_time = operator.attrgetter("time")
 
 
 class ManagerState(enum.Enum):
@@ -70,29 +74,6 @@ class ObservationOutcome:
     wedge_width_before: float
     wedge_width_after: float
 
-    @classmethod
-    def _new(
-        cls,
-        observation: Observation,
-        accepted: bool,
-        reason: RejectReason | None,
-        area_before: float,
-        area_after: float,
-        wedge_width_before: float,
-        wedge_width_after: float,
-    ) -> ObservationOutcome:
-        # The slots' own setters: the frozen __init__'s object.__setattr__ per field costs
-        # about twice as much, and the manager records an outcome for every observation.
-        outcome = object.__new__(cls)
-        _set_observation(outcome, observation)
-        _set_accepted(outcome, accepted)
-        _set_reason(outcome, reason)
-        _set_area_before(outcome, area_before)
-        _set_area_after(outcome, area_after)
-        _set_width_before(outcome, wedge_width_before)
-        _set_width_after(outcome, wedge_width_after)
-        return outcome
-
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ManagerStep:
@@ -129,30 +110,6 @@ class ManagerStep:
     relocalized: bool = False
     envelope_map: SpatialUncertaintyMap | None = None
 
-    @classmethod
-    def _new(
-        cls,
-        time: float,
-        uncertainty_map: SpatialUncertaintyMap,
-        state: ManagerState,
-        lost_reason: str,
-        outcomes: tuple[ObservationOutcome, ...],
-        grown_reports: int,
-        relocalized: bool,
-        envelope_map: SpatialUncertaintyMap | None,
-    ) -> ManagerStep:
-        # As ObservationOutcome._new: one step per update.
-        step = object.__new__(cls)
-        _set_time(step, time)
-        _set_map(step, uncertainty_map)
-        _set_state(step, state)
-        _set_lost_reason(step, lost_reason)
-        _set_outcomes(step, outcomes)
-        _set_grown_reports(step, grown_reports)
-        _set_relocalized(step, relocalized)
-        _set_envelope_map(step, envelope_map)
-        return step
-
     @property
     def accepted(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that reduced the map."""
@@ -162,51 +119,6 @@ class ManagerStep:
     def rejected(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that were rejected, with their reasons."""
         return tuple(o for o in self.outcomes if not o.accepted)
-
-
-# Setters of the records' slots (frozen: the dataclasses' own __setattr__ refuses).
-(
-    _set_observation,
-    _set_accepted,
-    _set_reason,
-    _set_area_before,
-    _set_area_after,
-    _set_width_before,
-    _set_width_after,
-) = (
-    ObservationOutcome.__dict__[name].__set__
-    for name in (
-        "observation",
-        "accepted",
-        "reason",
-        "area_before",
-        "area_after",
-        "wedge_width_before",
-        "wedge_width_after",
-    )
-)
-(
-    _set_time,
-    _set_map,
-    _set_state,
-    _set_lost_reason,
-    _set_outcomes,
-    _set_grown_reports,
-    _set_relocalized,
-    _set_envelope_map,
-) = (
-    ManagerStep.__dict__[name].__set__
-    for name in (
-        "time",
-        "map",
-        "state",
-        "lost_reason",
-        "outcomes",
-        "grown_reports",
-        "relocalized",
-        "envelope_map",
-    )
-)
 
 
 class UncertaintyMapManager:
@@ -540,20 +452,26 @@ class UncertaintyMapManager:
         self._check_blackboard(blackboard)
 
         identified = blackboard.identified
-        pending = identified._peek_until(time)
-        current, index, map_time, outcomes = self._advance(blackboard, time, pending)
+        pending = identified.peek(time)
+        # The reports this update consumes (the envelope map has consumed as many).
+        reports = blackboard.reports_until(time, start=self._consumed)
+        index = self._consumed + len(reports)
+        outcomes: list[ObservationOutcome] = []
+        current, map_time = self._advance(reports, pending, outcomes)
         outer = self._envelope
         if outer is not None:
             twins = self._twins(pending, envelope)
-            wide, wide_index, wide_time, _ = outer._advance(blackboard, time, twins)
+            # The envelope's outcomes are never reported: not recording them saves a record
+            # (and a rejected map's area) per observation.
+            wide, wide_time = outer._advance(reports, twins, None)
 
         # Commit: nothing above changed the manager or the blackboard.
-        identified._discard(len(pending))  # exactly ``pending``: single-threaded by contract
-        grown = index - self._consumed
+        identified.drain(time)  # exactly ``pending``: single-threaded by contract
+        grown = len(reports)
         found = self._commit(current, index, map_time, outcomes)
         relocalized = False
         if outer is not None:
-            outer._commit(wide, wide_index, wide_time, [])
+            outer._commit(wide, index, wide_time, ())
             recent = self._recent
             for outcome in outcomes:
                 reason = outcome.reason
@@ -565,7 +483,7 @@ class UncertaintyMapManager:
                 recent.clear()
                 relocalized = True
         self._update_state(found, missed_in_a_row)
-        return ManagerStep._new(
+        return ManagerStep(
             time,
             self._map,
             self._state,
@@ -577,33 +495,36 @@ class UncertaintyMapManager:
         )
 
     def _advance(
-        self, blackboard: Blackboard, time: float, pending: Sequence[Observation]
-    ) -> tuple[SpatialUncertaintyMap, int, float | None, list[ObservationOutcome]]:
-        """Grow and reduce by ``pending`` up to ``time``, changing nothing; return what to commit."""
-        current, index, map_time = self._map, self._consumed, self._map_time
-        reports = blackboard._reports  # read in place (the manager's own subpackage): no copies
-        outcomes: list[ObservationOutcome] = []
+        self,
+        reports: Sequence[PositionReport],
+        pending: Sequence[Observation],
+        outcomes: list[ObservationOutcome] | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None]:
+        """Grow by ``reports`` and reduce by ``pending`` in time order, changing nothing.
+
+        Returns the map and its time, to commit. What became of each observation is
+        appended to ``outcomes`` (None: not recorded).
+        """
+        current, map_time = self._map, self._map_time
+        index = 0
         first = 0
         while first < len(pending):
             instant = pending[first].time
             last = first + 1
             while last < len(pending) and pending[last].time == instant:
                 last += 1
-            stop = blackboard._report_stop(instant, index)
+            stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
             current, map_time = self._grow(current, reports, index, stop, map_time)
             index = stop
             if last - first == 1:
                 observation = pending[first]
-                outcome, current = self._reduce(
-                    current, observation, self._landmark_for(observation, map_time)
+                current = self._reduce(
+                    current, observation, self._landmark_for(observation, map_time), outcomes
                 )
-                outcomes.append(outcome)
             else:
                 current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
             first = last
-        stop = blackboard._report_stop(time, index)
-        current, map_time = self._grow(current, reports, index, stop, map_time)
-        return current, stop, map_time, outcomes
+        return self._grow(current, reports, index, len(reports), map_time)
 
     def _commit(
         self,
@@ -711,7 +632,7 @@ class UncertaintyMapManager:
                 f"position reports (consumed so far), got {count}"
             )
         if self._consumed:
-            last = blackboard._reports[self._consumed - 1].time  # one report, not a copy of all
+            last = blackboard.report(self._consumed - 1).time
             if last != self._map_time:
                 raise InputError(
                     f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
@@ -781,7 +702,7 @@ class UncertaintyMapManager:
         current: SpatialUncertaintyMap,
         observations: Sequence[Observation],
         map_time: float | None,
-        outcomes: list[ObservationOutcome],
+        outcomes: list[ObservationOutcome] | None,
     ) -> SpatialUncertaintyMap:
         """Reduce by observations of one instant: jointly when the wedge is wide, else one by one."""
         # One map time for the instant: each observation's landmark (or rejection) holds for both ways.
@@ -798,15 +719,17 @@ class UncertaintyMapManager:
                 )
                 if joint.consistent:
                     reduced = joint.map
+                    if outcomes is None:
+                        return reduced
                     area, width = current.area, current.wedge.width
                     for observation, found in zip(observations, checked, strict=True):
                         if isinstance(found, RejectReason):
                             outcomes.append(
-                                ObservationOutcome._new(observation, False, found, area, area, width, width)
+                                ObservationOutcome(observation, False, found, area, area, width, width)
                             )
                         else:
                             outcomes.append(
-                                ObservationOutcome._new(
+                                ObservationOutcome(
                                     observation,
                                     True,
                                     None,
@@ -818,8 +741,7 @@ class UncertaintyMapManager:
                             )
                     return reduced
         for observation, found in zip(observations, checked, strict=True):
-            outcome, current = self._reduce(current, observation, found)
-            outcomes.append(outcome)
+            current = self._reduce(current, observation, found, outcomes)
         return current
 
     def _landmark_for(self, observation: Observation, map_time: float | None) -> Landmark | RejectReason:
@@ -835,8 +757,12 @@ class UncertaintyMapManager:
         return landmark
 
     def _reduce(
-        self, current: SpatialUncertaintyMap, observation: Observation, landmark: Landmark | RejectReason
-    ) -> tuple[ObservationOutcome, SpatialUncertaintyMap]:
+        self,
+        current: SpatialUncertaintyMap,
+        observation: Observation,
+        landmark: Landmark | RejectReason,
+        outcomes: list[ObservationOutcome] | None,
+    ) -> SpatialUncertaintyMap:
         """Reduce by one observation and its landmark (from :meth:`_landmark_for`, or why not)."""
         if isinstance(landmark, RejectReason):
             reason = landmark
@@ -845,16 +771,21 @@ class UncertaintyMapManager:
             found = current._reduce_checked(observation, landmark, self._max_vertices)
             if not isinstance(found, str):
                 reduced, area_before, area_after = found
-                width_before, width_after = current.wedge.width, reduced.wedge.width
-                outcome = ObservationOutcome._new(
-                    observation, True, None, area_before, area_after, width_before, width_after
-                )
-                return outcome, reduced
+                if outcomes is not None:
+                    width_before, width_after = current.wedge.width, reduced.wedge.width
+                    outcomes.append(
+                        ObservationOutcome(
+                            observation, True, None, area_before, area_after, width_before, width_after
+                        )
+                    )
+                return reduced
             # The reductions word their reasons; each is a RejectReason's value.
             reason = RejectReason(found)
-        # Rejected: the map stays, and so do its area and width.
-        area, width = current.area, current.wedge.width
-        return ObservationOutcome._new(observation, False, reason, area, area, width, width), current
+        if outcomes is not None:
+            # Rejected: the map stays, and so do its area and width.
+            area, width = current.area, current.wedge.width
+            outcomes.append(ObservationOutcome(observation, False, reason, area, area, width, width))
+        return current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:
         reasons: list[str] = []
