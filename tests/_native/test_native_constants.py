@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import pytest
-from native_helpers import built
 
 from aura_ums._native import EmptyReason
 from aura_ums._native import _growth as growth
 from aura_ums._native import _reduce as reduce
 from aura_ums.geometry import _convex as convex
+from tests._native.native_helpers import built
 
 #: Each constant the extension exports, with its Python twin.
 TWINS: dict[str, float] = {

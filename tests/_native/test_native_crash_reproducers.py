@@ -13,9 +13,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from native_helpers import native
 
-from conftest import SHARED_DATA
+from tests._native.native_helpers import native
+from tests.conftest import SHARED_DATA
 
 MRCLAM6 = SHARED_DATA / "mrclam6"
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from native_helpers import built, random_polygon, scale_of
 
 from aura_ums._native._distance import polygon_distance_compiled, polygon_distance_reference
+from tests._native.native_helpers import built, random_polygon, scale_of
 
 
 @built

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from native_helpers import built, random_polygon, random_wedge
 
 from aura_ums._native._expecter import ExpectedPoints, expecter_points_compiled, expecter_points_reference
 from aura_ums.camera import CameraMount
+from tests._native.native_helpers import built, random_polygon, random_wedge
 
 #: Boxes far from the image axis (points near the cut plane, divided by a tiny depth) come
 #: from different but equally sound roundings; within this many units they must agree.

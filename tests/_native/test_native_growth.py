@@ -9,17 +9,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from native_helpers import (
-    Array,
-    built,
-    contains,
-    kernels,
-    random_commands,
-    random_polygon,
-    random_terrain,
-    random_wedge,
-    scale_of,
-)
 
 from aura_ums import _native
 from aura_ums._native._growth import (
@@ -33,6 +22,17 @@ from aura_ums._native._growth import (
 from aura_ums.geometry import polygon_area
 from aura_ums.geometry._convex import convexity_defect
 from aura_ums.uncertainty import TerrainStats
+from tests._native.native_helpers import (
+    Array,
+    built,
+    contains,
+    kernels,
+    random_commands,
+    random_polygon,
+    random_terrain,
+    random_wedge,
+    scale_of,
+)
 
 #: The implementations to hold to the cap: the reference always, the kernel when built.
 IMPLEMENTATIONS: list[Callable[..., Grown]] = [grow_commands_reference] + (

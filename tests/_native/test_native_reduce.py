@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from native_helpers import Array, built, contains, kernels, random_polygon, random_wedge, scale_of
 
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
@@ -22,6 +21,15 @@ from aura_ums._native._reduce import (
 )
 from aura_ums.geometry import convex_hull, polygon_area
 from aura_ums.geometry._convex import convexity_defect
+from tests._native.native_helpers import (
+    Array,
+    built,
+    contains,
+    kernels,
+    random_polygon,
+    random_wedge,
+    scale_of,
+)
 
 Result = RawReduction | int
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import SHARED_DATA
+from tests.conftest import SHARED_DATA
 
 MRCLAM6 = SHARED_DATA / "mrclam6"
 

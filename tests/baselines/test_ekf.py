@@ -7,12 +7,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from baselines_helpers import (
-    START_HEADING_SD,
-    START_POSITION_SD,
-    run_drive,
-    simulate_drive,
-)
 from filterpy.kalman import ExtendedKalmanFilter as FilterpyEkf
 from numpy.typing import NDArray
 
@@ -27,6 +21,12 @@ from aura_ums.uncertainty import (
     TerrainStats,
     TerrainTable,
     TurnAndRun,
+)
+from tests.baselines.baselines_helpers import (
+    START_HEADING_SD,
+    START_POSITION_SD,
+    run_drive,
+    simulate_drive,
 )
 
 Array = NDArray[np.float64]

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from baselines_helpers import START_HEADING_SD, START_POSITION_SD, run_drive, simulate_drive
 
 from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.baselines._particle import systematic_resample
@@ -20,6 +19,7 @@ from aura_ums.uncertainty import (
     TerrainTable,
     TurnAndRun,
 )
+from tests.baselines.baselines_helpers import START_HEADING_SD, START_POSITION_SD, run_drive, simulate_drive
 
 SDS = {"position_sd": 0.3, "heading_sd": 0.03, "bearing_sd": 0.02, "range_sd": 0.2}
 

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from expecter_helpers import CAMERAS, random_landmark, random_map, visible_pixels
 
 from aura_ums.errors import InputError
 from aura_ums.expecter import (
@@ -18,6 +17,7 @@ from aura_ums.expecter import (
 )
 from aura_ums.expecter._scenario import figure4_scenario
 from aura_ums.uncertainty import PointLandmark, Pose
+from tests.expecter.expecter_helpers import CAMERAS, random_landmark, random_map, visible_pixels
 
 
 def test_disk_model_encloses_the_polygon(rng: np.random.Generator) -> None:

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from expecter_helpers import CAMERAS, extreme_poses, landmark_points, visible_pixels
 
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
@@ -21,6 +20,7 @@ from aura_ums.uncertainty import (
     SpatialUncertaintyMap,
     VerticalLineLandmark,
 )
+from tests.expecter.expecter_helpers import CAMERAS, extreme_poses, landmark_points, visible_pixels
 
 CAMERA = CAMERAS["tilted_panned_offset"]
 STRIP = ConvexPolygon([(-2.0, -0.3), (2.0, -0.3), (2.0, 0.3), (-2.0, 0.3)])

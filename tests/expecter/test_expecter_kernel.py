@@ -10,14 +10,6 @@ from typing import TypeVar
 
 import numpy as np
 import pytest
-from expecter_helpers import (
-    CAMERAS,
-    extreme_poses,
-    landmark_points,
-    random_landmark,
-    random_map,
-    visible_pixels,
-)
 
 from aura_ums import _native
 from aura_ums._native import _expecter as native_expecter
@@ -29,6 +21,14 @@ from aura_ums.uncertainty import (
     PointLandmark,
     SpatialUncertaintyMap,
     VerticalLineLandmark,
+)
+from tests.expecter.expecter_helpers import (
+    CAMERAS,
+    extreme_poses,
+    landmark_points,
+    random_landmark,
+    random_map,
+    visible_pixels,
 )
 
 T = TypeVar("T")

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from expecter_helpers import (
+
+from aura_ums.expecter import Expecter
+from tests.expecter.expecter_helpers import (
     CAMERAS,
     extreme_poses,
     landmark_points,
@@ -16,8 +18,6 @@ from expecter_helpers import (
     random_map,
     visible_pixels,
 )
-
-from aura_ums.expecter import Expecter
 
 POSES_PER_MAP = 1000
 MAPS_PER_CAMERA = 4

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from expecter_helpers import (
+
+from aura_ums.expecter import Expecter
+from tests.expecter.expecter_helpers import (
     CAMERAS,
     extreme_poses,
     landmark_points,
@@ -18,8 +20,6 @@ from expecter_helpers import (
     random_map,
     visible_pixels,
 )
-
-from aura_ums.expecter import Expecter
 
 MAPS = 12
 SAMPLED_POSES = 5000

@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from export_helpers import Message, decode, descriptors, points_xy, read_messages
 
 from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
 from aura_ums.export import mcap_channels, write_replay_mcap, write_simulation_mcap
@@ -19,6 +18,7 @@ from aura_ums.geometry import ImageWindow
 from aura_ums.manager import ManagerState
 from aura_ums.sim import RunResult, Scenario, run_scenario
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TurnAndRun
+from tests.export.export_helpers import Message, decode, descriptors, points_xy, read_messages
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 

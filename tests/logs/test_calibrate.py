@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from log_helpers import MRCLAM6
 
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
@@ -19,6 +18,7 @@ from aura_ums.logs import (
     synthetic_log,
 )
 from aura_ums.uncertainty import TerrainTable
+from tests.logs.log_helpers import MRCLAM6
 
 MRCLAM = MRCLAM6
 

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from log_helpers import VALID_FILES, assert_same_log, small_log, write_files
 
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
@@ -26,6 +25,7 @@ from aura_ums.logs import (
 )
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import FOOT, TurnAndRun
+from tests.logs.log_helpers import VALID_FILES, assert_same_log, small_log, write_files
 
 # --- round trips ----------------------------------------------------------------------------
 

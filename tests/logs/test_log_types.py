@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from log_helpers import small_log
 
 from aura_ums.errors import InputError
 from aura_ums.logs import (
@@ -24,6 +23,7 @@ from aura_ums.logs import (
 )
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import TurnAndRun
+from tests.logs.log_helpers import small_log
 
 
 @pytest.mark.parametrize(

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from log_helpers import MRCLAM6, assert_same_log
 
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import ObservationKind, RobotLog, import_mrclam, load_log, read_mrclam
+from tests.logs.log_helpers import MRCLAM6, assert_same_log
 
 HEADER = "# UTIAS MRCLAM Dataset (made up)\n# produced by nobody\n# format\n# columns\n"
 TINY = {

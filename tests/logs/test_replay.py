@@ -6,7 +6,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-from log_helpers import MRCLAM6
 
 from aura_ums.errors import InputError
 from aura_ums.logs import (
@@ -28,6 +27,7 @@ from aura_ums.uncertainty import (
     RangeBearingObservation,
     TerrainTable,
 )
+from tests.logs.log_helpers import MRCLAM6
 
 MRCLAM = MRCLAM6
 FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from schema_scenes import CAMERA, map_around, pole_record
 
 from aura_ums.camera import CalibrationBounds
 from aura_ums.errors import InputError
@@ -16,6 +15,7 @@ from aura_ums.perception import FastLineFinder, LineSegments, MoravecOperator, R
 from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaStatus
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, Pose, VerticalLineLandmark
 from aura_ums.world import LandmarkRecord
+from tests.schemas.schema_scenes import CAMERA, map_around, pole_record
 
 EXPECTER = Expecter(CAMERA)
 POLE = VerticalLineLandmark("pole", 10.0, 0.0, 0.0, 4.0)

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from schema_scenes import CAMERA
 
 from aura_ums.camera import CalibrationBounds, Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
@@ -16,6 +15,7 @@ from aura_ums.perception import FastLineFinder, MoravecOperator
 from aura_ums.schemas import FindLandmarkSchema, Frame, Pilot, SchemaManager, SchemaState
 from aura_ums.uncertainty import LandmarkClass, Pose, SpatialUncertaintyMap
 from aura_ums.world import ShortTermMemory, plan_route, sample_world
+from tests.schemas.schema_scenes import CAMERA
 
 
 @pytest.fixture(scope="module")

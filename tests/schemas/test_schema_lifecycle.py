@@ -7,16 +7,6 @@ import math
 import numpy as np
 import pytest
 from numpy.typing import NDArray
-from schema_scenes import (
-    CAMERA,
-    assert_sound,
-    corner_image,
-    ground_edge_image,
-    map_around,
-    pole_column,
-    pole_image,
-    pole_record,
-)
 
 from aura_ums.expecter import Expecter, PerceptualStrategy
 from aura_ums.perception import FastLineFinder
@@ -30,6 +20,16 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord
+from tests.schemas.schema_scenes import (
+    CAMERA,
+    assert_sound,
+    corner_image,
+    ground_edge_image,
+    map_around,
+    pole_column,
+    pole_image,
+    pole_record,
+)
 
 EXPECTER = Expecter(CAMERA)
 TRUTH = Pose(0.0, 0.0, 0.0)

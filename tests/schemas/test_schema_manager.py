@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from schema_scenes import CAMERA, assert_sound, map_around, pole_image, pole_record
 
 from aura_ums.errors import InputError
 from aura_ums.expecter import Expecter
@@ -15,6 +14,7 @@ from aura_ums.manager import IdentifiedLandmarkBuffer
 from aura_ums.perception import FastLineFinder, LineSegments
 from aura_ums.schemas import FindLandmarkSchema, Frame, SchemaManager, SchemaState, StepReport
 from aura_ums.uncertainty import Pose, VerticalLineLandmark
+from tests.schemas.schema_scenes import CAMERA, assert_sound, map_around, pole_image, pole_record
 
 EXPECTER = Expecter(CAMERA)
 TRUTH = Pose(0.0, 0.0, 0.0)

@@ -9,7 +9,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
-from test_reduce import map_inside, wedge_inside
 
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
@@ -25,6 +24,7 @@ from aura_ums.uncertainty import (
     reduce_jointly,
 )
 from aura_ums.uncertainty._joint import JOINT_INCONSISTENT
+from tests.uncertainty.test_reduce import map_inside, wedge_inside
 
 Array = NDArray[np.float64]
 Sighting = tuple[Observation, Landmark]

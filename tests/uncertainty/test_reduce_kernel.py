@@ -11,17 +11,6 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from numpy.typing import NDArray
-from test_reduce import (
-    Case,
-    MakeCase,
-    class_one_cases,
-    class_three_cases,
-    class_two_cases,
-    map_inside,
-    observations,
-    priors,
-    random_prior,
-)
 
 from aura_ums import _native
 from aura_ums._native import _reduce as native_reduce
@@ -42,6 +31,17 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.uncertainty._reduce import reduce_map
+from tests.uncertainty.test_reduce import (
+    Case,
+    MakeCase,
+    class_one_cases,
+    class_three_cases,
+    class_two_cases,
+    map_inside,
+    observations,
+    priors,
+    random_prior,
+)
 
 Array = NDArray[np.float64]
 T = TypeVar("T")
