@@ -426,7 +426,7 @@ def simplify_outer(vertices: Array, max_vertices: int) -> Array:
     An edge whose neighbours would meet more than 10 extents of the polygon away, or
     whose neighbours are too short for their directions to be reliable, is never
     removed. When no edge can go and there are still too many, the support polygon
-    (:func:`_support_polygon`) of ``max(max_vertices, 3)`` directions replaces the
+    (``_support_polygon``) of ``max(max_vertices, 3)`` directions replaces the
     polygon: coarser, but the cap always holds.
 
     Examples
