@@ -220,6 +220,37 @@ def test_joint_map_lies_inside_the_prior_with_its_centre(seed: int, sector: floa
     assert joint.map.polygon.vertex_count <= max(64, prior.polygon.vertex_count)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(3, 8), st.floats(math.radians(1.0), math.radians(6.0)))
+def test_the_joint_hull_is_capped_and_keeps_every_true_pose(seed: int, cap: int, sector: float) -> None:
+    # Many narrow sectors and several observations: the sectors' hull runs past a small cap.
+    rng = np.random.default_rng(seed)
+    prior = wide_prior(rng)
+    sightings_count = int(rng.integers(2, 6))
+    for values in prior.sample_poses(4, rng):
+        pose = Pose(*values.tolist())
+        sightings = sightings_of(rng, prior, pose, sightings_count)
+        joint = reduce_jointly(prior, sightings, sector=sector, max_vertices=cap)
+        assert joint.consistent
+        assert joint.map.contains(pose), (prior, sightings, cap)
+        assert joint.map.polygon.vertex_count <= max(cap, prior.polygon.vertex_count)
+        assert map_inside(joint.map, prior)
+
+
+def test_the_cap_test_drives_the_joint_hull_past_the_cap() -> None:
+    # The property above bites only if the uncapped joint polygon is often past the cap.
+    rng = np.random.default_rng(17)
+    past = 0
+    for _ in range(40):
+        prior = wide_prior(rng)
+        cap = int(rng.integers(3, 9))
+        pose = Pose(*prior.sample_poses(1, rng)[0].tolist())
+        sightings = sightings_of(rng, prior, pose, int(rng.integers(2, 6)))
+        uncapped = reduce_jointly(prior, sightings, sector=math.radians(3.0), max_vertices=10**6)
+        past += uncapped.map.polygon.vertex_count > max(cap, prior.polygon.vertex_count)
+    assert past >= 10
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [

@@ -10,7 +10,10 @@ sectors keep, with the smallest wedge (inside the prior's) that holds their head
 
 Soundness follows from the single reductions': a true pose's heading lies in some
 sector, whose reductions keep the pose; the hull and the covering wedge only add. Every
-sector's result lies inside the prior, so their hull does too.
+sector's result lies inside the prior, so their hull does too. The hull may have more
+vertices than the cap; it is then replaced by an outer polygon inside the prior with at
+most ``max(max_vertices, prior's count)`` vertices, or by the prior itself, as a single
+reduction's result is: both only add.
 """
 
 from __future__ import annotations
@@ -179,8 +182,14 @@ def _combined(
     cap: int,
 ) -> Reduction:
     """One map holding every sector's result: their hull, and one wedge over their headings."""
-    hull = convex_hull(np.concatenate([m.polygon.vertices for _, m in kept]))
-    polygon = ConvexPolygon._trusted(cap_inside(hull, prior.polygon.vertices, cap))
+    outline = convex_hull(np.concatenate([m.polygon.vertices for _, m in kept]))
+    if len(outline) > cap:
+        # As a single reduction's tail does: an outer polygon inside the prior, or, when
+        # the hull hugs the prior too closely for that, the prior itself, which holds it.
+        outline = cap_inside(outline, prior.polygon.vertices, cap)
+        if len(outline) > max(cap, len(prior.polygon.vertices)):
+            outline = prior.polygon.vertices
+    polygon = ConvexPolygon._trusted(outline)
     # Each result's headings as an interval unwrapped next to its sector, in sector order.
     spans = []
     for start, result in kept:
