@@ -34,7 +34,6 @@ from aura_ums.geometry import (
     outer_arc,
     outer_disk,
     points_in_convex,
-    polygon_area,
     subtended_arc,
 )
 
@@ -142,7 +141,8 @@ def clip_halfplanes(vertices: Array, normals: Array, offsets: Array) -> Array:
     too), so the cost is one matrix product plus the clips that cut.
     Returns an empty ``(0, 2)`` array when nothing is left.
     """
-    signed = vertices @ normals.T - offsets
+    # Not vertices @ normals.T: BLAS may fuse the multiply and the add, the C does not.
+    signed = vertices[:, 0, None] * normals[None, :, 0] + vertices[:, 1, None] * normals[None, :, 1] - offsets
     if (signed.min(axis=0) > 0.0).any():
         return np.empty((0, 2))
     for j in np.flatnonzero(signed.max(axis=0) > 0.0).tolist():
@@ -160,10 +160,13 @@ def clip_convex(vertices: Array, other: Array, margin: float = TOLERANCE) -> Arr
     while one with a rounding-noise normal could cut into the true intersection.
     """
     edge = np.roll(other, -1, axis=0) - other
-    length = np.hypot(edge[:, 0], edge[:, 1])
+    # libm's hypot, as reduce.c: numpy's own may differ by an ulp.
+    length = np.array([math.hypot(x, y) for x, y in edge.tolist()])
     keep = length > 1e-9 * max(1.0, float(np.abs(other).max()))
     outward = np.column_stack([edge[keep, 1], -edge[keep, 0]]) / length[keep, None]
-    return clip_halfplanes(vertices, outward, np.einsum("ij,ij->i", outward, other[keep]) + margin)
+    start = other[keep]
+    offsets = outward[:, 0] * start[:, 0] + outward[:, 1] * start[:, 1] + margin
+    return clip_halfplanes(vertices, outward, offsets)
 
 
 def sector_halfplanes(
@@ -191,7 +194,8 @@ def sector_halfplanes(
             normals.append((math.cos(angle), math.sin(angle)))
             reach.append(r_max)
     normal_array = np.asarray(normals, dtype=np.float64)
-    offsets = normal_array @ apex + np.asarray(reach) + (widen + TOLERANCE)
+    along = normal_array[:, 0] * apex[0] + normal_array[:, 1] * apex[1]
+    offsets = along + np.asarray(reach) + (widen + TOLERANCE)
     return normal_array, offsets
 
 
@@ -314,6 +318,20 @@ def _bearing_headings(sensors: Array, landmark: Array, widen: float, bearing: fl
     return widen_arc((lo + math.pi - bearing, width), error + TOLERANCE)
 
 
+def _summed_area(vertices: Array) -> float:
+    """Return :func:`~aura_ums.geometry.polygon_area` summed in order, as ``polygon.c`` sums it (m^2).
+
+    ``polygon_area``'s np.dot adds in BLAS's order; the kernels' areas follow the C's.
+    """
+    if len(vertices) < 3:
+        return 0.0
+    x = vertices[:, 0] - vertices[0, 0]
+    y = vertices[:, 1] - vertices[0, 1]
+    xy = np.cumsum(x * np.roll(y, -1))[-1]
+    yx = np.cumsum(y * np.roll(x, -1))[-1]
+    return float(0.5 * (xy - yx))
+
+
 def _finish(positions: Array, prior: Array, center: Array, headings: Arc, max_vertices: int) -> RawReduction:
     """Apply the vertex cap, keep the centre (or move it to the nearest position) and measure both areas.
 
@@ -327,7 +345,7 @@ def _finish(positions: Array, prior: Array, center: Array, headings: Arc, max_ve
     _, nearest = nearest_on_polygon(positions, center)
     x, y = nearest.tolist()
     raw = np.ascontiguousarray(positions, dtype=np.float64).tobytes()
-    return (raw, headings[0], headings[1], x, y, polygon_area(prior), polygon_area(positions))
+    return (raw, headings[0], headings[1], x, y, _summed_area(prior), _summed_area(positions))
 
 
 def reduce_cone_reference(
@@ -490,7 +508,7 @@ def reduce_strip_reference(
     if headings is None:
         return EmptyReason.NO_LINE_HEADING
     normal = np.array([-math.sin(direction), math.cos(direction)])
-    base = float(normal @ np.array([start_x, start_y]))
+    base = float(normal[0] * start_x + normal[1] * start_y)
     margin = offset_error + position_uncertainty
     lo = base + offset - margin
     hi = base + offset + margin

@@ -160,7 +160,8 @@ def subtended_arc(vertices: NDArray[np.float64], point: NDArray[np.float64], rad
     relative = vertices - point
     # The polygon does not hold the point, so its directions span less than pi and
     # unwrap without ambiguity around the direction of any one of its vertices.
-    angles = np.arctan2(relative[:, 1], relative[:, 0])
+    # libm's atan2, as the compiled kernels: numpy's own (SIMD) arctan2 may differ by an ulp.
+    angles = np.array([math.atan2(y, x) for x, y in relative.tolist()])
     reference = float(angles[0])
     angles = (angles - (reference - math.pi)) % TWO_PI - math.pi
     # Every point within radius of a polygon point p lies within asin(radius/|p|) of
