@@ -138,7 +138,7 @@ def clip_halfplanes(vertices: Array, normals: Array, offsets: Array) -> Array:
     """Return the part of a convex polygon where ``normals[i] . p <= offsets[i]`` for all i.
 
     Half-planes that hold the whole polygon are skipped (they hold every part of it
-    too), so the cost is one matrix product plus the clips that cut.
+    too), so the cost is one elementwise projection plus the clips that cut.
     Returns an empty ``(0, 2)`` array when nothing is left.
     """
     # Not vertices @ normals.T: BLAS may fuse the multiply and the add, the C does not.
