@@ -127,8 +127,9 @@ def reduce_jointly(
     kept: list[tuple[float, SpatialUncertaintyMap]] = []
     for k in range(count):
         start = lo + k * step
+        # start is finite and half > 0: the checks of HeadingWedge() would all pass.
         restricted = SpatialUncertaintyMap._trusted(
-            prior.polygon, prior.center, HeadingWedge(start + 0.5 * step, half, half)
+            prior.polygon, prior.center, HeadingWedge._trusted(start + 0.5 * step, half, half)
         )
         found = _in_turn(restricted, pairs, cap)
         if not isinstance(found, str):
