@@ -15,13 +15,16 @@ from aura_ums._metrics import Metrics
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_window
 from aura_ums.plot._draw import draw_map
 from aura_ums.schemas import FindLandmarkSchema
-from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
-from aura_ums.uncertainty import GroundLineLandmark
+from aura_ums.sim import FrameRecord, RunResult, Scenario, run_scenario, summarize_runs
+from aura_ums.uncertainty import FOOT, GroundLineLandmark, PointLandmark
 
 #: Scenario files of the report, relative to the scenarios folder.
 PAPER = "paper_sidewalk.toml"
 PAPER_CLASS2 = "paper_sidewalk_class2.toml"
 OTHERS = ("indoor_corridor.toml", "four_terrains.toml")
+#: Pixels a correct detection may lie beyond the image of its landmark's uncertainty disk
+#: (pixel noise, the detector's localization): farther, the identification is counted wrong.
+_WRONG_PIXELS = 5.0
 _COLORS = ("tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:cyan", "tab:olive")
 
 
@@ -103,6 +106,19 @@ def _table_markdown(rows: list[TableRow]) -> list[str]:
     return lines
 
 
+def _scenario_lines(scenario: Scenario, rows: list[TableRow], seed: int) -> list[str]:
+    """The experiment's set-up, read from the scenario and the run's table."""
+    feet = ", ".join(f"{r.distance_ft:.0f}" for r in rows)
+    used = ", ".join(f"{r.symbol} (Class {r.landmark_class.value})" for r in scenario.landmarks)
+    confirm = sorted({r.confirm_frames for r in scenario.landmarks})
+    frames = " or ".join(str(n) for n in confirm)
+    return [
+        f"Scenario `{scenario.name}`: start known to ±{scenario.start.position_radius / FOOT:.3g} ft, "
+        f"images at {feet} ft; landmarks {used}, each identified from {frames} frame(s) "
+        f"(`confirm_frames`). Seed {seed}.",
+    ]
+
+
 def figure12(path: Path, scenario: Scenario, result: RunResult) -> Path:
     """Draw the maps before (left) and after (right) pruning at each position, with the true pose."""
     n = len(result.records)
@@ -118,10 +134,11 @@ def figure12(path: Path, scenario: Scenario, result: RunResult) -> Path:
             ax.set_xlim(cx - 1.5, cx + 1.5)
             ax.set_ylim(cy - 1.0, cy + 1.0)
             ax.set_aspect("equal")
+            by = f" ({', '.join(record.posted) or 'nothing recognized'})" if col else ""
             ax.set_title(
-                f"({chr(97 + 2 * row + col)}) position {row + 1} {title}: "
+                f"({chr(97 + 2 * row + col)}) position {row + 1} {title}{by}: "
                 f"{m.area:.3f} m², {math.degrees(m.wedge.width):.1f}°",
-                fontsize=8,
+                fontsize=7,
             )
             ax.tick_params(labelsize=7)
     figure.suptitle(f"{scenario.name}: spatial uncertainty map before and after pruning", fontsize=10)
@@ -247,6 +264,7 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
     class2 = Scenario.from_toml(base / PAPER_CLASS2)
     result2 = run_scenario(class2, np.random.default_rng(seed), keep_images=True)
     f12b = figure12(figures / "figure12_maps_class2.png", class2, result2)
+    rows, rows2 = experiment_table(paper, result), experiment_table(class2, result2)
     lines = [
         "",
         "## The localization experiment in the closed loop (Figures 12-14)",
@@ -254,8 +272,7 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
         "Each frame: the robot executes its command (position report), the camera renders the image,",
         "the manager grows the map, the pilot's find-landmark schemas search the Expecter's windows,",
         "post identifications, and the manager prunes the map (`aura_ums.sim.run_scenario`).",
-        f"Scenario `{paper.name}`: start known to ±1 ft, images at 0, 10, 20, 40 ft; the telephone pole,",
-        f"the lamppost and the building's corner edge as Class I landmarks. Seed {seed}.",
+        *_scenario_lines(paper, rows, seed),
         "",
         f"![Figure 12]({f12.relative_to(folder)})",
         "",
@@ -263,7 +280,9 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
         "",
         f"![Figure 14]({f14.relative_to(folder)})",
         "",
-        *_table_markdown(experiment_table(paper, result)),
+        *_table_markdown(rows),
+        "",
+        *position_sentences(rows),
         "",
         "Window areas are summed over the landmarks predicted in the frame, both computed on the",
         "map before pruning (the disk model: the smallest disk around the polygon).",
@@ -272,29 +291,31 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
         "",
         f"![Figure 12, Class II]({f12b.relative_to(folder)})",
         "",
-        *_table_markdown(experiment_table(class2, result2)),
+        *_table_markdown(rows2),
+        "",
+        *position_sentences(rows2),
         "",
     ]
-    mc = []
-    generators = np.random.default_rng(seed + 1).spawn(runs)
-    for name, scenario, prune in (
+    variants = (
         ("paper, pruning", paper, True),
         ("paper, growth only", paper, False),
         ("class II corner, pruning", class2, True),
-    ):
+    )
+    generators = np.random.default_rng(seed + 1).spawn(runs)
+    mc: list[tuple[str, Metrics]] = []
+    per_position: list[tuple[str, list[PositionCounts]]] = []
+    for name, scenario, prune in variants:
         results = [run_scenario(scenario, g, prune=prune) for g in generators]
         mc.append((name, summarize_runs(results)))
-    changes = _class2_changes(mc[0][1], mc[2][1])
-    lines.extend([*changes, "", f"### Monte Carlo ({runs} seeded runs each)", ""])
-    keys = list(mc[0][1])
-    lines.append("| metric | " + " | ".join(name for name, _ in mc) + " |")
-    lines.append("| --- | " + " | ".join("---" for _ in mc) + " |")
-    for key in keys:
-        cells = []
-        for _, metrics in mc:
-            cells.append(_cell(metrics[key]))
-        lines.append(f"| {key} | " + " | ".join(cells) + " |")
-    lines.extend(["", "### Other worlds (one seeded run each)", ""])
+        if prune:
+            per_position.append((name, position_counts(scenario, results)))
+    lines.extend([f"### Monte Carlo ({runs} seeded runs each)", ""])
+    lines.extend(monte_carlo_markdown(mc))
+    lines.append("")
+    for name, counts in per_position:
+        lines.extend([*position_counts_markdown(name, counts), "", *position_counts_sentences(counts), ""])
+    lines.extend([*class2_paragraph(mc[0][1], mc[2][1]), ""])
+    lines.extend(["### Other worlds (one seeded run each)", ""])
     for file in OTHERS:
         scenario = Scenario.from_toml(base / file)
         other = run_scenario(scenario, np.random.default_rng(seed), keep_images=True)
@@ -333,19 +354,230 @@ def _slice(result: RunResult, index: int) -> RunResult:
     )
 
 
-def _class2_changes(class1: Metrics, class2: Metrics) -> list[str]:
-    area1, area2 = class1.number("median_area_m2"), class2.number("median_area_m2")
-    wedge1, wedge2 = class1.number("median_wedge_width_rad"), class2.number("median_wedge_width_rad")
+def _positions(indices: list[int]) -> str:
+    """``[1, 2, 4]`` -> ``"positions 1, 2 and 4"``; ``[3]`` -> ``"position 3"``."""
+    names = [str(i) for i in indices]
+    if len(names) == 1:
+        return f"position {names[0]}"
+    return f"positions {', '.join(names[:-1])} and {names[-1]}"
+
+
+def _change(what: str, before: str, after: str, *, down: str, up: str) -> str:
+    """A comparison of two figures as the tables show them: equal shown values "stay"."""
+    if float(after.replace(",", "")) == float(before.replace(",", "")):
+        return f"{what} stays at {after}"
+    verb = down if float(after.replace(",", "")) < float(before.replace(",", "")) else up
+    return f"{what} {verb} from {before} to {after}"
+
+
+def position_sentences(rows: list[TableRow]) -> list[str]:
+    """Say, from a run's table (its shown values), where landmarks pruned the map and where the truth stayed.
+
+    Every claim is decided on the numbers as :func:`_table_markdown` prints them, so no
+    sentence can contradict the table above it.
+
+    Examples
+    --------
+    >>> row = TableRow(0, 0.0, 0.3, 0.3, 6.0, 3.5, 100.0, 120.0, ("pole",), True)
+    >>> print(" ".join(position_sentences([row, TableRow(1, 10.0, 0.7, 0.7, 6.5, 6.5, 90.0, 99.0, (), False)])))
+    Landmarks were recognized at position 1 and at no other. The heading wedge narrowed at position 1; the area shrank at no position. The true pose was inside the map after position 1 and outside it after position 2.
+    >>> position_sentences([])
+    []
+    """
+    if not rows:
+        return []
+    recognized = [r.index + 1 for r in rows if r.recognized]
+    narrowed = [r.index + 1 for r in rows if f"{r.wedge_after_deg:.2f}" != f"{r.wedge_before_deg:.2f}"]
+    shrank = [r.index + 1 for r in rows if f"{r.area_after:.3f}" != f"{r.area_before:.3f}"]
+    inside = [r.index + 1 for r in rows if r.inside]
+    outside = [r.index + 1 for r in rows if not r.inside]
+    if len(recognized) == len(rows):
+        seen = f"Landmarks were recognized at every position ({_positions(recognized)})."
+    elif recognized:
+        seen = f"Landmarks were recognized at {_positions(recognized)} and at no other."
+    else:
+        seen = "No landmark was recognized at any position."
+    wedge = f"at {_positions(narrowed)}" if narrowed else "at no position"
+    area = f"at {_positions(shrank)}" if shrank else "at no position"
+    if not outside:
+        truth = "The true pose was inside the map after every position."
+    elif not inside:
+        truth = "The true pose was outside the map after every position."
+    else:
+        truth = (
+            f"The true pose was inside the map after {_positions(inside)} "
+            f"and outside it after {_positions(outside)}."
+        )
+    return [seen, f"The heading wedge narrowed {wedge}; the area shrank {area}.", truth]
+
+
+@dataclass(frozen=True, slots=True)
+class PositionCounts:
+    """Over a Monte Carlo, per position (frame index) of the route: how often what happened."""
+
+    index: int
+    runs: int
+    pruned: int
+    inside: int
+    identifications: int
+    wrong: int
+
+
+def misidentified(scenario: Scenario, record: FrameRecord) -> tuple[str, ...]:
+    """Ids of the frame's posted identifications whose detection is not where the landmark truly is.
+
+    A detection of a Class I or II landmark lies within the image of its position
+    uncertainty disk, seen from the true pose, up to ``_WRONG_PIXELS`` of pixel error; one
+    farther away identified something else (another corner of a building, clutter).
+    Class III identifications are not judged.
+    """
+    camera = scenario.camera
+    wrong = []
+    detections = dict(record.detections)
+    for ident in record.posted:
+        landmark = scenario.meadow_map.landmark(ident).landmark
+        if ident not in detections or isinstance(landmark, GroundLineLandmark):
+            continue
+        u1, v1, u2, v2 = detections[ident]
+        z = landmark.z if isinstance(landmark, PointLandmark) else 0.5 * (landmark.z_bottom + landmark.z_top)
+        pose = record.true_pose
+        distance = max(math.hypot(landmark.x - pose.x, landmark.y - pose.y), 1e-3)
+        u, v = camera.project(pose, [(landmark.x, landmark.y, z)])[0]
+        tolerance = camera.intrinsics.fx * landmark.position_uncertainty / distance + _WRONG_PIXELS
+        off = abs(0.5 * (u1 + u2) - u)
+        if isinstance(landmark, PointLandmark):
+            off = max(off, abs(0.5 * (v1 + v2) - v))
+        if not off <= tolerance:  # NaN (behind the camera) is wrong too
+            wrong.append(ident)
+    return tuple(wrong)
+
+
+def position_counts(scenario: Scenario, results: list[RunResult]) -> list[PositionCounts]:
+    """Count, per position of the route, the runs that pruned there, kept the truth, misidentified."""
+    positions = max((len(r.records) for r in results), default=0)
+    counts = []
+    for index in range(positions):
+        records = [r.records[index] for r in results if len(r.records) > index]
+        counts.append(
+            PositionCounts(
+                index,
+                len(records),
+                sum(r.accepted > 0 for r in records),
+                sum(r.inside for r in records),
+                sum(len(r.posted) for r in records),
+                sum(len(misidentified(scenario, r)) for r in records),
+            )
+        )
+    return counts
+
+
+def position_counts_markdown(name: str, counts: list[PositionCounts]) -> list[str]:
+    """The per-position table of a Monte Carlo variant."""
+    lines = [
+        f"| {name}: position | runs | runs pruned here | true pose inside | identifications | wrong ones |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for c in counts:
+        lines.append(f"| {c.index + 1} | {c.runs} | {c.pruned} | {c.inside} | {c.identifications} | {c.wrong} |")
+    return lines
+
+
+def position_counts_sentences(counts: list[PositionCounts]) -> list[str]:
+    """Say, from the per-position counts, where the map was pruned and where the truth was lost.
+
+    Examples
+    --------
+    >>> a = PositionCounts(0, 10, 10, 10, 12, 0)
+    >>> b = PositionCounts(1, 10, 6, 9, 7, 1)
+    >>> print(" ".join(position_counts_sentences([a, b])))
+    The map was pruned at every position in some run: at position 1 in 10 of 10 runs, at position 2 in 6 of 10. The true pose stayed inside at position 1 in every run; at position 2 it was outside in 1 of 10 runs, with 1 of 7 identifications there wrong (detected away from the landmark's true image).
+    """
+    if not counts:
+        return []
+    pruned = [c for c in counts if c.pruned]
+    where = ", ".join(
+        f"at position {c.index + 1} in {c.pruned} of {c.runs}" + (" runs" if k == 0 else "")
+        for k, c in enumerate(counts)
+    )
+    if len(pruned) == len(counts):
+        first = f"The map was pruned at every position in some run: {where}."
+    elif pruned:
+        never = _positions([c.index + 1 for c in counts if not c.pruned])
+        first = f"The map was never pruned at {never}: {where}."
+    else:
+        first = "The map was pruned at no position in any run."
+    kept = [c.index + 1 for c in counts if c.inside == c.runs]
+    lost = [c for c in counts if c.inside < c.runs]
+    parts = []
+    if kept:
+        parts.append(f"The true pose stayed inside at {_positions(kept)} in every run")
+    for c in lost:
+        parts.append(
+            f"at position {c.index + 1} it was outside in {c.runs - c.inside} of {c.runs} runs, "
+            f"with {c.wrong} of {c.identifications} identifications there wrong "
+            "(detected away from the landmark's true image)"
+        )
+    second = "; ".join(parts)
+    return [first, second[0].upper() + second[1:] + "."]
+
+
+def monte_carlo_markdown(mc: list[tuple[str, Metrics]]) -> list[str]:
+    """The Monte Carlo table: one column per variant, one row per metric (shown by :func:`_cell`)."""
+    lines = ["| metric | " + " | ".join(name for name, _ in mc) + " |"]
+    lines.append("| --- | " + " | ".join("---" for _ in mc) + " |")
+    for key in mc[0][1]:
+        lines.append(f"| {key} | " + " | ".join(_cell(metrics[key]) for _, metrics in mc) + " |")
+    return lines
+
+
+def class2_paragraph(class1: Metrics, class2: Metrics) -> list[str]:
+    """What changes with the corner as a Class II landmark, each comparison chosen from the figures.
+
+    The figures are quoted as the Monte Carlo table shows them (:func:`_cell`), and the verb
+    ("stays at", "falls from", "rises from", ...) is decided on those shown values.
+
+    Examples
+    --------
+    >>> one = Metrics({"containment_rate": 1.0, "median_area_m2": 0.85, "median_wedge_width_rad": 0.16,
+    ...                "inconsistent_observations": 0})
+    >>> two = Metrics({"containment_rate": 0.95, "median_area_m2": 0.78, "median_wedge_width_rad": 0.16,
+    ...                "inconsistent_observations": 2})
+    >>> print(class2_paragraph(one, two)[-1])
+    With the corner as Class II, the median area shrinks from 0.85 to 0.78 m², the median wedge stays at 0.16 rad, containment falls from 1 to 0.95, and the inconsistent observations rise from 0 to 2.
+    """
+    area = _change(
+        "the median area",
+        _cell(class1["median_area_m2"]),
+        _cell(class2["median_area_m2"]),
+        down="shrinks",
+        up="grows",
+    )
+    wedge = _change(
+        "the median wedge",
+        _cell(class1["median_wedge_width_rad"]),
+        _cell(class2["median_wedge_width_rad"]),
+        down="narrows",
+        up="widens",
+    )
+    containment = _change(
+        "containment",
+        _cell(class1["containment_rate"]),
+        _cell(class2["containment_rate"]),
+        down="falls",
+        up="rises",
+    )
+    rejected = _change(
+        "the inconsistent observations",
+        _cell(class1["inconsistent_observations"]),
+        _cell(class2["inconsistent_observations"]),
+        down="fall",
+        up="rise",
+    ).replace(" stays at ", " stay at ")
     return [
         "What changes with the corner as a Class II landmark (a point of known height): its image",
         "row gives a range as well as a bearing, so a recognition can cut the polygon along the",
         "line of sight too, not only the heading (the paper's robot could not use it: its ground-",
-        "plane assumption failed). Here the range does shrink the map, but containment drops: a",
-        "recognized corner whose range agrees with the map yet is wrong prunes the true pose away.",
-        "Whether the interest operator confirms the wrong corner or the range bound is too tight",
-        "is not isolated yet. Median over all frames of the Monte Carlo below:",
-        f"area {area1:.3f} m² (Class I) vs {area2:.3f} m² (Class II); wedge "
-        f"{math.degrees(wedge1):.2f}° vs {math.degrees(wedge2):.2f}°; containment "
-        f"{class1.number('containment_rate'):.3f} vs {class2.number('containment_rate'):.3f}; inconsistent "
-        f"observations {class1['inconsistent_observations']} vs {class2['inconsistent_observations']}.",
+        "plane assumption failed). Compared over all frames of the Monte Carlo above (Class I",
+        "column \"paper, pruning\", Class II column \"class II corner, pruning\"):",
+        f"With the corner as Class II, {area} m², {wedge} rad, {containment}, and {rejected}.",
     ]

@@ -9,6 +9,8 @@ says ``_deg``, radians otherwise; every other unit SI)::
     terrain = "default"                 # a terrain table TOML file, or "default"
     camera = "paper_camera.toml"        # a camera TOML file (aura_ums.camera.load_camera)
     landmarks = ["lamppost_107"]        # optional: ids the robot uses (default: all)
+    confirm_frames = 1                  # optional: consecutive frames that confirm a discovery,
+                                        # for every landmark (default: each landmark's own)
     frame_spacing = 1.0                 # optional: metres of commanded run between frames
     # or: frame_rate = 2.0 (frames per second) with speed = 0.5 (m/s)
 
@@ -72,6 +74,7 @@ _TOP_KEYS = (
     "terrain",
     "camera",
     "landmarks",
+    "confirm_frames",
     "frame_spacing",
     "frame_rate",
     "speed",
@@ -395,7 +398,7 @@ class Scenario:
         if not isinstance(description, str):
             raise reader.fail("description", f"expected a string, got {describe(description)}")
         terrain = _load_terrain(document, reader, base)
-        meadow_map = _load_map(document, reader, base, terrain)
+        meadow_map = _with_confirm_frames(_load_map(document, reader, base, terrain), document, reader)
         if "camera" not in document:
             raise reader.fail("camera", "expected the path of a camera TOML file, got none")
         camera_path = reader.path(document["camera"], "camera", base)
@@ -576,6 +579,23 @@ def _load_map(
         return MeadowMap.from_geojson(path, terrain_table=terrain)
     except FileFormatError as exc:
         raise reader.fail("map", f"expected a meadow map file that loads, got: {exc}") from None
+
+
+def _with_confirm_frames(meadow_map: MeadowMap, document: Mapping[str, object], reader: _Reader) -> MeadowMap:
+    """The map with every landmark's ``confirm_frames`` set from the scenario's key, when given.
+
+    Frames far apart (the paper's still images, 10 to 20 ft apart) have no tracking between
+    them: each image must identify its landmarks on its own, with ``confirm_frames = 1``.
+    """
+    if "confirm_frames" not in document:
+        return meadow_map
+    frames = reader.integer(document["confirm_frames"], "confirm_frames", 1)
+    return MeadowMap(
+        meadow_map.meadows,
+        [dataclasses.replace(record, confirm_frames=frames) for record in meadow_map.landmarks],
+        terrain_table=meadow_map.terrain_table,
+        terrain_table_file=meadow_map.terrain_table_file,
+    )
 
 
 def _landmark_ids(document: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap) -> tuple[str, ...]:
