@@ -88,10 +88,14 @@ def test_paper_sidewalk_is_the_papers_experiment() -> None:
 def test_confirm_frames_sets_every_landmarks_count(folder: Path) -> None:
     default = Scenario.from_toml(folder / "good.toml")
     assert {r.confirm_frames for r in default.meadow_map.landmarks} == {3}  # the map's own
-    (folder / "single.toml").write_text(GOOD.replace("frame_spacing = 2.0", "frame_spacing = 2.0\nconfirm_frames = 1"))
+    (folder / "single.toml").write_text(
+        GOOD.replace("frame_spacing = 2.0", "frame_spacing = 2.0\nconfirm_frames = 1")
+    )
     single = Scenario.from_toml(folder / "single.toml")
     assert {r.confirm_frames for r in single.meadow_map.landmarks} == {1}
-    assert [r.landmark for r in single.meadow_map.landmarks] == [r.landmark for r in default.meadow_map.landmarks]
+    assert [r.landmark for r in single.meadow_map.landmarks] == [
+        r.landmark for r in default.meadow_map.landmarks
+    ]
     paper = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")  # still images: one frame each
     assert {r.confirm_frames for r in paper.landmarks} == {1}
 
@@ -199,7 +203,12 @@ MALFORMED = [
     ("frame_spacing = 2.0", "frame_rate = 1.0", "speed", "expected the speed"),
     ("frame_spacing = 2.0", "frame_spacing = 2.0\ncolour = 1", "colour", "unknown key 'colour'"),
     ("frame_spacing = 2.0", 'frame_spacing = 2.0\nlandmarks = ["nope"]', r"landmarks\[0\]", "got 'nope'"),
-    ("frame_spacing = 2.0", "frame_spacing = 2.0\nconfirm_frames = 0", "confirm_frames", "integer >= 1, got 0"),
+    (
+        "frame_spacing = 2.0",
+        "frame_spacing = 2.0\nconfirm_frames = 0",
+        "confirm_frames",
+        "integer >= 1, got 0",
+    ),
     ("frame_spacing = 2.0", "frame_spacing = 2.0\nconfirm_frames = 1.5", "confirm_frames", "integer >= 1"),
     ("x = 0.0\n", "", r"\[start\] x", "expected this key"),
     ("x = 0.0", 'x = "east"', r"\[start\] x", "expected a finite number, got 'east'"),

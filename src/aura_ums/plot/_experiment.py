@@ -107,14 +107,14 @@ def _table_markdown(rows: list[TableRow]) -> list[str]:
 
 
 def _scenario_lines(scenario: Scenario, rows: list[TableRow], seed: int) -> list[str]:
-    """The experiment's set-up, read from the scenario and the run's table."""
+    """Return the experiment's set-up, read from the scenario and the run's table."""
     feet = ", ".join(f"{r.distance_ft:.0f}" for r in rows)
     used = ", ".join(f"{r.symbol} (Class {r.landmark_class.value})" for r in scenario.landmarks)
     confirm = sorted({r.confirm_frames for r in scenario.landmarks})
-    frames = " or ".join(str(n) for n in confirm)
+    frames = "a single image" if confirm == [1] else f"{' or '.join(map(str, confirm))} consecutive frames"
     return [
         f"Scenario `{scenario.name}`: start known to ±{scenario.start.position_radius / FOOT:.3g} ft, "
-        f"images at {feet} ft; landmarks {used}, each identified from {frames} frame(s) "
+        f"images at {feet} ft; landmarks {used}, each identified from {frames} "
         f"(`confirm_frames`). Seed {seed}.",
     ]
 
@@ -363,7 +363,7 @@ def _positions(indices: list[int]) -> str:
 
 
 def _change(what: str, before: str, after: str, *, down: str, up: str) -> str:
-    """A comparison of two figures as the tables show them: equal shown values "stay"."""
+    """Compare two figures as the tables show them: equal shown values "stay"."""
     if float(after.replace(",", "")) == float(before.replace(",", "")):
         return f"{what} stays at {after}"
     verb = down if float(after.replace(",", "")) < float(before.replace(",", "")) else up
@@ -379,8 +379,12 @@ def position_sentences(rows: list[TableRow]) -> list[str]:
     Examples
     --------
     >>> row = TableRow(0, 0.0, 0.3, 0.3, 6.0, 3.5, 100.0, 120.0, ("pole",), True)
-    >>> print(" ".join(position_sentences([row, TableRow(1, 10.0, 0.7, 0.7, 6.5, 6.5, 90.0, 99.0, (), False)])))
-    Landmarks were recognized at position 1 and at no other. The heading wedge narrowed at position 1; the area shrank at no position. The true pose was inside the map after position 1 and outside it after position 2.
+    >>> later = TableRow(1, 10.0, 0.7, 0.7, 6.5, 6.5, 90.0, 99.0, (), False)
+    >>> for sentence in position_sentences([row, later]):
+    ...     print(sentence)
+    Landmarks were recognized at position 1 and at no other.
+    The heading wedge narrowed at position 1; the area shrank at no position.
+    The true pose was inside the map after position 1 and outside it after position 2.
     >>> position_sentences([])
     []
     """
@@ -472,13 +476,15 @@ def position_counts(scenario: Scenario, results: list[RunResult]) -> list[Positi
 
 
 def position_counts_markdown(name: str, counts: list[PositionCounts]) -> list[str]:
-    """The per-position table of a Monte Carlo variant."""
+    """Return the per-position table of a Monte Carlo variant."""
     lines = [
         f"| {name}: position | runs | runs pruned here | true pose inside | identifications | wrong ones |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for c in counts:
-        lines.append(f"| {c.index + 1} | {c.runs} | {c.pruned} | {c.inside} | {c.identifications} | {c.wrong} |")
+        lines.append(
+            f"| {c.index + 1} | {c.runs} | {c.pruned} | {c.inside} | {c.identifications} | {c.wrong} |"
+        )
     return lines
 
 
@@ -489,8 +495,11 @@ def position_counts_sentences(counts: list[PositionCounts]) -> list[str]:
     --------
     >>> a = PositionCounts(0, 10, 10, 10, 12, 0)
     >>> b = PositionCounts(1, 10, 6, 9, 7, 1)
-    >>> print(" ".join(position_counts_sentences([a, b])))
-    The map was pruned at every position in some run: at position 1 in 10 of 10 runs, at position 2 in 6 of 10. The true pose stayed inside at position 1 in every run; at position 2 it was outside in 1 of 10 runs, with 1 of 7 identifications there wrong (detected away from the landmark's true image).
+    >>> print(" ".join(position_counts_sentences([a, b])))  # doctest: +NORMALIZE_WHITESPACE
+    The map was pruned at every position in some run: at position 1 in 10 of 10 runs,
+    at position 2 in 6 of 10. The true pose stayed inside at position 1 in every run; at
+    position 2 it was outside in 1 of 10 runs, with 1 of 7 identifications there wrong
+    (detected away from the landmark's true image).
     """
     if not counts:
         return []
@@ -522,7 +531,7 @@ def position_counts_sentences(counts: list[PositionCounts]) -> list[str]:
 
 
 def monte_carlo_markdown(mc: list[tuple[str, Metrics]]) -> list[str]:
-    """The Monte Carlo table: one column per variant, one row per metric (shown by :func:`_cell`)."""
+    """Return the Monte Carlo table: a column per variant, a row per metric (shown by :func:`_cell`)."""
     lines = ["| metric | " + " | ".join(name for name, _ in mc) + " |"]
     lines.append("| --- | " + " | ".join("---" for _ in mc) + " |")
     for key in mc[0][1]:
@@ -531,7 +540,7 @@ def monte_carlo_markdown(mc: list[tuple[str, Metrics]]) -> list[str]:
 
 
 def class2_paragraph(class1: Metrics, class2: Metrics) -> list[str]:
-    """What changes with the corner as a Class II landmark, each comparison chosen from the figures.
+    """Say what changes with the corner as a Class II landmark, each comparison chosen from the figures.
 
     The figures are quoted as the Monte Carlo table shows them (:func:`_cell`), and the verb
     ("stays at", "falls from", "rises from", ...) is decided on those shown values.
@@ -542,8 +551,10 @@ def class2_paragraph(class1: Metrics, class2: Metrics) -> list[str]:
     ...                "inconsistent_observations": 0})
     >>> two = Metrics({"containment_rate": 0.95, "median_area_m2": 0.78, "median_wedge_width_rad": 0.16,
     ...                "inconsistent_observations": 2})
-    >>> print(class2_paragraph(one, two)[-1])
-    With the corner as Class II, the median area shrinks from 0.85 to 0.78 m², the median wedge stays at 0.16 rad, containment falls from 1 to 0.95, and the inconsistent observations rise from 0 to 2.
+    >>> print(class2_paragraph(one, two)[-1])  # doctest: +NORMALIZE_WHITESPACE
+    With the corner as Class II, the median area shrinks from 0.85 to 0.78 m², the median
+    wedge stays at 0.16 rad, containment falls from 1 to 0.95, and the inconsistent
+    observations rise from 0 to 2.
     """
     area = _change(
         "the median area",
@@ -578,6 +589,6 @@ def class2_paragraph(class1: Metrics, class2: Metrics) -> list[str]:
         "row gives a range as well as a bearing, so a recognition can cut the polygon along the",
         "line of sight too, not only the heading (the paper's robot could not use it: its ground-",
         "plane assumption failed). Compared over all frames of the Monte Carlo above (Class I",
-        "column \"paper, pruning\", Class II column \"class II corner, pruning\"):",
+        'column "paper, pruning", Class II column "class II corner, pruning"):',
         f"With the corner as Class II, {area} m², {wedge} rad, {containment}, and {rejected}.",
     ]

@@ -582,7 +582,7 @@ def _load_map(
 
 
 def _with_confirm_frames(meadow_map: MeadowMap, document: Mapping[str, object], reader: _Reader) -> MeadowMap:
-    """The map with every landmark's ``confirm_frames`` set from the scenario's key, when given.
+    """Return the map with every landmark's ``confirm_frames`` set by the scenario's key, if given.
 
     Frames far apart (the paper's still images, 10 to 20 ft apart) have no tracking between
     them: each image must identify its landmarks on its own, with ``confirm_frames = 1``.
