@@ -1,6 +1,6 @@
 """The fast line finder on real photographs (York Urban): vertical recall at least LSD's.
 
-Skips when the dataset (``../shared/data/york_urban`` next to the repository) is absent;
+Skips when the dataset (``york_urban`` in ``tests.conftest.SHARED_DATA``) is absent;
 the comparison with LSD needs the ``opencv`` extra. The 10 images are held out from the
 tuning of the finder's parameters (tuned on the odd-indexed images; see
 ``benchmarks/eval_york_urban.py``).
@@ -9,21 +9,21 @@ tuning of the finder's parameters (tuned on the odd-indexed images; see
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from aura_ums.perception import FastLineFinder, OpenCvLineFinder, RecallPrecision, segment_recall_precision
 from aura_ums.perception._york_urban import YorkUrbanImage, load_york_urban, york_urban_names
+from tests.conftest import SHARED_DATA
 
-YORK_URBAN = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "york_urban"
+YORK_URBAN = SHARED_DATA / "york_urban"
 VERTICAL = math.pi / 2
 TOLERANCE = math.radians(10.0)
 
 pytestmark = pytest.mark.skipif(
     not (YORK_URBAN / "segments.csv").is_file(),
-    reason=f"York Urban dataset not found at {YORK_URBAN} (shared data is not part of the repository)",
+    reason=f"York Urban dataset not found at {YORK_URBAN} (see docs/getting-real-data.md)",
 )
 
 

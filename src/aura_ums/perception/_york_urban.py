@@ -1,8 +1,8 @@
-"""Reader of the York Urban Line Segment Database as stored in ``shared/data/york_urban``.
+"""Reader of the York Urban Line Segment Database as a folder of ``images/`` and ``segments.csv``.
 
 Denis, Elder & Estrada, "Efficient Edge-Based Methods for Estimating Manhattan Frames in
-Urban Imagery", ECCV 2008. Used by the perception benchmark and tests; images are read
-without OpenCV (:func:`read_gray_image`).
+Urban Imagery", ECCV 2008 (where it is published: docs/getting-real-data.md). Used by the
+perception benchmark and tests; images are read without OpenCV (:func:`read_gray_image`).
 """
 
 from __future__ import annotations
