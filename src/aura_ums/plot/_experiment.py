@@ -122,7 +122,7 @@ def _scenario_lines(scenario: Scenario, rows: list[TableRow], seed: int) -> list
 def figure12(path: Path, scenario: Scenario, result: RunResult) -> Path:
     """Draw the maps before (left) and after (right) pruning at each position, with the true pose."""
     n = len(result.records)
-    figure = Figure(figsize=(8.0, 2.6 * n))
+    figure = Figure(figsize=(8.0, 2.8 * n))
     for row, record in enumerate(result.records):
         for col, (m, title) in enumerate(((record.map_before, "before"), (record.map_after, "after"))):
             ax = figure.add_subplot(n, 2, 2 * row + col + 1)
@@ -134,7 +134,7 @@ def figure12(path: Path, scenario: Scenario, result: RunResult) -> Path:
             ax.set_xlim(cx - 1.5, cx + 1.5)
             ax.set_ylim(cy - 1.0, cy + 1.0)
             ax.set_aspect("equal")
-            by = f" ({', '.join(record.posted) or 'nothing recognized'})" if col else ""
+            by = f"\n{', '.join(record.posted) or 'nothing recognized'}" if col else ""
             ax.set_title(
                 f"({chr(97 + 2 * row + col)}) position {row + 1} {title}{by}: "
                 f"{m.area:.3f} m², {math.degrees(m.wedge.width):.1f}°",
