@@ -25,6 +25,9 @@ OTHERS = ("indoor_corridor.toml", "four_terrains.toml")
 #: Pixels a correct detection may lie beyond the image of its landmark's uncertainty disk
 #: (pixel noise, the detector's localization): farther, the identification is counted wrong.
 _WRONG_PIXELS = 5.0
+#: Points around the uncertainty disk, and heights along a line, whose images bound the landmark's.
+_WRONG_DISK_POINTS = 16
+_WRONG_HEIGHTS = 9
 _COLORS = ("tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:cyan", "tab:olive")
 
 
@@ -430,29 +433,43 @@ class PositionCounts:
 def misidentified(scenario: Scenario, record: FrameRecord) -> tuple[str, ...]:
     """Ids of the frame's posted identifications whose detection is not where the landmark truly is.
 
-    A detection of a Class I or II landmark lies within the image of its position
-    uncertainty disk, seen from the true pose, up to ``_WRONG_PIXELS`` of pixel error; one
-    farther away identified something else (another corner of a building, clutter).
+    Seen from the true pose, a landmark lies within its ``position_uncertainty`` disk: a
+    Class I line on the vertical cylinder of that radius between its heights, a Class II
+    point on the disk at its height. A detection whose midpoint is more than
+    ``_WRONG_PIXELS`` outside the image of that cylinder (Class I: its columns; Class II:
+    its columns and rows) identified something else: another corner of a building, clutter.
     Class III identifications are not judged.
     """
     camera = scenario.camera
     wrong = []
     detections = dict(record.detections)
+    around = np.linspace(0.0, 2.0 * math.pi, _WRONG_DISK_POINTS, endpoint=False)
     for ident in record.posted:
         landmark = scenario.meadow_map.landmark(ident).landmark
         if ident not in detections or isinstance(landmark, GroundLineLandmark):
             continue
         u1, v1, u2, v2 = detections[ident]
-        z = landmark.z if isinstance(landmark, PointLandmark) else 0.5 * (landmark.z_bottom + landmark.z_top)
-        pose = record.true_pose
-        distance = max(math.hypot(landmark.x - pose.x, landmark.y - pose.y), 1e-3)
-        u, v = camera.project(pose, [(landmark.x, landmark.y, z)])[0]
-        tolerance = camera.intrinsics.fx * landmark.position_uncertainty / distance + _WRONG_PIXELS
-        off = abs(0.5 * (u1 + u2) - u)
         if isinstance(landmark, PointLandmark):
-            off = max(off, abs(0.5 * (v1 + v2) - v))
-        if not off <= tolerance:  # NaN (behind the camera) is wrong too
+            heights = np.array([landmark.z])
+        else:
+            heights = np.linspace(landmark.z_bottom, landmark.z_top, _WRONG_HEIGHTS)
+        r = landmark.position_uncertainty
+        a, z = np.meshgrid(around, heights)
+        points = np.column_stack(
+            [landmark.x + r * np.cos(a.ravel()), landmark.y + r * np.sin(a.ravel()), z.ravel()]
+        )
+        pixels = camera.project(record.true_pose, points)
+        pixels = pixels[np.isfinite(pixels).all(axis=1)]
+        if not len(pixels):  # behind the camera from the true pose
             wrong.append(ident)
+            continue
+        centre = (0.5 * (u1 + u2), 0.5 * (v1 + v2))
+        axes = (0, 1) if isinstance(landmark, PointLandmark) else (0,)
+        for axis in axes:
+            low, high = pixels[:, axis].min() - _WRONG_PIXELS, pixels[:, axis].max() + _WRONG_PIXELS
+            if not low <= centre[axis] <= high:
+                wrong.append(ident)
+                break
     return tuple(wrong)
 
 
