@@ -4,12 +4,13 @@ Each step is one camera frame of the log: the growth (or prediction) by the posi
 reports since the previous frame, then the frame's observations (built before the clock
 starts, for every method). All methods see the same reports and observations
 (aura_ums.logs.compare_on_log; filterpy's EKF joins through its ``others``, with the same
-model in numpy matrices and the same gate, from benchmarks/filterpy_ekf.py). Uses the MRCLAM Dataset 6 logs in
-../shared/data when present (calibrated on robot 1), else a synthetic log. Each log is
-run ``REPEATS`` times; a method's figure is the lowest of its per-run medians, so that a
-burst of load on this machine does not land on one method only. Robot 1 is also replayed
-with the map polygon capped at 16 vertices (``ManagerSettings.max_vertices``, default 64):
-the speed a coarser polygon buys and the area it costs.
+model in numpy matrices and the same gate, from benchmarks/filterpy_ekf.py). Uses the MRCLAM
+Dataset 6 logs in the data folder beside the clone (docs/getting-real-data.md) when present
+(calibrated on robot 1), else a synthetic log. Each log is run ``REPEATS`` times; a method's
+figure is the lowest of its per-run medians, so that a burst of load on this machine does not
+land on one method only. Robot 1 is also replayed with the map polygon capped at 16 vertices
+(``ManagerSettings.max_vertices``, default 64): the speed a coarser polygon buys and the area
+it costs.
 
     .venv/bin/python benchmarks/bench_logs.py
 """

@@ -1,13 +1,13 @@
 """Record, then check, that a change leaves replays and simulations bit-identical.
 
-Runs the ``aura-ums`` command of this environment over the real logs in
-``../shared/data`` (MRCLAM Dataset 6 robots 1-2 and Dataset 7 robots 1-5, Class I and II,
-all calibrated on Dataset 6 robot 1) and over ``scenarios/paper_sidewalk.toml`` (20 runs,
-seed 1), and keeps every metrics JSON and per-step CSV. Timings (``update_us``,
-``median_update_us``, ``median_frame_ms``: any key ending in ``_us`` or ``_ms``) are dropped;
-``NaN`` and ``null`` are the same undefined value. Everything else must match to the last digit, or, with
-``--rtol``, within that relative tolerance (for the numpy reference against the C kernels:
-``AURA_UMS_NATIVE=0``).
+Runs the ``aura-ums`` command of this environment over the real logs in the data folder
+beside the clone (docs/getting-real-data.md; MRCLAM Dataset 6 robots 1-2 and Dataset 7
+robots 1-5, Class I and II, all calibrated on Dataset 6 robot 1) and over
+``scenarios/paper_sidewalk.toml`` (20 runs, seed 1), and keeps every metrics JSON and per-step
+CSV. Timings (``update_us``, ``median_update_us``, ``median_frame_ms``: any key ending in
+``_us`` or ``_ms``) are dropped; ``NaN`` and ``null`` are the same undefined value. Everything
+else must match to the last digit, or, with ``--rtol``, within that relative tolerance (for
+the numpy reference against the C kernels: ``AURA_UMS_NATIVE=0``).
 
     .venv/bin/python benchmarks/check_identity.py record /tmp/identity-before
     .venv/bin/python benchmarks/check_identity.py check /tmp/identity-before

@@ -3,7 +3,8 @@
 Run: ``.venv/bin/python benchmarks/eval_york_urban.py [path/to/york_urban]``.
 
 Data: Denis, Elder & Estrada, ECCV 2008 (51 images, 640 x 480), read from
-``../shared/data/york_urban`` by default. Task: the Class I landmark's, vertical lines.
+the folder given, by default ``york_urban`` in the data folder beside the clone
+(docs/getting-real-data.md). Task: the Class I landmark's, vertical lines.
 
 - Ground truth for recall: the segments annotated ``vertical == 1`` (world verticals).
 - Detectors tuned to the image vertical (orientation pi/2) with a tolerance of 10
