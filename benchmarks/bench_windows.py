@@ -16,6 +16,7 @@ Class II, ours vs the EKF's box.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from pathlib import Path
@@ -61,14 +62,18 @@ def main(figure: Path) -> None:
             began = time.perf_counter()
             result, windows = replay_windows(log, table, camera, options)
             seconds = time.perf_counter() - began
-            metrics = windows.metrics()
-            for method, figures in [("aura-ums", metrics), *((r["method"], r) for r in metrics["window_baselines"])]:
-                print(
-                    f"{log.meta.name:16s} {landmark_class.value:5s} {method!s:16s} "
-                    f"{metrics['window_observations']!s:>6s} {_f(figures['window_containment'])} "
-                    f"{_f(figures['window_truth_containment'], 8)} {_f(figures['median_window_width_frac'], 6, 3)} "
-                    f"{_f(figures['median_window_area_frac'])} {result.containment_rate:7.4f} {seconds:5.1f}"
+            judged = len(windows.judged("aura-ums"))
+            for method in WindowReport.methods:
+                figures = windows.figures(method)
+                cells = (
+                    f"{judged:6d}",
+                    _f(figures.number("window_containment")),
+                    _f(figures.number("window_truth_containment"), 8),
+                    _f(figures.number("median_window_width_frac"), 6, 3),
+                    _f(figures.number("median_window_area_frac")),
+                    f"{result.containment_rate:7.4f} {seconds:5.1f}",
                 )
+                print(f"{log.meta.name:16s} {landmark_class.value:5s} {method:16s} " + " ".join(cells))
             if (dataset, robot) == FIGURE_LOG and landmark_class is LandmarkClass.POINT:
                 kept = windows
     if kept is not None:
@@ -76,8 +81,8 @@ def main(figure: Path) -> None:
         print(f"wrote {figure}")
 
 
-def _f(value: object, width: int = 7, digits: int = 4) -> str:
-    return f"{'n/a':>{width}s}" if value is None else f"{float(value):{width}.{digits}f}"  # type: ignore[arg-type]
+def _f(value: float, width: int = 7, digits: int = 4) -> str:
+    return f"{'n/a':>{width}s}" if math.isnan(value) else f"{value:{width}.{digits}f}"
 
 
 def _draw(windows: WindowReport, path: Path, title: str) -> None:

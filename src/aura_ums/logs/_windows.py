@@ -23,6 +23,7 @@ import math
 import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -100,7 +101,7 @@ class WindowRow:
     landmark_class : LandmarkClass
         ``VERTICAL_LINE`` (Class I, judged by column) or ``POINT`` (Class II, by column and row).
     method : str
-        One of :data:`WINDOW_METHODS`.
+        One of :attr:`WindowReport.methods`.
     window : ImageWindow or None
         The window searched, pixels: grown by the margin and clipped to the image; None when
         the method says the landmark cannot be in view.
@@ -146,7 +147,11 @@ class WindowReport:
     margin : float
         Pixels added on every side of each window before clipping it to the image.
     rows : tuple of WindowRow
-        One per observation and method, in time order, the methods in :data:`WINDOW_METHODS` order.
+        One per observation and method, in time order, the methods in :attr:`methods` order.
+    methods : tuple of str
+        Class attribute: the methods judged, ``("aura-ums", "EKF 3-sigma box", "disk model")``.
+    csv_columns : tuple of str
+        Class attribute: the columns of :meth:`to_csv`, each a key of the metrics table.
 
     Examples
     --------
@@ -162,6 +167,8 @@ class WindowReport:
     camera: Camera
     margin: float
     rows: tuple[WindowRow, ...]
+    methods: ClassVar[tuple[str, ...]] = WINDOW_METHODS
+    csv_columns: ClassVar[tuple[str, ...]] = CSV_COLUMNS
 
     def judged(self, method: str) -> tuple[WindowRow, ...]:
         """Return the rows of ``method`` whose observation is judged (measured pixel in the image)."""
@@ -201,7 +208,7 @@ class WindowReport:
         )
 
     def to_csv(self) -> str:
-        """Return the rows as CSV text: :data:`CSV_COLUMNS`, one line per observation and method.
+        """Return the rows as CSV text: :attr:`csv_columns`, one line per observation and method.
 
         Numbers are written with ``repr`` precision; an undefined cell (no window, no
         measured row, not judged) is empty; flags are 1 or 0.
