@@ -363,8 +363,9 @@ def replay_log(
     options : ReplayOptions or None
         How; default :class:`ReplayOptions`.
     before_frame : callable or None
-        Called once per frame, in time order, as ``before_frame(time, grown_map, rows)``
-        (:data:`FrameHook`); :func:`~aura_ums.logs.replay_windows` asks the Expecter there.
+        Called once per frame, in time order, as ``before_frame(time, grown_map, rows)``:
+        seconds, the working map grown to ``time``, the frame's :class:`LogObservation` s.
+        :func:`~aura_ums.logs.replay_windows` asks the Expecter there.
 
     Returns
     -------
