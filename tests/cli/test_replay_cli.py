@@ -208,3 +208,4 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
         ],
     )
     assert result.exit_code == 2
+    assert "--window-margin: expected a finite number of pixels >= 0, got -1.0" in result.output

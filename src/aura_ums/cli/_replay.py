@@ -47,7 +47,7 @@ _Camera = Annotated[
 ]
 _WindowMargin = Annotated[
     float,
-    typer.Option("--window-margin", min=0.0, help="Pixels added on every side of each window (--camera)."),
+    typer.Option("--window-margin", help="Pixels added on every side of each window (--camera)."),
 ]
 _WindowsCsv = Annotated[
     Path | None,
@@ -144,6 +144,8 @@ def replay(
 
     if windows_csv is not None and camera is None:
         raise fail("--windows-csv: expected --camera too, got no camera")
+    if not 0.0 <= window_margin < float("inf"):
+        raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
     windows = None
     try:
         log = load_log(log_dir)
