@@ -20,7 +20,16 @@ from aura_ums.errors import InputError
 DOC = Path(__file__).resolve().parents[1] / "docs" / "metrics.md"
 START = "<!-- metrics table: generated from aura_ums.Metrics.table(); tests/test_metrics.py checks it -->"
 END = "<!-- end of the metrics table -->"
-WRITERS = {"simulate", "replay", "compare", "compare (per method)", "replay --steps-csv"}
+WRITERS = {
+    "simulate",
+    "replay",
+    "compare",
+    "compare (per method)",
+    "replay --steps-csv",
+    "replay --camera",
+    "replay --camera (per baseline)",
+    "replay --windows-csv",
+}
 KINDS = {"text", "true/false", "integer", "count", "fraction", "number", "count by reason", "list of metrics"}
 NUMERIC = [key.name for key in Metrics.table() if key.kind in ("number", "fraction")]
 

@@ -45,6 +45,9 @@ REPLAY = "replay"
 COMPARE = "compare"
 COMPARE_ROW = "compare (per method)"
 STEPS_CSV = "replay --steps-csv"
+CAMERA = "replay --camera"
+CAMERA_ROW = "replay --camera (per baseline)"
+WINDOWS_CSV = "replay --windows-csv"
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,7 +67,9 @@ class MetricKey:
         ``"count by reason"`` (an object of counts) or ``"list of metrics"``.
     written_by : tuple of str
         The outputs that hold the key: ``"simulate"``, ``"replay"``, ``"compare"``,
-        ``"compare (per method)"``, ``"replay --steps-csv"`` (a column of the per-step CSV).
+        ``"compare (per method)"``, ``"replay --steps-csv"`` (a column of the per-step CSV),
+        ``"replay --camera"``, ``"replay --camera (per baseline)"`` (an entry of
+        ``window_baselines``), ``"replay --windows-csv"`` (a column of the per-window CSV).
     meaning : str
         One sentence, with what ``null`` means when the value can be undefined.
     """
@@ -88,7 +93,13 @@ _TABLE: tuple[MetricKey, ...] = (
     _key("seed", "", _K.INTEGER, (SIMULATE,), "Seed of the whole Monte Carlo."),
     _key("prune", "", _K.FLAG, (SIMULATE,), "Whether landmarks reduced the map (false: growth only)."),
     _key("log", "", _K.TEXT, (REPLAY, COMPARE), "Name of the log (its meta.toml)."),
-    _key("landmark_class", "", _K.TEXT, (REPLAY, COMPARE), "I (bearings only) or II (range and bearing)."),
+    _key(
+        "landmark_class",
+        "",
+        _K.TEXT,
+        (REPLAY, COMPARE, WINDOWS_CSV),
+        "I (bearings only) or II (range and bearing).",
+    ),
     _key("sigmas", "sd", _K.NUMBER, (REPLAY,), "Standard deviations of the motion bounded by the growth."),
     _key("robust", "", _K.FLAG, (REPLAY,), "Whether an envelope map re-localized the working map."),
     _key(
@@ -121,7 +132,14 @@ _TABLE: tuple[MetricKey, ...] = (
         "Range noise of the filters: standard deviation of the logs' range errors, a fraction of the range.",
     ),
     _key("methods", "", _K.ROWS, (COMPARE,), "One entry per method: ours, the EKF, the particle filter."),
-    _key("method", "", _K.TEXT, (COMPARE_ROW,), "aura-ums, EKF, PF (particles), or a method of yours."),
+    _key(
+        "method",
+        "",
+        _K.TEXT,
+        (COMPARE_ROW, CAMERA_ROW, WINDOWS_CSV),
+        "aura-ums, EKF, PF (particles), or a method of yours; for windows: aura-ums, "
+        "EKF 3-sigma box or disk model.",
+    ),
     _key("frames", "count", _K.COUNT, (SIMULATE,), "Frames of all runs (one command and one image each)."),
     _key(
         "steps",
@@ -216,7 +234,68 @@ _TABLE: tuple[MetricKey, ...] = (
         (SIMULATE,),
         "Median time of one frame of the loop: schemas, perception and manager, not the rendering.",
     ),
-    _key("time", "s", _K.NUMBER, (STEPS_CSV,), "Time stamp of the step."),
+    _key(
+        "window_margin_px",
+        "px",
+        _K.NUMBER,
+        (CAMERA,),
+        "Pixels added on every side of every image window before clipping it to the image.",
+    ),
+    _key(
+        "window_observations",
+        "count",
+        _K.COUNT,
+        (CAMERA,),
+        "Real observations the windows are judged on: those whose measured pixel "
+        "(Class I: column) lies in the camera's image.",
+    ),
+    _key(
+        "window_containment",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA, CAMERA_ROW),
+        "Fraction of the judged observations whose measured pixel (Class I: column; Class II: "
+        "column and row) lies inside the window asked for before the observation was applied; "
+        "null: none judged.",
+    ),
+    _key(
+        "window_truth_containment",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA, CAMERA_ROW),
+        "The same for the landmark projected from the true pose (the Expecter's guarantee), over "
+        "the judged observations whose true projection is in the image; null: none, or no ground truth.",
+    ),
+    _key(
+        "median_window_width_frac",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA, CAMERA_ROW),
+        "Median over the judged observations of the window's width over the image's "
+        "(0 without a window); null: none judged.",
+    ),
+    _key(
+        "median_window_area_frac",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA, CAMERA_ROW),
+        "Median over the judged observations of the window's area over the image's; null: none judged.",
+    ),
+    _key(
+        "window_baselines",
+        "",
+        _K.ROWS,
+        (CAMERA,),
+        "One entry per baseline judged on the same observations at the same moments: the EKF's "
+        "3-sigma box, the disk model.",
+    ),
+    _key(
+        "time",
+        "s",
+        _K.NUMBER,
+        (STEPS_CSV, WINDOWS_CSV),
+        "Time stamp of the step (windows: of the observation's step).",
+    ),
     _key(
         "inside",
         "",
@@ -231,6 +310,57 @@ _TABLE: tuple[MetricKey, ...] = (
     _key("update_us", "µs", _K.NUMBER, (STEPS_CSV,), "Time of the step's update."),
     _key("state", "", _K.TEXT, (STEPS_CSV,), "The manager's state after the step (nominal, lost, ...)."),
     _key("relocalized", "", _K.FLAG, (STEPS_CSV,), "1 if the envelope re-seeded the map at this step."),
+    _key("landmark_id", "", _K.TEXT, (WINDOWS_CSV,), "Id of the landmark observed."),
+    _key("u_min_px", "px", _K.NUMBER, (WINDOWS_CSV,), "Left bound of the window; empty: no window."),
+    _key("v_min_px", "px", _K.NUMBER, (WINDOWS_CSV,), "Top bound of the window; empty: no window."),
+    _key("u_max_px", "px", _K.NUMBER, (WINDOWS_CSV,), "Right bound of the window; empty: no window."),
+    _key("v_max_px", "px", _K.NUMBER, (WINDOWS_CSV,), "Bottom bound of the window; empty: no window."),
+    _key(
+        "measured_u_px",
+        "px",
+        _K.NUMBER,
+        (WINDOWS_CSV,),
+        "Column of the measured bearing (at the measured range); empty: behind the camera.",
+    ),
+    _key(
+        "measured_v_px",
+        "px",
+        _K.NUMBER,
+        (WINDOWS_CSV,),
+        "Row from the measured range and the landmark's height (Class II); empty: Class I, or no range.",
+    ),
+    _key(
+        "in_view", "", _K.FLAG, (WINDOWS_CSV,), "1 if the measured pixel is in the image (judged), 0 if not."
+    ),
+    _key(
+        "in_window",
+        "",
+        _K.FLAG,
+        (WINDOWS_CSV,),
+        "1 if the measured pixel is inside the window, 0 if not; empty: not judged.",
+    ),
+    _key(
+        "truth_in_window",
+        "",
+        _K.FLAG,
+        (WINDOWS_CSV,),
+        "1 if the landmark projected from the true pose is inside the window, 0 if not; empty: "
+        "not judged, no truth, or that projection is out of the image.",
+    ),
+    _key(
+        "window_width_frac",
+        "fraction",
+        _K.FRACTION,
+        (WINDOWS_CSV,),
+        "The window's width over the image's (0 without a window).",
+    ),
+    _key(
+        "window_area_frac",
+        "fraction",
+        _K.FRACTION,
+        (WINDOWS_CSV,),
+        "The window's area over the image's (0 without a window).",
+    ),
 )
 _BY_NAME: Mapping[str, MetricKey] = types.MappingProxyType({key.name: key for key in _TABLE})
 

@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
 from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import TerrainTable
 
 runner = CliRunner()
 
@@ -120,3 +121,91 @@ def test_the_landmark_classes_are_a_choice(command: str, log_folder: Path, tmp_p
     result = runner.invoke(app, [command, str(log_folder), "--terrain", str(terrain), "--classes", "III"])
     assert result.exit_code == 2
     assert "'III' is not one of 'I', 'II'" in result.output
+
+
+VIRTUAL_CAMERA = Path(__file__).resolve().parents[2] / "examples" / "virtual_camera_60deg.toml"
+FLOOR_TOML = TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml()
+
+
+def test_replay_with_a_camera_writes_the_window_figures_and_rows(log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    out, rows = tmp_path / "m.json", tmp_path / "out" / "windows.csv"
+    base = [str(log_folder), "--terrain", str(terrain), "--classes", "II"]
+    result = runner.invoke(
+        app,
+        [
+            "replay",
+            *base,
+            "--camera",
+            str(VIRTUAL_CAMERA),
+            "--metrics-json",
+            str(out),
+            "--windows-csv",
+            str(rows),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert "window_containment" in result.output
+    assert f"wrote {rows}" in result.output
+    metrics = strict_json(out.read_text())
+    assert set(metrics) == set(written_by("replay")) | set(written_by("replay --camera"))
+    assert [row["method"] for row in metrics["window_baselines"]] == ["EKF 3-sigma box", "disk model"]
+    for row in metrics["window_baselines"]:
+        assert set(row) == set(written_by("replay --camera (per baseline)"))
+    assert metrics["window_margin_px"] == 0.0
+    assert 0.0 < metrics["median_window_width_frac"] <= 1.0
+    header, *lines = rows.read_text().splitlines()
+    assert set(header.split(",")) == set(written_by("replay --windows-csv"))
+    assert len(lines) == 3 * sum(1 for line in lines if ",aura-ums," in line)
+    # Without --camera the replay is the same and writes no window keys.
+    plain_out = tmp_path / "plain.json"
+    result = runner.invoke(app, ["replay", *base, "--metrics-json", str(plain_out)])
+    assert result.exit_code == 0, result.output
+    plain = strict_json(plain_out.read_text())
+    assert set(plain) == set(written_by("replay"))
+    for key in ("containment_rate", "median_area_m2", "accepted_observations", "relocalizations"):
+        assert plain[key] == metrics[key]
+    # A margin widens every window.
+    wide_out = tmp_path / "wide.json"
+    extra = ["--camera", str(VIRTUAL_CAMERA), "--window-margin", "20", "--metrics-json", str(wide_out)]
+    result = runner.invoke(app, ["replay", *base, *extra])
+    assert result.exit_code == 0, result.output
+    wide = strict_json(wide_out.read_text())
+    assert wide["window_margin_px"] == 20.0
+    assert wide["median_window_width_frac"] > metrics["median_window_width_frac"]
+
+
+def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text("")
+    rows = tmp_path / "windows.csv"
+    result = runner.invoke(
+        app, ["replay", str(log_folder), "--terrain", str(terrain), "--windows-csv", str(rows)]
+    )
+    assert result.exit_code == 2
+    assert "--windows-csv: expected --camera too, got no camera" in result.output
+    assert not rows.exists()
+    camera = tmp_path / "camera.toml"
+    camera.write_text("[intrinsics]\nfx = 500.0\n")
+    floor = tmp_path / "floor.toml"
+    floor.write_text(FLOOR_TOML)
+    result = runner.invoke(app, ["replay", str(log_folder), "--terrain", str(floor), "--camera", str(camera)])
+    assert result.exit_code == 2
+    assert "camera.toml" in result.output
+    assert "Traceback" not in result.output
+    result = runner.invoke(
+        app,
+        [
+            "replay",
+            str(log_folder),
+            "--terrain",
+            str(floor),
+            "--camera",
+            str(VIRTUAL_CAMERA),
+            "--window-margin",
+            "-1",
+        ],
+    )
+    assert result.exit_code == 2
+    assert "--window-margin: expected a finite number of pixels >= 0, got -1.0" in result.output

@@ -38,6 +38,22 @@ _Sensors = Annotated[
     Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
 ]
 
+_Camera = Annotated[
+    Path | None,
+    typer.Option(
+        "--camera",
+        help="Camera TOML (e.g. examples/virtual_camera_60deg.toml): judge each observation's image window.",
+    ),
+]
+_WindowMargin = Annotated[
+    float,
+    typer.Option("--window-margin", help="Pixels added on every side of each window (--camera)."),
+]
+_WindowsCsv = Annotated[
+    Path | None,
+    typer.Option("--windows-csv", help="Write one row per observation and window method (--camera)."),
+]
+
 
 def _options(classes: Classes, sensors: Path | None, settings: ManagerSettings) -> ReplayOptions:
     from aura_ums.logs import ReplayOptions, load_sensors
@@ -111,20 +127,37 @@ def replay(
     mcap: Annotated[
         Path | None, typer.Option("--mcap", help="Write the replay as MCAP for Foxglove.")
     ] = None,
+    camera: _Camera = None,
+    window_margin: _WindowMargin = 0.0,
+    windows_csv: _WindowsCsv = None,
 ) -> None:
-    """Run the map manager over a log and report containment, area, wedge width and speed."""
+    """Run the map manager over a log and report containment, area, wedge width and speed.
+
+    With --camera, also the image windows of each real observation (ours, an EKF's
+    3-sigma box, the disk model) and how often the observation fell inside.
+    """
+    from aura_ums import Metrics
+    from aura_ums.camera import load_camera
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import load_log, replay_log
+    from aura_ums.logs import load_log, replay_log, replay_windows
     from aura_ums.uncertainty import TerrainTable
 
+    if windows_csv is not None and camera is None:
+        raise fail("--windows-csv: expected --camera too, got no camera")
+    if not 0.0 <= window_margin < float("inf"):
+        raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    windows = None
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
         options = _options(classes, sensors, settings.over())
-        result = replay_log(log, table, options)
+        if camera is None:
+            result = replay_log(log, table, options)
+        else:
+            result, windows = replay_windows(log, table, load_camera(camera), options, margin=window_margin)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    metrics = result.metrics()
+    metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if metrics_json is not None:
@@ -140,6 +173,10 @@ def replay(
             )
         steps_csv.write_text("\n".join(lines) + "\n")
         console.print(f"wrote {steps_csv}")
+    if windows_csv is not None and windows is not None:
+        windows_csv.parent.mkdir(parents=True, exist_ok=True)
+        windows_csv.write_text(windows.to_csv())
+        console.print(f"wrote {windows_csv}", highlight=False, markup=False)
     if plot is not None:
         from aura_ums.plot import draw_replay
 

@@ -13,7 +13,9 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
   (Leung et al., IJRR 2011);
 - :func:`replay_log` feeds a log to the :class:`~aura_ums.manager.UncertaintyMapManager`
   (the localizer, with its outlier recovery) and records what it did against the ground
-  truth; :func:`compare_on_log` sets it next to an EKF and a particle filter.
+  truth; :func:`compare_on_log` sets it next to an EKF and a particle filter;
+  :func:`replay_windows` judges the image windows the Expecter, an EKF's 3-sigma box and the
+  disk model give for each real observation, through a camera of your choosing.
 """
 
 # Replay and calibration are the lead's (_calibrate, _replay, _synthetic); the formats
@@ -50,6 +52,7 @@ from aura_ums.logs._replay import (
 )
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
+from aura_ums.logs._windows import WindowReport, WindowRow, ekf_noise, replay_windows
 
 __all__ = [
     "Calibration",
@@ -67,8 +70,11 @@ __all__ = [
     "ReverseMotion",
     "RobotLog",
     "SensorBounds",
+    "WindowReport",
+    "WindowRow",
     "calibrate_logs",
     "compare_on_log",
+    "ekf_noise",
     "filter_settings",
     "import_mrclam",
     "import_rosbag",
@@ -82,6 +88,7 @@ __all__ = [
     "read_mrclam",
     "read_rosbag",
     "replay_log",
+    "replay_windows",
     "synthetic_log",
     "write_log",
 ]

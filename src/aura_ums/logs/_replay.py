@@ -6,7 +6,7 @@ import dataclasses
 import math
 import time as _time
 import types
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +40,10 @@ from aura_ums.uncertainty import (
 from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
 
 _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
+
+#: :func:`replay_log`'s ``before_frame``: called with a frame's time (s), the working map grown
+#: to it (before the frame's observations reduce it) and the frame's log rows.
+FrameHook = Callable[[float, SpatialUncertaintyMap, Sequence[LogObservation]], None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -326,7 +330,13 @@ def meta_bounds(log: RobotLog) -> SensorBounds:
     )
 
 
-def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None = None) -> ReplayResult:
+def replay_log(
+    log: RobotLog,
+    table: TerrainTable,
+    options: ReplayOptions | None = None,
+    *,
+    before_frame: FrameHook | None = None,
+) -> ReplayResult:
     """Run the uncertainty map manager over a log, frame by frame, and judge it against ground truth.
 
     The start map is ``meta.start`` (or the ground truth's first pose) with the meta's
@@ -339,6 +349,11 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     frame, reduces it (re-localizing from its envelope when the settings are robust);
     the ground truth at that time is checked against the map.
 
+    With ``before_frame``, each frame's update is made in two: the manager first grows
+    the map to the frame's time (an update without observations), ``before_frame`` sees
+    that map, then the observations reduce it. The maps are the same as in one update;
+    the hook's time is not counted in ``update_us``.
+
     Parameters
     ----------
     log : RobotLog
@@ -347,6 +362,10 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         Must hold the log's terrain (``meta.terrain``).
     options : ReplayOptions or None
         How; default :class:`ReplayOptions`.
+    before_frame : callable or None
+        Called once per frame, in time order, as ``before_frame(time, grown_map, rows)``:
+        seconds, the working map grown to ``time``, the frame's :class:`LogObservation` s.
+        :func:`~aura_ums.logs.replay_windows` asks the Expecter there.
 
     Returns
     -------
@@ -414,6 +433,11 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         while next_report < len(reports) and reports[next_report].time <= frame_time:
             board.post_report(reports[next_report])
             next_report += 1
+        if before_frame is not None:
+            grown = manager.update(board, now=float(frame_time)).map
+            paused = _time.perf_counter()
+            before_frame(float(frame_time), grown, rows)
+            began += _time.perf_counter() - paused
         for observation in working:
             board.identified.post(observation)
         step = manager.update(board, now=float(frame_time), envelope=envelope)
