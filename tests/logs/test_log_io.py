@@ -12,7 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from aura_ums._files import MAX_BYTES
 from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs import _io as log_io
 from aura_ums.logs import (
     LogLandmark,
     LogMeta,
@@ -424,9 +426,18 @@ def test_too_many_rows_are_refused_at_the_first_one_over(
         load_log(folder)
 
 
-def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> None:
+def test_a_file_over_the_size_limit_is_refused_stating_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The real limit (256 MiB) would make the test read 256 MiB; a small one shows the same path.
+    monkeypatch.setattr(log_io, "LOG_CSV_MAX_BYTES", 2 * 1024 * 1024)
     folder = write_files(tmp_path, VALID_FILES)
     with (folder / "odometry.csv").open("ab") as handle:
-        handle.truncate(64 * 1024 * 1024 + 1)
-    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 64 MiB \("):
+        handle.truncate(2 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 2 MiB \("):
         load_log(folder)
+
+
+def test_a_log_csv_may_exceed_the_general_file_limit() -> None:
+    # 2,000,000 rows of repr floats do not fit in 64 MiB.
+    assert log_io.LOG_CSV_MAX_BYTES >= 2_000_000 * 80 > MAX_BYTES
