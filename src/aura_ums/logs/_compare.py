@@ -88,10 +88,13 @@ class MethodSummary:
 
 
 def _ours(result: ReplayResult) -> MethodSummary:
+    trace = result.trace
+    known = ~np.isnan(trace.truth[:, 0])
     errors = [
-        math.hypot(s.map.center[0] - s.truth.x, s.map.center[1] - s.truth.y)
-        for s in result.steps
-        if s.truth is not None
+        math.hypot(cx - x, cy - y)
+        for (cx, cy), (x, y) in zip(
+            trace.center[known].tolist(), trace.truth[known, :2].tolist(), strict=True
+        )
     ]
     return MethodSummary(
         "aura-ums",
@@ -216,7 +219,7 @@ def compare_on_log(
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
     extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})"})
-    ours = replay_log(log, table, opts)
+    ours = replay_log(log, table, opts, keep_maps=False)
     log = with_motion(log, opts.motion)
     terrain = table[log.meta.terrain]
     start_time, start_pose = replay_start(log)
