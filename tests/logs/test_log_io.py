@@ -14,7 +14,6 @@ from hypothesis import strategies as st
 
 from aura_ums._files import MAX_BYTES
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import _io as log_io
 from aura_ums.logs import (
     LogLandmark,
     LogMeta,
@@ -25,6 +24,7 @@ from aura_ums.logs import (
     load_log,
     write_log,
 )
+from aura_ums.logs import _io as log_io
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import FOOT, TurnAndRun
 from tests.logs.log_helpers import VALID_FILES, assert_same_log, small_log, write_files

@@ -39,11 +39,13 @@ from aura_ums.logs._log import (
     RobotLog,
 )
 from aura_ums.logs._mrclam import import_mrclam, read_mrclam
-from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
+from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, odometry_to_commands
 from aura_ums.logs._replay import (
+    STEPS_CSV_HEADER,
     ReplayOptions,
     ReplayResult,
     ReplayStep,
+    ReplayTrace,
     log_meadow_map,
     observation_for,
     replay_log,
@@ -52,6 +54,7 @@ from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
+    "STEPS_CSV_HEADER",
     "Calibration",
     "GroundTruth",
     "LogLandmark",
@@ -64,6 +67,7 @@ __all__ = [
     "ReplayOptions",
     "ReplayResult",
     "ReplayStep",
+    "ReplayTrace",
     "ReverseMotion",
     "RobotLog",
     "SensorBounds",
@@ -78,6 +82,7 @@ __all__ = [
     "log_meadow_map",
     "observation_errors",
     "observation_for",
+    "odometry_report_arrays",
     "odometry_to_commands",
     "read_mrclam",
     "read_rosbag",

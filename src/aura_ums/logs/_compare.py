@@ -88,13 +88,10 @@ class MethodSummary:
 
 
 def _ours(result: ReplayResult) -> MethodSummary:
-    trace = result.trace
-    known = ~np.isnan(trace.truth[:, 0])
     errors = [
-        math.hypot(cx - x, cy - y)
-        for (cx, cy), (x, y) in zip(
-            trace.center[known].tolist(), trace.truth[known, :2].tolist(), strict=True
-        )
+        math.hypot(s.map.center[0] - s.truth.x, s.map.center[1] - s.truth.y)
+        for s in result.steps
+        if s.truth is not None
     ]
     return MethodSummary(
         "aura-ums",
@@ -219,7 +216,7 @@ def compare_on_log(
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
     extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})"})
-    ours = replay_log(log, table, opts, keep_maps=False)
+    ours = replay_log(log, table, opts)
     log = with_motion(log, opts.motion)
     terrain = table[log.meta.terrain]
     start_time, start_pose = replay_start(log)

@@ -193,8 +193,6 @@ class ReplayTrace:
         judged (no truth; for the envelope, no envelope map either).
     area_m2, wedge_width_rad : ndarray, shape (n,)
         The working map's area (m^2) and heading wedge width (rad) after the step.
-    center : ndarray, shape (n, 2)
-        The working map's centre (m).
     accepted, rejected : ndarray of int64, shape (n,)
         Observations of the step that reduced the map, and that were rejected.
     update_us : ndarray, shape (n,)
@@ -211,7 +209,6 @@ class ReplayTrace:
     envelope_inside: NDArray[np.int8]
     area_m2: NDArray[np.float64]
     wedge_width_rad: NDArray[np.float64]
-    center: NDArray[np.float64]
     accepted: NDArray[np.int64]
     rejected: NDArray[np.int64]
     update_us: NDArray[np.float64]
@@ -231,7 +228,6 @@ class ReplayTrace:
             np.full(count, -1, dtype=np.int8),
             np.zeros(count),
             np.zeros(count),
-            np.zeros((count, 2)),
             np.zeros(count, dtype=np.int64),
             np.zeros(count, dtype=np.int64),
             np.zeros(count),
@@ -255,7 +251,6 @@ class ReplayTrace:
                 trace.truth[index] = (step.truth.x, step.truth.y, step.truth.heading)
             trace.area_m2[index] = step.map.area
             trace.wedge_width_rad[index] = step.map.wedge.width
-            trace.center[index] = step.map.center
             trace.accepted[index] = step.accepted
             trace.rejected[index] = step.rejected
             trace.update_us[index] = step.update_us
@@ -690,7 +685,6 @@ class _Judge:
         trace = self.trace
         trace.area_m2[index] = working.area
         trace.wedge_width_rad[index] = working.wedge.width
-        trace.center[index] = working.center
         self.indices.append(index)
         self.working.append(working)
         if envelope is not None:
