@@ -441,3 +441,37 @@ def test_a_file_over_the_size_limit_is_refused_stating_it(
 def test_a_log_csv_may_exceed_the_general_file_limit() -> None:
     # 2,000,000 rows of repr floats do not fit in 64 MiB.
     assert log_io.LOG_CSV_MAX_BYTES >= 2_000_000 * 80 > MAX_BYTES
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.floats(0.0, 1.0), st.floats(-2.0, 2.0), st.floats(-1.0, 1.0)), min_size=1, max_size=20
+    ),
+    st.sampled_from(["\n", "\r\n"]),
+)
+def test_numbers_read_column_wise_equal_those_read_cell_by_cell(
+    rows: list[tuple[float, float, float]], newline: str
+) -> None:
+    # A quoted cell sends the file through the cell-by-cell reader, which must agree.
+    times = np.cumsum([1.0 + step for step, _, _ in rows]).tolist()
+    plain = [
+        "# odometry",
+        "time,v,omega",
+        *(f"{t!r}, {v!r},{w!r}" for t, (_, v, w) in zip(times, rows, strict=True)),
+    ]
+    quoted = [
+        "# odometry",
+        "time,v,omega",
+        *(f'"{t!r}",{v!r},{w!r}' for t, (_, v, w) in zip(times, rows, strict=True)),
+    ]
+    read = []
+    for lines in (plain, quoted):
+        with tempfile.TemporaryDirectory() as scratch:
+            files = dict(VALID_FILES, **{"odometry.csv": newline.join(lines) + newline})
+            read.append(load_log(write_files(Path(scratch), files)).odometry)
+    fast, slow = read
+    assert fast is not None
+    assert slow is not None
+    for name in ("time", "v", "omega"):
+        assert np.array_equal(getattr(fast, name), getattr(slow, name))

@@ -416,22 +416,20 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
     table.at_least("range", measured)
     table.at_least("bearing_error", bearing_error, positive=True)
     table.at_least("range_error", range_error)
-    try:
-        return tuple(
-            LogObservation(*values)
-            for values in zip(
-                times.tolist(),
-                ids,
-                bearing.tolist(),
-                _given(measured),
-                _given(bearing_error),
-                _given(range_error),
-                table.lines,
-                strict=True,
-            )
+    # Every column was checked above, as LogObservation checks each value.
+    return tuple(
+        LogObservation._checked(*values)
+        for values in zip(
+            times.tolist(),
+            ids,
+            bearing.tolist(),
+            _given(measured),
+            _given(bearing_error),
+            _given(range_error),
+            table.lines,
+            strict=True,
         )
-    except InputError as exc:  # pragma: no cover - every value was checked above
-        table.fail("", str(exc))
+    )
 
 
 def _read_odometry(path: Path, units: Units) -> Odometry:

@@ -263,6 +263,36 @@ class LogObservation:
             object.__setattr__(self, "range_error", _bounded(self.range_error, "LogObservation.range_error"))
         integer_at_least(self.line, "LogObservation.line", 0)
 
+    @classmethod
+    def _checked(
+        cls,
+        time: float,
+        landmark_id: str,
+        bearing: float,
+        range: float | None,
+        bearing_error: float | None,
+        range_error: float | None,
+        line: int,
+    ) -> LogObservation:
+        """Build one from values a reader has already checked column by column.
+
+        The log reader validates every column at once (finite, in range, a listed
+        landmark id); a 10^6-row file then does not check each value a second time here.
+        Only the bearing is wrapped, as :meth:`__post_init__` wraps it.
+        """
+        observation = object.__new__(cls)
+        for name, value in (
+            ("time", time),
+            ("landmark_id", landmark_id),
+            ("bearing", _wrapped(bearing)),
+            ("range", range),
+            ("bearing_error", bearing_error),
+            ("range_error", range_error),
+            ("line", line),
+        ):
+            object.__setattr__(observation, name, value)
+        return observation
+
     @property
     def kind(self) -> ObservationKind:
         """:attr:`ObservationKind.RANGE_BEARING` when a range is given, else ``BEARING``."""
