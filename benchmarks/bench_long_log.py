@@ -48,6 +48,7 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
     began = time.perf_counter()
     log = load_log(folder)
     loaded = time.perf_counter()
+    load_peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     table = TerrainTable.from_toml(terrain)
     motion, working, envelope = load_sensors(sensors)
     options = ReplayOptions(
@@ -78,6 +79,7 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
         "steps": metrics["steps"],
         "containment_rate": metrics["containment_rate"],
         "peak_mb": peak_mb,
+        "load_peak_mb": load_peak_mb,
     }
     print(json.dumps(figures))
 
@@ -113,7 +115,7 @@ def main() -> None:
         terrain.write_text(calibration.terrain_table().to_toml())
         sensors.write_text(calibration.sensors_toml())
         print(f"{'rows':>9} {'steps':>7} {'load s':>7} {'update s':>9} {'total s':>8} "
-              f"{'ms/1000 rows':>13} {'peak MB':>8} {'containment':>11}")  # fmt: skip
+              f"{'ms/1000 rows':>13} {'load peak MB':>13} {'peak MB':>8} {'containment':>11}")  # fmt: skip
         for rows in args.rows:
             folder = make_long_log(work / f"log-{rows}", rows, frame_every=args.frame_every)
             out = work / f"out-{rows}"
@@ -121,8 +123,9 @@ def main() -> None:
             figures = _replay(args.src, folder, terrain, sensors, out)
             print(
                 f"{rows:>9} {figures['steps']:>7} {figures['load_s']:>7.2f} {figures['update_s']:>9.2f} "
-                f"{figures['total_s']:>8.2f} {1000.0 * figures['total_s'] / rows * 1000.0:>13.2f} "
-                f"{figures['peak_mb']:>8.0f} {figures['containment_rate']:>11.4f}",
+                f"{figures['total_s']:>8.2f} {1e6 * figures['total_s'] / rows:>13.2f} "
+                f"{figures['load_peak_mb']:>13.0f} {figures['peak_mb']:>8.0f} "
+                f"{figures['containment_rate']:>11.4f}",
                 flush=True,
             )
             for path in (*folder.iterdir(), *out.iterdir()):
