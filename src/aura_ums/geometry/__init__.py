@@ -19,11 +19,10 @@ from aura_ums.geometry._convex import (
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
 from aura_ums.geometry._pose import Pose
-from aura_ums.geometry._wedge import ANGLE_TOLERANCE, HeadingWedge
+from aura_ums.geometry._wedge import HeadingWedge
 from aura_ums.geometry._window import UNBOUNDED_PIXELS, ImageWindow
 
 __all__ = [
-    "ANGLE_TOLERANCE",
     "POSITION_TOLERANCE",
     "UNBOUNDED_PIXELS",
     "Arc",

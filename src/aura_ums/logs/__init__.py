@@ -41,7 +41,6 @@ from aura_ums.logs._log import (
 from aura_ums.logs._mrclam import import_mrclam, read_mrclam
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, odometry_to_commands
 from aura_ums.logs._replay import (
-    STEPS_CSV_HEADER,
     ReplayOptions,
     ReplayResult,
     ReplayStep,
@@ -54,7 +53,6 @@ from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
-    "STEPS_CSV_HEADER",
     "Calibration",
     "GroundTruth",
     "LogLandmark",

@@ -20,7 +20,7 @@ from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import ANGLE_TOLERANCE, POSITION_TOLERANCE, ConvexPolygon
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.manager import (
@@ -47,7 +47,7 @@ from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
 
 _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
 
-#: Header of the per-step CSV (``replay --steps-csv``): the metrics table's columns of that file.
+# Header of the per-step CSV (``replay --steps-csv``): the metrics table's columns of that file.
 STEPS_CSV_HEADER = ",".join(key.name for key in Metrics.table() if STEPS_CSV in key.written_by)
 
 # Steps judged against the ground truth together (and written to the per-step CSV together):
@@ -270,7 +270,7 @@ class ReplayTrace:
         return tuple(_STATES[code] for code in self.state.tolist())
 
     def csv_lines(self, start: int = 0, stop: int | None = None) -> list[str]:
-        """Return the per-step CSV rows (:data:`STEPS_CSV_HEADER`) of steps ``start`` to ``stop``.
+        """Return the per-step CSV rows of steps ``start`` to ``stop`` (columns: ``docs/metrics.md``).
 
         Floats are ``repr``, ``update_us`` three decimals; ``inside`` is empty without truth.
         """
@@ -553,10 +553,11 @@ def replay_log(
         :attr:`ReplayResult.steps`, which needs them). A long log's replay that only wants
         the figures passes False: its memory then stays a few numbers per step.
     steps_csv : path-like or None
-        Write the per-step CSV (:data:`STEPS_CSV_HEADER`, one row per step) here, row
-        blocks as the replay makes them: into a hidden scratch file beside it, renamed
-        onto it at the end, so a replay that fails or is interrupted leaves no partial
-        file under that name. Its folder is created when missing.
+        Write the per-step CSV (the ``replay --steps-csv`` columns of ``docs/metrics.md``,
+        one row per step) here, row blocks as the replay makes them: into a hidden scratch
+        file beside it, renamed onto it at the end, so a replay that fails or is
+        interrupted leaves no partial file under that name. Its folder is created when
+        missing.
 
     Returns
     -------
@@ -739,13 +740,10 @@ def _contains(maps: Sequence[SpatialUncertaintyMap], poses: NDArray[np.float64])
     relative_y = np.repeat(pose[:, 1], counts) - vertices[:, 1]
     signed = (edge[:, 0] * relative_y - edge[:, 1] * relative_x) / length
     in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
-    center = np.array([m.wedge.center for m in chosen])
-    cw = np.array([m.wedge.cw for m in chosen])
-    ccw = np.array([m.wedge.ccw for m in chosen])
-    full = cw + ccw >= math.tau
-    width = np.minimum(cw + ccw, math.tau)
-    offset = np.mod(pose[:, 2] - (center - cw), math.tau)
-    in_wedge = full | (offset <= width + ANGLE_TOLERANCE) | (offset >= math.tau - ANGLE_TOLERANCE)
+    in_wedge = np.array(
+        [m.wedge.contains(heading) for m, heading in zip(chosen, pose[:, 2].tolist(), strict=True)],
+        dtype=bool,
+    )
     result[batched] = in_polygon & in_wedge
     return result
 
