@@ -108,3 +108,33 @@ def assert_same_log(actual: RobotLog, expected: RobotLog, *, lines: bool = False
             np.testing.assert_array_equal(
                 getattr(actual.groundtruth, name), getattr(expected.groundtruth, name)
             )
+
+
+def long_odometry_log(rows: int, *, rate: float = 100.0, frame_every: int = 100) -> RobotLog:
+    """A long log of ``rows`` odometry rows: a figure of eight among four poles, all numpy.
+
+    The odometry is the exact path's speed and turn rate; every ``frame_every``-th row is
+    a frame observing, without error, each pole within 9 m and 0.6 rad of the heading.
+    """
+    w = 2.0 * np.pi / 120.0
+    t = np.arange(rows) / rate
+    x, y = 3.0 * np.sin(w * t), 1.5 * np.sin(2.0 * w * t)
+    dx, dy = 3.0 * w * np.cos(w * t), 3.0 * w * np.cos(2.0 * w * t)
+    ddx, ddy = -3.0 * w * w * np.sin(w * t), -6.0 * w * w * np.sin(2.0 * w * t)
+    speed = np.hypot(dx, dy)
+    heading = np.arctan2(dy, dx)
+    poles = {"N": (0.0, 6.5), "E": (6.5, 0.0), "S": (0.0, -6.5), "W": (-6.5, 0.0)}
+    observations = []
+    for row in range(frame_every, rows, frame_every):
+        for name, (px, py) in poles.items():
+            distance = float(np.hypot(px - x[row], py - y[row]))
+            bearing = float(np.angle(np.exp(1j * (np.arctan2(py - y[row], px - x[row]) - heading[row]))))
+            if distance <= 9.0 and abs(bearing) <= 0.6:
+                observations.append(LogObservation(float(t[row]), name, bearing, range=distance))
+    return RobotLog(
+        LogMeta("long", terrain="floor", bearing_error=0.01, range_error=0.05),
+        tuple(LogLandmark(name, px, py) for name, (px, py) in poles.items()),
+        tuple(observations),
+        odometry=Odometry(t, speed, (dx * ddy - dy * ddx) / speed**2),
+        groundtruth=GroundTruth(t, x, y, heading),
+    )

@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from aura_ums._files import MAX_BYTES
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
     LogLandmark,
@@ -23,6 +24,7 @@ from aura_ums.logs import (
     load_log,
     write_log,
 )
+from aura_ums.logs import _io as log_io
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import FOOT, TurnAndRun
 from tests.logs.log_helpers import VALID_FILES, assert_same_log, small_log, write_files
@@ -424,9 +426,52 @@ def test_too_many_rows_are_refused_at_the_first_one_over(
         load_log(folder)
 
 
-def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> None:
+def test_a_file_over_the_size_limit_is_refused_stating_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The real limit (256 MiB) would make the test read 256 MiB; a small one shows the same path.
+    monkeypatch.setattr(log_io, "LOG_CSV_MAX_BYTES", 2 * 1024 * 1024)
     folder = write_files(tmp_path, VALID_FILES)
     with (folder / "odometry.csv").open("ab") as handle:
-        handle.truncate(64 * 1024 * 1024 + 1)
-    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 64 MiB \("):
+        handle.truncate(2 * 1024 * 1024 + 1)
+    with pytest.raises(FileFormatError, match=r"odometry\.csv: expected a CSV file of at most 2 MiB \("):
         load_log(folder)
+
+
+def test_a_log_csv_may_exceed_the_general_file_limit() -> None:
+    # 2,000,000 rows of repr floats do not fit in 64 MiB.
+    assert log_io.LOG_CSV_MAX_BYTES >= 2_000_000 * 80 > MAX_BYTES
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.floats(0.0, 1.0), st.floats(-2.0, 2.0), st.floats(-1.0, 1.0)), min_size=1, max_size=20
+    ),
+    st.sampled_from(["\n", "\r\n"]),
+)
+def test_numbers_read_column_wise_equal_those_read_cell_by_cell(
+    rows: list[tuple[float, float, float]], newline: str
+) -> None:
+    # A quoted cell sends the file through the cell-by-cell reader, which must agree.
+    times = np.cumsum([1.0 + step for step, _, _ in rows]).tolist()
+    plain = [
+        "# odometry",
+        "time,v,omega",
+        *(f"{t!r}, {v!r},{w!r}" for t, (_, v, w) in zip(times, rows, strict=True)),
+    ]
+    quoted = [
+        "# odometry",
+        "time,v,omega",
+        *(f'"{t!r}",{v!r},{w!r}' for t, (_, v, w) in zip(times, rows, strict=True)),
+    ]
+    read = []
+    for lines in (plain, quoted):
+        with tempfile.TemporaryDirectory() as scratch:
+            files = dict(VALID_FILES, **{"odometry.csv": newline.join(lines) + newline})
+            read.append(load_log(write_files(Path(scratch), files)).odometry)
+    fast, slow = read
+    assert fast is not None
+    assert slow is not None
+    for name in ("time", "v", "omega"):
+        assert np.array_equal(getattr(fast, name), getattr(slow, name))

@@ -151,10 +151,15 @@ def replay(
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
         options = _options(classes, sensors, settings.over())
+        # A map per step only for the outputs that draw them: a long log's replay stays lean.
+        keep_maps = plot is not None or mcap is not None
         if camera is None:
-            result = replay_log(log, table, options)
+            result = replay_log(log, table, options, keep_maps=keep_maps, steps_csv=steps_csv)
         else:
-            result, windows = replay_windows(log, table, load_camera(camera), options, margin=window_margin)
+            result, windows = replay_windows(
+                log, table, load_camera(camera), options, margin=window_margin, keep_maps=keep_maps,
+                steps_csv=steps_csv,
+            )
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
@@ -163,15 +168,6 @@ def replay(
     if metrics_json is not None:
         write_metrics_json(metrics_json, metrics)
     if steps_csv is not None:
-        steps_csv.parent.mkdir(parents=True, exist_ok=True)
-        lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
-        for s in result.steps:
-            inside = "" if s.inside is None else str(int(s.inside))
-            lines.append(
-                f"{s.time!r},{inside},{s.map.area!r},{s.map.wedge.width!r},{s.accepted},{s.rejected},"
-                f"{s.update_us:.3f},{s.state.value},{int(s.relocalized)}"
-            )
-        steps_csv.write_text("\n".join(lines) + "\n")
         console.print(f"wrote {steps_csv}")
     if windows_csv is not None and windows is not None:
         windows_csv.parent.mkdir(parents=True, exist_ok=True)

@@ -41,11 +41,12 @@ from aura_ums.logs._log import (
     RobotLog,
 )
 from aura_ums.logs._mrclam import import_mrclam, read_mrclam
-from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
+from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, odometry_to_commands
 from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
     ReplayStep,
+    ReplayTrace,
     log_meadow_map,
     observation_for,
     replay_log,
@@ -67,6 +68,7 @@ __all__ = [
     "ReplayOptions",
     "ReplayResult",
     "ReplayStep",
+    "ReplayTrace",
     "ReverseMotion",
     "RobotLog",
     "SensorBounds",
@@ -84,6 +86,7 @@ __all__ = [
     "log_meadow_map",
     "observation_errors",
     "observation_for",
+    "odometry_report_arrays",
     "odometry_to_commands",
     "read_mrclam",
     "read_rosbag",

@@ -20,7 +20,16 @@ from typing import NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import Fields, describe, key_path, load_csv, load_toml
+from aura_ums._files import (
+    CsvFloats,
+    Fields,
+    describe,
+    key_path,
+    load_toml,
+    parse_csv,
+    parse_csv_floats,
+    read_text,
+)
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
 from aura_ums.manager import PositionReport
@@ -88,6 +97,11 @@ _FIELD_PLACES = {
 }
 _FIELD_PLACES["start"] = "[start]"
 
+#: Largest CSV file of a log, bytes (256 MiB), above :data:`aura_ums._files.MAX_BYTES`: a log
+#: may hold up to :data:`aura_ums._files.MAX_ROWS` (2,000,000) rows, and a ground-truth row
+#: written with ``repr`` floats (as :func:`write_log` writes) takes up to ~80 bytes.
+LOG_CSV_MAX_BYTES = 256 * 1024 * 1024
+
 #: Line of the first data row in the CSV files :func:`write_log` writes (a comment, then the header).
 FIRST_ROW_LINE = 3
 
@@ -119,29 +133,65 @@ class Units:
 
 
 class _CsvFile:
-    """One CSV file: its path for messages, its columns of stripped cells and their line numbers."""
+    """One CSV file: its path for messages, its columns and their line numbers.
+
+    A file of numbers only is parsed column-wise (:func:`parse_csv_floats`: no Python
+    object per cell, a 10^6-row odometry file in about a second); any other file, or one
+    that the fast path cannot read exactly, cell by cell (:func:`load_csv`).
+    """
 
     def __init__(self, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> None:
         self.source = str(path)
         self.units = columns
-        table = load_csv(path, columns=tuple(columns), required=required)
-        self.lines = table.lines
-        self.cells = table.columns()
+        self.cells: dict[str, list[str]] = {}
+        self.values: dict[str, NDArray[np.float64]] | None = None
+        self.fast: CsvFloats | None = None
+        numeric = all(unit != "text" for unit in columns.values())
+        text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
+        if numeric:
+            self.fast = parse_csv_floats(
+                text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
+            )
+        if self.fast is not None:
+            self.lines: NDArray[np.int64] | tuple[int, ...] = self.fast.lines
+            self.header = self.fast.header
+            self.values = {name: self.fast.values[:, index] for index, name in enumerate(self.fast.header)}
+        else:
+            table = parse_csv(
+                text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
+            )
+            self.lines = table.lines
+            self.header = table.header
+            self.cells = table.columns()
 
     def __len__(self) -> int:
         return len(self.lines)
+
+    def cell(self, column: str, row: int) -> str:
+        """Return one cell's stripped text (row index from 0)."""
+        return self.fast.cell(row, column) if self.fast is not None else self.cells[column][row]
 
     def fail(self, where: str, message: str) -> NoReturn:
         raise FileFormatError(self.source, where, message)
 
     def fail_at(self, row: int, message: str) -> NoReturn:
-        raise FileFormatError(self.source, "", message, line=self.lines[row])
+        raise FileFormatError(self.source, "", message, line=int(self.lines[row]))
 
     def numbers(self, column: str, units: Units, *, optional: bool = False) -> NDArray[np.float64]:
         """Return a column as finite floats in SI; with ``optional``, NaN where absent or empty."""
         factor = units.factor(self.units[column])
-        if column not in self.cells:
+        if column not in self.header:
             return np.full(len(self), np.nan)
+        if self.values is not None:
+            # The fast path read every cell as a number: none is empty.
+            values = self.values[column]
+            bad = ~np.isfinite(values)
+            if np.any(bad):
+                row = int(np.argmax(bad))
+                cell = describe(self.cell(column, row))
+                self.fail_at(row, f"expected a finite number in column {column!r}, got {cell}")
+            fast: NDArray[np.float64] = values * factor
+            return fast
         cells = self.cells[column]
         try:
             values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
@@ -176,7 +226,7 @@ class _CsvFile:
         if np.any(bad):
             row = int(np.argmax(bad))
             expected = f"a positive {column}" if positive else f"a {column} >= 0"
-            self.fail_at(row, f"expected {expected}, got {describe(self.cells[column][row])}")
+            self.fail_at(row, f"expected {expected}, got {describe(self.cell(column, row))}")
 
     def times(self, units: Units, *, strict: bool) -> NDArray[np.float64]:
         """Return the ``time`` column in seconds, checked increasing (strictly or not)."""
@@ -185,17 +235,16 @@ class _CsvFile:
         bad = steps <= 0.0 if strict else steps < 0.0
         if np.any(bad):
             row = int(np.argmax(bad)) + 1
-            cells = self.cells["time"]
             order = "strictly increasing" if strict else "non-decreasing"
             self.fail_at(
                 row,
-                f"expected {order} times, got {describe(cells[row])} after {describe(cells[row - 1])} "
-                f"(line {self.lines[row - 1]})",
+                f"expected {order} times, got {describe(self.cell('time', row))} after "
+                f"{describe(self.cell('time', row - 1))} (line {int(self.lines[row - 1])})",
             )
         return time
 
     def need_rows(self) -> None:
-        if not self.lines:
+        if not len(self.lines):
             self.fail("", "expected at least one data row, got none")
 
 
@@ -367,22 +416,20 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
     table.at_least("range", measured)
     table.at_least("bearing_error", bearing_error, positive=True)
     table.at_least("range_error", range_error)
-    try:
-        return tuple(
-            LogObservation(*values)
-            for values in zip(
-                times.tolist(),
-                ids,
-                bearing.tolist(),
-                _given(measured),
-                _given(bearing_error),
-                _given(range_error),
-                table.lines,
-                strict=True,
-            )
+    # Every column was checked above, as LogObservation checks each value.
+    return tuple(
+        LogObservation._checked(*values)
+        for values in zip(
+            times.tolist(),
+            ids,
+            bearing.tolist(),
+            _given(measured),
+            _given(bearing_error),
+            _given(range_error),
+            table.lines,
+            strict=True,
         )
-    except InputError as exc:  # pragma: no cover - every value was checked above
-        table.fail("", str(exc))
+    )
 
 
 def _read_odometry(path: Path, units: Units) -> Odometry:

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import finite_float, float_array, integer_at_least, read_only
 from aura_ums.errors import InputError, UnknownLandmarkError
 from aura_ums.geometry import wrap_angle
-from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
+from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, reports_of
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
@@ -262,6 +262,36 @@ class LogObservation:
         if self.range_error is not None:
             object.__setattr__(self, "range_error", _bounded(self.range_error, "LogObservation.range_error"))
         integer_at_least(self.line, "LogObservation.line", 0)
+
+    @classmethod
+    def _checked(
+        cls,
+        time: float,
+        landmark_id: str,
+        bearing: float,
+        range: float | None,
+        bearing_error: float | None,
+        range_error: float | None,
+        line: int,
+    ) -> LogObservation:
+        """Build one from values a reader has already checked column by column.
+
+        The log reader validates every column at once (finite, in range, a listed
+        landmark id); a 10^6-row file then does not check each value a second time here.
+        Only the bearing is wrapped, as :meth:`__post_init__` wraps it.
+        """
+        observation = object.__new__(cls)
+        for name, value in (
+            ("time", time),
+            ("landmark_id", landmark_id),
+            ("bearing", _wrapped(bearing)),
+            ("range", range),
+            ("bearing_error", bearing_error),
+            ("range_error", range_error),
+            ("line", line),
+        ):
+            object.__setattr__(observation, name, value)
+        return observation
 
     @property
     def kind(self) -> ObservationKind:
@@ -610,9 +640,58 @@ class RobotLog:
         tuple of PositionReport
             Runs >= 0; times increasing (strictly, except for the ``ReverseMotion.FLIP`` pairs).
         """
+        if self.odometry is None:
+            assert self.commands is not None
+            low, high = self._span(start, end)
+            meta = self.meta
+            reports = []
+            for report in self.commands:
+                time = report.time + meta.delay_s
+                if low < time <= high:
+                    command = TurnAndRun(
+                        report.command.turn * meta.turn_scale, report.command.run * meta.run_scale
+                    )
+                    reports.append(PositionReport(time, command))
+            return tuple(reports)
+        return tuple(
+            reports_of(
+                *self.position_report_arrays(
+                    cut_times, max_interval=max_interval, start=start, end=end, reverse=reverse
+                )
+            )
+        )
+
+    def position_report_arrays(
+        self,
+        cut_times: ArrayLike = (),
+        *,
+        max_interval: float = 0.25,
+        start: float | None = None,
+        end: float | None = None,
+        reverse: ReverseMotion = ReverseMotion.ERROR,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Return :meth:`position_reports` as three arrays: no Python object per report.
+
+        A long log's replay builds each report only when it posts it
+        (:func:`~aura_ums.logs.odometry_report_arrays`).
+
+        Returns
+        -------
+        times, turns, runs : ndarray, shape (m,)
+            Seconds, radians, metres (>= 0): report ``i`` is
+            ``PositionReport(times[i], TurnAndRun(turns[i], runs[i]))``.
+
+        Examples
+        --------
+        >>> log = RobotLog(LogMeta("tiny"), (), (), odometry=Odometry([0.0, 1.0], [1.0, 0.0], [0.0, 0.0]))
+        >>> [array.tolist() for array in log.position_report_arrays([0.5], max_interval=1.0)]
+        [[0.5, 1.0], [0.0, 0.0], [0.5, 0.5]]
+        >>> [array.tolist() for array in log.position_report_arrays(start=1.0)]   # nothing after 1 s
+        [[], [], []]
+        """
         meta = self.meta
         if self.odometry is not None:
-            return odometry_to_commands(
+            return odometry_report_arrays(
                 self.odometry.time,
                 self.odometry.v,
                 self.odometry.omega,
@@ -625,17 +704,17 @@ class RobotLog:
                 end=end,
                 reverse=reverse,
             )
-        assert self.commands is not None
+        reports = self.position_reports(start=start, end=end)
+        return (
+            np.array([report.time for report in reports], dtype=np.float64),
+            np.array([report.command.turn for report in reports], dtype=np.float64),
+            np.array([report.command.run for report in reports], dtype=np.float64),
+        )
+
+    @staticmethod
+    def _span(start: float | None, end: float | None) -> tuple[float, float]:
         low = -math.inf if start is None else finite_float(start, "start")
         high = math.inf if end is None else finite_float(end, "end")
         if high < low:
             raise InputError(f"end: expected a time >= start ({low!r}), got {high!r}")
-        reports = []
-        for report in self.commands:
-            time = report.time + meta.delay_s
-            if low < time <= high:
-                command = TurnAndRun(
-                    report.command.turn * meta.turn_scale, report.command.run * meta.run_scale
-                )
-                reports.append(PositionReport(time, command))
-        return tuple(reports)
+        return low, high

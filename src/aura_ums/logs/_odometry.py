@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -126,7 +127,7 @@ def report_times(
     return result
 
 
-def odometry_to_commands(
+def odometry_report_arrays(
     time: ArrayLike,
     v: ArrayLike,
     omega: ArrayLike,
@@ -139,59 +140,26 @@ def odometry_to_commands(
     start: float | None = None,
     end: float | None = None,
     reverse: ReverseMotion = ReverseMotion.ERROR,
-) -> tuple[PositionReport, ...]:
-    """Integrate recorded velocities into turn-and-run position reports.
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Return the reports of :func:`odometry_to_commands` as arrays: no Python object per report.
 
-    Row ``i`` holds from ``time[i]`` until ``time[i + 1]`` (zero-order hold); the last row
-    only ends the record, and there is no motion outside it. Every time is first delayed by
-    ``delay_s``. The motion from ``start`` to ``end`` is cut at each of ``cut_times`` in
-    ``(start, end]``, at ``end``, and evenly in between wherever two cuts are more than
-    ``max_interval`` apart. The piece ending at each cut ``T`` becomes
-    ``PositionReport(T, TurnAndRun(turn_scale * integral(omega), run_scale * integral(|v|)))``.
-
-    Parameters
-    ----------
-    time : array_like, shape (n,)
-        Seconds, strictly increasing, n >= 1.
-    v : array_like, shape (n,)
-        Forward velocity, m/s.
-    omega : array_like, shape (n,)
-        Angular velocity, rad/s, counter-clockwise positive.
-    cut_times : array_like, shape (k,)
-        Seconds (after the delay, like ``start`` and ``end``) at which a report must end.
-    max_interval : float
-        Longest time, seconds, a report may cover; > 0, ``math.inf`` for none.
-    delay_s : float
-        Seconds, >= 0: the motion recorded at ``t`` happens at ``t + delay_s``.
-    run_scale, turn_scale : float
-        Factors, > 0, applied to the integrated run and turn.
-    start, end : float or None
-        Seconds, ``start <= end``; default the first and the last delayed row time (but
-        never past the other bound when only one is given: the span is then empty).
-    reverse : ReverseMotion
-        ``ERROR`` (default) refuses negative ``v``; ``FLIP`` reports reversing pieces as a
-        turn round, a forward run and a turn back (two reports with the same time).
+    Parameters and errors are those of :func:`odometry_to_commands`.
 
     Returns
     -------
-    tuple of PositionReport
-        Runs >= 0; times strictly increasing (except the ``FLIP`` pairs); empty when
-        ``start == end``. The runs sum to ``run_scale`` times the integral of ``|v|`` and
-        the turns to ``turn_scale`` times the integral of ``omega`` (plus 0 net for flips).
-
-    Raises
-    ------
-    InputError
-        For non-finite or mismatched arrays, unsorted times, bad scales, ``end < start``,
-        or negative ``v`` with ``ReverseMotion.ERROR``.
+    times, turns, runs : ndarray, shape (m,)
+        Seconds, radians and metres (>= 0) of each report, in order; ``FLIP`` pairs are
+        two entries with the same time.
 
     Examples
     --------
-    >>> reports = odometry_to_commands([0.0, 2.0], [0.5, 0.0], [0.1, 0.0], [0.5], max_interval=1.0)
-    >>> [(r.time, round(r.command.turn, 3), r.command.run) for r in reports]
-    [(0.5, 0.05, 0.25), (1.25, 0.075, 0.375), (2.0, 0.075, 0.375)]
-    >>> odometry_to_commands([0.0, 1.0], [1.0, 1.0], [0.0, 0.0], start=1.0)   # nothing to cover
-    ()
+    >>> times, turns, runs = odometry_report_arrays([0.0, 2.0], [0.5, 0.0], [0.1, 0.0], max_interval=1.0)
+    >>> times.tolist(), runs.tolist()
+    ([1.0, 2.0], [0.5, 0.5])
+    >>> odometry_report_arrays([0.0, 1.0], [1.0, 0.0], [0.0, 0.0], max_interval=0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: max_interval: expected a positive number of seconds (or inf), got 0.0
     """
     t = float_array(time, "time").reshape(-1)
     forward = float_array(v, "v").reshape(-1)
@@ -245,23 +213,124 @@ def odometry_to_commands(
         boundaries = np.concatenate((cuts, t[changes]))
     times = report_times(boundaries, low, high, float(max_interval))
     if len(times) == 0:
-        return ()
+        empty = np.empty(0)
+        return empty, empty, empty
     edges = np.concatenate(([low], times))
     turn = np.diff(cumulative_integral(t, angular, edges)) * turn_scale
-    ahead = np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale
-    back = np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale
-    reports: list[PositionReport] = []
-    for when, piece_turn, piece_ahead, piece_back in zip(
-        times.tolist(),
-        turn.tolist(),
-        np.maximum(ahead, 0.0).tolist(),
-        np.maximum(back, 0.0).tolist(),
-        strict=True,
-    ):
-        if piece_back > 0.0:
-            # Cut at every sign change, so a piece backing up runs no distance forward.
-            reports.append(PositionReport(when, TurnAndRun(piece_turn + math.pi, piece_back)))
-            reports.append(PositionReport(when, TurnAndRun(-math.pi, 0.0)))
-        else:
-            reports.append(PositionReport(when, TurnAndRun(piece_turn, piece_ahead)))
-    return tuple(reports)
+    ahead = np.maximum(np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale, 0.0)
+    back = np.maximum(np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale, 0.0)
+    flipped = back > 0.0
+    if not np.any(flipped):
+        return times, turn, ahead
+    # Cut at every sign change, so a piece backing up runs no distance forward: it
+    # becomes a turn round and a run, then, at the same time, a turn back.
+    count = np.where(flipped, 2, 1)
+    first = np.cumsum(count) - count
+    out_times = np.repeat(times, count)
+    out_turns = np.repeat(turn, count)
+    out_runs = np.repeat(ahead, count)
+    out_turns[first[flipped]] = turn[flipped] + math.pi
+    out_runs[first[flipped]] = back[flipped]
+    out_turns[first[flipped] + 1] = -math.pi
+    out_runs[first[flipped] + 1] = 0.0
+    return out_times, out_turns, out_runs
+
+
+def odometry_to_commands(
+    time: ArrayLike,
+    v: ArrayLike,
+    omega: ArrayLike,
+    cut_times: ArrayLike = (),
+    *,
+    max_interval: float = 0.25,
+    delay_s: float = 0.0,
+    run_scale: float = 1.0,
+    turn_scale: float = 1.0,
+    start: float | None = None,
+    end: float | None = None,
+    reverse: ReverseMotion = ReverseMotion.ERROR,
+) -> tuple[PositionReport, ...]:
+    """Integrate recorded velocities into turn-and-run position reports.
+
+    Row ``i`` holds from ``time[i]`` until ``time[i + 1]`` (zero-order hold); the last row
+    only ends the record, and there is no motion outside it. Every time is first delayed by
+    ``delay_s``. The motion from ``start`` to ``end`` is cut at each of ``cut_times`` in
+    ``(start, end]``, at ``end``, and evenly in between wherever two cuts are more than
+    ``max_interval`` apart. The piece ending at each cut ``T`` becomes
+    ``PositionReport(T, TurnAndRun(turn_scale * integral(omega), run_scale * integral(|v|)))``.
+    :func:`odometry_report_arrays` gives the same reports as three arrays.
+
+    Parameters
+    ----------
+    time : array_like, shape (n,)
+        Seconds, strictly increasing, n >= 1.
+    v : array_like, shape (n,)
+        Forward velocity, m/s.
+    omega : array_like, shape (n,)
+        Angular velocity, rad/s, counter-clockwise positive.
+    cut_times : array_like, shape (k,)
+        Seconds (after the delay, like ``start`` and ``end``) at which a report must end.
+    max_interval : float
+        Longest time, seconds, a report may cover; > 0, ``math.inf`` for none.
+    delay_s : float
+        Seconds, >= 0: the motion recorded at ``t`` happens at ``t + delay_s``.
+    run_scale, turn_scale : float
+        Factors, > 0, applied to the integrated run and turn.
+    start, end : float or None
+        Seconds, ``start <= end``; default the first and the last delayed row time (but
+        never past the other bound when only one is given: the span is then empty).
+    reverse : ReverseMotion
+        ``ERROR`` (default) refuses negative ``v``; ``FLIP`` reports reversing pieces as a
+        turn round, a forward run and a turn back (two reports with the same time).
+
+    Returns
+    -------
+    tuple of PositionReport
+        Runs >= 0; times strictly increasing (except the ``FLIP`` pairs); empty when
+        ``start == end``. The runs sum to ``run_scale`` times the integral of ``|v|`` and
+        the turns to ``turn_scale`` times the integral of ``omega`` (plus 0 net for flips).
+
+    Raises
+    ------
+    InputError
+        For non-finite or mismatched arrays, unsorted times, bad scales, ``end < start``,
+        or negative ``v`` with ``ReverseMotion.ERROR``.
+
+    Examples
+    --------
+    >>> reports = odometry_to_commands([0.0, 2.0], [0.5, 0.0], [0.1, 0.0], [0.5], max_interval=1.0)
+    >>> [(r.time, round(r.command.turn, 3), r.command.run) for r in reports]
+    [(0.5, 0.05, 0.25), (1.25, 0.075, 0.375), (2.0, 0.075, 0.375)]
+    >>> odometry_to_commands([0.0, 1.0], [1.0, 1.0], [0.0, 0.0], start=1.0)   # nothing to cover
+    ()
+    """
+    times, turns, runs = odometry_report_arrays(
+        time,
+        v,
+        omega,
+        cut_times,
+        max_interval=max_interval,
+        delay_s=delay_s,
+        run_scale=run_scale,
+        turn_scale=turn_scale,
+        start=start,
+        end=end,
+        reverse=reverse,
+    )
+    return tuple(reports_of(times, turns, runs))
+
+
+def reports_of(
+    times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64]
+) -> Iterator[PositionReport]:
+    """Yield the position reports of :func:`odometry_report_arrays`' arrays, one at a time.
+
+    Examples
+    --------
+    >>> list(reports_of(np.array([0.5]), np.array([0.1]), np.array([0.2])))
+    [PositionReport(time=0.5, command=TurnAndRun(turn=0.1, run=0.2))]
+    >>> list(reports_of(np.empty(0), np.empty(0), np.empty(0)))
+    []
+    """
+    for when, turn, run in zip(times.tolist(), turns.tolist(), runs.tolist(), strict=True):
+        yield PositionReport(when, TurnAndRun(turn, run))

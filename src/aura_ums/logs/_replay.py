@@ -4,18 +4,23 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import secrets
 import time as _time
 import types
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TextIO
 
 import numpy as np
+from numpy.typing import NDArray
 
-from aura_ums._metrics import Metrics
+from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
-from aura_ums.errors import InputError
+from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import ConvexPolygon
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.manager import (
@@ -35,6 +40,7 @@ from aura_ums.uncertainty import (
     RangeBearingObservation,
     SpatialUncertaintyMap,
     TerrainTable,
+    TurnAndRun,
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
@@ -44,6 +50,17 @@ _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
 #: :func:`replay_log`'s ``before_frame``: called with a frame's time (s), the working map grown
 #: to it (before the frame's observations reduce it) and the frame's log rows.
 FrameHook = Callable[[float, SpatialUncertaintyMap, Sequence[LogObservation]], None]
+
+# Header of the per-step CSV (``replay --steps-csv``): the metrics table's columns of that file.
+STEPS_CSV_HEADER = ",".join(key.name for key in Metrics.table() if STEPS_CSV in key.written_by)
+
+# Steps judged against the ground truth together (and written to the per-step CSV together):
+# numpy over many maps at once costs far less than a call per map; the buffer stays small.
+_CHUNK = 1024
+# Polygons of more vertices are judged one by one (Polygon.contains' own dense branch holds
+# up to 4096 point-edge pairs: below that, the batched arithmetic is the same, bit for bit).
+_BATCHED_VERTICES = 1024
+_STATES = tuple(ManagerState)
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,6 +175,131 @@ class ReplayStep:
     envelope_inside: bool | None = None
 
 
+def _flags(values: Sequence[bool | None]) -> NDArray[np.int8]:
+    return np.array([-1 if value is None else int(value) for value in values], dtype=np.int8)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ReplayTrace:
+    """The figures of every step of a replay, column by column: all the metrics and the per-step CSV need.
+
+    A few numbers a step, whatever the size of its map: a replay of 10^5 frames keeps
+    about 10 MB here, where one map per step would take gigabytes.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        Seconds, one per frame, in time order.
+    truth : ndarray, shape (n, 3)
+        Ground-truth x (m), y (m), heading (rad) at each step; NaN rows without truth.
+    inside, envelope_inside : ndarray of int8, shape (n,)
+        1 when the truth is inside the working (envelope) map, 0 when not, -1 when not
+        judged (no truth; for the envelope, no envelope map either).
+    area_m2, wedge_width_rad : ndarray, shape (n,)
+        The working map's area (m^2) and heading wedge width (rad) after the step.
+    accepted, rejected : ndarray of int64, shape (n,)
+        Observations of the step that reduced the map, and that were rejected.
+    update_us : ndarray, shape (n,)
+        Microseconds of each update.
+    state : ndarray of int8, shape (n,)
+        Index of the manager's state into ``tuple(ManagerState)`` (:attr:`states` gives them).
+    relocalized : ndarray of bool, shape (n,)
+        Whether the working map was re-seeded from the envelope at the step.
+    """
+
+    time: NDArray[np.float64]
+    truth: NDArray[np.float64]
+    inside: NDArray[np.int8]
+    envelope_inside: NDArray[np.int8]
+    area_m2: NDArray[np.float64]
+    wedge_width_rad: NDArray[np.float64]
+    accepted: NDArray[np.int64]
+    rejected: NDArray[np.int64]
+    update_us: NDArray[np.float64]
+    state: NDArray[np.int8]
+    relocalized: NDArray[np.bool_]
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    @classmethod
+    def empty(cls, count: int) -> ReplayTrace:
+        """Return a trace of ``count`` steps to fill in (zeros; truth NaN, not judged)."""
+        return cls(
+            np.zeros(count),
+            np.full((count, 3), np.nan),
+            np.full(count, -1, dtype=np.int8),
+            np.full(count, -1, dtype=np.int8),
+            np.zeros(count),
+            np.zeros(count),
+            np.zeros(count, dtype=np.int64),
+            np.zeros(count, dtype=np.int64),
+            np.zeros(count),
+            np.zeros(count, dtype=np.int8),
+            np.zeros(count, dtype=bool),
+        )
+
+    @classmethod
+    def of_steps(cls, steps: Sequence[ReplayStep]) -> ReplayTrace:
+        """Return the trace of a sequence of :class:`ReplayStep` s.
+
+        Examples
+        --------
+        >>> ReplayTrace.of_steps(()).inside.tolist()
+        []
+        """
+        trace = cls.empty(len(steps))
+        for index, step in enumerate(steps):
+            trace.time[index] = step.time
+            if step.truth is not None:
+                trace.truth[index] = (step.truth.x, step.truth.y, step.truth.heading)
+            trace.area_m2[index] = step.map.area
+            trace.wedge_width_rad[index] = step.map.wedge.width
+            trace.accepted[index] = step.accepted
+            trace.rejected[index] = step.rejected
+            trace.update_us[index] = step.update_us
+            trace.state[index] = _STATES.index(step.state)
+            trace.relocalized[index] = step.relocalized
+        trace.inside[:] = _flags([step.inside for step in steps])
+        trace.envelope_inside[:] = _flags([step.envelope_inside for step in steps])
+        return trace
+
+    def truth_pose(self, index: int) -> Pose | None:
+        """Return the ground-truth pose of step ``index``, None without truth."""
+        x, y, heading = self.truth[index].tolist()
+        return None if math.isnan(x) else Pose(x, y, heading)
+
+    def states(self) -> tuple[ManagerState, ...]:
+        """Return the manager's state at each step."""
+        return tuple(_STATES[code] for code in self.state.tolist())
+
+    def csv_lines(self, start: int = 0, stop: int | None = None) -> list[str]:
+        """Return the per-step CSV rows of steps ``start`` to ``stop`` (columns: ``docs/metrics.md``).
+
+        Floats are ``repr``, ``update_us`` three decimals; ``inside`` is empty without truth.
+        """
+        last = len(self) if stop is None else stop
+        lines = []
+        for time, inside, area, width, accepted, rejected, update_us, state, relocalized in zip(
+            self.time[start:last].tolist(),
+            self.inside[start:last].tolist(),
+            self.area_m2[start:last].tolist(),
+            self.wedge_width_rad[start:last].tolist(),
+            self.accepted[start:last].tolist(),
+            self.rejected[start:last].tolist(),
+            self.update_us[start:last].tolist(),
+            self.state[start:last].tolist(),
+            self.relocalized[start:last].tolist(),
+            strict=True,
+        ):
+            judged = "" if inside < 0 else str(inside)
+            lines.append(
+                f"{time!r},{judged},{area!r},{width!r},{accepted},{rejected},"
+                f"{update_us:.3f},{_STATES[state].value},{int(relocalized)}"
+            )
+        return lines
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class ReplayResult:
     """The outcome of :func:`replay_log`.
@@ -168,35 +310,83 @@ class ReplayResult:
         The log replayed.
     options : ReplayOptions
         How.
-    steps : tuple of ReplayStep
-        One per frame, in time order.
+    trace : ReplayTrace
+        The figures of every step (one per frame, in time order), column by column.
     rejected_counts : Mapping[RejectReason, int]
         Rejected observations by reason.
     relocalizations : int
         Times the working map was re-seeded from the envelope.
+    maps : tuple of SpatialUncertaintyMap or None
+        The working map after each step when the replay kept them (``keep_maps=True``),
+        else None.
     """
 
     log: RobotLog
     options: ReplayOptions
-    steps: tuple[ReplayStep, ...]
+    trace: ReplayTrace
     rejected_counts: Mapping[RejectReason, int]
     relocalizations: int
+    maps: tuple[SpatialUncertaintyMap, ...] | None = None
+
+    @property
+    def steps(self) -> tuple[ReplayStep, ...]:
+        """One :class:`ReplayStep` per frame, in time order (built on each access).
+
+        Raises
+        ------
+        InputError
+            When the replay kept no maps (``keep_maps=False``): its figures are in :attr:`trace`.
+        """
+        if self.maps is None:
+            raise InputError(
+                "ReplayResult.steps: expected a replay that kept its maps (keep_maps=True), "
+                "got one without (its figures are in .trace)"
+            )
+        trace = self.trace
+        inside = trace.inside.tolist()
+        envelope = trace.envelope_inside.tolist()
+        return tuple(
+            ReplayStep(
+                time,
+                step_map,
+                trace.truth_pose(index),
+                None if inside[index] < 0 else bool(inside[index]),
+                accepted,
+                rejected,
+                update_us,
+                state,
+                relocalized,
+                None if envelope[index] < 0 else bool(envelope[index]),
+            )
+            for index, (time, step_map, accepted, rejected, update_us, state, relocalized) in enumerate(
+                zip(
+                    trace.time.tolist(),
+                    self.maps,
+                    trace.accepted.tolist(),
+                    trace.rejected.tolist(),
+                    trace.update_us.tolist(),
+                    trace.states(),
+                    trace.relocalized.tolist(),
+                    strict=True,
+                )
+            )
+        )
 
     @property
     def containment_rate(self) -> float:
         """Fraction of the steps with ground truth whose truth is inside the map (nan without)."""
-        judged = [s.inside for s in self.steps if s.inside is not None]
-        return float(np.mean(judged)) if judged else math.nan
+        judged = self.trace.inside[self.trace.inside >= 0].astype(bool)
+        return float(np.mean(judged)) if judged.size else math.nan
 
     @property
     def median_area_m2(self) -> float:
         """Median area of the map over the steps, m^2."""
-        return float(np.median([s.map.area for s in self.steps])) if self.steps else math.nan
+        return float(np.median(self.trace.area_m2)) if len(self.trace) else math.nan
 
     @property
     def median_wedge_width_rad(self) -> float:
         """Median width of the heading wedge over the steps, radians."""
-        return float(np.median([s.map.wedge.width for s in self.steps])) if self.steps else math.nan
+        return float(np.median(self.trace.wedge_width_rad)) if len(self.trace) else math.nan
 
     @property
     def inconsistent_observations(self) -> int:
@@ -206,14 +396,15 @@ class ReplayResult:
     @property
     def median_update_us(self) -> float:
         """Median microseconds per step's update."""
-        return float(np.median([s.update_us for s in self.steps])) if self.steps else math.nan
+        return float(np.median(self.trace.update_us)) if len(self.trace) else math.nan
 
     def metrics(self) -> Metrics:
         """Return the options and figures of the replay (keys: ``docs/metrics.md``).
 
         Undefined figures (no steps, no ground truth, no envelope) are ``None``.
         """
-        envelope = [s.envelope_inside for s in self.steps if s.envelope_inside is not None]
+        trace = self.trace
+        envelope = trace.envelope_inside[trace.envelope_inside >= 0].astype(bool)
         return Metrics(
             {
                 "log": self.log.meta.name,
@@ -223,13 +414,13 @@ class ReplayResult:
                 "joint_above_rad": self.options.settings.joint_above,
                 "max_vertices": self.options.settings.max_vertices,
                 "envelope_max_vertices": self.options.settings.envelope_max_vertices,
-                "steps": len(self.steps),
-                "steps_with_truth": sum(1 for s in self.steps if s.inside is not None),
+                "steps": len(trace),
+                "steps_with_truth": int(np.count_nonzero(trace.inside >= 0)),
                 "containment_rate": self.containment_rate,
-                "envelope_containment_rate": float(np.mean(envelope)) if envelope else None,
+                "envelope_containment_rate": float(np.mean(envelope)) if envelope.size else None,
                 "median_area_m2": self.median_area_m2,
                 "median_wedge_width_rad": self.median_wedge_width_rad,
-                "accepted_observations": sum(s.accepted for s in self.steps),
+                "accepted_observations": int(trace.accepted.sum()),
                 "inconsistent_observations": self.inconsistent_observations,
                 "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
@@ -336,6 +527,8 @@ def replay_log(
     options: ReplayOptions | None = None,
     *,
     before_frame: FrameHook | None = None,
+    keep_maps: bool = True,
+    steps_csv: str | os.PathLike[str] | None = None,
 ) -> ReplayResult:
     """Run the uncertainty map manager over a log, frame by frame, and judge it against ground truth.
 
@@ -354,6 +547,9 @@ def replay_log(
     that map, then the observations reduce it. The maps are the same as in one update;
     the hook's time is not counted in ``update_us``.
 
+    Memory: the position reports are made one at a time from arrays, and each step
+    keeps a few numbers (:class:`ReplayTrace`); only ``keep_maps`` keeps a map per step.
+
     Parameters
     ----------
     log : RobotLog
@@ -366,6 +562,16 @@ def replay_log(
         Called once per frame, in time order, as ``before_frame(time, grown_map, rows)``:
         seconds, the working map grown to ``time``, the frame's :class:`LogObservation` s.
         :func:`~aura_ums.logs.replay_windows` asks the Expecter there.
+    keep_maps : bool
+        Keep the working map of every step (:attr:`ReplayResult.maps`, and
+        :attr:`ReplayResult.steps`, which needs them). A long log's replay that only wants
+        the figures passes False: its memory then stays a few numbers per step.
+    steps_csv : path-like or None
+        Write the per-step CSV (the ``replay --steps-csv`` columns of ``docs/metrics.md``,
+        one row per step) here, row blocks as the replay makes them: into a hidden scratch
+        file beside it, renamed onto it at the end, so a replay that fails or is
+        interrupted leaves no partial file under that name. Its folder is created when
+        missing.
 
     Returns
     -------
@@ -375,6 +581,8 @@ def replay_log(
     ------
     InputError
         For a bad argument, a terrain missing from ``table``, or a log without a start.
+    FileFormatError
+        When ``steps_csv`` cannot be written.
 
     Examples
     --------
@@ -383,6 +591,9 @@ def replay_log(
     >>> result = replay_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}))
     >>> result.containment_rate, result.inconsistent_observations
     (1.0, 0)
+    >>> lean = replay_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}), keep_maps=False)
+    >>> lean.maps is None, lean.metrics()["steps"] == len(result.steps)
+    (True, True)
     >>> replay_log(log, TerrainTable.default())
     Traceback (most recent call last):
     ...
@@ -397,6 +608,8 @@ def replay_log(
         raise InputError(f"options: expected ReplayOptions or None, got {type(opts).__name__}")
     if log.meta.terrain not in table:
         raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
+    if not isinstance(keep_maps, bool):
+        raise InputError(f"keep_maps: expected True or False, got {keep_maps!r}")
     log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
@@ -414,64 +627,187 @@ def replay_log(
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
-    reports = log.position_reports(frame_times, max_interval=opts.max_interval, start=start_time, end=end)
-    truth_at = (
-        log.groundtruth.at(frame_times)
-        if log.groundtruth is not None
-        else np.full((frame_times.size, 3), np.nan)
+    report_times, report_turns, report_runs = log.position_report_arrays(
+        frame_times, max_interval=opts.max_interval, start=start_time, end=end
     )
+    trace = ReplayTrace.empty(frame_times.size)
+    if log.groundtruth is not None:
+        trace.truth[:] = log.groundtruth.at(frame_times)
+    maps: list[SpatialUncertaintyMap] = []
+    judge = _Judge(trace)
 
-    steps: list[ReplayStep] = []
-    next_report = 0
-    for index, frame_time in enumerate(frame_times):
-        rows = frames[float(frame_time)]
-        working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
-        envelope = (
-            [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows] if robust else None
-        )
-        began = _time.perf_counter()
-        while next_report < len(reports) and reports[next_report].time <= frame_time:
-            board.post_report(reports[next_report])
-            next_report += 1
-        if before_frame is not None:
-            grown = manager.update(board, now=float(frame_time)).map
-            paused = _time.perf_counter()
-            before_frame(float(frame_time), grown, rows)
-            began += _time.perf_counter() - paused
-        for observation in working:
-            board.identified.post(observation)
-        step = manager.update(board, now=float(frame_time), envelope=envelope)
-        elapsed = (_time.perf_counter() - began) * 1e6
-        x, y, heading = truth_at[index]
-        truth = None if math.isnan(x) else Pose(float(x), float(y), float(heading))
-        inside = None if truth is None else bool(step.map.contains(truth.x, truth.y, truth.heading))
-        envelope_map = step.envelope_map
-        envelope_inside = (
-            None
-            if truth is None or envelope_map is None
-            else bool(envelope_map.contains(truth.x, truth.y, truth.heading))
-        )
-        steps.append(
-            ReplayStep(
-                float(frame_time),
-                step.map,
-                truth,
-                inside,
-                len(step.accepted),
-                len(step.rejected),
-                elapsed,
-                step.state,
-                step.relocalized,
-                envelope_inside,
+    with _StepsCsv(steps_csv) as writer:
+        next_report = 0
+        for index, frame_time in enumerate(frame_times.tolist()):
+            rows = frames[frame_time]
+            working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
+            envelope = (
+                [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows] if robust else None
             )
-        )
+            due = []
+            while next_report < report_times.size and report_times[next_report] <= frame_time:
+                due.append(
+                    PositionReport(
+                        float(report_times[next_report]),
+                        TurnAndRun(float(report_turns[next_report]), float(report_runs[next_report])),
+                    )
+                )
+                next_report += 1
+            began = _time.perf_counter()
+            for report in due:
+                board.post_report(report)
+            if before_frame is not None:
+                grown = manager.update(board, now=frame_time).map
+                paused = _time.perf_counter()
+                before_frame(frame_time, grown, rows)
+                began += _time.perf_counter() - paused
+            for observation in working:
+                board.identified.post(observation)
+            step = manager.update(board, now=frame_time, envelope=envelope)
+            trace.update_us[index] = (_time.perf_counter() - began) * 1e6
+            trace.time[index] = frame_time
+            trace.accepted[index] = len(step.accepted)
+            trace.rejected[index] = len(step.rejected)
+            trace.state[index] = _STATES.index(step.state)
+            trace.relocalized[index] = step.relocalized
+            judge.add(index, step.map, step.envelope_map)
+            if keep_maps:
+                maps.append(step.map)
+            if judge.full():
+                writer.write(trace, *judge.flush())
+        writer.write(trace, *judge.flush())
     return ReplayResult(
         log,
         opts,
-        tuple(steps),
+        trace,
         types.MappingProxyType(dict(manager.rejected_counts)),
         manager.relocalizations,
+        tuple(maps) if keep_maps else None,
     )
+
+
+class _Judge:
+    """Collects the maps of a few steps, then judges the truth against them all at once.
+
+    Gives exactly :meth:`SpatialUncertaintyMap.contains`: the same arithmetic, element by
+    element, over the vertices of many polygons together instead of a call per map
+    (which costs more than the map's update on a long log).
+    """
+
+    def __init__(self, trace: ReplayTrace) -> None:
+        self.trace = trace
+        self.first = 0
+        self.indices: list[int] = []
+        self.working: list[SpatialUncertaintyMap] = []
+        self.envelope: list[tuple[int, SpatialUncertaintyMap]] = []
+
+    def add(self, index: int, working: SpatialUncertaintyMap, envelope: SpatialUncertaintyMap | None) -> None:
+        trace = self.trace
+        trace.area_m2[index] = working.area
+        trace.wedge_width_rad[index] = working.wedge.width
+        self.indices.append(index)
+        self.working.append(working)
+        if envelope is not None:
+            self.envelope.append((index, envelope))
+
+    def full(self) -> bool:
+        return len(self.indices) >= _CHUNK
+
+    def flush(self) -> tuple[int, int]:
+        """Judge the collected steps; return the range of step indices done."""
+        trace = self.trace
+        if self.indices:
+            steps = np.array(self.indices)
+            known = ~np.isnan(trace.truth[steps, 0])
+            judged = steps[known]
+            trace.inside[judged] = _contains(
+                [m for m, k in zip(self.working, known, strict=True) if k], trace.truth[judged]
+            )
+            with_envelope = [(i, m) for i, m in self.envelope if not math.isnan(trace.truth[i, 0])]
+            if with_envelope:
+                at = np.array([i for i, _ in with_envelope])
+                trace.envelope_inside[at] = _contains([m for _, m in with_envelope], trace.truth[at])
+        done = (self.first, self.first + len(self.indices))
+        self.first = done[1]
+        self.indices, self.working, self.envelope = [], [], []
+        return done
+
+
+def _contains(maps: Sequence[SpatialUncertaintyMap], poses: NDArray[np.float64]) -> NDArray[np.int8]:
+    """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``)."""
+    result = np.zeros(len(maps), dtype=np.int8)
+    batched: list[int] = []
+    for index, step_map in enumerate(maps):
+        vertices = step_map.polygon.vertices
+        if 3 <= len(vertices) <= _BATCHED_VERTICES and step_map.polygon.area > 0.0:
+            batched.append(index)
+        else:  # a point, a segment, or a huge polygon: its own test
+            x, y, heading = poses[index].tolist()
+            result[index] = step_map.contains(x, y, heading)
+    if not batched:
+        return result
+    chosen = [maps[index] for index in batched]
+    counts = np.array([len(m.polygon.vertices) for m in chosen])
+    first = np.cumsum(counts) - counts
+    vertices = np.concatenate([m.polygon.vertices for m in chosen])
+    following = np.arange(1, len(vertices) + 1)
+    following[first + counts - 1] = first
+    edge = vertices[following] - vertices
+    length = np.hypot(edge[:, 0], edge[:, 1])
+    pose = poses[batched]
+    relative_x = np.repeat(pose[:, 0], counts) - vertices[:, 0]
+    relative_y = np.repeat(pose[:, 1], counts) - vertices[:, 1]
+    signed = (edge[:, 0] * relative_y - edge[:, 1] * relative_x) / length
+    in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
+    in_wedge = np.array(
+        [m.wedge.contains(heading) for m, heading in zip(chosen, pose[:, 2].tolist(), strict=True)],
+        dtype=bool,
+    )
+    result[batched] = in_polygon & in_wedge
+    return result
+
+
+class _StepsCsv:
+    """The per-step CSV, written block by block into a scratch file renamed onto the target at the end."""
+
+    def __init__(self, target: str | os.PathLike[str] | None) -> None:
+        self.target = None if target is None else Path(target)
+        self.scratch: Path | None = None
+        self.stream: TextIO | None = None
+
+    def __enter__(self) -> _StepsCsv:
+        if self.target is not None:
+            target = self.target
+            self.scratch = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
+            try:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay).
+                self.stream = self.scratch.open("x", encoding="utf-8", newline="")
+                self.stream.write(STEPS_CSV_HEADER + "\n")
+            except OSError as exc:
+                raise FileFormatError(
+                    str(target), "", f"expected a writable file, got {exc.strerror or exc}"
+                ) from None
+        return self
+
+    def write(self, trace: ReplayTrace, start: int, stop: int) -> None:
+        if self.stream is not None and stop > start:
+            self.stream.write("".join(line + "\n" for line in trace.csv_lines(start, stop)))
+
+    def __exit__(self, kind: object, error: object, traceback: object) -> None:
+        if self.stream is None or self.scratch is None or self.target is None:
+            return
+        self.stream.close()
+        if error is not None:
+            self.scratch.unlink(missing_ok=True)
+            return
+        try:
+            os.replace(self.scratch, self.target)
+        except OSError as exc:
+            self.scratch.unlink(missing_ok=True)
+            raise FileFormatError(
+                str(self.target), "", f"expected a writable file, got {exc.strerror or exc}"
+            ) from None
 
 
 def with_motion(log: RobotLog, motion: MotionCalibration | None) -> RobotLog:

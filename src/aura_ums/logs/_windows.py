@@ -20,6 +20,7 @@ the range and the point's known height.
 from __future__ import annotations
 
 import math
+import os
 import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -268,6 +269,8 @@ def replay_windows(
     bearing_sd: float | None = None,
     range_sd_fraction: float | None = None,
     sigmas: float = 3.0,
+    keep_maps: bool = True,
+    steps_csv: str | os.PathLike[str] | None = None,
 ) -> tuple[ReplayResult, WindowReport]:
     """Replay a log and judge, for each real observation, the image windows of three methods.
 
@@ -298,6 +301,8 @@ def replay_windows(
         the replay's working bounds.
     sigmas : float
         Half-width of the EKF's box in standard deviations, > 0.
+    keep_maps, steps_csv
+        As for :func:`replay_log`.
 
     Returns
     -------
@@ -351,7 +356,7 @@ def replay_windows(
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
 
     judge = _Judge(log, table, camera, opts, pixels, box_sigmas, b_sd, r_sd, bounds)
-    result = replay_log(log, table, opts, before_frame=judge)
+    result = replay_log(log, table, opts, before_frame=judge, keep_maps=keep_maps, steps_csv=steps_csv)
     return result, WindowReport(camera, pixels, tuple(judge.rows))
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -210,6 +211,11 @@ Landmark = VerticalLineLandmark | PointLandmark | GroundLineLandmark
 
 
 def _sensor_offset(value: ArrayLike, name: str) -> tuple[float, float]:
+    if isinstance(value, tuple) and len(value) == 2:
+        forward, left = value
+        if type(forward) is float and type(left) is float and math.isfinite(forward + left):
+            # The common case (the default (0.0, 0.0)): no array built, twice per log row.
+            return (forward, left)
     offset = points_array(value, name, min_rows=1)
     if offset.shape != (1, 2):
         raise InputError(f"{name}: expected (forward, left) metres, got shape {offset.shape}")

@@ -1,0 +1,108 @@
+"""Long logs: a replay keeps a few numbers per step, streams its per-step CSV, and judges as before."""
+
+from __future__ import annotations
+
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs import (
+    ReplayOptions,
+    ReplayResult,
+    ReplayTrace,
+    RobotLog,
+    replay_log,
+    synthetic_log,
+)
+from aura_ums.uncertainty import LandmarkClass, TerrainTable
+from tests.logs.log_helpers import long_odometry_log
+
+FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
+OPTIONS = ReplayOptions(landmark_class=LandmarkClass.POINT)
+
+
+@pytest.fixture(scope="module")
+def long_log() -> RobotLog:
+    return long_odometry_log(100_000)  # 1,000 s of 100 Hz odometry, a frame a second
+
+
+def _retained_bytes(log: RobotLog, *, keep_maps: bool) -> tuple[int, ReplayResult]:
+    """Bytes the replay's result still holds once it returns (tracemalloc), and the result."""
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        result = replay_log(log, FLOOR, OPTIONS, keep_maps=keep_maps)
+        after = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    return after - before, result
+
+
+def test_a_long_log_replays_keeping_a_few_numbers_per_step_unless_maps_are_asked(
+    long_log: RobotLog,
+) -> None:
+    lean_bytes, lean = _retained_bytes(long_log, keep_maps=False)
+    full_bytes, full = _retained_bytes(long_log, keep_maps=True)
+    steps = len(lean.trace)
+    assert steps > 500
+    assert lean.maps is None
+    assert full.maps is not None
+    assert len(full.maps) == steps
+    # The trace's columns (~100 bytes a step); a map per step costs ten times that and more.
+    assert lean_bytes / steps < 300
+    assert full_bytes / steps > 1_000
+    assert lean.metrics().to_dict() | {"median_update_us": 0} == full.metrics().to_dict() | {
+        "median_update_us": 0
+    }
+    with pytest.raises(InputError, match=r"ReplayResult\.steps: expected a replay that kept its maps"):
+        _ = lean.steps
+
+
+def test_the_trace_holds_what_the_steps_hold(long_log: RobotLog) -> None:
+    result = replay_log(long_log, FLOOR, OPTIONS)
+    rebuilt = ReplayTrace.of_steps(result.steps)
+    for name in ReplayTrace.__slots__:
+        assert np.array_equal(getattr(rebuilt, name), getattr(result.trace, name), equal_nan=True), name
+    assert result.containment_rate == np.mean([s.inside for s in result.steps if s.inside is not None])
+
+
+def _csv_as_before(result: ReplayResult) -> str:
+    """The per-step CSV as the CLI wrote it from the steps before it was streamed."""
+    lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
+    for s in result.steps:
+        inside = "" if s.inside is None else str(int(s.inside))
+        lines.append(
+            f"{s.time!r},{inside},{s.map.area!r},{s.map.wedge.width!r},{s.accepted},{s.rejected},"
+            f"{s.update_us:.3f},{s.state.value},{int(s.relocalized)}"
+        )
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_the_streamed_csv_equals_the_one_written_from_the_steps(tmp_path: Path, seed: int) -> None:
+    # Longer than one block of judged steps, with truth missing at the end.
+    log = synthetic_log(np.random.default_rng(seed), duration=400.0, frame_every=1)
+    target = tmp_path / "out" / "steps.csv"
+    result = replay_log(log, FLOOR, OPTIONS, steps_csv=target)
+    assert len(result.trace) > 2048
+    assert target.read_text(encoding="utf-8") == _csv_as_before(result)
+    assert [path.name for path in target.parent.iterdir()] == ["steps.csv"]  # no scratch left
+
+
+def test_a_replay_that_fails_leaves_the_old_csv_and_no_scratch(tmp_path: Path) -> None:
+    target = tmp_path / "steps.csv"
+    target.write_text("old\n", encoding="utf-8")
+    log = synthetic_log(np.random.default_rng(3), duration=10.0)
+    onto_a_folder = tmp_path / "folder"
+    onto_a_folder.mkdir()
+    (onto_a_folder / "keep").write_text("", encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"folder: expected a writable file, got"):
+        replay_log(log, FLOOR, OPTIONS, steps_csv=onto_a_folder)
+    with pytest.raises(InputError, match=r"keep_maps: expected True or False, got 1"):
+        replay_log(log, FLOOR, OPTIONS, keep_maps=1, steps_csv=target)  # type: ignore[arg-type]
+    assert target.read_text(encoding="utf-8") == "old\n"
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["folder", "steps.csv"]
+    assert [path.name for path in onto_a_folder.iterdir()] == ["keep"]
