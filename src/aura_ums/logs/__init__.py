@@ -30,6 +30,7 @@ from aura_ums.logs._calibrate import (
 from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
 from aura_ums.logs._io import load_log, log_files_in, write_log
 from aura_ums.logs._log import (
+    DEFAULT_MAX_TRUTH_GAP,
     GroundTruth,
     LogLandmark,
     LogMeta,
@@ -52,6 +53,7 @@ from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
+    "DEFAULT_MAX_TRUTH_GAP",
     "Calibration",
     "GroundTruth",
     "LogLandmark",
