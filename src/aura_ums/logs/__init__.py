@@ -20,12 +20,18 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
 # and readers are helper-logs' (_io, _log, _mrclam, _odometry).
 # One sorted import block (ruff's isort), so the two are interleaved below.
 from aura_ums.logs._calibrate import (
+    DEFAULT_HORIZONS,
     Calibration,
+    FilterNoise,
+    HorizonCheck,
     MotionCalibration,
     SensorBounds,
     calibrate_logs,
+    horizon_checks,
+    load_noise,
     load_sensors,
     observation_errors,
+    sensors_path,
 )
 from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
 from aura_ums.logs._io import load_log, log_files_in, write_log
@@ -53,9 +59,12 @@ from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
+    "DEFAULT_HORIZONS",
     "DEFAULT_MAX_TRUTH_GAP",
     "Calibration",
+    "FilterNoise",
     "GroundTruth",
+    "HorizonCheck",
     "LogLandmark",
     "LogMeta",
     "LogObservation",
@@ -72,9 +81,11 @@ __all__ = [
     "calibrate_logs",
     "compare_on_log",
     "filter_settings",
+    "horizon_checks",
     "import_mrclam",
     "import_rosbag",
     "load_log",
+    "load_noise",
     "load_sensors",
     "log_files_in",
     "log_meadow_map",
@@ -84,6 +95,7 @@ __all__ = [
     "read_mrclam",
     "read_rosbag",
     "replay_log",
+    "sensors_path",
     "synthetic_log",
     "write_log",
 ]

@@ -19,7 +19,6 @@ from aura_ums.logs._odometry import ReverseMotion, odometry_to_commands
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
-
 #: Seconds: the longest interval between two ground-truth rows interpolated across by
 #: default (:attr:`GroundTruth.max_gap`); motion capture records at 50-100 Hz, so a longer
 #: interval is a lost track, not a slow sampler.
