@@ -874,7 +874,10 @@ def _observation_errors(
         keep = ~np.isnan(pose[:, 0])
         lx = np.array([log.landmark(o.landmark_id).x for o in log.observations])
         ly = np.array([log.landmark(o.landmark_id).y for o in log.observations])
-        dx, dy = lx - pose[:, 0], ly - pose[:, 1]
+        forward, left = log.meta.sensor_offset  # bearings and ranges are the sensor's
+        cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        dx = lx - (pose[:, 0] + forward * cos - left * sin)
+        dy = ly - (pose[:, 1] + forward * sin + left * cos)
         true_bearing = np.arctan2(dy, dx) - pose[:, 2]
         measured = np.array([o.bearing for o in log.observations])
         error = np.angle(np.exp(1j * (measured - true_bearing)))

@@ -75,6 +75,9 @@ class LogMeta:
     range_error_fraction : float
         Relative part of the range error bound, >= 0: the bound is
         ``range_error + range_error_fraction * range``.
+    sensor_forward, sensor_left : float
+        Metres: where the landmark sensor sits in the robot frame (x forward, y left);
+        bearings and ranges are measured from there, not from the robot's reference point.
     delay_s : float
         Seconds, >= 0, by which the motion rows lag: the motion recorded at ``t``
         happens at ``t + delay_s``.
@@ -112,6 +115,8 @@ class LogMeta:
     bearing_error: float = 0.05
     range_error: float = 0.1
     range_error_fraction: float = 0.0
+    sensor_forward: float = 0.0
+    sensor_left: float = 0.0
     delay_s: float = 0.0
     run_scale: float = 1.0
     turn_scale: float = 1.0
@@ -136,7 +141,7 @@ class LogMeta:
             "start_heading_halfwidth",
         ):
             object.__setattr__(self, name, _bounded(getattr(self, name), f"LogMeta.{name}"))
-        for name in ("landmark_z_bottom", "landmark_z_top"):
+        for name in ("landmark_z_bottom", "landmark_z_top", "sensor_forward", "sensor_left"):
             object.__setattr__(self, name, finite_float(getattr(self, name), f"LogMeta.{name}"))
         if self.landmark_z_top < self.landmark_z_bottom:
             raise InputError(
@@ -145,6 +150,11 @@ class LogMeta:
             )
         if self.start is not None and not isinstance(self.start, Pose):
             raise InputError(f"LogMeta.start: expected a Pose or None, got {type(self.start).__name__}")
+
+    @property
+    def sensor_offset(self) -> tuple[float, float]:
+        """``(sensor_forward, sensor_left)``, metres: the sensor's place in the robot frame."""
+        return self.sensor_forward, self.sensor_left
 
     def range_bound(self, measured_range: float) -> float:
         """Return the range error bound, metres, for a measured range (metres) given without one."""

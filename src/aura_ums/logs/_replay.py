@@ -18,6 +18,7 @@ from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._odometry import ReverseMotion
 from aura_ums.manager import (
     Blackboard,
     ManagerSettings,
@@ -65,6 +66,8 @@ class ReplayOptions:
         ``settings.envelope_factor``.
     motion : MotionCalibration or None
         Delay and scales of the recorded motion; None takes the log's ``meta.toml``.
+    reverse : ReverseMotion
+        What to do with negative forward velocities (:class:`ReverseMotion`; default: refuse).
     arena_margin : float
         Metres, >= 0, by which the one meadow of the replay (the log's terrain) extends
         beyond the landmarks, the start and the ground truth.
@@ -87,6 +90,7 @@ class ReplayOptions:
     working: SensorBounds | None = None
     envelope: SensorBounds | None = None
     motion: MotionCalibration | None = None
+    reverse: ReverseMotion = ReverseMotion.ERROR
     arena_margin: float = 5.0
 
     def __post_init__(self) -> None:
@@ -110,6 +114,8 @@ class ReplayOptions:
                 raise InputError(
                     f"ReplayOptions.{name}: expected SensorBounds or None, got {type(value).__name__}"
                 )
+        if not isinstance(self.reverse, ReverseMotion):
+            raise InputError(f"ReplayOptions.reverse: expected a ReverseMotion, got {self.reverse!r}")
         if self.motion is not None and not isinstance(self.motion, MotionCalibration):
             raise InputError(
                 f"ReplayOptions.motion: expected MotionCalibration or None, got {type(self.motion).__name__}"
@@ -298,24 +304,32 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
 
 
 def observation_for(
-    row: LogObservation, landmark_class: LandmarkClass, bounds: SensorBounds, *, factor: float = 1.0
+    row: LogObservation,
+    landmark_class: LandmarkClass,
+    bounds: SensorBounds,
+    *,
+    factor: float = 1.0,
+    sensor_offset: tuple[float, float] = (0.0, 0.0),
 ) -> Observation:
     """Turn a log row into a bounded observation of the replay's landmark class.
 
     The row's own ``bearing_error`` / ``range_error`` (absolute, metres) take precedence
     over ``bounds``; ``factor`` (>= 1) widens whichever is used. A Class II replay skips
     rows without a range (returns a bearing observation, which the manager rejects as of
-    the wrong class and counts).
+    the wrong class and counts). ``sensor_offset`` (forward, left; metres) is where the
+    sensor sits in the robot frame (the log's ``meta.sensor_offset``).
     """
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:
-        return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error)
+        return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, sensor_offset)
     if row.range_error is not None:
         error = row.range_error * factor
         low, high = max(0.0, row.range - error), row.range + error
     else:
         low, high = (bounds.widened(factor) if factor > 1.0 else bounds).range_interval(row.range)
-    return RangeBearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, low, high)
+    return RangeBearingObservation(
+        row.landmark_id, row.time, row.bearing, bearing_error, low, high, sensor_offset
+    )
 
 
 def meta_bounds(log: RobotLog) -> SensorBounds:
@@ -395,7 +409,9 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
-    reports = log.position_reports(frame_times, max_interval=opts.max_interval, start=start_time, end=end)
+    reports = log.position_reports(
+        frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
+    )
     truth_at = (
         log.groundtruth.at(frame_times)
         if log.groundtruth is not None
@@ -406,9 +422,14 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     next_report = 0
     for index, frame_time in enumerate(frame_times):
         rows = frames[float(frame_time)]
-        working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
+        offset = log.meta.sensor_offset
+        working = [
+            observation_for(r, opts.landmark_class, working_bounds, sensor_offset=offset) for r in rows
+        ]
         envelope = (
-            [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows] if robust else None
+            [observation_for(r, opts.landmark_class, envelope_bounds, sensor_offset=offset) for r in rows]
+            if robust
+            else None
         )
         began = _time.perf_counter()
         while next_report < len(reports) and reports[next_report].time <= frame_time:
@@ -478,4 +499,6 @@ def position_reports_for(log: RobotLog, options: ReplayOptions) -> tuple[Positio
     start_time, _ = replay_start(log)
     times = np.array(sorted(frames_after(log, start_time)), dtype=np.float64)
     end = float(times[-1]) if times.size else start_time
-    return log.position_reports(times, max_interval=options.max_interval, start=start_time, end=end)
+    return log.position_reports(
+        times, max_interval=options.max_interval, start=start_time, end=end, reverse=options.reverse
+    )
