@@ -12,7 +12,6 @@ from hypothesis import strategies as st
 
 from aura_ums.errors import InputError
 from aura_ums.logs import (
-    DEFAULT_MAX_TRUTH_GAP,
     GroundTruth,
     LogLandmark,
     LogMeta,
@@ -181,7 +180,7 @@ def test_groundtruth_keeps_gaps_as_gaps() -> None:
     # but its two edge rows are poses like any other.
     time = [0.0, 0.1, 0.2, 2.2, 2.3]
     truth = GroundTruth(time, [0.0, 0.1, 0.2, 2.2, 2.3], [0.0] * 5, [0.0] * 5)
-    assert truth.max_gap == DEFAULT_MAX_TRUTH_GAP
+    assert truth.max_gap == 0.5  # the documented default
     poses = truth.at([0.05, 0.2, 0.21, 1.2, 2.19, 2.2, 2.25])
     np.testing.assert_array_equal(np.isnan(poses[:, 0]), [False, False, True, True, True, False, False])
     np.testing.assert_allclose(poses[[0, 1, 5, 6], 0], [0.05, 0.2, 2.2, 2.25])

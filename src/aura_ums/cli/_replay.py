@@ -62,7 +62,7 @@ _MaxTruthGap = Annotated[
     typer.Option(
         "--max-truth-gap",
         help="Longest interval, seconds, between ground-truth rows interpolated across; frames in a "
-        "longer gap are not scored (default DEFAULT_MAX_TRUTH_GAP, 0.5 s; 'inf' for none).",
+        "longer gap are not scored (default 0.5 s; 'inf' for none).",
     ),
 ]
 
@@ -130,13 +130,14 @@ def calibrate(
 ) -> None:
     """Estimate terrain statistics and sensor bounds from logs with ground truth."""
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import DEFAULT_HORIZONS, calibrate_logs, load_log, sensors_path
+    from aura_ums.logs import calibrate_logs, load_log, sensors_path
 
     try:
         logs = [_with_truth_gap(load_log(folder), max_truth_gap) for folder in log_dirs]
-        calibration = calibrate_logs(
-            logs, quantile=quantile, move=move, horizons=tuple(horizons) if horizons else DEFAULT_HORIZONS
-        )
+        if horizons:
+            calibration = calibrate_logs(logs, quantile=quantile, move=move, horizons=tuple(horizons))
+        else:  # calibrate_logs' default horizons
+            calibration = calibrate_logs(logs, quantile=quantile, move=move)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     sensors = sensors_out if sensors_out is not None else sensors_path(out)
@@ -153,6 +154,7 @@ def calibrate(
         console.print(
             f"{name}: bearing +-{bounds.bearing_error:.4f} rad, range "
             f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
+            f"+-{bounds.range_error:.3f} m "
             f"({calibration.observations} observations)"
         )
     console.print("growth bound against the truth, by horizon without correction:", highlight=False)

@@ -20,7 +20,6 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
 # and readers are helper-logs' (_io, _log, _mrclam, _odometry).
 # One sorted import block (ruff's isort), so the two are interleaved below.
 from aura_ums.logs._calibrate import (
-    DEFAULT_HORIZONS,
     Calibration,
     FilterNoise,
     HorizonCheck,
@@ -36,7 +35,6 @@ from aura_ums.logs._calibrate import (
 from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
 from aura_ums.logs._io import load_log, log_files_in, write_log
 from aura_ums.logs._log import (
-    DEFAULT_MAX_TRUTH_GAP,
     GroundTruth,
     LogLandmark,
     LogMeta,
@@ -59,8 +57,6 @@ from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
-    "DEFAULT_HORIZONS",
-    "DEFAULT_MAX_TRUTH_GAP",
     "Calibration",
     "FilterNoise",
     "GroundTruth",
