@@ -13,8 +13,9 @@ from typer.testing import CliRunner
 
 from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
-from aura_ums.logs import synthetic_log, write_log
+from aura_ums.logs import ReverseMotion, load_noise, synthetic_log, write_log
 from aura_ums.uncertainty import TerrainTable
+from tests.logs.log_helpers import VALID_FILES, write_files
 
 runner = CliRunner()
 
@@ -209,3 +210,81 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
     )
     assert result.exit_code == 2
     assert "--window-margin: expected a finite number of pixels >= 0, got -1.0" in result.output
+
+
+def test_replay_reads_the_sensors_file_calibrate_wrote_beside_the_terrain(
+    log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    sensors = terrain.with_suffix(".sensors.toml")
+    given, beside = tmp_path / "given.json", tmp_path / "beside.json"
+    args = [str(log_folder), "--terrain", str(terrain), "--classes", "II"]
+    result = runner.invoke(app, ["replay", *args, "--sensors", str(sensors), "--metrics-json", str(given)])
+    assert result.exit_code == 0, result.output
+    assert "written by calibrate" not in result.output
+    result = runner.invoke(app, ["replay", *args, "--metrics-json", str(beside)])
+    assert result.exit_code == 0, result.output
+    assert f"sensors: {sensors}" in " ".join(result.output.split())
+    drop = {"median_update_us"}
+    first, second = strict_json(given.read_text()), strict_json(beside.read_text())
+    assert {k: v for k, v in first.items() if k not in drop} == {
+        k: v for k, v in second.items() if k not in drop
+    }
+
+
+def test_compare_takes_the_filters_noise_from_the_calibration_never_the_log(
+    log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    args = ["compare", str(log_folder), "--terrain", str(terrain), "--particles", "20"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert "expected the filters' noise from a sensors file" in " ".join(result.output.split())
+    calibrated = tmp_path / "cal.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(calibrated)]).exit_code == 0
+    table = tmp_path / "compare.json"
+    sensors = calibrated.with_suffix(".sensors.toml")
+    result = runner.invoke(app, [*args, "--sensors", str(sensors), "--metrics-json", str(table)])
+    assert result.exit_code == 0, result.output
+    noise = load_noise(sensors)
+    assert noise is not None
+    written = strict_json(table.read_text())
+    assert (written["bearing_sd_rad"], written["range_sd_fraction"]) == (
+        noise.bearing_sd,
+        noise.range_sd_fraction,
+    )
+
+
+def test_reversing_is_replayable_from_the_command_line(tmp_path: Path) -> None:
+    files = dict(VALID_FILES, **{"odometry.csv": "time,v,omega\n0.0,0.5,0.0\n0.75,-0.25,0.1\n2.0,0.0,0.0\n"})
+    folder = write_files(tmp_path / "reversing", files)
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable.default().to_toml())
+    args = ["replay", str(folder), "--terrain", str(terrain)]
+    refused = runner.invoke(app, args)
+    assert refused.exit_code == 2
+    assert "--reverse flip" in " ".join(refused.output.split())
+    flipped = runner.invoke(app, [*args, "--reverse", "flip"])
+    assert flipped.exit_code == 0, flipped.output
+    assert {choice.value for choice in ReverseMotion} == {"error", "flip"}
+    wrong = runner.invoke(app, [*args, "--reverse", "backwards"])
+    assert wrong.exit_code == 2
+
+
+def test_frames_in_a_ground_truth_gap_are_not_scored(tmp_path: Path) -> None:
+    # The ground truth has rows at 0 s and 2 s only: frames at 0.5 s and 1 s lie in a gap.
+    folder = write_files(tmp_path / "gap", VALID_FILES)
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable.default().to_toml())
+    figures = {}
+    for label, extra in (("default", []), ("no limit", ["--max-truth-gap", "inf"])):
+        out = tmp_path / f"{label}.json"
+        result = runner.invoke(
+            app, ["replay", str(folder), "--terrain", str(terrain), *extra, "--metrics-json", str(out)]
+        )
+        assert result.exit_code == 0, result.output
+        figures[label] = strict_json(out.read_text())
+    assert (figures["default"]["steps_with_truth"], figures["default"]["containment_rate"]) == (0, None)
+    assert figures["no limit"]["steps_with_truth"] == 2

@@ -41,6 +41,8 @@ def small_log(*, commands: bool = False, groundtruth: bool = True, start: bool =
         bearing_error=0.03,
         range_error=0.07,
         range_error_fraction=0.02,
+        sensor_forward=0.15,
+        sensor_left=-0.05,
         delay_s=0.125,
         run_scale=1.1,
         turn_scale=1.05,

@@ -12,6 +12,7 @@ from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
     SensorBounds,
     calibrate_logs,
+    load_noise,
     load_sensors,
     observation_errors,
     read_mrclam,
@@ -143,3 +144,46 @@ def test_latin1_sensor_file_is_refused_naming_it(tmp_path: Path) -> None:
         FileFormatError, match=r"latin\.toml:2: byte 15: expected UTF-8 text, got the byte 0xb0"
     ):
         load_sensors(tmp_path / "latin.toml")
+
+
+def test_sensor_file_carries_the_filters_noise(tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    calibration = calibrate_logs([log])
+    path = _write(tmp_path / "sensors.toml", calibration.sensors_toml())
+    assert load_noise(path) == calibration.noise
+    bearing, _ = observation_errors([log])
+    assert calibration.noise.bearing_sd == pytest.approx(float(np.std(bearing)))
+    # A file written before the [noise] table existed still reads, without noise.
+    older = calibration.sensors_toml().split("\n[noise]")[0] + "\n"
+    assert load_noise(_write(tmp_path / "older.toml", older)) is None
+    assert load_sensors(tmp_path / "older.toml") == load_sensors(path)
+
+
+def test_range_bounds_are_absolute_plus_relative() -> None:
+    log = synthetic_log(np.random.default_rng(0), duration=120.0, range_noise=0.05)
+    working = calibrate_logs([log]).working
+    assert working.range_error > 0.0
+    low, high = working.range_interval(0.0)
+    assert high - low > 0.0  # a zero range still gets a bound of some width
+
+
+@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
+def test_mrclam_growth_bound_holds_over_the_horizons_it_is_used() -> None:
+    calibration = calibrate_logs([read_mrclam(MRCLAM, 1)])
+    checks = {check.horizon: check for check in calibration.checks}
+    assert sorted(checks) == [1.0, 2.0, 5.0, 10.0, 30.0]
+    for horizon in (5.0, 10.0, 30.0):
+        assert checks[horizon].containment >= 0.99
+        assert checks[horizon].heading_bound >= checks[horizon].heading_error
+    # The bound still grows faster than the error: the report shows by how much.
+    assert (
+        checks[30.0].heading_bound / checks[30.0].heading_error
+        > checks[5.0].heading_bound / checks[5.0].heading_error
+    )
+    assert "horizon s" in calibration.report()
+
+
+def test_horizons_shorter_than_a_move_are_refused() -> None:
+    log = synthetic_log(np.random.default_rng(0), duration=30.0)
+    with pytest.raises(InputError, match=r"horizons: expected seconds, each >= move \(0\.5\)"):
+        calibrate_logs([log], horizons=(0.25, 1.0))

@@ -154,7 +154,7 @@ def test_odometry_rejects_bad_arrays(args: tuple[Any, Any, Any], pattern: str) -
 
 
 def test_groundtruth_interpolates_across_plus_minus_pi() -> None:
-    truth = GroundTruth([0.0, 1.0, 2.0], [0.0, 1.0, 1.0], [0.0, 0.0, 2.0], [3.0, -3.0, -2.0])
+    truth = GroundTruth([0.0, 1.0, 2.0], [0.0, 1.0, 1.0], [0.0, 0.0, 2.0], [3.0, -3.0, -2.0], max_gap=1.0)
     poses = truth.at([0.0, 0.25, 0.5, 0.75, 1.5, 2.0])
     step = 2 * math.pi - 6.0  # from 3.0 to -3.0 the short way is through pi, +0.283 rad
     expected = [3.0, 3.0 + 0.25 * step, math.pi, -3.0 - 0.25 * step, -2.5, -2.0]
@@ -165,7 +165,7 @@ def test_groundtruth_interpolates_across_plus_minus_pi() -> None:
 
 
 def test_groundtruth_is_nan_outside_its_span_and_exact_at_rows() -> None:
-    truth = GroundTruth([1.0, 2.0], [0.5, 0.7], [0.1, 0.2], [4.0, 0.0])
+    truth = GroundTruth([1.0, 2.0], [0.5, 0.7], [0.1, 0.2], [4.0, 0.0], max_gap=math.inf)
     assert truth.heading[0] == pytest.approx(4.0 - 2 * math.pi)  # stored wrapped
     poses = truth.at([0.999, 1.0, 2.0, 2.001])
     assert np.isnan(poses[[0, 3]]).all()
@@ -173,6 +173,25 @@ def test_groundtruth_is_nan_outside_its_span_and_exact_at_rows() -> None:
     assert truth.at(1.5).shape == (1, 3)
     single = GroundTruth([3.0], [1.0], [2.0], [0.5])
     np.testing.assert_array_equal(single.at([3.0, 3.5]), [[1.0, 2.0, 0.5], [np.nan] * 3])
+
+
+def test_groundtruth_keeps_gaps_as_gaps() -> None:
+    # Rows 0.1 s apart, then a lost track of 2 s: nothing is interpolated across the gap,
+    # but its two edge rows are poses like any other.
+    time = [0.0, 0.1, 0.2, 2.2, 2.3]
+    truth = GroundTruth(time, [0.0, 0.1, 0.2, 2.2, 2.3], [0.0] * 5, [0.0] * 5)
+    assert truth.max_gap == 0.5  # the documented default
+    poses = truth.at([0.05, 0.2, 0.21, 1.2, 2.19, 2.2, 2.25])
+    np.testing.assert_array_equal(np.isnan(poses[:, 0]), [False, False, True, True, True, False, False])
+    np.testing.assert_allclose(poses[[0, 1, 5, 6], 0], [0.05, 0.2, 2.2, 2.25])
+    assert not np.isnan(truth.with_max_gap(2.5).at([1.2])).any()
+    assert not np.isnan(truth.with_max_gap(math.inf).at([1.2])).any()
+
+
+@pytest.mark.parametrize("max_gap", [0.0, -1.0, math.nan, True, "1"])
+def test_groundtruth_max_gap_must_be_positive(max_gap: object) -> None:
+    with pytest.raises(InputError, match=r"GroundTruth\.max_gap: expected a positive number of seconds"):
+        GroundTruth([0.0], [0.0], [0.0], [0.0], max_gap=max_gap)  # type: ignore[arg-type]
 
 
 @given(
@@ -185,7 +204,11 @@ def test_groundtruth_heading_moves_the_short_way(steps: list[float], first: floa
     # the short arc between its two neighbours, at the fraction of the way along it.
     headings = first + np.concatenate(([0.0], np.cumsum(steps[1:])))
     truth = GroundTruth(
-        np.arange(len(headings), dtype=float), np.zeros(len(headings)), np.zeros(len(headings)), headings
+        np.arange(len(headings), dtype=float),
+        np.zeros(len(headings)),
+        np.zeros(len(headings)),
+        headings,
+        max_gap=1.0,
     )
     row = len(headings) // 2 - 1
     heading = truth.at(row + fraction)[0, 2]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -167,3 +168,35 @@ def test_the_settings_are_reported(clean_log: RobotLog) -> None:
     metrics = replay_log(clean_log, FLOOR, options).metrics()
     assert (metrics["max_vertices"], metrics["envelope_max_vertices"]) == (8, None)
     assert metrics["containment_rate"] == 1.0
+
+
+def test_replay_measures_from_the_sensor_offset_in_the_meta() -> None:
+    # Observations re-measured, exactly, from a sensor 0.4 m ahead and 0.1 m left of the
+    # reference point: with the offset in the meta the truth stays inside every map.
+    log = synthetic_log(np.random.default_rng(5), duration=30.0)
+    truth = log.groundtruth
+    assert truth is not None
+    rows = []
+    for row in log.observations:
+        x, y, heading = truth.at([row.time])[0]
+        landmark = log.landmark(row.landmark_id)
+        sx = x + 0.4 * math.cos(heading) - 0.1 * math.sin(heading)
+        sy = y + 0.4 * math.sin(heading) + 0.1 * math.cos(heading)
+        bearing = math.atan2(landmark.y - sy, landmark.x - sx) - heading
+        rows.append(
+            dataclasses.replace(
+                row,
+                bearing=math.remainder(bearing, math.tau),
+                range=math.hypot(landmark.x - sx, landmark.y - sy),
+            )
+        )
+    meta = dataclasses.replace(log.meta, sensor_forward=0.4, sensor_left=0.1, bearing_error=0.01)
+    shifted = dataclasses.replace(log, meta=meta, observations=tuple(rows))
+    table = TerrainTable({"floor": TerrainTable.default()["tile"]})
+    options = ReplayOptions(landmark_class=LandmarkClass.POINT)
+    assert replay_log(shifted, table, options).containment_rate == 1.0
+    ignored = dataclasses.replace(
+        shifted, meta=dataclasses.replace(meta, sensor_forward=0.0, sensor_left=0.0)
+    )
+    result = replay_log(ignored, table, options)
+    assert result.inconsistent_observations > 0 or result.containment_rate < 1.0

@@ -19,7 +19,7 @@ from aura_ums.cli._common import (
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayOptions
+    from aura_ums.logs import ReplayOptions, RobotLog
     from aura_ums.manager import ManagerSettings
 
 
@@ -32,10 +32,38 @@ class Classes(enum.StrEnum):
     POINT = "II"
 
 
+class Reverse(enum.StrEnum):
+    """What a replay does with negative forward speeds (``--reverse``): ``ReverseMotion``'s choices."""
+
+    #: Refuse the log, naming the first reversing row.
+    ERROR = "error"
+    #: Report each reversing piece as a half turn, a forward run and a half turn back.
+    FLIP = "flip"
+
+
 _Classes = Annotated[Classes, typer.Option("--classes", help="I: bearings only; II: range and bearing.")]
 _Terrain = Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")]
 _Sensors = Annotated[
-    Path | None, typer.Option("--sensors", help="Sensor calibration TOML from `aura-ums calibrate`.")
+    Path | None,
+    typer.Option(
+        "--sensors",
+        help="Sensor calibration TOML from `aura-ums calibrate` (default: the one it wrote beside "
+        "--terrain, TERRAIN.sensors.toml, when there is one; else the log's meta.toml).",
+    ),
+]
+_ReverseOption = Annotated[
+    Reverse,
+    typer.Option(
+        "--reverse", help="Negative forward speed: refuse (error) or replay as turn, run, turn (flip)."
+    ),
+]
+_MaxTruthGap = Annotated[
+    float | None,
+    typer.Option(
+        "--max-truth-gap",
+        help="Longest interval, seconds, between ground-truth rows interpolated across; frames in a "
+        "longer gap are not scored (default 0.5 s; 'inf' for none).",
+    ),
 ]
 
 _Camera = Annotated[
@@ -55,8 +83,32 @@ _WindowsCsv = Annotated[
 ]
 
 
-def _options(classes: Classes, sensors: Path | None, settings: ManagerSettings) -> ReplayOptions:
-    from aura_ums.logs import ReplayOptions, load_sensors
+def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
+    """Return the sensors file to read: the one given, else the one calibrate wrote beside ``terrain``."""
+    from aura_ums.logs import sensors_path
+
+    if sensors is not None:
+        return sensors
+    beside = sensors_path(terrain)
+    if beside.is_file():
+        # Replaying without the calibrated sensor bounds is silently much worse: read them.
+        console.print(f"sensors: {beside} (written by calibrate beside {terrain})", highlight=False)
+        return beside
+    return None
+
+
+def _with_truth_gap(log: RobotLog, max_truth_gap: float | None) -> RobotLog:
+    import dataclasses
+
+    if max_truth_gap is None or log.groundtruth is None:
+        return log
+    return dataclasses.replace(log, groundtruth=log.groundtruth.with_max_gap(max_truth_gap))
+
+
+def _options(
+    classes: Classes, sensors: Path | None, settings: ManagerSettings, reverse: Reverse = Reverse.ERROR
+) -> ReplayOptions:
+    from aura_ums.logs import ReplayOptions, ReverseMotion, load_sensors
     from aura_ums.uncertainty import LandmarkClass
 
     # Without a sensors file, the options' defaults: the log's meta.toml.
@@ -67,6 +119,7 @@ def _options(classes: Classes, sensors: Path | None, settings: ManagerSettings) 
         working=working,
         envelope=envelope,
         motion=motion,
+        reverse=ReverseMotion(reverse.value),
     )
 
 
@@ -80,18 +133,30 @@ def calibrate(
         ),
     ] = None,
     quantile: Annotated[float, typer.Option(help="Quantile the motion and working bounds cover.")] = 0.99,
-    horizon: Annotated[float, typer.Option(help="Seconds per motion window of the fit.")] = 1.0,
+    move: Annotated[float, typer.Option("--move", help="Seconds per move of the motion fit.")] = 0.5,
+    horizons: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--horizon",
+            help="Seconds without correction over which the motion bound must hold; repeat it "
+            "(default 1, 2, 5, 10 and 30).",
+        ),
+    ] = None,
+    max_truth_gap: _MaxTruthGap = None,
 ) -> None:
     """Estimate terrain statistics and sensor bounds from logs with ground truth."""
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import calibrate_logs, load_log
+    from aura_ums.logs import calibrate_logs, load_log, sensors_path
 
     try:
-        logs = [load_log(folder) for folder in log_dirs]
-        calibration = calibrate_logs(logs, quantile=quantile, horizon=horizon)
+        logs = [_with_truth_gap(load_log(folder), max_truth_gap) for folder in log_dirs]
+        if horizons:
+            calibration = calibrate_logs(logs, quantile=quantile, move=move, horizons=tuple(horizons))
+        else:  # calibrate_logs' default horizons
+            calibration = calibrate_logs(logs, quantile=quantile, move=move)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    sensors = sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml")
+    sensors = sensors_out if sensors_out is not None else sensors_path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     sensors.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(calibration.terrain_table().to_toml())
@@ -105,8 +170,11 @@ def calibrate(
         console.print(
             f"{name}: bearing +-{bounds.bearing_error:.4f} rad, range "
             f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
+            f"+-{bounds.range_error:.3f} m "
             f"({calibration.observations} observations)"
         )
+    console.print("growth bound against the truth, by horizon without correction:", highlight=False)
+    console.print(calibration.report(), highlight=False, markup=False)
     console.print(f"wrote {out} and {sensors}")
 
 
@@ -116,6 +184,8 @@ def replay(
     terrain: _Terrain,
     sensors: _Sensors = None,
     classes: _Classes = Classes.VERTICAL_LINE,
+    reverse: _ReverseOption = Reverse.ERROR,
+    max_truth_gap: _MaxTruthGap = None,
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
@@ -148,16 +218,21 @@ def replay(
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
     windows = None
     try:
-        log = load_log(log_dir)
+        log = _with_truth_gap(load_log(log_dir), max_truth_gap)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, sensors, settings.over())
+        options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
         if camera is None:
             result = replay_log(log, table, options, keep_maps=keep_maps, steps_csv=steps_csv)
         else:
             result, windows = replay_windows(
-                log, table, load_camera(camera), options, margin=window_margin, keep_maps=keep_maps,
+                log,
+                table,
+                load_camera(camera),
+                options,
+                margin=window_margin,
+                keep_maps=keep_maps,
                 steps_csv=steps_csv,
             )
     except AuraUmsError as exc:
@@ -191,10 +266,14 @@ def compare(
     calibration_logs: Annotated[
         list[Path] | None,
         typer.Option(
-            "--noise-from", help="Logs whose observation errors give the filters' noise (default LOG_DIR)."
+            "--noise-from",
+            help="Calibration logs whose observation errors give the filters' noise (default: the "
+            "[noise] of the sensors file; never LOG_DIR itself).",
         ),
     ] = None,
     classes: _Classes = Classes.POINT,
+    reverse: _ReverseOption = Reverse.ERROR,
+    max_truth_gap: _MaxTruthGap = None,
     particles: Annotated[int, typer.Option("--particles", help="Particles of the particle filter.")] = 1000,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
     settings: SettingOptions = NO_OPTIONS,
@@ -207,21 +286,36 @@ def compare(
 
     from aura_ums import Metrics
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import compare_on_log, load_log, observation_errors
+    from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
     from aura_ums.uncertainty import TerrainTable
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
     try:
-        log = load_log(log_dir)
+        log = _with_truth_gap(load_log(log_dir), max_truth_gap)
         table = TerrainTable.from_toml(terrain)
-        options = _options(classes, sensors, settings.over())
-        noise_logs = [load_log(p) for p in calibration_logs] if calibration_logs else [log]
-        bearing, ranges = observation_errors(noise_logs)
-        if bearing.size < 2:
-            raise fail("--noise-from: expected logs with observations inside their ground truth, got none")
-        bearing_sd = float(np.std(bearing))
-        range_sd = float(np.std(ranges)) if ranges.size > 1 else 0.05
+        sensors_file = _sensors_file(sensors, terrain)
+        options = _options(classes, sensors_file, settings.over(), reverse)
+        if calibration_logs:
+            bearing, ranges = observation_errors([load_log(p) for p in calibration_logs])
+            if bearing.size < 2:
+                raise fail(
+                    "--noise-from: expected logs with observations inside their ground truth, got none"
+                )
+            bearing_sd = float(np.std(bearing))
+            range_sd = float(np.std(ranges)) if ranges.size > 1 else 0.05
+        else:
+            # The filters' noise comes from the calibration, never from the log they are judged on.
+            noise = load_noise(sensors_file) if sensors_file is not None else None
+            if noise is None:
+                where = (
+                    "no sensors file" if sensors_file is None else f"{sensors_file} without a [noise] table"
+                )
+                raise fail(
+                    "compare: expected the filters' noise from a sensors file written by "
+                    f"`aura-ums calibrate` (--sensors) or from calibration logs (--noise-from), got {where}"
+                )
+            bearing_sd, range_sd = noise.bearing_sd, noise.range_sd_fraction
         rows = compare_on_log(
             log,
             table,

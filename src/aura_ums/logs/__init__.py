@@ -23,11 +23,16 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
 # One sorted import block (ruff's isort), so the two are interleaved below.
 from aura_ums.logs._calibrate import (
     Calibration,
+    FilterNoise,
+    HorizonCheck,
     MotionCalibration,
     SensorBounds,
     calibrate_logs,
+    horizon_checks,
+    load_noise,
     load_sensors,
     observation_errors,
+    sensors_path,
 )
 from aura_ums.logs._compare import MethodSummary, compare_on_log, filter_settings
 from aura_ums.logs._io import load_log, log_files_in, write_log
@@ -57,7 +62,9 @@ from aura_ums.logs._windows import WindowReport, WindowRow, ekf_noise, replay_wi
 
 __all__ = [
     "Calibration",
+    "FilterNoise",
     "GroundTruth",
+    "HorizonCheck",
     "LogLandmark",
     "LogMeta",
     "LogObservation",
@@ -78,9 +85,11 @@ __all__ = [
     "compare_on_log",
     "ekf_noise",
     "filter_settings",
+    "horizon_checks",
     "import_mrclam",
     "import_rosbag",
     "load_log",
+    "load_noise",
     "load_sensors",
     "log_files_in",
     "log_meadow_map",
@@ -92,6 +101,7 @@ __all__ = [
     "read_rosbag",
     "replay_log",
     "replay_windows",
+    "sensors_path",
     "synthetic_log",
     "write_log",
 ]

@@ -1,14 +1,16 @@
 """Calibration from logs with ground truth: terrain statistics, motion delay and scales, sensor bounds.
 
 The paper gathers its growth statistics from the robot's own runs ("Uncertainty Map Growth
-Statistics"). Here the runs are logs with ground truth: the recorded motion is compared
-with the true motion over windows of ``horizon`` seconds, and the observations with the
-bearings and ranges the true poses imply.
+Statistics"). Here the runs are logs with ground truth: the recorded motion, cut into moves,
+is compared with the true motion accumulated over the horizons a map goes without a
+correction (1 to 30 s), and the observations with the bearings and ranges the true poses
+imply.
 
-Why windows, not single reports: the map's bound is a sum of per-report bounds, so it
-needs to cover the accumulated error between two reductions, not every report's own
-error; per-report errors of a 10 Hz velocity log are dominated by timing jitter that
-averages out within a second.
+Why horizons, not single moves: the map's bound over a span is the sum of its moves'
+bounds, while the true errors of consecutive moves largely cancel (timing jitter, a lagging
+controller). A per-move worst case, summed over a hundred moves, bounds an error that
+never happens; the bound is fitted where it is used instead, and checked there
+(:class:`HorizonCheck`).
 """
 
 from __future__ import annotations
@@ -26,10 +28,11 @@ from aura_ums._files import Fields, key_path, load_toml
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
-from aura_ums.uncertainty import TerrainStats, TerrainTable
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
 
 _SENSOR_KEYS = ("bearing_error", "range_error", "range_fraction_low", "range_fraction_high")
 _MOTION_KEYS = ("delay_s", "run_scale", "turn_scale")
+_NOISE_KEYS = ("bearing_sd", "range_sd_fraction")
 _KIND = "aura-ums/sensor-calibration"
 _T = TypeVar("_T")
 
@@ -134,6 +137,35 @@ class MotionCalibration:
 
 
 @dataclass(frozen=True, slots=True)
+class FilterNoise:
+    """Measurement noise for probabilistic filters (EKF, particle filter), from calibration logs.
+
+    Parameters
+    ----------
+    bearing_sd : float
+        Standard deviation of the bearing error, radians, > 0.
+    range_sd_fraction : float
+        Standard deviation of the range error as a fraction of the range, > 0.
+
+    Examples
+    --------
+    >>> FilterNoise(0.02, 0.05).bearing_sd
+    0.02
+    >>> FilterNoise(0.0, 0.05)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: FilterNoise.bearing_sd: expected a positive number, got 0.0
+    """
+
+    bearing_sd: float
+    range_sd_fraction: float
+
+    def __post_init__(self) -> None:
+        for name in _NOISE_KEYS:
+            object.__setattr__(self, name, positive_float(getattr(self, name), f"FilterNoise.{name}"))
+
+
+@dataclass(frozen=True, slots=True)
 class Calibration:
     """The outcome of :func:`calibrate_logs`.
 
@@ -149,12 +181,18 @@ class Calibration:
         Sensor bounds at the calibration quantile: the working map's.
     envelope : SensorBounds
         Bounds covering every calibration error, widened by the margin: the envelope's.
+    noise : FilterNoise
+        Standard deviations of the observation errors, for filters compared with the map.
     quantile : float
         The quantile the motion and working bounds cover.
-    horizon : float
-        Window length, seconds, of the motion fit.
+    move : float
+        Seconds per move of the motion fit.
+    horizons : tuple of float
+        Seconds: the spans over which the motion bound was fitted and checked.
+    checks : tuple of HorizonCheck
+        How the growth bound holds over each horizon on the calibration logs.
     motion_windows, observations : int
-        Samples the fit used.
+        Samples the fit used (moving windows over all horizons; observations).
     """
 
     terrain: str
@@ -162,8 +200,11 @@ class Calibration:
     motion: MotionCalibration
     working: SensorBounds
     envelope: SensorBounds
+    noise: FilterNoise
     quantile: float
-    horizon: float
+    move: float
+    horizons: tuple[float, ...]
+    checks: tuple[HorizonCheck, ...]
     motion_windows: int
     observations: int
 
@@ -171,11 +212,26 @@ class Calibration:
         """Return a one-terrain table holding :attr:`stats` under :attr:`terrain`."""
         return TerrainTable({self.terrain: self.stats})
 
-    def sensors_toml(self) -> str:
-        """Return the motion calibration and both sensor bounds as TOML (read by :func:`load_sensors`)."""
+    def report(self) -> str:
+        """Return the horizon checks as a text table: true error quantile against the bound."""
         lines = [
-            f"# aura-ums sensor calibration: quantile {self.quantile!r}, horizon {self.horizon!r} s,",
+            f"horizon s  windows  inside  heading q{self.quantile:g} rad  bound rad  "
+            f"position q{self.quantile:g} m  bound m"
+        ]
+        for c in self.checks:
+            lines.append(
+                f"{c.horizon:9g}  {c.windows:7d}  {c.containment:6.3f}  {c.heading_error:14.3f}  "
+                f"{c.heading_bound:9.3f}  {c.position_error:13.3f}  {c.position_bound:7.3f}"
+            )
+        return "\n".join(lines)
+
+    def sensors_toml(self) -> str:
+        """Return motion calibration, sensor bounds and filter noise as TOML (:func:`load_sensors`)."""
+        lines = [
+            f"# aura-ums sensor calibration: quantile {self.quantile!r}, moves of {self.move!r} s,",
             f"# {self.motion_windows} motion windows, {self.observations} observations.",
+            "# Growth bound against the truth over each horizon (calibration logs):",
+            *(f"# {line}" for line in self.report().splitlines()),
             f'format = "{_KIND}"',
             "",
             "[motion]",
@@ -183,7 +239,45 @@ class Calibration:
         ]
         for table, bounds in (("working", self.working), ("envelope", self.envelope)):
             lines += ["", f"[{table}]", *(f"{key} = {getattr(bounds, key)!r}" for key in _SENSOR_KEYS)]
+        lines += ["", "[noise]", *(f"{key} = {getattr(self.noise, key)!r}" for key in _NOISE_KEYS)]
         return "\n".join(lines) + "\n"
+
+
+def sensors_path(terrain: str | Path) -> Path:
+    """Return where ``aura-ums calibrate`` writes the sensors file beside a terrain file.
+
+    Examples
+    --------
+    >>> sensors_path("runs/calib/terrain.toml").as_posix()
+    'runs/calib/terrain.sensors.toml'
+    """
+    return Path(terrain).with_suffix(".sensors.toml")
+
+
+def _read_sensors(path: str | Path) -> tuple[Fields, dict[str, object]]:
+    document = load_toml(path, kind="sensor calibration TOML")
+    reader = Fields(str(path))
+    expected, optional = {"format", "motion", "working", "envelope"}, {"noise"}
+    if not expected <= set(document) <= expected | optional:
+        missing, extra = sorted(expected - set(document)), sorted(set(document) - expected - optional)
+        raise reader.error("", f"expected keys {sorted(expected)}, got missing {missing}, unknown {extra}")
+    if document["format"] != _KIND:
+        raise reader.error("format", f"expected {_KIND!r}, got {reader.describe(document['format'])}")
+    return reader, document
+
+
+def _build(
+    reader: Fields, document: dict[str, object], name: str, keys: tuple[str, ...], make: Callable[..., _T]
+) -> _T:
+    values = reader.table(document[name], f"[{name}]")
+    if set(values) != set(keys):
+        raise reader.error(f"[{name}]", f"expected keys {list(keys)}, got {sorted(values)}")
+    numbers = {key: reader.number(values[key], key_path(f"[{name}]", key)) for key in keys}
+    try:
+        return make(**numbers)
+    except InputError as exc:  # named "SensorBounds.bearing_error": name the key instead
+        field, _, message = str(exc).partition(": ")
+        raise reader.error(key_path(f"[{name}]", field.rpartition(".")[2]), message) from None
 
 
 def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, SensorBounds]:
@@ -205,36 +299,40 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
         Naming the file and table for a missing file, bad TOML, a missing or unknown key,
         or a value out of range.
     """
-    source = str(path)
-    document = load_toml(path, kind="sensor calibration TOML")
-    reader = Fields(source)
-    expected = {"format", "motion", "working", "envelope"}
-    if set(document) != expected:
-        missing, extra = sorted(expected - set(document)), sorted(set(document) - expected)
-        raise reader.error("", f"expected keys {sorted(expected)}, got missing {missing}, unknown {extra}")
-    if document["format"] != _KIND:
-        raise reader.error("format", f"expected {_KIND!r}, got {reader.describe(document['format'])}")
+    reader, document = _read_sensors(path)
+    motion = _build(reader, document, "motion", _MOTION_KEYS, MotionCalibration)
+    working = _build(reader, document, "working", _SENSOR_KEYS, SensorBounds)
+    return motion, working, _build(reader, document, "envelope", _SENSOR_KEYS, SensorBounds)
 
-    def table(name: str, keys: tuple[str, ...]) -> dict[str, float]:
-        values = reader.table(document[name], f"[{name}]")
-        if set(values) != set(keys):
-            raise reader.error(f"[{name}]", f"expected keys {list(keys)}, got {sorted(values)}")
-        return {key: reader.number(values[key], key_path(f"[{name}]", key)) for key in keys}
 
-    def build(name: str, keys: tuple[str, ...], make: Callable[..., _T]) -> _T:
-        values = table(name, keys)
-        try:
-            return make(**values)
-        except InputError as exc:  # named "SensorBounds.bearing_error": name the key instead
-            field, _, message = str(exc).partition(": ")
-            raise reader.error(key_path(f"[{name}]", field.rpartition(".")[2]), message) from None
+def load_noise(path: str | Path) -> FilterNoise | None:
+    """Read the filter noise of a sensor calibration file; None when it has no ``[noise]`` table.
 
-    motion = build("motion", _MOTION_KEYS, MotionCalibration)
-    working = build("working", _SENSOR_KEYS, SensorBounds)
-    return motion, working, build("envelope", _SENSOR_KEYS, SensorBounds)
+    Files written before the table existed have none.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`load_sensors`, and for a bad ``[noise]`` table.
+    """
+    reader, document = _read_sensors(path)
+    if "noise" not in document:
+        return None
+    return _build(reader, document, "noise", _NOISE_KEYS, FilterNoise)
 
 
 # --- the fit ---------------------------------------------------------------------------
+
+#: Seconds: the horizons over which :func:`calibrate_logs` makes the growth bound hold and
+#: checks it (the time a map typically goes without a correcting observation).
+DEFAULT_HORIZONS = (1.0, 2.0, 5.0, 10.0, 30.0)
+#: Seconds: the grid of the delay search.
+_DELAY_STEP = 0.05
+#: Metres per second: a window whose recorded run is slower than this does not fit drift
+#: or run (its heading and position errors are the ground truth's noise, not motion's).
+_MOVING = 0.02
+#: The band fractions tried for the turn (0, 0.01, ..., 0.95).
+_BANDS = np.linspace(0.0, 0.95, 96)
 
 
 def _cumulative_motion(log: RobotLog) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -253,94 +351,366 @@ def _cumulative_motion(log: RobotLog) -> tuple[NDArray[np.float64], NDArray[np.f
 
 
 @dataclass(frozen=True, slots=True)
-class _Windows:
-    recorded_run: NDArray[np.float64]
-    recorded_turn: NDArray[np.float64]
-    actual_run: NDArray[np.float64]
-    actual_turn: NDArray[np.float64]
+class _Moves:
+    """One log cut into moves of equal duration: per move, recorded and true motion.
+
+    ``run``/``turn`` are recorded (before scales), ``path``/``heading`` the true chord
+    length and heading change; ``pose`` the true pose at each move's start and at the
+    last one's end, ``(n + 1, 3)``; ``valid`` marks moves whose both ends lie in the
+    ground truth (not in a gap).
+    """
+
+    run: NDArray[np.float64]
+    turn: NDArray[np.float64]
+    path: NDArray[np.float64]
+    heading: NDArray[np.float64]
+    pose: NDArray[np.float64]
+    valid: NDArray[np.bool_]
 
 
-def _windows(log: RobotLog, delay: float, horizon: float, step: float) -> _Windows:
-    assert log.groundtruth is not None
-    time, run, turn = _cumulative_motion(log)
+def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
     truth = log.groundtruth
-    start = max(time[0] + delay, truth.time[0])
-    end = min(time[-1] + delay, truth.time[-1])
-    if end - start < 2 * horizon:
-        empty = np.empty(0)
-        return _Windows(empty, empty, empty, empty)
-    grid = np.arange(start, end, step)
-    lag = max(1, round(horizon / step))
-    cum_run = np.interp(grid, time + delay, run)
-    cum_turn = np.interp(grid, time + delay, turn)
-    x = np.interp(grid, truth.time, truth.x)
-    y = np.interp(grid, truth.time, truth.y)
-    heading = np.interp(grid, truth.time, np.unwrap(truth.heading))
-    return _Windows(
-        cum_run[lag:] - cum_run[:-lag],
-        cum_turn[lag:] - cum_turn[:-lag],
-        np.hypot(x[lag:] - x[:-lag], y[lag:] - y[:-lag]),
-        heading[lag:] - heading[:-lag],
+    assert truth is not None
+    time, run, turn = _cumulative_motion(log)
+    first = max(float(time[0]) + delay, float(truth.time[0]))
+    last = min(float(time[-1]) + delay, float(truth.time[-1]))
+    count = math.floor((last - first) / move) if last > first else 0
+    edges = first + move * np.arange(count + 1)
+    cum_run = np.interp(edges, time + delay, run)
+    cum_turn = np.interp(edges, time + delay, turn)
+    pose = truth.at(edges)
+    known = ~np.isnan(pose[:, 0])
+    return _Moves(
+        np.diff(cum_run),
+        np.diff(cum_turn),
+        np.hypot(np.diff(pose[:, 0]), np.diff(pose[:, 1])),
+        np.angle(np.exp(1j * np.diff(pose[:, 2]))),
+        pose,
+        known[:-1] & known[1:],
     )
 
 
-def _pool(logs: Sequence[RobotLog], delay: float, horizon: float, step: float) -> _Windows:
-    parts = [_windows(log, delay, horizon, step) for log in logs]
-    return _Windows(*(np.concatenate([getattr(p, f) for p in parts]) for f in _Windows.__slots__))
+def _window_sums(values: NDArray[np.float64], length: int) -> NDArray[np.float64]:
+    """Return the sums of ``length`` consecutive values, one per start (``len(values) - length + 1``)."""
+    if len(values) < length:
+        return np.empty(0)
+    total = np.concatenate(([0.0], np.cumsum(values)))
+    result: NDArray[np.float64] = total[length:] - total[:-length]
+    return result
 
 
-def _fit_delay(logs: Sequence[RobotLog], delays: NDArray[np.float64], horizon: float, step: float) -> float:
+@dataclass(frozen=True, slots=True)
+class _Windows:
+    """Sums over every window of consecutive valid moves at one horizon, pooled over logs."""
+
+    run: NDArray[np.float64]
+    turn: NDArray[np.float64]
+    abs_turn: NDArray[np.float64]
+    path: NDArray[np.float64]
+    heading: NDArray[np.float64]
+
+
+def _windows(moves: Sequence[_Moves], length: int) -> _Windows:
+    parts: list[list[NDArray[np.float64]]] = [[], [], [], [], []]
+    for m in moves:
+        whole = _window_sums((~m.valid).astype(np.float64), length) == 0.0
+        values = (m.run, m.turn, np.abs(m.turn), m.path, m.heading)
+        for part, value in zip(parts, values, strict=True):
+            part.append(_window_sums(np.where(m.valid, value, 0.0), length)[whole])
+    return _Windows(*(np.concatenate(p) if p else np.empty(0) for p in parts))
+
+
+def _fit_delay(logs: Sequence[RobotLog], delays: NDArray[np.float64], move: float) -> float:
     # The delay that best aligns recorded and true heading changes (turns carry the timing).
     best, best_cost = 0.0, math.inf
     for delay in delays:
-        w = _pool(logs, float(delay), horizon, step)
-        if not w.actual_turn.size:
+        pooled = [_moves(log, float(delay), move) for log in logs]
+        turn = np.concatenate([m.turn[m.valid] for m in pooled])
+        heading = np.concatenate([m.heading[m.valid] for m in pooled])
+        if not turn.size:
             continue
-        cost = float(np.mean((w.recorded_turn - w.actual_turn) ** 2))
+        cost = float(np.mean((turn - heading) ** 2))
         if cost < best_cost:
             best, best_cost = float(delay), cost
     return best
 
 
-def _ratio_fit(
-    actual: NDArray[np.float64], recorded: NDArray[np.float64], quantile: float
-) -> tuple[float, float, float]:
-    """Scale, loss and sd such that scale*recorded*clip(1 - loss +- 3 sd, 0, 1) covers ``quantile``."""
-    if actual.size < 10:
+def _gain(actual: NDArray[np.float64], recorded: NDArray[np.float64]) -> float:
+    """Least-squares factor ``k`` of ``actual ~ k * recorded``; 1 when it is undefined or not positive."""
+    power = float(np.sum(recorded * recorded))
+    if power <= 0.0:
+        return 1.0
+    gain = float(np.sum(actual * recorded)) / power
+    return gain if gain > 1e-3 else 1.0
+
+
+def _band_stats(gain: float, band: float, sigmas: float) -> tuple[float, float, float]:
+    """Scale, loss and sd of a factor within ``gain * [1 - band, 1 + band]`` at ``sigmas``.
+
+    The growth model's actual value is ``scale * recorded * clip(1 - loss + sd z, 0, 1)``;
+    with |z| <= sigmas this spans exactly ``gain * recorded * [1 - band, 1 + band]``, and
+    its mean is ``gain * recorded``.
+    """
+    scale = gain * (1.0 + band)
+    loss = band / (1.0 + band)
+    return scale, loss, loss / sigmas
+
+
+def _fit_turn_and_drift(windows: Sequence[_Windows], gain: float, q: float) -> tuple[float, float]:
+    """Return the turn band and the drift (rad/m) whose summed bound covers ``q`` at every horizon.
+
+    Over a window the bound on the true heading change is ``gain * turn +- (band * gain *
+    sum|turn| + drift * path)``: the growth sums it move by move. For each band the drift
+    is the smallest that covers the ``q`` quantile of every horizon's moving windows; the
+    band kept is the one whose bound is smallest, each horizon weighing the same.
+    """
+    best = (0.0, 0.0)
+    best_cost = math.inf
+    for band in _BANDS.tolist():
+        drift = 0.0
+        for w in windows:
+            moving = w.run > 0.0
+            if not moving.any():
+                continue
+            excess = np.abs(w.heading - gain * w.turn) - band * gain * w.abs_turn
+            need = np.maximum(excess[moving], 0.0) / np.maximum(w.path[moving], 1e-3)
+            drift = max(drift, float(np.quantile(need, q)))
+        cost = 0.0
+        for w in windows:
+            if w.run.size:
+                error = float(np.mean(np.abs(w.heading - gain * w.turn))) + 1e-9
+                cost += float(np.mean(band * gain * w.abs_turn + drift * w.path)) / error
+        if cost < best_cost:
+            best, best_cost = (band, drift), cost
+    return best
+
+
+def _fit_run(windows: Sequence[_Windows], gain: float, q: float, sigmas: float) -> tuple[float, float, float]:
+    """Return run scale, loss and sd: the true path over recorded run lies in ``[low, high]``.
+
+    ``high`` is the largest ``(1 + q) / 2`` quantile and ``low`` the smallest ``(1 - q) / 2``
+    quantile of the ratio over the horizons (runs lag their commands more often than they
+    lead them, so the band is not symmetric); the loss keeps the mean at ``gain``.
+    """
+    high, low = 0.0, math.inf
+    for w in windows:
+        moving = w.run > 0.0
+        if moving.any():
+            ratio = w.path[moving] / w.run[moving]
+            high = max(high, float(np.quantile(ratio, (1.0 + q) / 2.0)))
+            low = min(low, float(np.quantile(ratio, (1.0 - q) / 2.0)))
+    if not high > 0.0:
         return 1.0, 0.0, 0.0
-    ratio = actual / recorded
-    scale = max(float(np.quantile(ratio, quantile)), 1e-6)
-    scaled = ratio / scale
-    mean = float(np.mean(scaled))
-    loss = min(max(0.0, 1.0 - mean), 0.99)
-    sd = max(0.0, (1.0 - loss - float(np.quantile(scaled, 1.0 - quantile))) / 3.0)
-    return scale, loss, sd
+    floor = min(max(low / high, 0.0), 1.0)
+    loss = min(max(1.0 - gain / high, 0.0), 1.0 - floor)
+    return high, loss, (1.0 - loss - floor) / sigmas
+
+
+@dataclass(frozen=True, slots=True)
+class HorizonCheck:
+    """How the calibrated growth bound holds over one horizon (a row of the calibration report).
+
+    From the true pose at the start of every window of ``horizon`` seconds in the
+    calibration logs, a point map is grown by the window's recorded moves (scaled, at the
+    calibration's sigmas) and set against the true pose at its end.
+
+    Attributes
+    ----------
+    horizon : float
+        Seconds without a correcting observation.
+    windows : int
+        Windows checked (those inside the ground truth).
+    containment : float
+        Fraction of the windows whose true end pose is inside the grown map.
+    heading_error : float
+        The calibration quantile of the true heading's distance from the middle of the
+        grown wedge, radians.
+    heading_bound : float
+        Median half-width of the grown wedge, radians.
+    position_error : float
+        The calibration quantile of the true position's distance from the grown map's
+        centre, metres.
+    position_bound : float
+        Median distance from the grown map's centre to its farthest vertex, metres.
+    """
+
+    horizon: float
+    windows: int
+    containment: float
+    heading_error: float
+    heading_bound: float
+    position_error: float
+    position_bound: float
+
+
+def horizon_checks(
+    logs: Sequence[RobotLog],
+    stats: TerrainStats,
+    motion: MotionCalibration,
+    *,
+    quantile: float = 0.99,
+    horizons: Sequence[float] = DEFAULT_HORIZONS,
+    move: float = 0.5,
+    sigmas: float = 3.0,
+    stride: float = 1.0,
+) -> tuple[HorizonCheck, ...]:
+    """Check growth bounds against logs with ground truth over each horizon.
+
+    Windows start every ``stride`` seconds; each grows a point map at the true start pose
+    by the recorded motion cut into ``move``-second pieces (``motion``'s delay and scales
+    applied; each piece half its turn, its run, the other half) on ``stats`` at
+    ``sigmas``, and is compared with the truth after each horizon. A point start is the
+    strictest test: a replay's map is never a point, and millimetres of ground-truth
+    noise count here.
+
+    Parameters
+    ----------
+    logs : sequence of RobotLog
+        Logs with ground truth.
+    stats : TerrainStats
+        The growth statistics to check.
+    motion : MotionCalibration
+        Delay and scales of the recorded motion.
+    quantile : float
+        In (0, 1): the quantile of the errors reported.
+    horizons : sequence of float
+        Seconds, each >= ``move``.
+    move, stride : float
+        Seconds, > 0.
+    sigmas : float
+        Standard deviations the growth bounds, > 0.
+
+    Returns
+    -------
+    tuple of HorizonCheck
+        One per horizon, in the order given; figures are NaN for a horizon without windows.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=60.0)
+    >>> calibration = calibrate_logs([log], horizons=(1.0, 2.0))
+    >>> [(c.horizon, c.windows) for c in calibration.checks]
+    [(1.0, 59), (2.0, 58)]
+    >>> horizon_checks([log], calibration.stats, calibration.motion, horizons=(120.0,))[0].windows
+    0
+    """
+    q = finite_float(quantile, "quantile")
+    if not 0.0 < q < 1.0:
+        raise InputError(f"quantile: expected a number in (0, 1), got {q!r}")
+    step = positive_float(move, "move")
+    every = max(1, round(positive_float(stride, "stride") / step))
+    lengths = [max(1, round(positive_float(h, "horizons") / step)) for h in horizons]
+    sigma = positive_float(sigmas, "sigmas")
+    rows: list[list[tuple[bool, float, float, float, float]]] = [[] for _ in lengths]
+    longest = max(lengths, default=0)
+    for log in logs:
+        m = _moves(log, motion.delay_s, step)
+        # Half the turn before the run and half after: a move turns while it runs, and its
+        # chord points along the middle heading, not the last one.
+        commands = [
+            (
+                TurnAndRun(turn * motion.turn_scale / 2.0, run * motion.run_scale),
+                TurnAndRun(turn * motion.turn_scale / 2.0, 0.0),
+            )
+            for turn, run in zip(m.turn.tolist(), m.run.tolist(), strict=True)
+        ]
+        for first in range(0, len(commands), every):
+            x, y, heading = m.pose[first]
+            if not m.valid[first]:
+                continue
+            grown = SpatialUncertaintyMap.from_pose(Pose(float(x), float(y), float(heading)), 0.0, 0.0)
+            for done in range(1, min(longest, len(commands) - first) + 1):
+                index = first + done - 1
+                if not m.valid[index]:
+                    break
+                for command in commands[index]:
+                    grown = grown.grow(command, stats, sigmas=sigma)
+                for row, length in zip(rows, lengths, strict=True):
+                    if length == done:
+                        row.append(_judge(grown, m.pose[index + 1]))
+    checks = []
+    for horizon, row in zip(horizons, rows, strict=True):
+        if not row:
+            checks.append(HorizonCheck(float(horizon), 0, *([math.nan] * 5)))
+            continue
+        table = np.array(row, dtype=np.float64)
+        checks.append(
+            HorizonCheck(
+                float(horizon),
+                len(row),
+                float(np.mean(table[:, 0])),
+                float(np.quantile(table[:, 1], q)),
+                float(np.median(table[:, 2])),
+                float(np.quantile(table[:, 3], q)),
+                float(np.median(table[:, 4])),
+            )
+        )
+    return tuple(checks)
+
+
+def _judge(
+    grown: SpatialUncertaintyMap, truth: NDArray[np.float64]
+) -> tuple[bool, float, float, float, float]:
+    """Containment, heading error and half-width, position error and reach of one grown map."""
+    x, y, heading = (float(v) for v in truth)
+    wedge = grown.wedge
+    middle = wedge.center + (wedge.ccw - wedge.cw) / 2.0
+    cx, cy = (float(v) for v in grown.center)
+    reach = float(np.max(np.hypot(grown.polygon.vertices[:, 0] - cx, grown.polygon.vertices[:, 1] - cy)))
+    return (
+        bool(grown.contains(x, y, heading)),
+        abs(math.remainder(heading - middle, math.tau)),
+        (wedge.cw + wedge.ccw) / 2.0,
+        math.hypot(x - cx, y - cy),
+        reach,
+    )
 
 
 def calibrate_logs(
     logs: Sequence[RobotLog],
     *,
     quantile: float = 0.99,
-    horizon: float = 1.0,
+    move: float = 0.5,
+    horizons: Sequence[float] = DEFAULT_HORIZONS,
+    sigmas: float = 3.0,
     envelope_margin: float = 1.25,
     max_delay: float = 1.0,
 ) -> Calibration:
     """Estimate terrain statistics, motion delay and scales, and sensor bounds from logs.
 
-    Motion (pooled over the logs, which must share one terrain): the delay is the one in
-    ``[0, max_delay]`` (0.05 s steps) that best aligns recorded and true heading changes
-    over ``horizon``-second windows. Over the same windows (sampled every 0.05 s):
-    ``run_scale`` is the ``quantile`` of actual/recorded run (windows that move), so that
-    scaled runs bound actual ones, and ``translation_loss`` / ``translation_sd`` are
-    the mean loss and the spread that puts the ``1 - quantile`` shortest runs within
-    3 sd; turns likewise (windows that turn more than 0.1 rad/s). ``drift`` is the
-    ``quantile`` of the heading change the turn bound leaves unexplained, per metre
-    actually run. Skitter and inertial loss are 0 (not separable at this rate).
+    **Motion** (pooled over the logs, which must share one terrain). The recorded motion is
+    cut into moves of ``move`` seconds and set against the ground truth's over the same
+    moves; the growth bound of a span is the sum of its moves' bounds, so it is fitted to
+    the true error *accumulated* over windows of each of ``horizons`` seconds (the time
+    a map goes without a correcting observation), never to one move's worst case:
 
-    Sensors (every observation inside the ground truth's span): the working bounds are
-    the ``quantile`` of |bearing error|, and the ``(1 - quantile) / 2`` and ``(1 +
-    quantile) / 2`` quantiles of the range error relative to the measured range; the
-    envelope bounds are the largest errors seen, times ``envelope_margin``.
+    - the delay in ``[0, max_delay]`` (0.05 s steps) best aligns recorded and true
+      heading changes per move;
+    - turns: the true heading change is ``k_t`` times the recorded turn on average
+      (least squares), within a band ``k_t * [1 - e_t, 1 + e_t]`` of it per move, plus
+      ``drift`` radians per metre actually run either side; for each band the drift is
+      the smallest whose summed bound covers the ``quantile`` of the windows' heading
+      errors at every horizon, and the band kept gives the smallest bound;
+    - runs: the true path is ``k_r`` times the recorded run on average, within a band
+      ``k_r * [1 - e_r, 1 + e_r]`` covering the ``quantile`` at every horizon;
+    - a band becomes the paper's statistics at ``sigmas``: ``turn_scale = k_t (1 + e_t)``,
+      ``rotation_loss = e_t / (1 + e_t)``, ``rotation_sd = rotation_loss / sigmas`` (the
+      same for runs); skitter and inertial loss are 0 (not separable from the rest).
+
+    Windows slower than 0.02 m/s do not fit drift or runs. :attr:`Calibration.checks`
+    then grows a point map over every window and reports how the bound holds.
+
+    **Sensors** (every observation inside the ground truth): the working bearing bound is
+    the ``quantile`` of |bearing error|; the working range bound is relative to the
+    measured range plus absolute, ``fraction * range + range_error`` on each side: the
+    fractions are the ``(1 - quantile) / 2`` and ``(1 + quantile) / 2`` quantiles of the
+    relative range error, and ``range_error`` the median |range error| of the shortest
+    tenth of the ranges (so that short ranges never get a zero-width bound). The envelope
+    bounds cover every relative error seen, times ``envelope_margin``, plus the absolute
+    part times ``envelope_margin``. The filters' noise (:class:`FilterNoise`) is the standard deviation
+    of the bearing errors and of the relative range errors.
 
     Parameters
     ----------
@@ -348,8 +718,13 @@ def calibrate_logs(
         Logs with ground truth, on the same terrain.
     quantile : float
         In (0.5, 1).
-    horizon : float
-        Seconds, > 0.
+    move : float
+        Seconds, > 0: the pieces the fit cuts the motion into. Replays cut at least as
+        finely (at every observation), which only widens their bound.
+    horizons : sequence of float
+        Seconds, each >= ``move``: where the bound must hold.
+    sigmas : float
+        Standard deviations the replay's growth bounds (its ``sigmas`` setting), > 0.
     envelope_margin : float
         >= 1.
     max_delay : float
@@ -371,7 +746,7 @@ def calibrate_logs(
     >>> from aura_ums.logs import synthetic_log
     >>> log = synthetic_log(np.random.default_rng(0), duration=120.0)
     >>> calibration = calibrate_logs([log])
-    >>> calibration.terrain, calibration.motion.run_scale <= 1.0, calibration.working.bearing_error < 0.05
+    >>> calibration.terrain, calibration.motion.run_scale <= 1.1, calibration.working.bearing_error < 0.05
     ('floor', True, True)
     >>> calibrate_logs([])
     Traceback (most recent call last):
@@ -392,9 +767,11 @@ def calibrate_logs(
     q = finite_float(quantile, "quantile")
     if not 0.5 < q < 1.0:
         raise InputError(f"quantile: expected a number in (0.5, 1), got {q!r}")
-    span = finite_float(horizon, "horizon")
-    if not span > 0.0:
-        raise InputError(f"horizon: expected a positive number of seconds, got {span!r}")
+    step = positive_float(move, "move")
+    spans = tuple(finite_float(h, "horizons") for h in horizons)
+    if not spans or min(spans) < step:
+        raise InputError(f"horizons: expected seconds, each >= move ({step!r}), got {list(spans)}")
+    sigma = positive_float(sigmas, "sigmas")
     margin = finite_float(envelope_margin, "envelope_margin")
     if margin < 1.0:
         raise InputError(f"envelope_margin: expected a number >= 1, got {margin!r}")
@@ -402,23 +779,28 @@ def calibrate_logs(
     if delay_limit < 0.0:
         raise InputError(f"max_delay: expected a number >= 0, got {delay_limit!r}")
 
-    step = 0.05
-    delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, step), span, step)
-    w = _pool(logs, delay, span, step)
-    moving = w.recorded_run > 0.02 * span
-    if moving.sum() < 10:
+    delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, _DELAY_STEP), step)
+    moves = [_moves(log, delay, step) for log in logs]
+    windows = [_windows(moves, max(1, round(h / step))) for h in spans]
+    windows = [
+        _Windows(*(getattr(w, f)[w.run > _MOVING * h] for f in _Windows.__slots__))
+        for w, h in zip(windows, spans, strict=True)
+    ]
+    counted = sum(int(w.run.size) for w in windows)
+    if windows[0].run.size < 10:
         raise InputError(
-            f"logs: expected at least 10 {span!r}-second windows of motion, got {int(moving.sum())}"
+            f"logs: expected at least 10 {spans[0]!r}-second windows of motion, got {windows[0].run.size}"
         )
-    run_scale, translation_loss, translation_sd = _ratio_fit(w.actual_run[moving], w.recorded_run[moving], q)
-    turning = np.abs(w.recorded_turn) > 0.1 * span
-    turn_scale, rotation_loss, rotation_sd = _ratio_fit(w.actual_turn[turning], w.recorded_turn[turning], q)
-    # Heading change outside the turn bound [scale*turn*low, scale*turn], per metre run.
-    low = min(max(1.0 - rotation_loss - 3.0 * rotation_sd, 0.0), 1.0)
-    commanded = w.recorded_turn * turn_scale
-    lower, upper = np.minimum(commanded * low, commanded), np.maximum(commanded * low, commanded)
-    unexplained = np.maximum(0.0, np.maximum(lower - w.actual_turn, w.actual_turn - upper))
-    drift = float(np.quantile(unexplained[moving] / np.maximum(w.actual_run[moving], 1e-3), q))
+    valid = np.concatenate([m.valid for m in moves])
+    run_gain = _gain(
+        np.concatenate([m.path for m in moves])[valid], np.concatenate([m.run for m in moves])[valid]
+    )
+    turn_gain = _gain(
+        np.concatenate([m.heading for m in moves])[valid], np.concatenate([m.turn for m in moves])[valid]
+    )
+    turn_band, drift = _fit_turn_and_drift(windows, turn_gain, q)
+    run_scale, translation_loss, translation_sd = _fit_run(windows, run_gain, q, sigma)
+    turn_scale, rotation_loss, rotation_sd = _band_stats(turn_gain, turn_band, sigma)
     stats = TerrainStats(
         translation_loss=translation_loss,
         translation_inertial_loss=0.0,
@@ -429,22 +811,31 @@ def calibrate_logs(
         skitter=0.0,
         skitter_sd=0.0,
     )
+    motion = MotionCalibration(delay, run_scale, turn_scale)
+    checks = horizon_checks(logs, stats, motion, quantile=q, horizons=spans, move=step, sigmas=sigma)
 
-    bearing_errors, range_errors = observation_errors(logs)
+    bearing_errors, range_errors, range_measured = _observation_errors(logs)
     if bearing_errors.size < 10:
         raise InputError(
             f"logs: expected at least 10 observations within the ground truth, got {bearing_errors.size}"
         )
-    working, envelope = _sensor_bounds(bearing_errors, range_errors, q, margin)
+    working, envelope = _sensor_bounds(bearing_errors, range_errors, range_measured, q, margin)
+    noise = FilterNoise(
+        max(float(np.std(bearing_errors)), 1e-6),
+        max(float(np.std(range_errors / range_measured)), 1e-3) if range_errors.size > 1 else 0.05,
+    )
     return Calibration(
         terrains[0],
         stats,
-        MotionCalibration(delay, run_scale, turn_scale),
+        motion,
         working,
         envelope,
+        noise,
         q,
-        span,
-        int(moving.sum()),
+        step,
+        spans,
+        checks,
+        counted,
         int(bearing_errors.size),
     )
 
@@ -455,7 +846,7 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
     Parameters
     ----------
     logs : sequence of RobotLog
-        Logs with ground truth; observations outside its span are skipped.
+        Logs with ground truth; observations outside it (or in one of its gaps) are skipped.
 
     Returns
     -------
@@ -464,8 +855,17 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
     range_errors : ndarray, shape (k,)
         ``(measured - true) / measured`` for the observations with a range (k <= n).
     """
+    bearing, error, measured = _observation_errors(logs)
+    return bearing, error / measured
+
+
+def _observation_errors(
+    logs: Sequence[RobotLog],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Bearing errors (rad), and range errors ``measured - true`` (m) with their measured ranges (m)."""
     bearing: list[NDArray[np.float64]] = []
-    ranges: list[NDArray[np.float64]] = []
+    errors: list[NDArray[np.float64]] = []
+    measured_ranges: list[NDArray[np.float64]] = []
     for log in logs:
         if log.groundtruth is None or not log.observations:
             continue
@@ -474,41 +874,49 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
         keep = ~np.isnan(pose[:, 0])
         lx = np.array([log.landmark(o.landmark_id).x for o in log.observations])
         ly = np.array([log.landmark(o.landmark_id).y for o in log.observations])
-        dx, dy = lx - pose[:, 0], ly - pose[:, 1]
+        forward, left = log.meta.sensor_offset  # bearings and ranges are the sensor's
+        cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+        dx = lx - (pose[:, 0] + forward * cos - left * sin)
+        dy = ly - (pose[:, 1] + forward * sin + left * cos)
         true_bearing = np.arctan2(dy, dx) - pose[:, 2]
         measured = np.array([o.bearing for o in log.observations])
         error = np.angle(np.exp(1j * (measured - true_bearing)))
         bearing.append(error[keep])
         measured_range = np.array([np.nan if o.range is None else o.range for o in log.observations])
         with_range = keep & ~np.isnan(measured_range) & (measured_range > 0.0)
-        ranges.append(
-            (measured_range[with_range] - np.hypot(dx, dy)[with_range]) / measured_range[with_range]
-        )
+        errors.append(measured_range[with_range] - np.hypot(dx, dy)[with_range])
+        measured_ranges.append(measured_range[with_range])
     empty = np.empty(0, dtype=np.float64)
     return (
         np.concatenate(bearing) if bearing else empty,
-        np.concatenate(ranges) if ranges else empty,
+        np.concatenate(errors) if errors else empty,
+        np.concatenate(measured_ranges) if measured_ranges else empty,
     )
 
 
 def _sensor_bounds(
-    bearing: NDArray[np.float64], ranges: NDArray[np.float64], q: float, margin: float
+    bearing: NDArray[np.float64],
+    errors: NDArray[np.float64],
+    measured: NDArray[np.float64],
+    q: float,
+    margin: float,
 ) -> tuple[SensorBounds, SensorBounds]:
     magnitude = np.abs(bearing)
     working_bearing = max(float(np.quantile(magnitude, q)), 1e-6)
     envelope_bearing = max(float(magnitude.max()) * margin, working_bearing)
-    if ranges.size:
-        low = max(0.0, -float(np.quantile(ranges, (1.0 - q) / 2.0)))
-        high = max(0.0, float(np.quantile(ranges, (1.0 + q) / 2.0)))
-        env_low = min(max(0.0, -float(ranges.min())) * margin, 0.95)
-        env_high = min(max(0.0, float(ranges.max())) * margin, 0.95)
+    if errors.size:
+        relative = errors / measured
+        low = min(max(0.0, -float(np.quantile(relative, (1.0 - q) / 2.0))), 0.95)
+        high = min(max(0.0, float(np.quantile(relative, (1.0 + q) / 2.0))), 0.95)
+        # Plus an absolute part, so that short ranges never get a zero-width bound: the
+        # median error of the shortest tenth of the ranges, where the relative part vanishes.
+        shortest = measured <= float(np.quantile(measured, 0.1))
+        absolute = float(np.median(np.abs(errors[shortest])))
+        wide = absolute * margin
+        env_low = min(max(0.0, -float(relative.min())) * margin, 0.95)
+        env_high = min(max(0.0, float(relative.max())) * margin, 0.95)
     else:
-        low = high = env_low = env_high = 0.0
-    working = SensorBounds(working_bearing, 0.0, min(low, 0.95), min(high, 0.95))
-    envelope = SensorBounds(
-        envelope_bearing,
-        0.0,
-        max(env_low, working.range_fraction_low),
-        max(env_high, working.range_fraction_high),
-    )
+        absolute = wide = low = high = env_low = env_high = 0.0
+    working = SensorBounds(working_bearing, absolute, low, high)
+    envelope = SensorBounds(envelope_bearing, wide, max(env_low, low), max(env_high, high))
     return working, envelope

@@ -257,7 +257,9 @@ def compare_on_log(
                 (observation, landmarks[row.landmark_id])
                 for row in frames[frame_time]
                 if isinstance(
-                    observation := observation_for(row, opts.landmark_class, bounds),
+                    observation := observation_for(
+                        row, opts.landmark_class, bounds, sensor_offset=log.meta.sensor_offset
+                    ),
                     (BearingObservation, RangeBearingObservation),
                 )
             ]

@@ -78,6 +78,8 @@ _META_KEYS: dict[str, dict[str, tuple[str, str]]] = {
         "bearing_error": ("bearing_error", "angle"),
         "range_error": ("range_error", "length"),
         "range_error_fraction": ("range_error_fraction", ""),
+        "forward": ("sensor_forward", "length"),
+        "left": ("sensor_left", "length"),
     },
     "motion": {"delay_s": ("delay_s", ""), "run_scale": ("run_scale", ""), "turn_scale": ("turn_scale", "")},
     "start": {
@@ -482,6 +484,8 @@ def _meta_toml(meta: LogMeta) -> str:
         f"bearing_error = {meta.bearing_error!r}",
         f"range_error = {meta.range_error!r}",
         f"range_error_fraction = {meta.range_error_fraction!r}",
+        f"forward = {meta.sensor_forward!r}",
+        f"left = {meta.sensor_left!r}",
         "",
         "[motion]",
         f"delay_s = {meta.delay_s!r}",

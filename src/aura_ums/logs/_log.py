@@ -19,6 +19,11 @@ from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, repor
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
+#: Seconds: the longest interval between two ground-truth rows interpolated across by
+#: default (:attr:`GroundTruth.max_gap`); motion capture records at 50-100 Hz, so a longer
+#: interval is a lost track, not a slow sampler.
+DEFAULT_MAX_TRUTH_GAP = 0.5
+
 
 class ObservationKind(enum.Enum):
     """What a log observation measured: a bearing only, or a range and a bearing.
@@ -70,6 +75,9 @@ class LogMeta:
     range_error_fraction : float
         Relative part of the range error bound, >= 0: the bound is
         ``range_error + range_error_fraction * range``.
+    sensor_forward, sensor_left : float
+        Metres: where the landmark sensor sits in the robot frame (x forward, y left);
+        bearings and ranges are measured from there, not from the robot's reference point.
     delay_s : float
         Seconds, >= 0, by which the motion rows lag: the motion recorded at ``t``
         happens at ``t + delay_s``.
@@ -107,6 +115,8 @@ class LogMeta:
     bearing_error: float = 0.05
     range_error: float = 0.1
     range_error_fraction: float = 0.0
+    sensor_forward: float = 0.0
+    sensor_left: float = 0.0
     delay_s: float = 0.0
     run_scale: float = 1.0
     turn_scale: float = 1.0
@@ -131,7 +141,7 @@ class LogMeta:
             "start_heading_halfwidth",
         ):
             object.__setattr__(self, name, _bounded(getattr(self, name), f"LogMeta.{name}"))
-        for name in ("landmark_z_bottom", "landmark_z_top"):
+        for name in ("landmark_z_bottom", "landmark_z_top", "sensor_forward", "sensor_left"):
             object.__setattr__(self, name, finite_float(getattr(self, name), f"LogMeta.{name}"))
         if self.landmark_z_top < self.landmark_z_bottom:
             raise InputError(
@@ -140,6 +150,11 @@ class LogMeta:
             )
         if self.start is not None and not isinstance(self.start, Pose):
             raise InputError(f"LogMeta.start: expected a Pose or None, got {type(self.start).__name__}")
+
+    @property
+    def sensor_offset(self) -> tuple[float, float]:
+        """``(sensor_forward, sensor_left)``, metres: the sensor's place in the robot frame."""
+        return self.sensor_forward, self.sensor_left
 
     def range_bound(self, measured_range: float) -> float:
         """Return the range error bound, metres, for a measured range (metres) given without one."""
@@ -396,25 +411,42 @@ class GroundTruth:
         Position, metres, world frame.
     heading : array_like, shape (n,)
         Radians counter-clockwise from +x; stored wrapped to (-pi, pi].
+    max_gap : float
+        Seconds, > 0 (``math.inf`` for no limit): the longest interval between two rows
+        that :meth:`at` interpolates across. Times strictly inside a longer interval are a
+        gap in the record (a lost motion-capture track, say) and get no pose; default
+        :data:`DEFAULT_MAX_TRUTH_GAP`.
 
     Examples
     --------
     >>> import math
-    >>> truth = GroundTruth([0.0, 1.0], [0.0, 2.0], [0.0, 0.0], [3.0, -3.0])
+    >>> truth = GroundTruth([0.0, 1.0], [0.0, 2.0], [0.0, 0.0], [3.0, -3.0], max_gap=2.0)
     >>> pose = truth.at([0.5, 2.0])     # the heading turns through pi, not through 0
     >>> bool(abs(pose[0, 2]) == math.pi), bool(np.isnan(pose[1]).all())
     (True, True)
+    >>> GroundTruth([0.0, 1.0], [0.0, 2.0], [0.0, 0.0], [0.0, 0.0]).at([0.0, 0.5, 1.0])[:, 0]
+    array([ 0., nan,  2.])
     """
 
     time: NDArray[np.float64]
     x: NDArray[np.float64]
     y: NDArray[np.float64]
     heading: NDArray[np.float64]
+    max_gap: float
     _unwrapped: NDArray[np.float64] = field(init=False, repr=False)
 
-    def __init__(self, time: ArrayLike, x: ArrayLike, y: ArrayLike, heading: ArrayLike) -> None:
+    def __init__(
+        self,
+        time: ArrayLike,
+        x: ArrayLike,
+        y: ArrayLike,
+        heading: ArrayLike,
+        *,
+        max_gap: float = DEFAULT_MAX_TRUTH_GAP,
+    ) -> None:
         for name, value in (("time", time), ("x", x), ("y", y), ("heading", heading)):
             object.__setattr__(self, name, _series(value, f"GroundTruth.{name}"))
+        object.__setattr__(self, "max_gap", _max_gap(max_gap, "GroundTruth.max_gap"))
         _same_length("GroundTruth", time=self.time, x=self.x, y=self.y, heading=self.heading)
         _increasing(self.time, "GroundTruth.time")
         outside = (self.heading <= -math.pi) | (self.heading > math.pi)
@@ -440,7 +472,8 @@ class GroundTruth:
         ndarray, shape (n, 3)
             Rows of x (m), y (m), heading (rad, wrapped to (-pi, pi]) interpolated
             linearly (the heading along the shorter way round); NaN rows for times outside
-            ``[time[0], time[-1]]``.
+            ``[time[0], time[-1]]`` and for times strictly inside a gap (two rows more than
+            :attr:`max_gap` apart).
         """
         query = float_array(times, "times").reshape(-1)
         out = np.empty((len(query), 3))
@@ -448,7 +481,29 @@ class GroundTruth:
         out[:, 1] = np.interp(query, self.time, self.y)
         out[:, 2] = wrap_angle(np.interp(query, self.time, self._unwrapped))
         out[(query < self.time[0]) | (query > self.time[-1])] = np.nan
+        out[self._in_gap(query)] = np.nan
         return out
+
+    def _in_gap(self, query: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Whether each query time lies strictly between two rows more than ``max_gap`` apart."""
+        after = np.searchsorted(self.time, query, side="right")
+        inner = (after > 0) & (after < len(self.time))
+        gap = np.zeros(len(query), dtype=bool)
+        before = after[inner] - 1
+        gap[inner] = (self.time[before + 1] - self.time[before] > self.max_gap) & (
+            query[inner] > self.time[before]
+        )
+        return gap
+
+    def with_max_gap(self, max_gap: float) -> GroundTruth:
+        """Return this record with another :attr:`max_gap` (seconds, > 0, or ``math.inf``)."""
+        return GroundTruth(self.time, self.x, self.y, self.heading, max_gap=max_gap)
+
+
+def _max_gap(value: object, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0.0:
+        raise InputError(f"{name}: expected a positive number of seconds (or inf), got {value!r}")
+    return float(value)
 
 
 def _tuple_of(value: object, kind: type, name: str) -> tuple[object, ...]:

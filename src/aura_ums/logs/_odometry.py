@@ -194,7 +194,8 @@ def odometry_report_arrays(
         row = int(np.argmax(reversing))
         raise InputError(
             f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
-            f"pass reverse=ReverseMotion.FLIP), got {float(forward[row])!r} at row {row}"
+            f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), "
+            f"got {float(forward[row])!r} at row {row}"
         )
 
     t = t + delay

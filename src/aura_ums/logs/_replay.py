@@ -23,6 +23,7 @@ from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._odometry import ReverseMotion
 from aura_ums.manager import (
     Blackboard,
     ManagerSettings,
@@ -86,6 +87,8 @@ class ReplayOptions:
         ``settings.envelope_factor``.
     motion : MotionCalibration or None
         Delay and scales of the recorded motion; None takes the log's ``meta.toml``.
+    reverse : ReverseMotion
+        What to do with negative forward velocities (:class:`ReverseMotion`; default: refuse).
     arena_margin : float
         Metres, >= 0, by which the one meadow of the replay (the log's terrain) extends
         beyond the landmarks, the start and the ground truth.
@@ -108,6 +111,7 @@ class ReplayOptions:
     working: SensorBounds | None = None
     envelope: SensorBounds | None = None
     motion: MotionCalibration | None = None
+    reverse: ReverseMotion = ReverseMotion.ERROR
     arena_margin: float = 5.0
 
     def __post_init__(self) -> None:
@@ -131,6 +135,8 @@ class ReplayOptions:
                 raise InputError(
                     f"ReplayOptions.{name}: expected SensorBounds or None, got {type(value).__name__}"
                 )
+        if not isinstance(self.reverse, ReverseMotion):
+            raise InputError(f"ReplayOptions.reverse: expected a ReverseMotion, got {self.reverse!r}")
         if self.motion is not None and not isinstance(self.motion, MotionCalibration):
             raise InputError(
                 f"ReplayOptions.motion: expected MotionCalibration or None, got {type(self.motion).__name__}"
@@ -493,24 +499,32 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
 
 
 def observation_for(
-    row: LogObservation, landmark_class: LandmarkClass, bounds: SensorBounds, *, factor: float = 1.0
+    row: LogObservation,
+    landmark_class: LandmarkClass,
+    bounds: SensorBounds,
+    *,
+    factor: float = 1.0,
+    sensor_offset: tuple[float, float] = (0.0, 0.0),
 ) -> Observation:
     """Turn a log row into a bounded observation of the replay's landmark class.
 
     The row's own ``bearing_error`` / ``range_error`` (absolute, metres) take precedence
     over ``bounds``; ``factor`` (>= 1) widens whichever is used. A Class II replay skips
     rows without a range (returns a bearing observation, which the manager rejects as of
-    the wrong class and counts).
+    the wrong class and counts). ``sensor_offset`` (forward, left; metres) is where the
+    sensor sits in the robot frame (the log's ``meta.sensor_offset``).
     """
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:
-        return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error)
+        return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, sensor_offset)
     if row.range_error is not None:
         error = row.range_error * factor
         low, high = max(0.0, row.range - error), row.range + error
     else:
         low, high = (bounds.widened(factor) if factor > 1.0 else bounds).range_interval(row.range)
-    return RangeBearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, low, high)
+    return RangeBearingObservation(
+        row.landmark_id, row.time, row.bearing, bearing_error, low, high, sensor_offset
+    )
 
 
 def meta_bounds(log: RobotLog) -> SensorBounds:
@@ -628,7 +642,7 @@ def replay_log(
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
     report_times, report_turns, report_runs = log.position_report_arrays(
-        frame_times, max_interval=opts.max_interval, start=start_time, end=end
+        frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
     )
     trace = ReplayTrace.empty(frame_times.size)
     if log.groundtruth is not None:
@@ -636,13 +650,18 @@ def replay_log(
     maps: list[SpatialUncertaintyMap] = []
     judge = _Judge(trace)
 
+    offset = log.meta.sensor_offset
     with _StepsCsv(steps_csv) as writer:
         next_report = 0
         for index, frame_time in enumerate(frame_times.tolist()):
             rows = frames[frame_time]
-            working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
+            working = [
+                observation_for(r, opts.landmark_class, working_bounds, sensor_offset=offset) for r in rows
+            ]
             envelope = (
-                [observation_for(r, opts.landmark_class, envelope_bounds) for r in rows] if robust else None
+                [observation_for(r, opts.landmark_class, envelope_bounds, sensor_offset=offset) for r in rows]
+                if robust
+                else None
             )
             due = []
             while next_report < report_times.size and report_times[next_report] <= frame_time:
@@ -838,4 +857,6 @@ def position_reports_for(log: RobotLog, options: ReplayOptions) -> tuple[Positio
     start_time, _ = replay_start(log)
     times = np.array(sorted(frames_after(log, start_time)), dtype=np.float64)
     end = float(times[-1]) if times.size else start_time
-    return log.position_reports(times, max_interval=options.max_interval, start=start_time, end=end)
+    return log.position_reports(
+        times, max_interval=options.max_interval, start=start_time, end=end, reverse=options.reverse
+    )
