@@ -11,16 +11,22 @@ from rich.table import Table
 
 from aura_ums.cli._common import (
     NO_OPTIONS,
+    Quiet,
     SettingOptions,
     console,
     fail,
     manager_options,
-    write_metrics_json,
+    progress_bar,
 )
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, safe_name, staged, write_text
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayOptions
+    from aura_ums.logs import ReplayOptions, ReplayResult
     from aura_ums.manager import ManagerSettings
+
+
+# draw_replay's file name after the log's name
+_FIGURE = "_replay.png"
 
 
 class Classes(enum.StrEnum):
@@ -65,21 +71,35 @@ def calibrate(
     ] = None,
     quantile: Annotated[float, typer.Option(help="Quantile the motion and working bounds cover.")] = 0.99,
     horizon: Annotated[float, typer.Option(help="Seconds per motion window of the fit.")] = 1.0,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Estimate terrain statistics and sensor bounds from logs with ground truth."""
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import calibrate_logs, load_log
 
+    out_target = Target("--out", out)
+    sensors_target = Target(
+        "--sensors-out" if sensors_out is not None else "--out (its .sensors.toml)",
+        sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml"),
+    )
+    check_outputs(
+        [out_target, sensors_target],
+        [Source("LOG_DIRS", folder, folder=True) for folder in log_dirs],
+        overwrite=overwrite,
+    )
     try:
-        logs = [load_log(folder) for folder in log_dirs]
+        logs = []
+        with progress_bar("calibrate: logs", quiet=quiet) as advance:
+            for folder in log_dirs:
+                logs.append(load_log(folder))
+                if advance is not None:
+                    advance(len(logs), len(log_dirs))
         calibration = calibrate_logs(logs, quantile=quantile, horizon=horizon)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    sensors = sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    sensors.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(calibration.terrain_table().to_toml())
-    sensors.write_text(calibration.sensors_toml())
+    write_text(out_target, calibration.terrain_table().to_toml())
+    write_text(sensors_target, calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
     console.print(
         f"motion: delay {motion.delay_s:.2f} s, run scale {motion.run_scale:.3f}, "
@@ -91,7 +111,6 @@ def calibrate(
             f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
             f"({calibration.observations} observations)"
         )
-    console.print(f"wrote {out} and {sensors}")
 
 
 @manager_options()
@@ -111,26 +130,67 @@ def replay(
     mcap: Annotated[
         Path | None, typer.Option("--mcap", help="Write the replay as MCAP for Foxglove.")
     ] = None,
+    save_state: Annotated[
+        Path | None,
+        typer.Option(
+            "--save-state", help="Write where the replay stopped (versioned JSON), to --resume from."
+        ),
+    ] = None,
+    resume: Annotated[
+        Path | None,
+        typer.Option("--resume", help="Continue a replay of this log from a state saved by --save-state."),
+    ] = None,
+    until: Annotated[
+        float | None,
+        typer.Option("--until", help="Stop after the last frame at or before this log time, in s."),
+    ] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
-    """Run the map manager over a log and report containment, area, wedge width and speed."""
+    """Run the map manager over a log and report containment, area, wedge width and speed.
+
+    With --resume the replay continues where a --save-state left it (its settings are the
+    saved ones) and reports the frames after it; it ends with exactly the map of a
+    replay run in one go.
+    """
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import load_log, replay_log
+    from aura_ums.logs import ReplayState, load_log, replay_log
     from aura_ums.uncertainty import TerrainTable
 
+    sources = [
+        Source("LOG_DIR", log_dir, folder=True),
+        Source("--terrain", terrain),
+        None if sensors is None else Source("--sensors", sensors),
+        None if resume is None else Source("--resume", resume),
+    ]
+    targets = [
+        None if metrics_json is None else Target("--metrics-json", metrics_json),
+        None if steps_csv is None else Target("--steps-csv", steps_csv),
+        None if mcap is None else Target("--mcap", mcap),
+        None if save_state is None else Target("--save-state", save_state),
+    ]
+    check_outputs(targets, sources, overwrite=overwrite)
+    json_target, csv_target, mcap_target, state_target = targets
     try:
         log = load_log(log_dir)
+        figure = f"{safe_name(log.meta.name)}{_FIGURE}"
+        plot_target = None if plot is None else Target("--plot", plot / figure)
+        check_outputs([*targets, plot_target], sources, overwrite=overwrite)
         table = TerrainTable.from_toml(terrain)
         options = _options(classes, sensors, settings.over())
-        result = replay_log(log, table, options)
+        saved = None if resume is None else ReplayState.load(resume)
+        with progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
+            result = replay_log(log, table, options, progress=advance, until=until, resume=saved)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = result.metrics()
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
-    if metrics_json is not None:
-        write_metrics_json(metrics_json, metrics)
-    if steps_csv is not None:
-        steps_csv.parent.mkdir(parents=True, exist_ok=True)
+    if json_target is not None:
+        write_text(json_target, metrics.to_json())
+    if state_target is not None and result.state is not None:
+        write_text(state_target, result.state.to_json())
+    if csv_target is not None:
         lines = ["time,inside,area_m2,wedge_width_rad,accepted,rejected,update_us,state,relocalized"]
         for s in result.steps:
             inside = "" if s.inside is None else str(int(s.inside))
@@ -138,16 +198,26 @@ def replay(
                 f"{s.time!r},{inside},{s.map.area!r},{s.map.wedge.width!r},{s.accepted},{s.rejected},"
                 f"{s.update_us:.3f},{s.state.value},{int(s.relocalized)}"
             )
-        steps_csv.write_text("\n".join(lines) + "\n")
-        console.print(f"wrote {steps_csv}")
-    if plot is not None:
-        from aura_ums.plot import draw_replay
-
-        console.print(f"wrote {draw_replay(result, plot)}")
-    if mcap is not None:
+        write_text(csv_target, "\n".join(lines) + "\n")
+    if plot_target is not None:
+        _draw(result, plot_target)
+    if mcap_target is not None:
         from aura_ums.cli._interop import write_replay_mcap_option
 
-        write_replay_mcap_option(mcap, result)
+        write_replay_mcap_option(mcap_target, result, quiet=quiet)
+
+
+def _draw(result: ReplayResult, target: Target) -> None:
+    """Draw the replay figure into a scratch folder and move it onto ``target`` (named safely)."""
+    import dataclasses
+
+    from aura_ums.plot import draw_replay
+
+    # The figure's file name comes from the log's name: drawn under the safe name only.
+    meta = dataclasses.replace(result.log.meta, name=target.path.name.removesuffix(_FIGURE))
+    named = dataclasses.replace(result, log=dataclasses.replace(result.log, meta=meta))
+    with staged(Target(target.option, target.path.parent, folder=True)) as stage:
+        draw_replay(named, stage)
 
 
 @manager_options()
@@ -168,6 +238,8 @@ def compare(
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
     ] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Print our map next to an EKF and a particle filter on the same log (99% regions)."""
     import numpy as np
@@ -179,6 +251,14 @@ def compare(
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
+    json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
+    sources = [
+        Source("LOG_DIR", log_dir, folder=True),
+        Source("--terrain", terrain),
+        None if sensors is None else Source("--sensors", sensors),
+        *(Source("--noise-from", p, folder=True) for p in calibration_logs or ()),
+    ]
+    check_outputs([json_target], sources, overwrite=overwrite)
     try:
         log = load_log(log_dir)
         table = TerrainTable.from_toml(terrain)
@@ -189,15 +269,17 @@ def compare(
             raise fail("--noise-from: expected logs with observations inside their ground truth, got none")
         bearing_sd = float(np.std(bearing))
         range_sd = float(np.std(ranges)) if ranges.size > 1 else 0.05
-        rows = compare_on_log(
-            log,
-            table,
-            options,
-            bearing_sd=bearing_sd,
-            range_sd_fraction=max(range_sd, 1e-3),
-            rng=np.random.default_rng(seed),
-            particles=particles,
-        )
+        with progress_bar(f"{safe_name(log.meta.name)}: frames x methods", quiet=quiet) as advance:
+            rows = compare_on_log(
+                log,
+                table,
+                options,
+                bearing_sd=bearing_sd,
+                range_sd_fraction=max(range_sd, 1e-3),
+                rng=np.random.default_rng(seed),
+                particles=particles,
+                progress=advance,
+            )
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters")
@@ -222,7 +304,7 @@ def compare(
             str(row.inconsistent_observations),
         )
     console.print(grid)
-    if metrics_json is not None:
+    if json_target is not None:
         table_metrics = Metrics(
             {
                 "log": log.meta.name,
@@ -232,4 +314,4 @@ def compare(
                 "methods": tuple(row.metrics() for row in rows),
             }
         )
-        write_metrics_json(metrics_json, table_metrics)
+        write_text(json_target, table_metrics.to_json())

@@ -49,6 +49,7 @@ from aura_ums.logs._replay import (
     replay_log,
 )
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+from aura_ums.logs._state import ReplayState
 from aura_ums.logs._synthetic import synthetic_log
 
 __all__ = [
@@ -63,6 +64,7 @@ __all__ = [
     "Odometry",
     "ReplayOptions",
     "ReplayResult",
+    "ReplayState",
     "ReplayStep",
     "ReverseMotion",
     "RobotLog",

@@ -6,7 +6,7 @@ import dataclasses
 import math
 import time as _time
 import types
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,6 +18,7 @@ from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._state import ReplayState
 from aura_ums.manager import (
     Blackboard,
     ManagerSettings,
@@ -170,6 +171,9 @@ class ReplayResult:
         Rejected observations by reason.
     relocalizations : int
         Times the working map was re-seeded from the envelope.
+    state : ReplayState or None
+        Where the replay stopped (the manager and blackboard after its last frame), to
+        save and resume from; None when not recorded.
     """
 
     log: RobotLog
@@ -177,6 +181,7 @@ class ReplayResult:
     steps: tuple[ReplayStep, ...]
     rejected_counts: Mapping[RejectReason, int]
     relocalizations: int
+    state: ReplayState | None = None
 
     @property
     def containment_rate(self) -> float:
@@ -326,7 +331,15 @@ def meta_bounds(log: RobotLog) -> SensorBounds:
     )
 
 
-def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None = None) -> ReplayResult:
+def replay_log(
+    log: RobotLog,
+    table: TerrainTable,
+    options: ReplayOptions | None = None,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+    until: float | None = None,
+    resume: ReplayState | None = None,
+) -> ReplayResult:
     """Run the uncertainty map manager over a log, frame by frame, and judge it against ground truth.
 
     The start map is ``meta.start`` (or the ground truth's first pose) with the meta's
@@ -347,6 +360,16 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         Must hold the log's terrain (``meta.terrain``).
     options : ReplayOptions or None
         How; default :class:`ReplayOptions`.
+    progress : callable or None
+        Called as ``progress(done, total)`` after each frame (``total`` frames of the log
+        after its start); nothing is printed here.
+    until : float or None
+        Stop after the last frame at or before this time, s (None: replay to the end);
+        the result's ``state`` then resumes from there.
+    resume : ReplayState or None
+        Continue a replay of this same log from a saved :class:`ReplayState` (the
+        manager and blackboard as they were, its settings included): the steps are those
+        after it, and the last map is bit for bit that of an uninterrupted replay.
 
     Returns
     -------
@@ -355,7 +378,8 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
     Raises
     ------
     InputError
-        For a bad argument, a terrain missing from ``table``, or a log without a start.
+        For a bad argument, a terrain missing from ``table``, a log without a start, or a
+        ``resume`` state saved from another log.
 
     Examples
     --------
@@ -378,6 +402,11 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         raise InputError(f"options: expected ReplayOptions or None, got {type(opts).__name__}")
     if log.meta.terrain not in table:
         raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
+    stop = math.inf if until is None else finite_float(until, "until")
+    if resume is not None and not isinstance(resume, ReplayState):
+        raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")
     log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
@@ -402,9 +431,17 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
         else np.full((frame_times.size, 3), np.nan)
     )
 
+    first, next_report = 0, 0
+    if resume is not None:
+        first, next_report = _resumed_at(resume, log, frame_times, len(reports))
+        manager = UncertaintyMapManager.from_json(resume.manager_json, meadow_map, table, source="resume")
+        board = Blackboard.from_json(resume.blackboard_json, source="resume")
     steps: list[ReplayStep] = []
-    next_report = 0
-    for index, frame_time in enumerate(frame_times):
+    done = first
+    for index in range(first, frame_times.size):
+        frame_time = frame_times[index]
+        if frame_time > stop:
+            break
         rows = frames[float(frame_time)]
         working = [observation_for(r, opts.landmark_class, working_bounds) for r in rows]
         envelope = (
@@ -441,13 +478,46 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
                 envelope_inside,
             )
         )
+        done = index + 1
+        if progress is not None:
+            progress(done, int(frame_times.size))
+    state = ReplayState(
+        log.meta.name,
+        done,
+        next_report,
+        float(frame_times[done - 1]) if done else math.nan,
+        manager.to_json(),
+        board.to_json(),
+    )
     return ReplayResult(
         log,
         opts,
         tuple(steps),
         types.MappingProxyType(dict(manager.rejected_counts)),
         manager.relocalizations,
+        state,
     )
+
+
+def _resumed_at(state: ReplayState, log: RobotLog, frame_times: np.ndarray, reports: int) -> tuple[int, int]:
+    """Return the frame and report indices to resume at; a state from another log is refused."""
+    fits = (
+        state.log_name == log.meta.name
+        and state.frames_done <= frame_times.size
+        and state.reports_posted <= reports
+        and (
+            math.isnan(state.last_time)
+            if state.frames_done == 0
+            else float(frame_times[state.frames_done - 1]) == state.last_time
+        )
+    )
+    if not fits:
+        raise InputError(
+            f"resume: expected a state saved from a replay of log {log.meta.name!r} "
+            f"({frame_times.size} frames), got one of log {state.log_name!r} after "
+            f"{state.frames_done} frames at {state.last_time!r} s"
+        )
+    return state.frames_done, state.reports_posted
 
 
 def with_motion(log: RobotLog, motion: MotionCalibration | None) -> RobotLog:
