@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 import time as _time
 import types
@@ -433,7 +434,7 @@ def replay_log(
 
     first, next_report = 0, 0
     if resume is not None:
-        first, next_report = _resumed_at(resume, log, frame_times, len(reports))
+        first, next_report = _resumed_at(resume, log, frames, frame_times, len(reports))
         manager = UncertaintyMapManager.from_json(resume.manager_json, meadow_map, table, source="resume")
         board = Blackboard.from_json(resume.blackboard_json, source="resume")
     steps: list[ReplayStep] = []
@@ -486,6 +487,7 @@ def replay_log(
         done,
         next_report,
         float(frame_times[done - 1]) if done else math.nan,
+        _digest(frames, frame_times[:done]),
         manager.to_json(),
         board.to_json(),
     )
@@ -499,11 +501,27 @@ def replay_log(
     )
 
 
-def _resumed_at(state: ReplayState, log: RobotLog, frame_times: np.ndarray, reports: int) -> tuple[int, int]:
+def _digest(frames: Mapping[float, list[LogObservation]], times: np.ndarray) -> str:
+    """SHA-256 of the observations of the frames at ``times``: what a saved state was replayed on."""
+    digest = hashlib.sha256()
+    for frame_time in times:
+        for row in frames[float(frame_time)]:
+            digest.update(repr((row.time, row.landmark_id, row.bearing, row.range)).encode("utf-8"))
+    return digest.hexdigest()
+
+
+def _resumed_at(
+    state: ReplayState,
+    log: RobotLog,
+    frames: Mapping[float, list[LogObservation]],
+    frame_times: np.ndarray,
+    reports: int,
+) -> tuple[int, int]:
     """Return the frame and report indices to resume at; a state from another log is refused."""
     fits = (
         state.log_name == log.meta.name
         and state.frames_done <= frame_times.size
+        and state.log_digest == _digest(frames, frame_times[: state.frames_done])
         and state.reports_posted <= reports
         and (
             math.isnan(state.last_time)

@@ -22,7 +22,17 @@ from aura_ums.errors import InputError
 STATE_FORMAT = "aura_ums.ReplayState"
 #: Its version; bumped when the layout changes.
 STATE_VERSION = 1
-_KEYS = ("format", "version", "log", "frames_done", "reports_posted", "last_time", "manager", "blackboard")
+_KEYS = (
+    "format",
+    "version",
+    "log",
+    "frames_done",
+    "reports_posted",
+    "last_time",
+    "log_digest",
+    "manager",
+    "blackboard",
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,6 +49,9 @@ class ReplayState:
         Position reports posted to the blackboard so far.
     last_time : float
         Time of the last frame replayed, s (nan when none was).
+    log_digest : str
+        SHA-256 (hex) of the observations replayed (times, landmark ids, bearings,
+        ranges): a state is resumed only on the log it was saved from.
     manager_json : str
         :meth:`UncertaintyMapManager.to_json` after that frame.
     blackboard_json : str
@@ -67,6 +80,7 @@ class ReplayState:
     frames_done: int
     reports_posted: int
     last_time: float
+    log_digest: str
     manager_json: str
     blackboard_json: str
 
@@ -79,6 +93,7 @@ class ReplayState:
             "frames_done": self.frames_done,
             "reports_posted": self.reports_posted,
             "last_time": self.last_time if math.isfinite(self.last_time) else None,
+            "log_digest": self.log_digest,
             "manager": json.loads(self.manager_json),
             "blackboard": json.loads(self.blackboard_json),
         }
@@ -116,6 +131,7 @@ class ReplayState:
             fields.integer(top["frames_done"], "frames_done", minimum=0),
             fields.integer(top["reports_posted"], "reports_posted", minimum=0),
             math.nan if last is None else fields.number(last, "last_time"),
+            fields.string(top["log_digest"], "log_digest"),
             json.dumps(fields.table(top["manager"], "manager")),
             json.dumps(fields.table(top["blackboard"], "blackboard")),
         )
