@@ -47,11 +47,6 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(code=2)
 
 
-def warn(message: str) -> None:
-    """Print ``warning: <message>`` (markup-safe) on stderr."""
-    err_console.print(f"[yellow]warning:[/yellow] {escape(message)}", highlight=False)
-
-
 @contextmanager
 def progress_bar(label: str, *, quiet: bool) -> Iterator[Callable[[int, int], None] | None]:
     """Yield a ``(done, total)`` callback drawing a rich bar on stderr, or None when quiet or not a terminal.

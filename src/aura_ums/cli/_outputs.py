@@ -135,20 +135,22 @@ def check_outputs(
 
 
 def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
-    what = f"the input {source.option} ({source.path})"
+    what = f"the input {source.option} ({_shown(source.path, origin)})"
+    given, option = _shown(target.path, where), target.option
     if where == origin:
-        raise fail(
-            f"{target.option}: expected an output apart from the inputs, got {target.path}, which is {what}"
-        )
+        raise fail(f"{option}: expected an output apart from the inputs, got {given}, which is {what}")
     if source.folder and where.is_relative_to(origin):
-        raise fail(
-            f"{target.option}: expected an output outside the input folders, got {target.path}, inside {what}"
-        )
+        raise fail(f"{option}: expected an output outside the input folders, got {given}, inside {what}")
     if target.folder and origin.is_relative_to(where):
         raise fail(
-            f"{target.option}: expected an output folder apart from the inputs, got {target.path}, "
-            f"which holds {what}"
+            f"{option}: expected an output folder apart from the inputs, got {given}, which holds {what}"
         )
+
+
+def _shown(path: Path, where: Path) -> str:
+    """``path`` as given, with where it leads when a symlink takes it elsewhere."""
+    plain = Path(os.path.abspath(path.expanduser()))
+    return str(path) if plain == where else f"{path} (a link to {where})"
 
 
 def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
