@@ -13,7 +13,9 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
   (Leung et al., IJRR 2011);
 - :func:`replay_log` feeds a log to the :class:`~aura_ums.manager.UncertaintyMapManager`
   (the localizer, with its outlier recovery) and records what it did against the ground
-  truth; :func:`compare_on_log` sets it next to an EKF and a particle filter.
+  truth; :func:`compare_on_log` sets it next to an EKF and a particle filter;
+  :class:`ReplayState` is where a replay stopped, saved as versioned JSON and resumed
+  (``replay_log(..., resume=state)``) to end with exactly the map of an uninterrupted one.
 """
 
 # Replay and calibration are the lead's (_calibrate, _replay, _synthetic); the formats
