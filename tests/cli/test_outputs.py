@@ -213,3 +213,16 @@ def test_errors_go_to_stderr_and_results_to_stdout(inputs: Path, tmp_path: Path)
     assert result.exit_code == 0, result.output
     assert result.stderr == ""
     assert "containment_rate" in result.stdout
+
+
+def test_an_output_through_a_symlink_replaces_the_file_it_leads_to(inputs: Path, tmp_path: Path) -> None:
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", link)
+    refused(invoke(*common), str(link), "exists")
+    result = invoke(*common, "--overwrite")
+    assert result.exit_code == 0, result.output
+    assert link.is_symlink()
+    assert real.read_text().startswith("{")

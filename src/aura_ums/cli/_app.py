@@ -135,7 +135,7 @@ def simulate(
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
     try:
-        with progress_bar(f"{loaded.name}: runs", quiet=quiet) as advance:
+        with progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
             for done, rng in enumerate(generators, start=1):
                 results.append(run_scenario(loaded, rng, prune=prune))
                 if advance is not None:

@@ -48,7 +48,9 @@ def fail(message: str) -> typer.Exit:
 
 
 @contextmanager
-def progress_bar(label: str, *, quiet: bool) -> Iterator[Callable[[int, int], None] | None]:
+def progress_bar(
+    label: str, *, quiet: bool, total: int | None = None
+) -> Iterator[Callable[[int, int], None] | None]:
     """Yield a ``(done, total)`` callback drawing a rich bar on stderr, or None when quiet or not a terminal.
 
     The library reports progress through such callbacks and never prints; the bar is
@@ -61,7 +63,7 @@ def progress_bar(label: str, *, quiet: bool) -> Iterator[Callable[[int, int], No
 
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     with Progress(*columns, console=err_console, transient=True) as bar:
-        task = bar.add_task(escape(label), total=None)
+        task = bar.add_task(escape(label), total=total)
 
         def advance(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from aura_ums.cli._common import Quiet, fail, print_log_summary, progress_bar
-from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, wrote
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, resolved, wrote
 
 if TYPE_CHECKING:
     from aura_ums.logs import ReplayResult
@@ -108,11 +108,11 @@ def write_simulation_mcap_option(
     try:
         result = run_scenario(scenario, rng, prune=prune, keep_images=True)
         with progress_bar(f"{target.path.name}: frames", quiet=quiet) as advance:
-            written = write_simulation_mcap(target.path, scenario, result, progress=advance)
+            write_simulation_mcap(resolved(target.path), scenario, result, progress=advance)
     except AuraUmsError as exc:
         raise fail(f"{target.option}: {exc}") from None
-    wrote(written, f" (run 1 of seed {seed}; open it in Foxglove)")
-    return written
+    wrote(target.path, f" (run 1 of seed {seed}; open it in Foxglove)")
+    return target.path
 
 
 def write_replay_mcap_option(target: Target, replay: ReplayResult, *, quiet: bool) -> Path:
@@ -122,8 +122,8 @@ def write_replay_mcap_option(target: Target, replay: ReplayResult, *, quiet: boo
 
     try:
         with progress_bar(f"{target.path.name}: steps", quiet=quiet) as advance:
-            written = write_replay_mcap(target.path, replay, progress=advance)
+            write_replay_mcap(resolved(target.path), replay, progress=advance)
     except AuraUmsError as exc:
         raise fail(f"{target.option}: {exc}") from None
-    wrote(written, " (open it in Foxglove)")
-    return written
+    wrote(target.path, " (open it in Foxglove)")
+    return target.path

@@ -202,11 +202,12 @@ def wrote(path: Path, note: str = "") -> None:
 def write_text(target: Target, text: str) -> Path:
     """Write ``text`` to the target file atomically; a system error exits 2 naming the option."""
     try:
-        written = write_text_atomic(target.path, text)
+        # through a symlink to its file (the link stays), as the checks resolved it
+        write_text_atomic(resolved(target.path), text)
     except OSError as exc:
         raise _unwritable(target, target.path, exc) from None
-    wrote(written)
-    return written
+    wrote(target.path)
+    return target.path
 
 
 @contextmanager
@@ -217,7 +218,7 @@ def staged(target: Target) -> Iterator[Path]:
     (sub-folders kept): every file there is an old one or a whole new one. On an error
     or a Ctrl-C the scratch folder is removed and the target folder left as it was.
     """
-    final = Path(target.path)
+    final = resolved(target.path)
     try:
         final.mkdir(parents=True, exist_ok=True)
         stage = scratch_path(final)
@@ -230,7 +231,7 @@ def staged(target: Target) -> Iterator[Path]:
             place = final / path.relative_to(stage)
             place.parent.mkdir(parents=True, exist_ok=True)
             os.replace(path, place)
-            wrote(place)
+            wrote(target.path / path.relative_to(stage))
     except OSError as exc:
         raise _unwritable(target, final, exc) from None
     finally:

@@ -90,7 +90,7 @@ def calibrate(
     )
     try:
         logs = []
-        with progress_bar("calibrate: logs", quiet=quiet) as advance:
+        with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
             for folder in log_dirs:
                 logs.append(load_log(folder))
                 if advance is not None:
