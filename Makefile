@@ -47,10 +47,10 @@ lock: | $(UV_STAMP)
 	$(UV) lock $(LOCK_ARGS)
 
 demo: $(VENV)/.stamp-install
-	$(BIN)/aura-ums demo --out $(REPORT)
+	$(BIN)/aura-ums demo --out $(REPORT) --overwrite
 
 figures: $(VENV)/.stamp-install
-	$(BIN)/aura-ums figures --out $(REPORT)/figures
+	$(BIN)/aura-ums figures --out $(REPORT)/figures --overwrite
 
 lint: $(VENV)/.stamp-dev
 	$(BIN)/ruff check src tests benchmarks setup.py

@@ -66,7 +66,8 @@ def produce(out: Path, extra: list[str], sim_extra: list[str]) -> list[str]:
                     name = f"{dataset}-r{robot}-{classes}"
                     _run(
                         "replay", folder, "--terrain", terrain, "--sensors", sensors, "--classes", classes,
-                        "--metrics-json", out / f"{name}.json", "--steps-csv", out / f"{name}.csv", *extra,
+                        "--metrics-json", out / f"{name}.json", "--steps-csv", out / f"{name}.csv",
+                        "--overwrite", *extra,
                     )  # fmt: skip
                     names += [f"{name}.json", f"{name}.csv"]
         else:
@@ -80,6 +81,7 @@ def produce(out: Path, extra: list[str], sim_extra: list[str]) -> list[str]:
             "1",
             "--metrics-json",
             out / "simulate.json",
+            "--overwrite",
             *sim_extra,
         )
         names.append("simulate.json")

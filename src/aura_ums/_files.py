@@ -15,6 +15,10 @@ Every failure is a :class:`~aura_ums.errors.FileFormatError` whose message reads
 ``file:line: expected ..., got ...`` or ``file: key path: expected ..., got ...``; the
 wording of the common cases (a number, an integer, a string, a table, an unknown key)
 is made here once. Nothing here evaluates what it reads: no pickle, no eval.
+
+Writing goes the other way once too: :func:`atomic_path` gives a scratch name beside
+the target and moves it over the target in one ``os.replace``, so a reader (or a
+command killed half-way) sees the old file or the whole new one, never a part.
 """
 
 from __future__ import annotations
@@ -25,9 +29,12 @@ import json
 import math
 import os
 import re
+import secrets
 import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal, NoReturn, TypeVar, cast
 
 import numpy as np
@@ -38,9 +45,11 @@ from aura_ums.errors import FileFormatError
 __all__ = [
     "MAX_BYTES",
     "MAX_ROWS",
+    "SCRATCH_SUFFIX",
     "CsvFloats",
     "CsvTable",
     "Fields",
+    "atomic_path",
     "decode",
     "describe",
     "key_path",
@@ -53,6 +62,8 @@ __all__ = [
     "parse_toml",
     "read_bytes",
     "read_text",
+    "scratch_path",
+    "write_text_atomic",
 ]
 
 #: Largest file read, bytes (64 MiB): far above any aura-ums file, far below memory trouble.
@@ -817,3 +828,76 @@ _EXPECTED: dict[type, str] = {
     bool: "true or false",
     list: "an array",
 }
+
+
+#: Ending of the scratch names beside a target being written (``.<name>.<random>.tmp``).
+SCRATCH_SUFFIX = ".tmp"
+
+
+def scratch_path(target: Path) -> Path:
+    """Return a fresh hidden name beside ``target``: ``.<name>.<16 hex digits>.tmp``.
+
+    In the target's folder, so that :func:`os.replace` onto the target is one rename on
+    one file system.
+
+    Examples
+    --------
+    >>> name = scratch_path(Path("out/metrics.json"))
+    >>> name.parent.as_posix(), name.name.startswith(".metrics.json."), name.suffix
+    ('out', True, '.tmp')
+    """
+    return target.with_name(f".{target.name}.{secrets.token_hex(8)}{SCRATCH_SUFFIX}")
+
+
+@contextmanager
+def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a scratch path beside ``target`` to write; when the block ends, it replaces ``target``.
+
+    The folder of ``target`` is created when missing. When the block raises (a
+    ``KeyboardInterrupt`` too) the scratch file is removed and ``target`` is left as it
+    was. A process killed outright (``SIGKILL``) leaves at most the hidden scratch file:
+    never a partial file under the target's name.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> with atomic_path(folder / "a.txt") as scratch:
+    ...     _ = scratch.write_text("whole")
+    >>> (folder / "a.txt").read_text(), len(list(folder.iterdir()))
+    ('whole', 1)
+    >>> with atomic_path(folder / "a.txt") as scratch:          # a failure leaves the old file
+    ...     _ = scratch.write_text("part")
+    ...     raise OSError("disk full")
+    Traceback (most recent call last):
+    ...
+    OSError: disk full
+    >>> (folder / "a.txt").read_text(), len(list(folder.iterdir()))
+    ('whole', 1)
+    """
+    final = Path(target)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    scratch = scratch_path(final)
+    try:
+        yield scratch
+        os.replace(scratch, final)
+    except BaseException:
+        scratch.unlink(missing_ok=True)
+        raise
+
+
+def write_text_atomic(target: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``target`` through :func:`atomic_path` and return the path.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> path = write_text_atomic(Path(tempfile.mkdtemp()) / "new" / "b.csv", "x,1")
+    >>> path.read_text(), len(list(path.parent.iterdir()))
+    ('x,1', 1)
+    """
+    final = Path(target)
+    # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay on the result)
+    with atomic_path(final) as scratch, scratch.open("x", encoding="utf-8", newline="") as stream:
+        stream.write(text)
+    return final

@@ -98,7 +98,7 @@ def robot1(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def replay_all(folder: Path, cases: list[list[str]]) -> list[tuple[dict[str, object], dict[str, int]]]:
     """Replay each case; return its metrics and the largest polygons, or fail on a crash."""
     runs = [
-        [str(folder / "log"), *case, "--metrics-json", str(folder / f"{i}.json")]
+        [str(folder / "log"), *case, "--metrics-json", str(folder / f"{i}.json"), "--overwrite"]
         for i, case in enumerate(cases)
     ]
     done = subprocess.run(

@@ -13,6 +13,7 @@ from rosbags.typesys import Stores, get_typestore
 from typer.testing import CliRunner
 
 from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
+from aura_ums.cli._outputs import Target
 from aura_ums.export import mcap_channels
 from aura_ums.logs import load_log
 from aura_ums.sim import Scenario
@@ -33,7 +34,9 @@ def make_app() -> typer.Typer:
         seed: int = 0,
     ) -> None:
         if mcap is not None:
-            write_simulation_mcap_option(mcap, Scenario.from_toml(scenario), seed, prune=True)
+            write_simulation_mcap_option(
+                Target("--mcap", mcap), Scenario.from_toml(scenario), seed, prune=True, quiet=True
+            )
 
     return app
 
@@ -105,7 +108,7 @@ def test_import_rosbag_writes_the_log_and_a_summary(bag: Path, landmarks: Path, 
     # again without --overwrite: a clean error; with it: replaced
     again = invoke(*args, "--landmarks", str(landmarks))
     assert again.exit_code == 2
-    assert "error: folder: expected a folder without a log" in again.output
+    assert "error: OUT_DIR: expected a new or empty folder" in again.stderr
     assert invoke(*args, "--landmarks", str(landmarks), "--overwrite").exit_code == 0
     assert load_log(out).meta.name == "walk"
     assert load_log(out).groundtruth is None

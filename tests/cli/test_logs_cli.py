@@ -57,8 +57,8 @@ def test_import_refuses_to_overwrite_unless_told(app: typer.Typer, dataset: Path
     assert runner.invoke(app, args).exit_code == 0
     result = runner.invoke(app, args)
     assert result.exit_code == 2
-    assert f"error: {out}: expected a folder without a log" in result.output
-    assert "--overwrite" in result.output
+    assert f"error: OUT_DIR: expected a new or empty folder, got {out}" in result.stderr
+    assert "--overwrite" in result.stderr
     assert runner.invoke(app, [*args, "--overwrite"]).exit_code == 0
 
 

@@ -7,51 +7,90 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
-from aura_ums.cli._common import NO_OPTIONS, SettingOptions, fail, manager_options, write_metrics_json
+from aura_ums.cli._common import (
+    NO_OPTIONS,
+    PlainCommand,
+    PlainGroup,
+    Quiet,
+    SettingOptions,
+    console,
+    fail,
+    manager_options,
+    progress_bar,
+)
 from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
 from aura_ums.cli._logs import import_app
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, staged, write_text
 from aura_ums.cli._replay import calibrate, compare, replay
 
 app = typer.Typer(
     name="aura-ums",
-    help="Guaranteed spatial uncertainty management for a mobile robot (after Arkin's AuRA).",
     no_args_is_help=True,
     add_completion=False,
+    cls=PlainGroup,
 )
-_console = Console()
 
 
-@app.command()
+def _version(value: bool) -> None:
+    if value:
+        from importlib.metadata import version
+
+        console.print(f"aura-ums {version('aura-ums')}", highlight=False, markup=False)
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    show_version: Annotated[
+        bool,
+        typer.Option("--version", help="Print the version and exit.", callback=_version, is_eager=True),
+    ] = False,
+) -> None:
+    """Guaranteed spatial uncertainty management for a mobile robot (after Arkin's AuRA).
+
+    Results go to stdout and files; errors, warnings and progress to stderr. A refused
+    input or output exits with code 2, a Ctrl-C with 130 (no partial file is left).
+    """
+
+
+@app.command(cls=PlainCommand)
+@interruptible
 def figures(
     out: Annotated[Path, typer.Option("--out", help="Folder to write the PNG figures into.")] = Path(
         "report/figures"
     ),
     seed: Annotated[int, typer.Option(help="Seed of the sampled true outcomes drawn over the maps.")] = 0,
+    overwrite: Overwrite = False,
 ) -> None:
     """Draw the paper's figures 3-7 (maps, windows, growth) with sampled true outcomes over them."""
     from aura_ums.plot import draw_all_figures
 
-    written = draw_all_figures(out, seed=seed)
-    for path in written:
-        _console.print(f"wrote {path}")
+    target = Target("--out", out, folder=True)
+    check_outputs([target], [], overwrite=overwrite)
+    with staged(target) as stage:
+        draw_all_figures(stage, seed=seed)
 
 
-@app.command()
+@app.command(cls=PlainCommand)
+@interruptible
 def demo(
     out: Annotated[Path, typer.Option("--out", help="Folder for the report.")] = Path("report"),
     seed: Annotated[int, typer.Option(help="Seed of every random draw in the report.")] = 0,
     runs: Annotated[int, typer.Option(help="Monte Carlo runs per variant in the summary.")] = 40,
+    overwrite: Overwrite = False,
 ) -> None:
     """Run the paper's experiment and write its report (figures and summary.md) into OUT."""
     from aura_ums.plot import write_experiment_report
 
-    summary = write_experiment_report(out, seed=seed, runs=runs)
-    _console.print(f"wrote {summary}")
+    target = Target("--out", out, folder=True)
+    check_outputs([target], [], overwrite=overwrite)
+    with staged(target) as stage:
+        write_experiment_report(stage, seed=seed, runs=runs)
 
 
-@app.command()
+@app.command(cls=PlainCommand)
+@interruptible
 @manager_options(default_from="the scenario's [manager]")
 def simulate(
     scenario: Annotated[Path, typer.Argument(help="Scenario TOML file (see aura_ums.sim).")],
@@ -65,6 +104,8 @@ def simulate(
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
     mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
     settings: SettingOptions = NO_OPTIONS,
 ) -> None:
     """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics.
@@ -72,7 +113,6 @@ def simulate(
     The map manager's options override the scenario's [manager] table.
     """
     import numpy as np
-    from rich.progress import Progress
 
     from aura_ums import Metrics
     from aura_ums.errors import AuraUmsError
@@ -84,6 +124,9 @@ def simulate(
         raise fail(f"--seed: expected an integer >= 0, got {seed}")
     if not scenario.is_file():
         raise fail(f"{scenario}: expected a scenario TOML file, got no such file")
+    json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
+    mcap_target = None if mcap is None else Target("--mcap", mcap)
+    check_outputs([json_target, mcap_target], [Source("SCENARIO", scenario)], overwrite=overwrite)
     try:
         loaded = Scenario.from_toml(scenario)
     except AuraUmsError as exc:
@@ -92,30 +135,30 @@ def simulate(
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
     try:
-        with Progress(console=_console, transient=True) as progress:
-            task = progress.add_task(f"{loaded.name}", total=runs)
-            for rng in generators:
+        with progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
+            for done, rng in enumerate(generators, start=1):
                 results.append(run_scenario(loaded, rng, prune=prune))
-                progress.advance(task)
+                if advance is not None:
+                    advance(done, runs)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = Metrics(
         {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune, **summarize_runs(results)}
     )
     for line in metrics.lines():
-        _console.print(line, highlight=False, markup=False)
-    if metrics_json is not None:
-        write_metrics_json(metrics_json, metrics)
-    if mcap is not None:
-        write_simulation_mcap_option(mcap, loaded, seed, prune=prune)
+        console.print(line, highlight=False, markup=False)
+    if json_target is not None:
+        write_text(json_target, metrics.to_json())
+    if mcap_target is not None:
+        write_simulation_mcap_option(mcap_target, loaded, seed, prune=prune, quiet=quiet)
 
 
 # Commands on recorded logs, and the dataset importers (``aura-ums import ...``).
-import_app.command("rosbag")(rosbag_command)
+import_app.command("rosbag", cls=PlainCommand)(interruptible(rosbag_command))
 app.add_typer(import_app, name="import")
-app.command()(calibrate)
-app.command()(replay)
-app.command()(compare)
+app.command(cls=PlainCommand)(interruptible(calibrate))
+app.command(cls=PlainCommand)(interruptible(replay))
+app.command(cls=PlainCommand)(interruptible(compare))
 
 
 def main() -> None:

@@ -1,4 +1,9 @@
-"""What the ``aura-ums`` commands share: console, error exit, manager options, log summaries, metrics JSON."""
+"""What the ``aura-ums`` commands share: consoles, error exit, progress bars, manager options, log summaries.
+
+Results go to stdout (:data:`console`); errors, warnings, progress and the ``wrote``
+notes go to stderr (:data:`err_console`), so a script piping the results never mixes
+them with a message.
+"""
 
 from __future__ import annotations
 
@@ -7,40 +12,63 @@ import functools
 import inspect
 import math
 from collections import Counter
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 from rich.markup import escape
+from typer.core import TyperCommand, TyperGroup
 
 from aura_ums.manager import ManagerSettings, SettingInfo
 
 if TYPE_CHECKING:
-    from aura_ums import Metrics
     from aura_ums.logs import RobotLog
 
+#: Results (metrics, tables, summaries): stdout.
 console = Console(soft_wrap=True)
+#: Errors, warnings, progress bars and notes: stderr.
+err_console = Console(soft_wrap=True, stderr=True)
+
+#: The option that turns the progress bars off (they are off anyway when stderr is not a terminal).
+Quiet = Annotated[
+    bool, typer.Option("--quiet", "-q", help="No progress bars (none either when stderr is not a terminal).")
+]
 
 # The parameter name under which a flag that sets a setting to None arrives (``--one-by-one``).
 _OFF = "{}__off"
 
 
 def fail(message: str) -> typer.Exit:
-    """Print ``error: <message>`` (markup-safe) and return the exit (code 2) for the caller to raise."""
-    console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
+    """Print ``error: <message>`` (markup-safe) on stderr; return the exit (code 2) to raise."""
+    err_console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
     return typer.Exit(code=2)
 
 
-def write_metrics_json(path: Path, metrics: Metrics) -> None:
-    """Write ``--metrics-json`` (strict JSON, atomically) and say so; an unwritable path fails cleanly."""
-    try:
-        metrics.write_json(path)
-    except OSError as exc:
-        raise fail(f"--metrics-json: expected a writable path, got {path}: {exc.strerror}") from None
-    console.print(f"wrote {path}", highlight=False, markup=False)
+@contextmanager
+def progress_bar(
+    label: str, *, quiet: bool, total: int | None = None
+) -> Iterator[Callable[[int, int], None] | None]:
+    """Yield a ``(done, total)`` callback drawing a rich bar on stderr, or None when quiet or not a terminal.
+
+    The library reports progress through such callbacks and never prints; the bar is
+    transient (gone once the work is done).
+    """
+    if quiet or not err_console.is_terminal:
+        yield None
+        return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=err_console, transient=True) as bar:
+        task = bar.add_task(escape(label), total=total)
+
+        def advance(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        yield advance
 
 
 def span(first: float, last: float) -> str:
@@ -55,7 +83,6 @@ def print_log_summary(log: RobotLog) -> None:
     kinds = Counter(observation.kind.value for observation in log.observations)
     seen = len({observation.landmark_id for observation in log.observations})
     times = [observation.time for observation in log.observations]
-    console.print(f"wrote {log.path}", highlight=False, markup=False)
     rows = [
         ("log", log.meta.name),
         ("source", log.meta.source),
@@ -179,3 +206,38 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
             )
         )
     return parameters
+
+
+def _plain_help(params: list[Any]) -> list[Any]:
+    """Show flags as ``--flag/--no-flag`` without a ``<bool>`` type, and help text as written.
+
+    Typer renders help as rich markup: a ``[foxglove]`` in a help text would vanish as an
+    unknown tag, so every help text is escaped once here, where it is shown.
+    """
+    for param in params:
+        # typer's options are not click.Option subclasses: duck-typed on what they have
+        if getattr(param, "is_flag", False):
+            param.metavar = ""
+        text = getattr(param, "help", None)
+        if text and not getattr(param, "_escaped", False):
+            setattr(param, "help", escape(text))  # noqa: B010 - an attribute of typer's options only
+            setattr(param, "_escaped", True)  # noqa: B010
+    return params
+
+
+class PlainCommand(TyperCommand):
+    """A typer command whose help shows flags and bracketed text as written (see :func:`_plain_help`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help = escape(self.help) if self.help else self.help
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _plain_help(super().get_params(ctx))
+
+
+class PlainGroup(TyperGroup):
+    """A typer group whose help shows flags and bracketed text as written (see :func:`_plain_help`)."""
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _plain_help(super().get_params(ctx))

@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from aura_ums.cli._common import console, fail, print_log_summary
+from aura_ums.cli._common import Quiet, fail, print_log_summary, progress_bar
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, resolved, wrote
 
 if TYPE_CHECKING:
     from aura_ums.logs import ReplayResult
@@ -50,32 +51,37 @@ def rosbag_command(
         ),
     ] = None,
     name: Annotated[str | None, typer.Option("--name", help="Log name (default: the bag's name).")] = None,
-    overwrite: Annotated[
-        bool, typer.Option("--overwrite", help="Replace an existing log in OUT_DIR.")
-    ] = False,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Import the ROS bag BAG as a log folder OUT_DIR (topics and conventions: docs/interop.md).
 
     Sensor bounds are the log defaults (meta.toml): edit them, or calibrate, before replaying.
     """
-    from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import LogMeta, import_rosbag
+    import dataclasses
 
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import LogMeta, read_rosbag, write_log
+
+    target = Target("OUT_DIR", out_dir, folder=True)
+    sources = [Source("BAG", bag, folder=bag.is_dir()), Source("--landmarks", landmarks)]
+    check_outputs([target], sources, overwrite=overwrite)
     try:
         meta = None if name is None else LogMeta(name, source=f"ROS bag {bag.name}")
-        log = import_rosbag(
+        log = read_rosbag(
             bag,
-            out_dir,
             odom_topic=odom,
             observations_topic=observations,
             landmarks=landmarks,
             meta=meta,
             groundtruth_topic=groundtruth,
-            overwrite=overwrite,
         )
+        with progress_bar(f"{out_dir}: files", quiet=quiet) as advance:
+            folder = write_log(log, out_dir, overwrite=overwrite, progress=advance)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    print_log_summary(log)
+    wrote(folder)
+    print_log_summary(dataclasses.replace(log, path=folder))
 
 
 # --- MCAP export, for the commands that run or replay (``--mcap``) ---------------------------
@@ -83,12 +89,14 @@ def rosbag_command(
 MCAP_HELP = "Also write an MCAP file to open in Foxglove (needs aura-ums[foxglove]; topics: docs/interop.md)."
 
 
-def write_simulation_mcap_option(path: Path, scenario: Scenario, seed: int, *, prune: bool) -> Path:
+def write_simulation_mcap_option(
+    target: Target, scenario: Scenario, seed: int, *, prune: bool, quiet: bool
+) -> Path:
     """Run the first Monte Carlo run of ``seed`` again, with its images, and write it as MCAP.
 
     The run is the one ``simulate --seed SEED`` runs first (the first child of
-    ``default_rng(seed).spawn(...)``). Prints where it wrote; on an aura-ums error prints
-    ``error: ...`` and exits with code 2.
+    ``default_rng(seed).spawn(...)``). Says where it wrote; on an aura-ums error prints
+    ``error: ...`` and exits with code 2. The file is written whole or not at all.
     """
     import numpy as np
 
@@ -99,23 +107,23 @@ def write_simulation_mcap_option(path: Path, scenario: Scenario, seed: int, *, p
     (rng,) = np.random.default_rng(seed).spawn(1)
     try:
         result = run_scenario(scenario, rng, prune=prune, keep_images=True)
-        written = write_simulation_mcap(path, scenario, result)
+        with progress_bar(f"{target.path.name}: frames", quiet=quiet) as advance:
+            write_simulation_mcap(resolved(target.path), scenario, result, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
-    console.print(
-        f"wrote {written} (run 1 of seed {seed}; open it in Foxglove)", highlight=False, markup=False
-    )
-    return written
+        raise fail(f"{target.option}: {exc}") from None
+    wrote(target.path, f" (run 1 of seed {seed}; open it in Foxglove)")
+    return target.path
 
 
-def write_replay_mcap_option(path: Path, replay: ReplayResult) -> Path:
-    """Write a replay as MCAP; prints where, or ``error: ...`` and exits with code 2."""
+def write_replay_mcap_option(target: Target, replay: ReplayResult, *, quiet: bool) -> Path:
+    """Write a replay as MCAP (whole or not at all); says where, or ``error: ...`` and exits with code 2."""
     from aura_ums.errors import AuraUmsError
     from aura_ums.export import write_replay_mcap
 
     try:
-        written = write_replay_mcap(path, replay)
+        with progress_bar(f"{target.path.name}: steps", quiet=quiet) as advance:
+            write_replay_mcap(resolved(target.path), replay, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
-    console.print(f"wrote {written} (open it in Foxglove)", highlight=False, markup=False)
-    return written
+        raise fail(f"{target.option}: {exc}") from None
+    wrote(target.path, " (open it in Foxglove)")
+    return target.path

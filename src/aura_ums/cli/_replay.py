@@ -11,16 +11,32 @@ from rich.table import Table
 
 from aura_ums.cli._common import (
     NO_OPTIONS,
+    Quiet,
     SettingOptions,
     console,
     fail,
     manager_options,
-    write_metrics_json,
+    progress_bar,
+)
+from aura_ums.cli._outputs import (
+    Overwrite,
+    Source,
+    Target,
+    check_outputs,
+    resolved,
+    safe_name,
+    staged,
+    write_text,
+    wrote,
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayOptions, RobotLog
+    from aura_ums.logs import ReplayOptions, ReplayResult, RobotLog
     from aura_ums.manager import ManagerSettings
+
+
+# draw_replay's file name after the log's name
+_FIGURE = "_replay.png"
 
 
 class Classes(enum.StrEnum):
@@ -143,24 +159,38 @@ def calibrate(
         ),
     ] = None,
     max_truth_gap: _MaxTruthGap = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Estimate terrain statistics and sensor bounds from logs with ground truth."""
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import calibrate_logs, load_log, sensors_path
+    from aura_ums.logs import calibrate_logs, load_log
 
+    out_target = Target("--out", out)
+    sensors_target = Target(
+        "--sensors-out" if sensors_out is not None else "--out (its .sensors.toml)",
+        sensors_out if sensors_out is not None else out.with_suffix(".sensors.toml"),
+    )
+    check_outputs(
+        [out_target, sensors_target],
+        [Source("LOG_DIRS", folder, folder=True) for folder in log_dirs],
+        overwrite=overwrite,
+    )
     try:
-        logs = [_with_truth_gap(load_log(folder), max_truth_gap) for folder in log_dirs]
+        logs = []
+        with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
+            for folder in log_dirs:
+                logs.append(_with_truth_gap(load_log(folder), max_truth_gap))
+                if advance is not None:
+                    advance(len(logs), len(log_dirs))
         if horizons:
             calibration = calibrate_logs(logs, quantile=quantile, move=move, horizons=tuple(horizons))
         else:  # calibrate_logs' default horizons
             calibration = calibrate_logs(logs, quantile=quantile, move=move)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    sensors = sensors_out if sensors_out is not None else sensors_path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    sensors.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(calibration.terrain_table().to_toml())
-    sensors.write_text(calibration.sensors_toml())
+    write_text(out_target, calibration.terrain_table().to_toml())
+    write_text(sensors_target, calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
     console.print(
         f"motion: delay {motion.delay_s:.2f} s, run scale {motion.run_scale:.3f}, "
@@ -175,7 +205,6 @@ def calibrate(
         )
     console.print("growth bound against the truth, by horizon without correction:", highlight=False)
     console.print(calibration.report(), highlight=False, markup=False)
-    console.print(f"wrote {out} and {sensors}")
 
 
 @manager_options()
@@ -200,62 +229,115 @@ def replay(
     camera: _Camera = None,
     window_margin: _WindowMargin = 0.0,
     windows_csv: _WindowsCsv = None,
+    save_state: Annotated[
+        Path | None,
+        typer.Option(
+            "--save-state", help="Write where the replay stopped (versioned JSON), to --resume from."
+        ),
+    ] = None,
+    resume: Annotated[
+        Path | None,
+        typer.Option("--resume", help="Continue a replay of this log from a state saved by --save-state."),
+    ] = None,
+    until: Annotated[
+        float | None,
+        typer.Option("--until", help="Stop after the last frame at or before this log time, in s."),
+    ] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Run the map manager over a log and report containment, area, wedge width and speed.
 
     With --camera, also the image windows of each real observation (ours, an EKF's
     3-sigma box, the disk model) and how often the observation fell inside.
+
+    With --resume the replay continues where a --save-state left it (its settings are the
+    saved ones) and reports the frames after it; it ends with exactly the map of a
+    replay run in one go.
     """
     from aura_ums import Metrics
     from aura_ums.camera import load_camera
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import load_log, replay_log, replay_windows
+    from aura_ums.logs import ReplayState, load_log, replay_log, replay_windows
     from aura_ums.uncertainty import TerrainTable
 
     if windows_csv is not None and camera is None:
         raise fail("--windows-csv: expected --camera too, got no camera")
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    sources = [
+        Source("LOG_DIR", log_dir, folder=True),
+        Source("--terrain", terrain),
+        None if sensors is None else Source("--sensors", sensors),
+        None if resume is None else Source("--resume", resume),
+        None if camera is None else Source("--camera", camera),
+    ]
+    targets = [
+        None if metrics_json is None else Target("--metrics-json", metrics_json),
+        None if steps_csv is None else Target("--steps-csv", steps_csv),
+        None if mcap is None else Target("--mcap", mcap),
+        None if save_state is None else Target("--save-state", save_state),
+        None if windows_csv is None else Target("--windows-csv", windows_csv),
+    ]
+    check_outputs(targets, sources, overwrite=overwrite)
+    json_target, csv_target, mcap_target, state_target, windows_target = targets
     windows = None
     try:
         log = _with_truth_gap(load_log(log_dir), max_truth_gap)
+        figure = f"{safe_name(log.meta.name)}{_FIGURE}"
+        plot_target = None if plot is None else Target("--plot", plot / figure)
+        check_outputs([*targets, plot_target], sources, overwrite=overwrite)
         table = TerrainTable.from_toml(terrain)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
+        saved = None if resume is None else ReplayState.load(resume)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
-        if camera is None:
-            result = replay_log(log, table, options, keep_maps=keep_maps, steps_csv=steps_csv)
-        else:
-            result, windows = replay_windows(
-                log,
-                table,
-                load_camera(camera),
-                options,
-                margin=window_margin,
-                keep_maps=keep_maps,
-                steps_csv=steps_csv,
-            )
+        # The per-step CSV is streamed, through a scratch file renamed onto it whole.
+        steps_path = None if csv_target is None else resolved(csv_target.path)
+        with progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
+            if camera is None:
+                result = replay_log(
+                    log, table, options, keep_maps=keep_maps, steps_csv=steps_path, progress=advance,
+                    until=until, resume=saved, save_state=save_state is not None,
+                )  # fmt: skip
+            else:
+                result, windows = replay_windows(
+                    log, table, load_camera(camera), options, margin=window_margin, keep_maps=keep_maps,
+                    steps_csv=steps_path, progress=advance, until=until, resume=saved,
+                    save_state=save_state is not None,
+                )  # fmt: skip
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
-    if metrics_json is not None:
-        write_metrics_json(metrics_json, metrics)
-    if steps_csv is not None:
-        console.print(f"wrote {steps_csv}")
-    if windows_csv is not None and windows is not None:
-        windows_csv.parent.mkdir(parents=True, exist_ok=True)
-        windows_csv.write_text(windows.to_csv())
-        console.print(f"wrote {windows_csv}", highlight=False, markup=False)
-    if plot is not None:
-        from aura_ums.plot import draw_replay
-
-        console.print(f"wrote {draw_replay(result, plot)}")
-    if mcap is not None:
+    if json_target is not None:
+        write_text(json_target, metrics.to_json())
+    if state_target is not None and result.state is not None:
+        write_text(state_target, result.state.to_json())
+    if csv_target is not None:
+        wrote(csv_target.path)  # streamed by replay_log, renamed onto it whole
+    if windows_target is not None and windows is not None:
+        write_text(windows_target, windows.to_csv())
+    if plot_target is not None:
+        _draw(result, plot_target)
+    if mcap_target is not None:
         from aura_ums.cli._interop import write_replay_mcap_option
 
-        write_replay_mcap_option(mcap, result)
+        write_replay_mcap_option(mcap_target, result, quiet=quiet)
+
+
+def _draw(result: ReplayResult, target: Target) -> None:
+    """Draw the replay figure into a scratch folder and move it onto ``target`` (named safely)."""
+    import dataclasses
+
+    from aura_ums.plot import draw_replay
+
+    # The figure's file name comes from the log's name: drawn under the safe name only.
+    meta = dataclasses.replace(result.log.meta, name=target.path.name.removesuffix(_FIGURE))
+    named = dataclasses.replace(result, log=dataclasses.replace(result.log, meta=meta))
+    with staged(Target(target.option, target.path.parent, folder=True)) as stage:
+        draw_replay(named, stage)
 
 
 @manager_options()
@@ -280,6 +362,8 @@ def compare(
     metrics_json: Annotated[
         Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
     ] = None,
+    overwrite: Overwrite = False,
+    quiet: Quiet = False,
 ) -> None:
     """Print our map next to an EKF and a particle filter on the same log (99% regions)."""
     import numpy as np
@@ -291,6 +375,14 @@ def compare(
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
+    json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
+    sources = [
+        Source("LOG_DIR", log_dir, folder=True),
+        Source("--terrain", terrain),
+        None if sensors is None else Source("--sensors", sensors),
+        *(Source("--noise-from", p, folder=True) for p in calibration_logs or ()),
+    ]
+    check_outputs([json_target], sources, overwrite=overwrite)
     try:
         log = _with_truth_gap(load_log(log_dir), max_truth_gap)
         table = TerrainTable.from_toml(terrain)
@@ -316,15 +408,17 @@ def compare(
                     f"`aura-ums calibrate` (--sensors) or from calibration logs (--noise-from), got {where}"
                 )
             bearing_sd, range_sd = noise.bearing_sd, noise.range_sd_fraction
-        rows = compare_on_log(
-            log,
-            table,
-            options,
-            bearing_sd=bearing_sd,
-            range_sd_fraction=max(range_sd, 1e-3),
-            rng=np.random.default_rng(seed),
-            particles=particles,
-        )
+        with progress_bar(f"{safe_name(log.meta.name)}: frames x methods", quiet=quiet) as advance:
+            rows = compare_on_log(
+                log,
+                table,
+                options,
+                bearing_sd=bearing_sd,
+                range_sd_fraction=max(range_sd, 1e-3),
+                rng=np.random.default_rng(seed),
+                particles=particles,
+                progress=advance,
+            )
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters")
@@ -349,7 +443,7 @@ def compare(
             str(row.inconsistent_observations),
         )
     console.print(grid)
-    if metrics_json is not None:
+    if json_target is not None:
         table_metrics = Metrics(
             {
                 "log": log.meta.name,
@@ -359,4 +453,4 @@ def compare(
                 "methods": tuple(row.metrics() for row in rows),
             }
         )
-        write_metrics_json(metrics_json, table_metrics)
+        write_text(json_target, table_metrics.to_json())

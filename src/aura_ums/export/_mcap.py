@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import struct
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO, TYPE_CHECKING
 
@@ -39,7 +40,12 @@ def _path(path: str | Path, name: str = "path") -> Path:
 
 
 def write_simulation_mcap(
-    path: str | Path, scenario: Scenario, result: RunResult, *, camera_topic_images: bool = True
+    path: str | Path,
+    scenario: Scenario,
+    result: RunResult,
+    *,
+    camera_topic_images: bool = True,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Write a simulation run to an MCAP file that Foxglove opens, and return its path.
 
@@ -66,6 +72,10 @@ def write_simulation_mcap(
 
     Log times (and message timestamps) are the frames' times, in nanoseconds.
 
+    The file is written under a hidden scratch name in its folder and renamed onto
+    ``path`` when complete: an error, a ``KeyboardInterrupt`` or a killed process leaves
+    the old file (or none), never a part of one under ``path``.
+
     Parameters
     ----------
     path : str or Path
@@ -77,6 +87,9 @@ def write_simulation_mcap(
         after a resume the images are those of the last call, i.e. of the last frames).
     camera_topic_images : bool
         Write ``/camera/image`` (needs ``result.images``).
+    progress : callable or None
+        Called as ``progress(done, total)`` after each frame written (``total`` frames);
+        nothing is printed here.
 
     Returns
     -------
@@ -115,13 +128,21 @@ def write_simulation_mcap(
         raise InputError(f"result: expected a RunResult, got {type(result).__name__}")
     if not isinstance(camera_topic_images, bool):
         raise InputError(f"camera_topic_images: expected a bool, got {camera_topic_images!r}")
+    _check_progress(progress)
     _require("foxglove.channels", "writing MCAP")
     from aura_ums.export._writer import write_simulation
 
-    return write_simulation(target, scenario, result, camera_topic_images)
+    return write_simulation(target, scenario, result, camera_topic_images, progress)
 
 
-def write_replay_mcap(path: str | Path, replay: ReplayLike) -> Path:
+def _check_progress(progress: object) -> None:
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
+
+
+def write_replay_mcap(
+    path: str | Path, replay: ReplayLike, *, progress: Callable[[int, int], None] | None = None
+) -> Path:
     """Write a log replay to an MCAP file that Foxglove opens, and return its path.
 
     Channels (frame ``"world"``): ``/landmarks`` (once, the log's landmarks: cylinders
@@ -135,11 +156,14 @@ def write_replay_mcap(path: str | Path, replay: ReplayLike) -> Path:
     Parameters
     ----------
     path : str or Path
-        The file to write; its folder is created, an existing file replaced.
+        The file to write; its folder is created, an existing file replaced, atomically
+        (as for :func:`write_simulation_mcap`).
     replay : aura_ums.logs.ReplayResult
         The replay: ``replay.log.meta.name``, ``replay.log.landmarks`` and ``replay.steps``
         are read (each step's ``time``, ``map``, ``truth``, ``inside``, ``accepted``,
         ``rejected``, ``update_us`` and ``state``).
+    progress : callable or None
+        Called as ``progress(done, total)`` after each step written.
 
     Returns
     -------
@@ -176,10 +200,11 @@ def write_replay_mcap(path: str | Path, replay: ReplayLike) -> Path:
     for name in ("log", "steps"):
         if not hasattr(replay, name):
             raise InputError(f"replay: expected a ReplayResult (with .{name}), got {type(replay).__name__}")
+    _check_progress(progress)
     _require("foxglove.channels", "writing MCAP")
     from aura_ums.export._writer import write_replay
 
-    return write_replay(target, replay)
+    return write_replay(target, replay, progress)
 
 
 def mcap_channels(path: str | Path) -> dict[str, str]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -22,6 +22,7 @@ from foxglove import messages as fm
 from numpy.typing import NDArray
 
 from aura_ums import __version__
+from aura_ums._files import atomic_path
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.export._scene import (
     seconds_to_nanoseconds,
@@ -440,18 +441,33 @@ def frame_annotations(
 # --- writing ----------------------------------------------------------------------------------
 
 
+#: Reports ``(done, total)`` units of work after each one (the CLI draws it as a bar).
+Progress = Callable[[int, int], None]
+
+
 @contextmanager
 def _mcap(path: Path, kind: str, name: str) -> Iterator[foxglove.Context]:
-    """Open an MCAP file on a private SDK context (nothing leaks to the global one)."""
+    """Open an MCAP file on a private SDK context (nothing leaks to the global one).
+
+    The file is written under a scratch name beside ``path`` and renamed onto it once
+    closed: an error, a Ctrl-C or a kill leaves the old file (or none), never a part.
+    """
     context = foxglove.Context()
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        writer = foxglove.open_mcap(path, allow_overwrite=True, context=context)
+        with atomic_path(path) as scratch:
+            writer = foxglove.open_mcap(scratch, allow_overwrite=False, context=context)
+            with writer:
+                writer.write_metadata(
+                    "aura_ums", {"kind": kind, "name": name, "aura_ums_version": __version__}
+                )
+                yield context
     except OSError as exc:
         raise FileFormatError(str(path), "", f"expected a writable file, got {exc.strerror or exc}") from exc
-    with writer:
-        writer.write_metadata("aura_ums", {"kind": kind, "name": name, "aura_ums_version": __version__})
-        yield context
+
+
+def _report(progress: Progress | None, done: int, total: int) -> None:
+    if progress is not None:
+        progress(done, total)
 
 
 def _json_channel(topic: str, schema: dict[str, Any], context: foxglove.Context) -> foxglove.Channel:
@@ -465,7 +481,13 @@ def _json_channel(topic: str, schema: dict[str, Any], context: foxglove.Context)
     )
 
 
-def write_simulation(path: Path, scenario: Scenario, result: RunResult, camera_topic_images: bool) -> Path:
+def write_simulation(
+    path: Path,
+    scenario: Scenario,
+    result: RunResult,
+    camera_topic_images: bool,
+    progress: Progress | None = None,
+) -> Path:
     """Write a simulation run; see :func:`aura_ums.export.write_simulation_mcap`."""
     records = result.records
     if not records:
@@ -539,6 +561,7 @@ def write_simulation(path: Path, scenario: Scenario, result: RunResult, camera_t
                 },
                 log_time=ns,
             )
+            _report(progress, index + 1, len(records))
     return path
 
 
@@ -556,7 +579,7 @@ def _replay_world(replay: ReplayLike) -> MeadowMap | None:
     return log_meadow_map(replay.log, options.landmark_class, margin=options.arena_margin)
 
 
-def write_replay(path: Path, replay: ReplayLike) -> Path:
+def write_replay(path: Path, replay: ReplayLike, progress: Progress | None = None) -> Path:
     """Write a replay; see :func:`aura_ums.export.write_replay_mcap`."""
     steps = tuple(replay.steps)
     if not steps:
@@ -613,4 +636,5 @@ def write_replay(path: Path, replay: ReplayLike) -> Path:
                 },
                 log_time=ns,
             )
+            _report(progress, index + 1, len(steps))
     return path

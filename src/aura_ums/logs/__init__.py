@@ -16,6 +16,8 @@ A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
   truth; :func:`compare_on_log` sets it next to an EKF and a particle filter;
   :func:`replay_windows` judges the image windows the Expecter, an EKF's 3-sigma box and the
   disk model give for each real observation, through a camera of your choosing.
+  :class:`ReplayState` is where a replay stopped, saved as versioned JSON and resumed
+  (``replay_log(..., resume=state)``) to end with exactly the map of an uninterrupted one.
 """
 
 # Replay and calibration are the lead's (_calibrate, _replay, _synthetic); the formats
@@ -57,6 +59,7 @@ from aura_ums.logs._replay import (
     replay_log,
 )
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+from aura_ums.logs._state import ReplayState
 from aura_ums.logs._synthetic import synthetic_log
 from aura_ums.logs._windows import WindowReport, WindowRow, ekf_noise, replay_windows
 
@@ -74,6 +77,7 @@ __all__ = [
     "Odometry",
     "ReplayOptions",
     "ReplayResult",
+    "ReplayState",
     "ReplayStep",
     "ReplayTrace",
     "ReverseMotion",

@@ -139,6 +139,7 @@ def compare_on_log(
     particles: int = 1000,
     probability: float = 0.99,
     others: Mapping[str, Callable[[Pose], Estimator]] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> tuple[MethodSummary, ...]:
     """Run our map, an EKF and a particle filter over the same log and judge each against ground truth.
 
@@ -174,6 +175,10 @@ def compare_on_log(
         and returning an :class:`~aura_ums.baselines.Estimator` (a filter of yours;
         :meth:`ConfidenceRegion.gaussian <aura_ums.baselines.ConfidenceRegion.gaussian>`
         gives a Gaussian one its region). Its start spread and noise are its own.
+    progress : callable or None
+        Called as ``progress(done, total)`` as the work advances: after each frame of our
+        replay, then after each filter's pass (``total`` is the frames times the methods);
+        nothing is printed here.
 
     Returns
     -------
@@ -216,7 +221,15 @@ def compare_on_log(
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
     extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})"})
-    ours = replay_log(log, table, opts)
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
+    methods = 3 + len(extra)
+
+    def tick(done: int, frames: int) -> None:
+        if progress is not None:
+            progress(done, frames * methods)
+
+    ours = replay_log(log, table, opts, progress=tick)
     log = with_motion(log, opts.motion)
     terrain = table[log.meta.terrain]
     start_time, start_pose = replay_start(log)
@@ -244,6 +257,7 @@ def compare_on_log(
     if truth is None:  # replaced above by the motion calibration, never dropped
         raise InputError(f"log {log.meta.name!r}: expected ground truth to compare against, got none")
     summaries = [_ours(ours)]
+    done = len(frames)
     for name, estimator in filters:
         inside: list[bool] = []
         areas: list[float] = []
@@ -279,6 +293,8 @@ def compare_on_log(
             inside.append(bool(region.contains(x, y, heading)))
             mean = estimator.mean
             errors.append(math.hypot(mean.x - x, mean.y - y))
+        done += len(frames)
+        tick(done, len(frames))
         summaries.append(
             MethodSummary(
                 name,

@@ -7,12 +7,14 @@ written log reads back equal.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import math
 import os
-from collections.abc import Iterator, Mapping, Sequence
+import shutil
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import NoReturn
@@ -23,12 +25,14 @@ from numpy.typing import NDArray
 from aura_ums._files import (
     CsvFloats,
     Fields,
+    atomic_path,
     describe,
     key_path,
     load_toml,
     parse_csv,
     parse_csv_floats,
     read_text,
+    scratch_path,
 )
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
@@ -564,8 +568,21 @@ def log_files_in(folder: str | os.PathLike[str]) -> tuple[str, ...]:
     return tuple(name for name in LOG_FILES if (base / name).exists())
 
 
-def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+def write_log(
+    log: RobotLog,
+    folder: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
     """Write ``log`` as a log folder (SI units, ``repr`` floats) that :func:`load_log` reads back equal.
+
+    Nothing partial is ever left under a final name. A new (or empty) folder is written
+    whole under a hidden scratch name beside it and renamed onto ``folder`` at the end,
+    so an error, a ``KeyboardInterrupt`` or a killed process leaves no log folder at all
+    (at most the hidden scratch folder). Into a folder that already holds files, every
+    file is first written under a scratch name, then each is renamed onto its final name:
+    each file is the old one or the whole new one.
 
     Parameters
     ----------
@@ -576,6 +593,8 @@ def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool 
     overwrite : bool
         Replace the log files of a folder that already has some. The log files this log
         does not have (e.g. ``groundtruth.csv``) are then removed. Other files are left alone.
+    progress : callable or None
+        Called as ``progress(done, total)`` after each file written (``total`` files).
 
     Returns
     -------
@@ -639,16 +658,52 @@ def write_log(log: RobotLog, folder: str | os.PathLike[str], *, overwrite: bool 
             ("time", "x", "y", "heading"),
             zip(_floats(truth.time), _floats(truth.x), _floats(truth.y), _floats(truth.heading), strict=True),
         )
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
     try:
-        base.mkdir(parents=True, exist_ok=True)
-        for name in existing:
-            if name not in files:
-                (base / name).unlink()
-        for name, text in files.items():
-            (base / name).write_text(text, encoding="utf-8")
+        if base.is_dir() and any(base.iterdir()):
+            _write_into(base, files, existing, progress)
+        else:
+            _write_fresh(base, files, progress)
     except OSError as exc:
         raise FileFormatError(str(base), "", f"expected a writable folder, got {exc}") from exc
     return base
+
+
+def _write_fresh(base: Path, files: Mapping[str, str], progress: Callable[[int, int], None] | None) -> None:
+    """Write a whole new folder under a scratch name, then rename it onto ``base`` (absent or empty)."""
+    base.parent.mkdir(parents=True, exist_ok=True)
+    scratch = scratch_path(base)
+    try:
+        scratch.mkdir()
+        for done, (name, text) in enumerate(files.items(), start=1):
+            (scratch / name).write_text(text, encoding="utf-8")
+            if progress is not None:
+                progress(done, len(files))
+        # rename(2) replaces an empty folder in one step, and refuses a non-empty one
+        os.replace(scratch, base)
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+
+
+def _write_into(
+    base: Path,
+    files: Mapping[str, str],
+    existing: Sequence[str],
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Replace the log files of a folder holding other files too: every file whole, or the old one."""
+    with contextlib.ExitStack() as stack:
+        for done, (name, text) in enumerate(files.items(), start=1):
+            scratch = stack.enter_context(atomic_path(base / name))
+            scratch.write_text(text, encoding="utf-8")
+            if progress is not None:
+                progress(done, len(files))
+        # leaving the stack renames each scratch file onto its name, all text already on disk
+    for name in existing:
+        if name not in files:
+            (base / name).unlink()
 
 
 def _landmarks_csv(landmarks: Sequence[LogLandmark]) -> str:

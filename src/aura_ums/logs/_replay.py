@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 import os
 import secrets
@@ -24,6 +25,7 @@ from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.logs._odometry import ReverseMotion
+from aura_ums.logs._state import ReplayState
 from aura_ums.manager import (
     Blackboard,
     ManagerSettings,
@@ -325,6 +327,9 @@ class ReplayResult:
     maps : tuple of SpatialUncertaintyMap or None
         The working map after each step when the replay kept them (``keep_maps=True``),
         else None.
+    state : ReplayState or None
+        Where the replay stopped (the manager and blackboard after its last frame), to
+        save and resume from; None when not recorded.
     """
 
     log: RobotLog
@@ -377,6 +382,8 @@ class ReplayResult:
                 )
             )
         )
+
+    state: ReplayState | None = None
 
     @property
     def containment_rate(self) -> float:
@@ -543,6 +550,10 @@ def replay_log(
     before_frame: FrameHook | None = None,
     keep_maps: bool = True,
     steps_csv: str | os.PathLike[str] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    until: float | None = None,
+    resume: ReplayState | None = None,
+    save_state: bool = False,
 ) -> ReplayResult:
     """Run the uncertainty map manager over a log, frame by frame, and judge it against ground truth.
 
@@ -586,6 +597,19 @@ def replay_log(
         file beside it, renamed onto it at the end, so a replay that fails or is
         interrupted leaves no partial file under that name. Its folder is created when
         missing.
+    progress : callable or None
+        Called as ``progress(done, total)`` after each frame (``total`` frames of the log
+        after its start); nothing is printed here.
+    until : float or None
+        Stop after the last frame at or before this time, s (None: replay to the end);
+        the result's ``state`` then resumes from there.
+    resume : ReplayState or None
+        Continue a replay of this same log from a saved :class:`ReplayState` (the
+        manager and blackboard as they were, its settings included): the steps are those
+        after it, and the last map is bit for bit that of an uninterrupted replay.
+    save_state : bool
+        Record where the replay stopped (:attr:`ReplayResult.state`, the manager's and
+        blackboard's JSON, which grows with the log), to save and resume from.
 
     Returns
     -------
@@ -594,7 +618,8 @@ def replay_log(
     Raises
     ------
     InputError
-        For a bad argument, a terrain missing from ``table``, or a log without a start.
+        For a bad argument, a terrain missing from ``table``, a log without a start, or a
+        ``resume`` state saved from another log.
     FileFormatError
         When ``steps_csv`` cannot be written.
 
@@ -624,6 +649,13 @@ def replay_log(
         raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
     if not isinstance(keep_maps, bool):
         raise InputError(f"keep_maps: expected True or False, got {keep_maps!r}")
+    if not isinstance(save_state, bool):
+        raise InputError(f"save_state: expected True or False, got {save_state!r}")
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
+    stop = math.inf if until is None else finite_float(until, "until")
+    if resume is not None and not isinstance(resume, ReplayState):
+        raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")
     log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
@@ -644,16 +676,22 @@ def replay_log(
     report_times, report_turns, report_runs = log.position_report_arrays(
         frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
     )
-    trace = ReplayTrace.empty(frame_times.size)
+    first, next_report = 0, 0
+    if resume is not None:
+        first, next_report = _resumed_at(resume, log, frames, frame_times, int(report_times.size))
+        manager = UncertaintyMapManager.from_json(resume.manager_json, meadow_map, table, source="resume")
+        board = Blackboard.from_json(resume.blackboard_json, source="resume")
+    # The frames this replay makes: those after a resumed state's, up to ``until``.
+    last = int(np.searchsorted(frame_times, stop, side="right")) if until is not None else frame_times.size
+    last = max(last, first)
+    trace = ReplayTrace.empty(last - first)
     if log.groundtruth is not None:
-        trace.truth[:] = log.groundtruth.at(frame_times)
+        trace.truth[:] = log.groundtruth.at(frame_times[first:last])
     maps: list[SpatialUncertaintyMap] = []
     judge = _Judge(trace)
-
     offset = log.meta.sensor_offset
     with _StepsCsv(steps_csv) as writer:
-        next_report = 0
-        for index, frame_time in enumerate(frame_times.tolist()):
+        for index, frame_time in enumerate(frame_times[first:last].tolist()):
             rows = frames[frame_time]
             working = [
                 observation_for(r, opts.landmark_class, working_bounds, sensor_offset=offset) for r in rows
@@ -694,7 +732,20 @@ def replay_log(
                 maps.append(step.map)
             if judge.full():
                 writer.write(trace, *judge.flush())
+            if progress is not None:
+                progress(first + index + 1, int(frame_times.size))
         writer.write(trace, *judge.flush())
+    state = None
+    if save_state:
+        state = ReplayState(
+            log.meta.name,
+            last,
+            next_report,
+            float(frame_times[last - 1]) if last else math.nan,
+            _digest(frames, frame_times[:last]),
+            manager.to_json(),
+            board.to_json(),
+        )
     return ReplayResult(
         log,
         opts,
@@ -702,6 +753,7 @@ def replay_log(
         types.MappingProxyType(dict(manager.rejected_counts)),
         manager.relocalizations,
         tuple(maps) if keep_maps else None,
+        state,
     )
 
 
@@ -827,6 +879,43 @@ class _StepsCsv:
             raise FileFormatError(
                 str(self.target), "", f"expected a writable file, got {exc.strerror or exc}"
             ) from None
+
+
+def _digest(frames: Mapping[float, list[LogObservation]], times: np.ndarray) -> str:
+    """SHA-256 of the observations of the frames at ``times``: what a saved state was replayed on."""
+    digest = hashlib.sha256()
+    for frame_time in times:
+        for row in frames[float(frame_time)]:
+            digest.update(repr((row.time, row.landmark_id, row.bearing, row.range)).encode("utf-8"))
+    return digest.hexdigest()
+
+
+def _resumed_at(
+    state: ReplayState,
+    log: RobotLog,
+    frames: Mapping[float, list[LogObservation]],
+    frame_times: np.ndarray,
+    reports: int,
+) -> tuple[int, int]:
+    """Return the frame and report indices to resume at; a state from another log is refused."""
+    fits = (
+        state.log_name == log.meta.name
+        and state.frames_done <= frame_times.size
+        and state.log_digest == _digest(frames, frame_times[: state.frames_done])
+        and state.reports_posted <= reports
+        and (
+            math.isnan(state.last_time)
+            if state.frames_done == 0
+            else float(frame_times[state.frames_done - 1]) == state.last_time
+        )
+    )
+    if not fits:
+        raise InputError(
+            f"resume: expected a state saved from a replay of log {log.meta.name!r} "
+            f"({frame_times.size} frames), got one of log {state.log_name!r} after "
+            f"{state.frames_done} frames at {state.last_time!r} s"
+        )
+    return state.frames_done, state.reports_posted
 
 
 def with_motion(log: RobotLog, motion: MotionCalibration | None) -> RobotLog:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import os
 import statistics
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -48,6 +48,7 @@ from aura_ums.logs._replay import (
     replay_start,
     with_motion,
 )
+from aura_ums.logs._state import ReplayState
 from aura_ums.uncertainty import (
     BearingObservation,
     LandmarkClass,
@@ -271,6 +272,10 @@ def replay_windows(
     sigmas: float = 3.0,
     keep_maps: bool = True,
     steps_csv: str | os.PathLike[str] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    until: float | None = None,
+    resume: ReplayState | None = None,
+    save_state: bool = False,
 ) -> tuple[ReplayResult, WindowReport]:
     """Replay a log and judge, for each real observation, the image windows of three methods.
 
@@ -301,7 +306,7 @@ def replay_windows(
         the replay's working bounds.
     sigmas : float
         Half-width of the EKF's box in standard deviations, > 0.
-    keep_maps, steps_csv
+    keep_maps, steps_csv, progress, until, resume, save_state
         As for :func:`replay_log`.
 
     Returns
@@ -356,7 +361,10 @@ def replay_windows(
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
 
     judge = _Judge(log, table, camera, opts, pixels, box_sigmas, b_sd, r_sd, bounds)
-    result = replay_log(log, table, opts, before_frame=judge, keep_maps=keep_maps, steps_csv=steps_csv)
+    result = replay_log(
+        log, table, opts, before_frame=judge, keep_maps=keep_maps, steps_csv=steps_csv, progress=progress,
+        until=until, resume=resume, save_state=save_state,
+    )  # fmt: skip
     return result, WindowReport(camera, pixels, tuple(judge.rows))
 
 

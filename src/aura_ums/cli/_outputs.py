@@ -1,0 +1,264 @@
+"""Where the commands write: checked before any work, written whole, never onto an input.
+
+Every command declares its inputs (:class:`Source`) and its outputs (:class:`Target`)
+and calls :func:`check_outputs` before it computes anything. Paths are compared after
+resolving symlinks. An output may not be an input file, lie inside an input folder, be
+a folder holding an input, or share its path with another output; an existing output is
+replaced only with ``--overwrite``; the folder an output goes into must be writable.
+Each refusal exits with code 2 and names the option and both paths on stderr.
+
+Files are then written through :func:`aura_ums._files.atomic_path` (a scratch name
+beside the target, renamed onto it when whole), and folders of figures are drawn into a
+scratch folder and moved in file by file: a failure, a Ctrl-C or a kill leaves the old
+file or none, never a part of one under its final name. :func:`interruptible` turns a
+Ctrl-C into exit code 130 and says what was (not) written.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import shutil
+import unicodedata
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from aura_ums._files import scratch_path, write_text_atomic
+from aura_ums.cli._common import err_console, fail
+
+#: The option every command that writes takes, with the same help everywhere.
+Overwrite = Annotated[
+    bool,
+    typer.Option(
+        "--overwrite", help="Replace outputs that exist already (without it, an existing output is refused)."
+    ),
+]
+
+#: Exit code after a Ctrl-C (128 + SIGINT), as shells report it.
+INTERRUPTED = 130
+
+# What the running command has written so far, for the message after a Ctrl-C.
+_written: list[Path] = []
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
+_SAFE_NAME_LENGTH = 100
+
+
+@dataclass(frozen=True, slots=True)
+class Source:
+    """An input of a command.
+
+    Attributes
+    ----------
+    option : str
+        How the user gave it (``"LOG_DIR"``, ``"--terrain"``).
+    path : Path
+        As given.
+    folder : bool
+        A folder (a log folder, a dataset): nothing may be written inside it.
+    """
+
+    option: str
+    path: Path
+    folder: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class Target:
+    """An output of a command: a file, or a folder the command fills.
+
+    Attributes
+    ----------
+    option : str
+        How the user gave it (``"--metrics-json"``, ``"OUT_DIR"``).
+    path : Path
+        As given (or derived, e.g. ``--out`` with ``.sensors.toml``).
+    folder : bool
+        A folder of outputs: it must be new or empty unless ``--overwrite``.
+    """
+
+    option: str
+    path: Path
+    folder: bool = False
+
+
+def resolved(path: Path) -> Path:
+    """Return ``path`` absolute with every symlink resolved (the missing tail kept as is)."""
+    return Path(os.path.realpath(path.expanduser()))
+
+
+def safe_name(text: str, default: str = "log") -> str:
+    """Return ``text`` as one file name: no folder, no leading dot, only ``A-Z a-z 0-9 . _ -``.
+
+    For output names taken from data (a log's name), so that no name reaches outside
+    the output folder.
+
+    Examples
+    --------
+    >>> safe_name("../x"), safe_name("/abs/x"), safe_name("Robot 1: café*?"), safe_name("..")
+    ('x', 'abs_x', 'Robot_1_cafe', 'log')
+    """
+    ascii_text = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
+    name = _UNSAFE.sub("_", ascii_text).strip("._-")[:_SAFE_NAME_LENGTH].strip("._-")
+    return name or default
+
+
+def check_outputs(
+    targets: Sequence[Target | None], sources: Sequence[Source | None], *, overwrite: bool
+) -> None:
+    """Refuse (exit 2) outputs that would touch an input, collide, exist, or cannot be written.
+
+    Called before any computation, so a refusal costs nothing. ``None`` entries (options
+    not given) are skipped.
+    """
+    inputs = [(source, resolved(source.path)) for source in sources if source is not None]
+    seen: list[tuple[Target, Path]] = []
+    for target in (t for t in targets if t is not None):
+        where = resolved(target.path)
+        for source, origin in inputs:
+            _apart(target, where, source, origin)
+        for other, taken in seen:
+            if taken == where:
+                raise fail(
+                    f"{target.option}: expected a path of its own, got {target.path}, which is also "
+                    f"the output of {other.option} ({other.path})"
+                )
+        seen.append((target, where))
+        _replaceable(target, where, overwrite)
+        _writable(target, where)
+
+
+def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
+    what = f"the input {source.option} ({_shown(source.path, origin)})"
+    given, option = _shown(target.path, where), target.option
+    if where == origin:
+        raise fail(f"{option}: expected an output apart from the inputs, got {given}, which is {what}")
+    if source.folder and where.is_relative_to(origin):
+        raise fail(f"{option}: expected an output outside the input folders, got {given}, inside {what}")
+    if target.folder and origin.is_relative_to(where):
+        raise fail(
+            f"{option}: expected an output folder apart from the inputs, got {given}, which holds {what}"
+        )
+
+
+def _shown(path: Path, where: Path) -> str:
+    """``path`` as given, with where it leads when a symlink takes it elsewhere."""
+    plain = Path(os.path.abspath(path.expanduser()))
+    return str(path) if plain == where else f"{path} (a link to {where})"
+
+
+def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
+    if target.folder:
+        if where.exists() and not where.is_dir():
+            raise fail(f"{target.option}: expected a folder, got {target.path}, which is a file")
+        if where.is_dir() and any(where.iterdir()) and not overwrite:
+            raise fail(
+                f"{target.option}: expected a new or empty folder, got {target.path}, which holds files "
+                "(pass --overwrite to replace what is written there)"
+            )
+        return
+    if where.is_dir():
+        raise fail(f"{target.option}: expected a file, got {target.path}, which is a folder")
+    if where.exists() and not overwrite:
+        raise fail(
+            f"{target.option}: expected a new file, got {target.path}, which exists "
+            "(pass --overwrite to replace it)"
+        )
+
+
+def _writable(target: Target, where: Path) -> None:
+    """Probe the deepest existing folder the output goes into with a file of our own."""
+    folder = where if target.folder else where.parent
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise fail(
+            f"{target.option}: expected a path in a folder, got {target.path}, where {folder} is a file"
+        )
+    probe = scratch_path(folder / "write-probe")
+    try:
+        probe.open("x").close()
+        probe.unlink()
+    except OSError as exc:
+        raise _unwritable(target, folder, exc) from None
+
+
+def _unwritable(target: Target, path: Path, exc: OSError) -> typer.Exit:
+    return fail(f"{target.option}: expected a writable place, got {path}: {exc.strerror or exc}")
+
+
+def wrote(path: Path, note: str = "") -> None:
+    """Record that ``path`` is written whole, and say so on stderr."""
+    _written.append(path)
+    err_console.print(f"wrote {path}{note}", highlight=False, markup=False)
+
+
+def write_text(target: Target, text: str) -> Path:
+    """Write ``text`` to the target file atomically; a system error exits 2 naming the option."""
+    try:
+        # through a symlink to its file (the link stays), as the checks resolved it
+        write_text_atomic(resolved(target.path), text)
+    except OSError as exc:
+        raise _unwritable(target, target.path, exc) from None
+    wrote(target.path)
+    return target.path
+
+
+@contextmanager
+def staged(target: Target) -> Iterator[Path]:
+    """Yield a scratch folder beside the target folder; when the block ends, move its files in.
+
+    Each file is moved onto its place in the target folder with one ``os.replace``
+    (sub-folders kept): every file there is an old one or a whole new one. On an error
+    or a Ctrl-C the scratch folder is removed and the target folder left as it was.
+    """
+    final = resolved(target.path)
+    try:
+        final.mkdir(parents=True, exist_ok=True)
+        stage = scratch_path(final)
+        stage.mkdir()
+    except OSError as exc:
+        raise _unwritable(target, final, exc) from None
+    try:
+        yield stage
+        for path in sorted(p for p in stage.rglob("*") if p.is_file()):
+            place = final / path.relative_to(stage)
+            place.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, place)
+            wrote(target.path / path.relative_to(stage))
+    except OSError as exc:
+        raise _unwritable(target, final, exc) from None
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def interruptible(command: Callable[..., None]) -> Callable[..., None]:
+    """Turn a Ctrl-C inside ``command`` into exit code 130 and a message on stderr of what was written."""
+
+    @functools.wraps(command)
+    def run(*args: Any, **kwargs: Any) -> None:
+        _written.clear()
+        try:
+            command(*args, **kwargs)
+        except KeyboardInterrupt:
+            if _written:
+                done = ", ".join(str(path) for path in _written)
+                message = f"interrupted: only {done} written whole; nothing else was written"
+            else:
+                message = "interrupted: nothing was written"
+            err_console.print(f"[red]error:[/red] {_escape(message)}", highlight=False)
+            raise typer.Exit(code=INTERRUPTED) from None
+
+    return run
+
+
+def _escape(text: str) -> str:
+    from rich.markup import escape
+
+    return escape(text)

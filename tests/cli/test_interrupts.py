@@ -1,0 +1,112 @@
+"""A Ctrl-C leaves the old file or none, exits 130 and says what was (not) written.
+
+The interrupt is raised deterministically from inside the work (a monkeypatched step),
+where a user's Ctrl-C would land.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import aura_ums.logs
+from aura_ums.cli import app
+from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import TerrainTable
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("inputs")
+    write_log(synthetic_log(np.random.default_rng(5), duration=20.0), base / "log")
+    (base / "terrain.toml").write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    return base
+
+
+def interrupted(result: object) -> str:
+    exit_code = getattr(result, "exit_code", None)
+    stderr = str(getattr(result, "stderr", ""))
+    assert exit_code == 130, getattr(result, "output", "")
+    assert "Traceback" not in stderr
+    return stderr
+
+
+def test_ctrl_c_during_the_replay_writes_nothing(
+    inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def stop(*_: object, **__: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(aura_ums.logs, "replay_log", stop)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "metrics.json").write_text("old")
+    result = runner.invoke(
+        app,
+        [
+            "replay",
+            str(inputs / "log"),
+            "--terrain",
+            str(inputs / "terrain.toml"),
+            "--metrics-json",
+            str(out / "metrics.json"),
+            "--steps-csv",
+            str(out / "steps.csv"),
+            "--overwrite",
+        ],
+    )
+    assert "interrupted: nothing was written" in interrupted(result)
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json"]
+    assert (out / "metrics.json").read_text() == "old"
+
+
+def test_ctrl_c_during_the_mcap_export_leaves_no_partial_file(
+    inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from foxglove import channels
+
+    original = channels.SceneUpdateChannel.log
+    calls = []
+
+    def log(self: object, *args: object, **kwargs: object) -> None:
+        calls.append(1)
+        if len(calls) == 25:  # half-way through the steps
+            raise KeyboardInterrupt
+        original(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(channels.SceneUpdateChannel, "log", log)
+    metrics = tmp_path / "metrics.json"
+    mcap = tmp_path / "replay.mcap"
+    mcap.write_bytes(b"the old file")
+    arguments = [str(inputs / "log"), "--terrain", str(inputs / "terrain.toml"), "--overwrite"]
+    result = runner.invoke(app, ["replay", *arguments, "--metrics-json", str(metrics), "--mcap", str(mcap)])
+    message = interrupted(result)
+    assert f"interrupted: only {metrics} written whole; nothing else was written" in message
+    assert mcap.read_bytes() == b"the old file"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["metrics.json", "replay.mcap"]
+
+
+def test_ctrl_c_during_import_leaves_no_log_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from tests.cli.test_logs_cli import DATASET
+
+    dataset = tmp_path / "dataset"
+    dataset.mkdir()
+    for name, text in DATASET.items():
+        (dataset / name).write_text(text)
+    original = Path.write_text
+
+    def write_text(self: Path, *args: object, **kwargs: object) -> int:
+        if self.name == "observations.csv":
+            raise KeyboardInterrupt
+        return original(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Path, "write_text", write_text)
+    out = tmp_path / "robot1"
+    result = runner.invoke(app, ["import", "mrclam", str(dataset), str(out), "--robot", "1"])
+    assert "interrupted: nothing was written" in interrupted(result)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dataset"]

@@ -1,0 +1,228 @@
+"""Outputs never touch inputs, collide, or silently replace a file; names from data stay in their folder.
+
+Each case is one failure class of issue 19: the command must exit 2 before it computes,
+say why on stderr (naming the option and both paths), print nothing on stdout, show no
+traceback, and leave every input byte-identical.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+import typer
+from typer.main import get_command
+from typer.testing import CliRunner, Result
+
+from aura_ums.cli import app
+from aura_ums.cli._outputs import safe_name
+from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import TerrainTable
+
+runner = CliRunner()
+
+
+def invoke(*arguments: str | Path) -> Result:
+    return runner.invoke(app, [str(a) for a in arguments])
+
+
+def digest(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` with its SHA-256: inputs must stay byte-identical."""
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def refused(result: Result, *words: str) -> None:
+    """A clean refusal: exit 2, the message on stderr only, no traceback."""
+    assert result.exit_code == 2, result.output
+    assert result.stdout == ""
+    assert result.stderr.startswith("error: ")
+    assert "Traceback" not in result.output
+    for word in words:
+        assert word in result.stderr, result.stderr
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("inputs")
+    write_log(synthetic_log(np.random.default_rng(4), duration=20.0), base / "log")
+    (base / "terrain.toml").write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    return base
+
+
+@pytest.fixture
+def untouched(inputs: Path) -> object:
+    before = digest(inputs)
+    yield
+    assert digest(inputs) == before
+
+
+def test_replay_refuses_to_write_into_its_log_folder(inputs: Path, untouched: object) -> None:
+    log = inputs / "log"
+    target = log / "observations.csv"
+    result = invoke("replay", log, "--terrain", inputs / "terrain.toml", "--steps-csv", target, "--overwrite")
+    refused(result, "--steps-csv", str(target), str(log), "LOG_DIR")
+
+
+def test_calibrate_refuses_to_write_onto_its_meta_toml(inputs: Path, untouched: object) -> None:
+    log = inputs / "log"
+    result = invoke("calibrate", log, "--out", log / "meta.toml", "--overwrite")
+    refused(result, "--out", str(log / "meta.toml"), "LOG_DIRS")
+
+
+def test_an_input_file_is_refused_as_output(inputs: Path, untouched: object) -> None:
+    terrain = inputs / "terrain.toml"
+    result = invoke("replay", inputs / "log", "--terrain", terrain, "--metrics-json", terrain, "--overwrite")
+    refused(result, "--metrics-json", "--terrain", str(terrain))
+
+
+def test_symlinks_are_resolved_before_comparing(inputs: Path, tmp_path: Path, untouched: object) -> None:
+    link = tmp_path / "innocent.toml"
+    link.symlink_to(inputs / "log" / "meta.toml")
+    folder_link = tmp_path / "elsewhere"
+    folder_link.symlink_to(inputs / "log", target_is_directory=True)
+    refused(invoke("calibrate", inputs / "log", "--out", link, "--overwrite"), str(link), "LOG_DIRS")
+    out = folder_link / "steps.csv"
+    result = invoke("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--steps-csv", out)
+    refused(result, "--steps-csv", str(out))
+
+
+def test_two_outputs_may_not_share_a_path(inputs: Path, tmp_path: Path, untouched: object) -> None:
+    same = tmp_path / "same.toml"
+    refused(
+        invoke("calibrate", inputs / "log", "--out", same, "--sensors-out", same),
+        "--sensors-out",
+        "--out",
+        str(same),
+    )
+    both = tmp_path / "both.out"
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml")
+    refused(invoke(*common, "--metrics-json", both, "--steps-csv", both), "--steps-csv", "--metrics-json")
+    assert not same.exists()
+    assert not both.exists()
+
+
+def test_an_existing_output_is_replaced_only_with_overwrite(inputs: Path, tmp_path: Path) -> None:
+    out = tmp_path / "metrics.json"
+    out.write_text("old")
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", out)
+    refused(invoke(*common), "--metrics-json", str(out), "--overwrite")
+    assert out.read_text() == "old"
+    result = invoke(*common, "--overwrite")
+    assert result.exit_code == 0, result.output
+    assert out.read_text().startswith("{")
+    assert f"wrote {out}" in result.stderr
+    assert "containment_rate" in result.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["metrics.json"]  # no scratch file left
+
+
+def test_an_unwritable_output_is_refused_before_the_computation(
+    inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import aura_ums.sim
+
+    def never(*_: object, **__: object) -> None:
+        raise AssertionError("the computation started")
+
+    monkeypatch.setattr(aura_ums.sim, "run_scenario", never)
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+    result = invoke("simulate", scenario, "--runs", "3", "--metrics-json", blocker / "m.json")
+    refused(result, "--metrics-json", str(blocker))
+
+
+def test_an_output_folder_may_not_hold_an_input(inputs: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    landmarks = out / "landmarks.csv"
+    landmarks.write_text((inputs / "log" / "landmarks.csv").read_text())
+    bag = tmp_path / "walk.bag"
+    bag.write_bytes(b"not read: refused before")
+    topics = ("--odom", "/o", "--observations", "/s")
+    result = invoke("import", "rosbag", bag, out, *topics, "--landmarks", landmarks, "--overwrite")
+    refused(result, "OUT_DIR", "--landmarks", str(landmarks))
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [
+        ("../x", "x"),
+        ("/abs/x", "abs_x"),
+        ("../../etc/passwd", "etc_passwd"),
+        ("a b:c*?\u00e9", "a_b_c_e"),
+        ("..", "log"),
+    ],
+)
+def test_names_from_data_are_sanitized(name: str, expected: str) -> None:
+    assert safe_name(name) == expected
+
+
+@pytest.mark.parametrize("name", ["../../escaped", "/abs/escaped", "we?ird:*na\u00efme"])
+def test_replay_plot_stays_in_its_folder(name: str, inputs: Path, tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(4), duration=8.0)
+    import dataclasses
+
+    crafted = dataclasses.replace(log, meta=dataclasses.replace(log.meta, name=name))
+    folder = write_log(crafted, tmp_path / "data" / "crafted")
+    plots = tmp_path / "data" / "plots" / "inner"
+    result = invoke("replay", folder, "--terrain", inputs / "terrain.toml", "--plot", plots, "--quiet")
+    assert result.exit_code == 0, result.output
+    written = sorted(p for p in tmp_path.rglob("*.png"))
+    assert written == [plots / f"{safe_name(name)}_replay.png"]
+    assert [p.name for p in plots.iterdir()] == [f"{safe_name(name)}_replay.png"]
+
+
+def test_every_command_that_writes_takes_the_same_overwrite() -> None:
+    root = get_command(app)
+    assert isinstance(root, typer.core.TyperGroup)
+    commands = dict(root.commands)
+    imports = commands.pop("import")
+    assert isinstance(imports, typer.core.TyperGroup)
+    commands.update({f"import {name}": command for name, command in imports.commands.items()})
+    helps = {}
+    for name, command in commands.items():
+        options = {option: param for param in command.params for option in getattr(param, "opts", ())}
+        assert "--overwrite" in options, name
+        helps[name] = getattr(options["--overwrite"], "help", None)
+    assert set(commands) == {
+        "figures",
+        "demo",
+        "simulate",
+        "calibrate",
+        "replay",
+        "compare",
+        "import mrclam",
+        "import rosbag",
+    }
+    assert len(set(helps.values())) == 1, helps
+
+
+def test_errors_go_to_stderr_and_results_to_stdout(inputs: Path, tmp_path: Path) -> None:
+    missing = tmp_path / "no-such-log"
+    refused(invoke("replay", missing, "--terrain", inputs / "terrain.toml"), str(missing))
+    bad = tmp_path / "latin1.toml"
+    bad.write_bytes("[floor]\nname = 'caf\u00e9'\n".encode("latin-1"))
+    refused(invoke("replay", inputs / "log", "--terrain", bad), str(bad))
+    result = invoke("replay", inputs / "log", "--terrain", inputs / "terrain.toml")
+    assert result.exit_code == 0, result.output
+    assert result.stderr == ""
+    assert "containment_rate" in result.stdout
+
+
+def test_an_output_through_a_symlink_replaces_the_file_it_leads_to(inputs: Path, tmp_path: Path) -> None:
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", link)
+    refused(invoke(*common), str(link), "exists")
+    result = invoke(*common, "--overwrite")
+    assert result.exit_code == 0, result.output
+    assert link.is_symlink()
+    assert real.read_text().startswith("{")

@@ -1,0 +1,140 @@
+"""``--version``, help as written, progress bars on stderr, and ``replay --save-state/--resume``."""
+
+from __future__ import annotations
+
+import io
+import json
+from importlib.metadata import version
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rich.console import Console
+from typer.testing import CliRunner, Result
+
+import aura_ums.cli._common as common
+from aura_ums.cli import app
+from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import TerrainTable
+from tests.conftest import SHARED_DATA
+
+runner = CliRunner()
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+MRCLAM6 = SHARED_DATA / "mrclam6"
+
+
+def invoke(*arguments: object) -> Result:
+    result = runner.invoke(app, [str(a) for a in arguments])
+    assert result.exit_code == 0, result.output
+    return result
+
+
+def test_version_is_the_installed_one() -> None:
+    result = invoke("--version")
+    assert result.stdout == f"aura-ums {version('aura-ums')}\n"
+
+
+@pytest.mark.parametrize("command", ["simulate", "replay", "compare", "calibrate", "import mrclam", "demo"])
+def test_help_shows_flags_and_brackets_as_written(command: str) -> None:
+    result = runner.invoke(app, [*command.split(), "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert "<bool>" not in result.stdout
+    assert "--overwrite" in result.stdout
+    if command == "simulate":
+        assert "aura-ums[foxglove]" in result.stdout
+        assert "[manager]" in result.stdout
+        assert "--prune" in result.stdout
+        assert "--no-prune" in result.stdout
+
+
+def test_progress_is_drawn_on_a_terminal_and_not_with_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
+    screen = io.StringIO()
+    monkeypatch.setattr(common, "err_console", Console(file=screen, force_terminal=True, width=100))
+    result = invoke("simulate", SCENARIO, "--runs", "3")
+    assert "runs" in screen.getvalue()
+    assert "3/3" in screen.getvalue()
+    assert "3/3" not in result.stdout + result.stderr
+    screen.truncate(0)
+    screen.seek(0)
+    invoke("simulate", SCENARIO, "--runs", "3", "--quiet")
+    assert screen.getvalue() == ""
+
+
+def test_no_progress_when_stderr_is_not_a_terminal() -> None:
+    result = invoke("simulate", SCENARIO, "--runs", "2")
+    assert result.stderr == ""
+
+
+@pytest.fixture(scope="module")
+def walk(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    base = tmp_path_factory.mktemp("walk")
+    folder = write_log(synthetic_log(np.random.default_rng(6), duration=40.0), base / "log")
+    terrain = base / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    return folder, terrain
+
+
+def resumed_alike(folder: Path, terrain: Path, tmp: Path, first: float, last: float, *extra: str) -> None:
+    """Replay to ``last`` in one go, and to ``first`` then resumed to ``last``: the same final state."""
+    common_args = ("replay", folder, "--terrain", terrain, "--quiet", *extra)
+    whole_out = ("--save-state", tmp / "whole.json", "--steps-csv", tmp / "whole.csv")
+    invoke(*common_args, "--until", last, *whole_out)
+    invoke(*common_args, "--until", first, "--save-state", tmp / "half.json")
+    rest = invoke(
+        *common_args,
+        "--resume",
+        tmp / "half.json",
+        "--until",
+        last,
+        "--save-state",
+        tmp / "rest.json",
+        "--steps-csv",
+        tmp / "rest.csv",
+    )
+    whole = json.loads((tmp / "whole.json").read_text())
+    again = json.loads((tmp / "rest.json").read_text())
+    half = json.loads((tmp / "half.json").read_text())
+    assert 0 < half["frames_done"] < whole["frames_done"]
+    assert again == whole  # the map, the envelope, the counters and the blackboard, bit for bit
+    whole_rows = (tmp / "whole.csv").read_text().splitlines()
+    rest_rows = (tmp / "rest.csv").read_text().splitlines()
+    assert len(rest_rows) - 1 == whole["frames_done"] - half["frames_done"]
+    # the same maps step by step after the resume (the update timing column aside)
+    trimmed = [",".join(row.split(",")[:6]) for row in whole_rows[-(len(rest_rows) - 1) :]]
+    assert [",".join(row.split(",")[:6]) for row in rest_rows[1:]] == trimmed
+    assert "steps" in rest.stdout
+
+
+def test_a_resumed_replay_ends_with_the_same_map(walk: tuple[Path, Path], tmp_path: Path) -> None:
+    folder, terrain = walk
+    resumed_alike(folder, terrain, tmp_path, 15.0, 40.0)
+
+
+def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: Path) -> None:
+    folder, terrain = walk
+    invoke("replay", folder, "--terrain", terrain, "--until", "10", "--save-state", tmp_path / "s.json")
+    other = write_log(synthetic_log(np.random.default_rng(9), duration=40.0), tmp_path / "other")
+    result = runner.invoke(
+        app, ["replay", str(other), "--terrain", str(terrain), "--resume", str(tmp_path / "s.json")]
+    )
+    assert result.exit_code == 2
+    assert "resume: expected a state saved from a replay of log" in result.stderr
+    broken = tmp_path / "broken.json"
+    broken.write_text('{"format": "aura_ums.ReplayState", "version": 1, "log": "x"}')
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(broken)])
+    assert result.exit_code == 2
+    assert str(broken) in result.stderr
+    assert "Traceback" not in result.output
+
+
+@pytest.mark.skipif(
+    not (MRCLAM6 / "Robot1_Measurement.dat").is_file(),
+    reason=f"UTIAS MRCLAM Dataset 6 not found at {MRCLAM6} (shared data is not part of the repository)",
+)
+def test_a_resumed_mrclam6_replay_ends_with_the_same_map(tmp_path: Path) -> None:
+    log = tmp_path / "log"
+    invoke("import", "mrclam", MRCLAM6, log, "--robot", "1", "--quiet")
+    invoke("calibrate", log, "--out", tmp_path / "terrain.toml")
+    first = float((log / "observations.csv").read_text().splitlines()[2].split(",")[0])
+    sensors = ("--sensors", str(tmp_path / "terrain.sensors.toml"), "--classes", "II")
+    resumed_alike(log, tmp_path / "terrain.toml", tmp_path, first + 60.0, first + 150.0, *sensors)

@@ -1,0 +1,75 @@
+"""``replay_log`` and ``compare_on_log`` report progress through a callback; a replay saves and resumes."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs import ReplayState, compare_on_log, replay_log, synthetic_log
+from aura_ums.uncertainty import TerrainTable
+
+TABLE = TerrainTable({"floor": TerrainTable.default()["tile"]})
+
+
+def test_replay_and_compare_report_progress_to_the_total() -> None:
+    log = synthetic_log(np.random.default_rng(11), duration=15.0)
+    seen: list[tuple[int, int]] = []
+    result = replay_log(log, TABLE, progress=lambda done, total: seen.append((done, total)))
+    frames = len(result.steps)
+    assert seen == [(k, frames) for k in range(1, frames + 1)]
+    compared: list[tuple[int, int]] = []
+    compare_on_log(
+        log,
+        TABLE,
+        bearing_sd=0.006,
+        range_sd_fraction=0.012,
+        rng=np.random.default_rng(0),
+        particles=50,
+        progress=lambda done, total: compared.append((done, total)),
+    )
+    assert compared[-1] == (3 * frames, 3 * frames)
+    assert [done for done, _ in compared] == sorted(done for done, _ in compared)
+    with pytest.raises(InputError, match="progress: expected a callable or None, got int"):
+        replay_log(log, TABLE, progress=3)  # type: ignore[arg-type]
+
+
+def test_until_stops_and_the_state_resumes_bit_for_bit() -> None:
+    log = synthetic_log(np.random.default_rng(12), duration=30.0)
+    whole = replay_log(log, TABLE, save_state=True)
+    half = replay_log(log, TABLE, until=12.0, save_state=True)
+    assert half.steps[-1].time <= 12.0 < whole.steps[len(half.steps)].time
+    assert half.state is not None
+    assert whole.state is not None
+    saved = ReplayState.from_json(half.state.to_json())
+    assert saved.to_json() == half.state.to_json()
+    rest = replay_log(log, TABLE, resume=saved, save_state=True)
+    assert len(half.steps) + len(rest.steps) == len(whole.steps)
+    for ours, theirs in zip(rest.steps, whole.steps[len(half.steps) :], strict=True):
+        assert ours.map.polygon.vertices.tobytes() == theirs.map.polygon.vertices.tobytes()
+        assert ours.map.wedge == theirs.map.wedge
+    assert rest.state is not None
+    assert json.loads(rest.state.manager_json) == json.loads(whole.state.manager_json)
+
+
+def test_a_state_before_any_frame_and_bad_states() -> None:
+    log = synthetic_log(np.random.default_rng(12), duration=10.0)
+    empty = replay_log(log, TABLE, until=-1.0, save_state=True)
+    assert empty.steps == ()
+    assert empty.state is not None
+    assert math.isnan(empty.state.last_time)
+    assert math.isnan(ReplayState.from_json(empty.state.to_json()).last_time)
+    other = synthetic_log(np.random.default_rng(13), duration=10.0)
+    state = replay_log(log, TABLE, until=5.0, save_state=True).state
+    with pytest.raises(InputError, match="resume: expected a state saved from a replay of log 'synthetic'"):
+        replay_log(other, TABLE, resume=state)
+    with pytest.raises(FileFormatError, match="log_digest: expected a string"):
+        ReplayState.from_json(
+            '{"format": "aura_ums.ReplayState", "version": 1, "log": "x", "frames_done": 0, '
+            '"reports_posted": 0, "last_time": null, "log_digest": 1, "manager": {}, "blackboard": {}}'
+        )
+    with pytest.raises(FileFormatError, match="expected a key 'log', got none"):
+        ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 1}')
