@@ -21,13 +21,14 @@ per-case limit: ``AURA_FUZZ_CASE_SECONDS``. Counts per reader:
 
 from __future__ import annotations
 
+import collections
 import json
 import math
 import os
 import shutil
 import signal
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import FrameType
 
@@ -218,8 +219,26 @@ def outcome(read: Callable[[], object], seconds: float = CASE_SECONDS) -> AuraUm
     return None
 
 
+#: Cases run per reader (the test's name), read or refused: written as JSON to the file
+#: ``AURA_FUZZ_COUNTS`` names, when set, at the end of the module.
+COUNTS: collections.Counter[tuple[str, str]] = collections.Counter()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _write_counts() -> Iterator[None]:
+    yield
+    target = os.environ.get("AURA_FUZZ_COUNTS")
+    if target:
+        table: dict[str, dict[str, int]] = {}
+        for (reader, result), count in sorted(COUNTS.items()):
+            table.setdefault(reader, {})[result] = count
+        Path(target).write_text(json.dumps(table, indent=1), encoding="utf-8")
+
+
 def assert_clean(error: AuraUmsError | None, name: str) -> None:
     """An error from a file is a ValueError that names the file and says what it expected and got."""
+    reader = os.environ.get("PYTEST_CURRENT_TEST", "?").split("::")[-1].split(" ")[0]
+    COUNTS[(reader, "read" if error is None else "refused")] += 1
     if error is None:
         return
     text = str(error)
