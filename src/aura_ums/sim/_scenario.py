@@ -471,7 +471,7 @@ class Scenario:
         raise InputError(f"{name}: expected {limits}, got {work}")
 
     def check_runs(self, runs: object) -> int:
-        """Return ``runs`` checked: an integer in [1, :data:`MAX_RUNS`], refused with the estimate.
+        """Return ``runs`` checked: an integer in [1, ``MAX_RUNS``] (100,000), refused with the estimate.
 
         Examples
         --------

@@ -25,8 +25,8 @@ _ALTERNATE_UNITS = {"drift_deg_per_m": ("drift", math.pi / 180.0)}
 class TerrainStats:
     """Slippage statistics of the robot on one terrain type (DESIGN §3).
 
-    Each field's physical range is in its metadata (``"range"``, a
-    :class:`~aura_ums._validate.Range`) and :meth:`field_ranges`; a value outside it is an
+    Each field's physical range is in its metadata (``"range"``, an
+    ``aura_ums._validate.Range``) and :meth:`field_ranges`; a value outside it is an
     error, not a statistic (a drift of 1e20 rad/m would make every map a full disk).
 
     Parameters
