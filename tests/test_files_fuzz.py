@@ -1,30 +1,47 @@
 """Fuzz every file reader: random bytes and mutations of a valid file fail only with our errors.
 
 Each reader gets random bytes and a valid file of its format mutated (bytes replaced,
-tokens of TOML/JSON/CSV/YAML inserted, slices deleted or repeated, the tail cut). The
-guarantee: the reader returns, or raises an :class:`AuraUmsError` that is a
+tokens of TOML/JSON/CSV/YAML/.dat inserted, slices deleted or repeated, the tail cut).
+The guarantee: the reader returns, or raises an :class:`AuraUmsError` that is a
 ``ValueError`` naming the file and reading "expected ..., got ..."; never anything else
-(no ``KeyError``, ``TypeError``, ``RecursionError``, ``UnicodeDecodeError``...).
+(no ``KeyError``, ``TypeError``, ``RecursionError``, ``UnicodeDecodeError``...), and
+never a hang: each case runs under a time limit (:data:`CASE_SECONDS`, SIGALRM).
 
-More cases: ``AURA_HYPOTHESIS_PROFILE=thorough`` (1000 a reader); counts per reader:
+The readers: terrain tables, cameras (TOML, OpenCV YAML and JSON), scenarios, sensor
+calibrations, a log folder's ``meta.toml`` and CSV files (odometry, commands,
+observations, landmarks, ground truth), saved manager and blackboard state, GeoJSON meadow
+maps, the MRCLAM ``.dat`` files, York Urban's ``segments.csv``, and the files
+``aura-ums calibrate`` writes (its terrain table and sensor calibration).
+
+CI runs the loaded hypothesis profile (100 cases a reader, derandomized); more cases:
+``AURA_HYPOTHESIS_PROFILE=thorough`` (1000 a reader) or ``AURA_FUZZ_EXAMPLES=N``; the
+per-case limit: ``AURA_FUZZ_CASE_SECONDS``. Counts per reader:
 ``pytest tests/test_files_fuzz.py --hypothesis-show-statistics``.
 """
 
 from __future__ import annotations
 
+import collections
 import json
 import math
+import os
 import shutil
-from collections.abc import Callable
+import signal
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from types import FrameType
 
+import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from aura_ums.camera import CameraMount, load_calibration_bounds, load_camera, load_opencv_calibration
 from aura_ums.errors import AuraUmsError
-from aura_ums.logs import load_log, load_sensors
+from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, synthetic_log
 from aura_ums.manager import Blackboard, PositionReport, UncertaintyMapManager
+from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
 from aura_ums.uncertainty import BearingObservation, Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
 from aura_ums.world import MeadowMap, make_grid_world
@@ -112,6 +129,22 @@ LOG_FILES: dict[str, bytes] = {
     "odometry.csv": b"time,v,omega\n0.0,0.5,0.0\n1.0,0.5,5.7\n2.0,0.0,0.0\n",
     "groundtruth.csv": b"time,x,y,heading\n0.0,0.0,0.0,0.0\n2.0,1.0,0.0,5.7\n",
 }
+MRCLAM_HEADER = b"# UTIAS MRCLAM Dataset (made up)\n# columns\n"
+MRCLAM_FILES: dict[str, bytes] = {
+    "Barcodes.dat": MRCLAM_HEADER + b"  1 \t 5\n  6 \t 63\n  7 \t 81\n",
+    "Landmark_Groundtruth.dat": MRCLAM_HEADER
+    + b"  6 \t 0.5 \t -4.0 \t 0.001 \t 0.002\n  7 \t 1.5 \t 2.0 \t 0.003 \t 0.0001\n",
+    "Robot1_Measurement.dat": MRCLAM_HEADER
+    + b"10.0 \t 63 \t 2.0 \t 0.5\n10.5 \t 99 \t 1.0 \t 0.0\n11.0 \t 81 \t 4.0 \t -0.1\n",
+    "Robot1_Odometry.dat": MRCLAM_HEADER + b"9.0 \t 0.1 \t 0.0\n9.5 \t 0.2 \t 0.1\n12.0 \t 0.0 \t 0.0\n",
+    "Robot1_Groundtruth.dat": MRCLAM_HEADER + b"8.0 \t 0.0 \t 0.0 \t 3.1\n12.0 \t 1.0 \t 0.0 \t -3.1\n",
+}
+YORK_SEGMENTS = b"image,x1,y1,x2,y2,vp,vertical\nP0001,1.5,2.0,10.0,2.5,1,0\nP0001,3.0,1.0,3.5,9.0,2,1\n"
+COMMANDS_CSV = b"time,turn,run\n1.0,0.1,0.5\n2.0,0.0,0.5\n"
+#: What `aura-ums calibrate` writes: a terrain table and a sensor calibration.
+CALIBRATION = calibrate_logs([synthetic_log(np.random.default_rng(19), duration=60.0)])
+CALIBRATED_TERRAIN = CALIBRATION.terrain_table().to_toml().encode()
+CALIBRATED_SENSORS = CALIBRATION.sensors_toml().encode()
 WORLD = make_grid_world(2, 2)
 TABLE = TerrainTable.default()
 MOUNT = CameraMount(1.0)
@@ -123,6 +156,7 @@ TOKENS = (
     b"nan", b"inf", b"-inf", b"NaN", b"Infinity", b".Nan", b"1e999", b"-1", b"0", b"1.5", b"true",
     b"null", b"[[[[[[[[[[[[", b"{{{{{{{{", b"9" * 40, b"0x" + b"f" * 80, b"1979-05-27",
     b'"\\ud800"', b"\xc3\xa9", b"[x]\n", b"[[x]]\n", b"a = 1\n", b'"a": 1, ', b"x,y\n",
+    b"1e300", b"-1e300", b"1e15", b"1e-6", b"100000000", b"2000000", b" \t ", b"\t", b"4.9e-324",
 )  # fmt: skip
 
 
@@ -156,17 +190,55 @@ def contents(valid: bytes) -> st.SearchStrategy[bytes]:
     return st.one_of(st.binary(max_size=400), mutated(valid), mutated(valid), mutated(valid))
 
 
-def outcome(read: Callable[[], object]) -> AuraUmsError | None:
-    """Run a reader: None if it returns, our error if it raises one (anything else propagates)."""
+#: Longest a reader may take on one case, seconds: a case that takes longer is a hang.
+CASE_SECONDS = float(os.environ.get("AURA_FUZZ_CASE_SECONDS", "20"))
+
+
+class HangError(Exception):
+    """A reader took longer than :data:`CASE_SECONDS` on one case."""
+
+
+def _hang(signum: int, frame: FrameType | None) -> None:
+    raise HangError(f"expected a reader to finish within {CASE_SECONDS} s, got a hang")
+
+
+def outcome(read: Callable[[], object], seconds: float = CASE_SECONDS) -> AuraUmsError | None:
+    """Run a reader: None if it returns, our error if it raises one (anything else propagates).
+
+    The reader runs under an alarm of ``seconds``: a hang fails the case.
+    """
+    previous = signal.signal(signal.SIGALRM, _hang)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
         read()
     except AuraUmsError as error:
         return error
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
     return None
+
+
+#: Cases run per reader (the test's name), read or refused: written as JSON to the file
+#: ``AURA_FUZZ_COUNTS`` names, when set, at the end of the module.
+COUNTS: collections.Counter[tuple[str, str]] = collections.Counter()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _write_counts() -> Iterator[None]:
+    yield
+    target = os.environ.get("AURA_FUZZ_COUNTS")
+    if target:
+        table: dict[str, dict[str, int]] = {}
+        for (reader, result), count in sorted(COUNTS.items()):
+            table.setdefault(reader, {})[result] = count
+        Path(target).write_text(json.dumps(table, indent=1), encoding="utf-8")
 
 
 def assert_clean(error: AuraUmsError | None, name: str) -> None:
     """An error from a file is a ValueError that names the file and says what it expected and got."""
+    reader = os.environ.get("PYTEST_CURRENT_TEST", "?").split("::")[-1].split(" ")[0]
+    COUNTS[(reader, "read" if error is None else "refused")] += 1
     if error is None:
         return
     text = str(error)
@@ -202,9 +274,24 @@ def test_the_valid_files_load(tmp_path: Path) -> None:
         == _manager_json()
     )
     assert Blackboard.from_json(_board_json().decode()).to_json().encode() == _board_json()
+    assert len(read_mrclam(_mrclam_folder(tmp_path, "", b""), 1).observations) == 2
+    [image] = load_york_urban(_york_urban_folder(tmp_path, YORK_SEGMENTS))
+    assert image.segments.shape == (2, 4)
+    (tmp_path / "calibrated.toml").write_bytes(CALIBRATED_TERRAIN)
+    assert TerrainTable.from_toml(tmp_path / "calibrated.toml") == CALIBRATION.terrain_table()
+    (tmp_path / "calibrated_sensors.toml").write_bytes(CALIBRATED_SENSORS)
+    assert load_sensors(tmp_path / "calibrated_sensors.toml")[0] == CALIBRATION.motion
+    folder = _log_folder(tmp_path, "odometry.csv", b"")
+    (folder / "odometry.csv").unlink()
+    (folder / "commands.csv").write_bytes(COMMANDS_CSV)
+    assert len(load_log(folder).commands or ()) == 2
 
 
-FUZZ = settings(suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+_EXAMPLES = os.environ.get("AURA_FUZZ_EXAMPLES")
+FUZZ = settings(
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+    max_examples=int(_EXAMPLES) if _EXAMPLES else settings().max_examples,
+)
 
 
 @FUZZ
@@ -323,3 +410,77 @@ def test_manager_state_json(data: bytes) -> None:
 def test_blackboard_state_json(data: bytes) -> None:
     text = data.decode("utf-8", errors="replace")
     assert_clean(outcome(lambda: Blackboard.from_json(text, source="board.json")), "board.json")
+
+
+@FUZZ
+@given(data=contents(COMMANDS_CSV))
+def test_log_commands_csv(tmp_path: Path, data: bytes) -> None:
+    folder = _log_folder(tmp_path, "odometry.csv", b"")
+    (folder / "odometry.csv").unlink()
+    (folder / "commands.csv").write_bytes(data)
+    assert_clean(outcome(lambda: load_log(folder)), str(folder))
+
+
+def _mrclam_folder(tmp_path: Path, name: str, data: bytes) -> Path:
+    folder = tmp_path / "mrclam"
+    shutil.rmtree(folder, ignore_errors=True)
+    folder.mkdir()
+    for file, valid in MRCLAM_FILES.items():
+        (folder / file).write_bytes(data if file == name else valid)
+    return folder
+
+
+@FUZZ
+@given(name=st.sampled_from(sorted(MRCLAM_FILES)), seed=st.data())
+def test_mrclam_dat(tmp_path: Path, name: str, seed: st.DataObject) -> None:
+    data = seed.draw(contents(MRCLAM_FILES[name]))
+    folder = _mrclam_folder(tmp_path, name, data)
+    assert_clean(outcome(lambda: read_mrclam(folder, 1)), str(folder))
+
+
+def _york_urban_folder(tmp_path: Path, data: bytes) -> Path:
+    folder = tmp_path / "york_urban"
+    image = folder / "images" / "P0001.jpg"
+    if not image.exists():
+        import matplotlib.image
+
+        image.parent.mkdir(parents=True)
+        pixels = np.random.default_rng(19).integers(0, 255, (12, 16), dtype=np.uint8)
+        matplotlib.image.imsave(image.with_suffix(".png"), pixels, cmap="gray")
+        image.with_suffix(".png").rename(image)
+    (folder / "segments.csv").write_bytes(data)
+    return folder
+
+
+@FUZZ
+@given(data=contents(YORK_SEGMENTS))
+def test_york_urban_segments_csv(tmp_path: Path, data: bytes) -> None:
+    folder = _york_urban_folder(tmp_path, data)
+    assert_clean(outcome(lambda: load_york_urban(folder)), "segments.csv")
+
+
+@FUZZ
+@given(data=contents(CALIBRATED_TERRAIN))
+def test_calibrated_terrain_toml(tmp_path: Path, data: bytes) -> None:
+    path = tmp_path / "calibrated.toml"
+    path.write_bytes(data)
+    assert_clean(outcome(lambda: TerrainTable.from_toml(path)), "calibrated.toml")
+
+
+@FUZZ
+@given(data=contents(CALIBRATED_SENSORS))
+def test_calibrated_sensors_toml(tmp_path: Path, data: bytes) -> None:
+    path = tmp_path / "calibrated_sensors.toml"
+    path.write_bytes(data)
+    assert_clean(outcome(lambda: load_sensors(path)), "calibrated_sensors.toml")
+
+
+def test_a_hang_fails_the_case() -> None:
+    """The time limit works: a reader that does not return within it fails with HangError."""
+
+    def forever() -> None:
+        while True:
+            time.sleep(0.01)
+
+    with pytest.raises(HangError, match=r"expected a reader to finish within .* s, got a hang"):
+        outcome(forever, seconds=0.2)

@@ -40,6 +40,7 @@ from typing import Literal, NoReturn, TypeVar, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._validate import Range
 from aura_ums.errors import FileFormatError
 
 __all__ = [
@@ -757,6 +758,25 @@ class Fields:
         result = self.number(value, where)
         if result < 0.0:
             self.fail(where, f"expected a non-negative number, got {self.describe(value)}")
+        return result
+
+    def ranged(self, value: object, where: str, bounds: Range, *, scale: float = 1.0) -> float:
+        """Return ``value`` times ``scale`` (a unit's factor to SI) checked in ``bounds``.
+
+        The message quotes the value as written (not scaled).
+
+        Examples
+        --------
+        >>> from aura_ums._validate import START_RADIUS
+        >>> Fields("meta.toml").ranged(2e4, "radius", START_RADIUS)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.FileFormatError: meta.toml: radius: expected a number in [0, 10000] m, got 20000.0
+        """
+        result = self.number(value, where) * scale
+        if not bounds.contains(result):
+            in_si = "" if scale == 1.0 else f" ({result:g} {bounds.unit})"
+            self.fail(where, f"expected {bounds.text()}, got {self.describe(value)}{in_si}")
         return result
 
     def integer(self, value: object, where: str, minimum: int | None = None) -> int:

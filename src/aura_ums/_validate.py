@@ -3,11 +3,16 @@
 These helpers raise :class:`~aura_ums.errors.InputError` with messages that name
 the argument, what was expected and what was found. Code behind them trusts
 what they return.
+
+The physical ranges shared by several inputs are defined here once (:class:`Range`
+constants: :data:`COORDINATE`, :data:`START_RADIUS`, ...); the readers check every
+numeric field against one, and the docs pages of the file formats list them.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,6 +53,98 @@ def integer_at_least(value: object, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
     return value
+
+
+@dataclass(frozen=True, slots=True)
+class Range:
+    """A physical range of a numeric field: ``low <= value <= high`` in ``unit``.
+
+    Parameters
+    ----------
+    low, high : float
+        The bounds (finite), ``low <= high``.
+    unit : str
+        The unit, for messages and docs ("m", "rad/m", "px", "" for none).
+    low_open, high_open : bool
+        Exclude the bound itself (``low < value``, ``value < high``).
+
+    Examples
+    --------
+    >>> DRIFT = Range(0.0, 10.0, "rad/m")
+    >>> DRIFT.check(0.02, "drift"), DRIFT.text()
+    (0.02, 'a number in [0, 10] rad/m')
+    >>> DRIFT.check(1e20, "drift")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: drift: expected a number in [0, 10] rad/m, got 1e+20
+    """
+
+    low: float
+    high: float
+    unit: str = ""
+    low_open: bool = False
+    high_open: bool = False
+
+    def contains(self, value: float) -> bool:
+        """Whether the finite ``value`` is in the range."""
+        above = value > self.low if self.low_open else value >= self.low
+        below = value < self.high if self.high_open else value <= self.high
+        return above and below
+
+    def interval(self) -> str:
+        """Write the range as an interval with its unit: ``"[0, 10] rad/m"`` (as the docs list it)."""
+        left, right = "(" if self.low_open else "[", ")" if self.high_open else "]"
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{left}{self.low:g}, {self.high:g}{right}{unit}"
+
+    def text(self) -> str:
+        """Describe the range in a message: ``"a number in [0, 10] rad/m"``."""
+        return f"a number in {self.interval()}"
+
+    def check(self, value: object, name: str) -> float:
+        """Return ``value`` as a float in the range, or raise naming ``name``."""
+        result = finite_float(value, name)
+        if not self.contains(result):
+            raise InputError(f"{name}: expected {self.text()}, got {result!r}")
+        return result
+
+
+#: Any position in a world frame, each coordinate, metres: a 2000 km square is far beyond a
+#: mobile robot's work area, and keeps areas (m^2) and squared distances far from overflow.
+COORDINATE = Range(-1e6, 1e6, "m")
+#: Radius of the start position's uncertainty, metres (10 km).
+#: Where a sensor sits in the robot frame (forward, left), metres.
+SENSOR_OFFSET = Range(-100.0, 100.0, "m")
+START_RADIUS = Range(0.0, 1e4, "m")
+#: Radius of a landmark's position uncertainty, metres (1 km).
+POSITION_UNCERTAINTY = Range(0.0, 1e3, "m")
+#: A length a sensor measures or a bound on its error (range, range error, heights), metres.
+LENGTH = Range(0.0, 1e4, "m")
+#: A height above (or below) the ground, metres.
+HEIGHT = Range(-1e4, 1e4, "m")
+#: An angle as given (bearing, heading, turn), radians; wrapped where it is used.
+ANGLE = Range(-1e3, 1e3, "rad")
+#: A bound on an angle's error, radians, > 0 (from pi on it says nothing; a widened
+#: envelope may pass it, so only absurd magnitudes are refused).
+ANGLE_ERROR = Range(0.0, 1e3, "rad", low_open=True)
+#: A time stamp, seconds (Unix times run to 1e10 s in the year 2286).
+TIME = Range(-1e10, 1e10, "s")
+#: Forward velocity of a ground robot, m/s (100 m/s is 360 km/h).
+SPEED = Range(-100.0, 100.0, "m/s")
+#: Angular velocity, rad/s (100 rad/s is 16 turns a second).
+ANGULAR_SPEED = Range(-100.0, 100.0, "rad/s")
+#: A dimensionless factor (scales, fractions of a range), > 0.
+FACTOR = Range(0.0, 100.0, "", low_open=True)
+#: Delay of recorded motion behind the true motion, seconds (an hour).
+DELAY = Range(0.0, 3600.0, "s")
+#: Seconds between two motion rows of a log: a longer gap is a clock jump, not a held velocity.
+ROW_GAP = Range(0.0, 86_400.0, "s", low_open=True)
+#: Pixels along one side of an image.
+IMAGE_SIDE = Range(1, 20_000, "px")
+#: A focal length, pixels (1e6 px is a field of view of 1 mrad on a 1000 px image).
+FOCAL_LENGTH = Range(0.0, 1e6, "px", low_open=True)
+#: A principal point or pixel coordinate, pixels.
+PIXEL = Range(-1e5, 1e5, "px")
 
 
 def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:

@@ -63,3 +63,12 @@ def test_simulate_bad_input_is_a_clean_error(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["simulate", str(SCENARIOS / "paper_sidewalk.toml"), "--runs", "0"])
     assert result.exit_code == 2
     assert "--runs" in result.output
+
+
+def test_simulate_refuses_too_many_runs_before_allocating() -> None:
+    result = CliRunner().invoke(
+        app, ["simulate", str(SCENARIOS / "paper_sidewalk.toml"), "--runs", "1000000000"]
+    )
+    assert result.exit_code == 2
+    assert "--runs: expected an integer in [1, 100000], got 1000000000 (about" in result.output
+    assert "Traceback" not in result.output

@@ -55,7 +55,7 @@ def small_log(*, commands: bool = False, groundtruth: bool = True, start: bool =
     )
     landmarks = (
         LogLandmark("a", 1.0 / 3.0, 2.0, 0.01, 0.0, 3.0, "lamppost"),
-        LogLandmark("#7", -1e-9, 1e9, symbol="sign, red"),
+        LogLandmark("#7", -1e-9, 999999.123456789, symbol="sign, red"),
         LogLandmark('b"q', 0.5, 0.25),
     )
     observations = (

@@ -94,7 +94,7 @@ def test_out_of_range_sensor_value_is_named(tmp_path: Path) -> None:
         .replace("[working]\nbearing_error = ", "[working]\nbearing_error = -")
     )
     with pytest.raises(
-        FileFormatError, match=r"neg\.toml: \[working\] bearing_error: expected a positive number"
+        FileFormatError, match=r"neg\.toml: \[working\] bearing_error: expected a number in \(0, 1000\] rad"
     ):
         load_sensors(_write(tmp_path / "neg.toml", text))
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 import tempfile
@@ -13,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from aura_ums._files import MAX_BYTES
+from aura_ums._validate import ANGULAR_SPEED, COORDINATE, DELAY, ROW_GAP, SPEED, TIME, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
     LogLandmark,
@@ -51,8 +53,19 @@ def test_write_then_load_gives_the_same_log(
         assert lines[observation.line - 1].startswith(repr(observation.time) + ",")
 
 
-finite = st.floats(min_value=-1e12, max_value=1e12, allow_nan=False, allow_subnormal=True)
-positive = st.floats(min_value=1e-300, max_value=1e6, allow_nan=False)
+def within(bounds: Range) -> st.SearchStrategy[float]:
+    """Any float in a reader's physical range (the values a written log may hold)."""
+    return st.floats(
+        min_value=bounds.low,
+        max_value=bounds.high,
+        exclude_min=bounds.low_open,
+        exclude_max=bounds.high_open,
+        allow_nan=False,
+        allow_subnormal=True,
+    )
+
+
+positive = st.floats(min_value=1e-300, max_value=1e3, allow_nan=False)
 
 
 @st.composite
@@ -65,8 +78,11 @@ def random_logs(draw: st.DrawFn) -> RobotLog:
             unique=True,
         )
     )
-    landmarks = tuple(LogLandmark(ident, draw(finite), draw(finite), draw(positive)) for ident in ids)
-    times = sorted(draw(st.lists(finite, min_size=0, max_size=6)))
+    landmarks = tuple(
+        LogLandmark(ident, draw(within(COORDINATE)), draw(within(COORDINATE)), draw(positive))
+        for ident in ids
+    )
+    times = sorted(draw(st.lists(within(TIME), min_size=0, max_size=6)))
     observations = tuple(
         LogObservation(
             time,
@@ -77,9 +93,13 @@ def random_logs(draw: st.DrawFn) -> RobotLog:
         )
         for time in times
     )
-    motion = sorted(set(draw(st.lists(finite, min_size=1, max_size=6))))
-    odometry = Odometry(motion, [draw(finite) for _ in motion], [draw(finite) for _ in motion])
-    meta = LogMeta(draw(st.text(max_size=12)), bearing_error=draw(positive), delay_s=draw(positive))
+    # Rows at most a day apart: a longer gap is a clock jump (refused on reading).
+    gaps = draw(st.lists(st.floats(1e-3, ROW_GAP.high), min_size=0, max_size=5))
+    motion = list(itertools.accumulate(gaps, initial=draw(st.floats(-1e9, 1e9))))
+    odometry = Odometry(
+        motion, [draw(within(SPEED)) for _ in motion], [draw(within(ANGULAR_SPEED)) for _ in motion]
+    )
+    meta = LogMeta(draw(st.text(max_size=12)), bearing_error=draw(positive), delay_s=draw(within(DELAY)))
     return RobotLog(meta, landmarks, observations, odometry=odometry)
 
 
@@ -252,17 +272,17 @@ BAD_CSV_CASES = [
     (
         "observations.csv",
         "time,landmark_id,bearing,range\n0,A,0,-1\n",
-        "observations.csv:2: expected a range >= 0, got '-1'",
+        r"observations.csv:2: expected a number in \[0, 10000\] m in column 'range', got '-1'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing,bearing_error\n0,A,0,0\n",
-        "observations.csv:2: expected a positive bearing_error, got '0'",
+        r"observations.csv:2: expected a number in \(0, 1000\] rad in column 'bearing_error', got '0'",
     ),
     (
         "observations.csv",
         "time,landmark_id,bearing,range_error\n0,A,0,-0.1\n",
-        "observations.csv:2: expected a range_error >= 0",
+        r"observations.csv:2: expected a number in \[0, 10000\] m in column 'range_error'",
     ),
     (
         "landmarks.csv",
@@ -272,7 +292,7 @@ BAD_CSV_CASES = [
     (
         "landmarks.csv",
         "id,x,y,position_uncertainty\nA,0,0,-1\n",
-        "landmarks.csv:2: expected a position_uncertainty >= 0",
+        r"landmarks.csv:2: expected a number in \[0, 1000\] m in column 'position_uncertainty'",
     ),
     (
         "landmarks.csv",
@@ -298,7 +318,10 @@ def test_bad_csv_files_are_named_with_their_line(
 def test_negative_run_in_commands(tmp_path: Path) -> None:
     files: dict[str, str | None] = dict(VALID_FILES, **{"odometry.csv": None})
     files["commands.csv"] = "time,turn,run\n1,0.1,0.5\n2,0.0,-0.5\n"
-    with pytest.raises(FileFormatError, match=r"commands\.csv:3: expected a run >= 0, got '-0\.5'"):
+    with pytest.raises(
+        FileFormatError,
+        match=r"commands\.csv:3: expected a number in \[0, 10000\] m in column 'run', got '-0\.5'",
+    ):
         load_log(write_files(tmp_path, files))
 
 
@@ -351,19 +374,22 @@ BAD_META_CASES = [
     ),
     (
         "[sensor]\nbearing_error = 0\n",
-        r"meta\.toml: \[sensor\] bearing_error: expected a positive number, got 0\.0",
+        r"meta\.toml: \[sensor\] bearing_error: expected a number in \(0, 1000\] rad, got 0",
     ),
-    ("[sensor]\nrange_error = -0.1\n", r"meta\.toml: \[sensor\] range_error: expected a non-negative number"),
+    (
+        "[sensor]\nrange_error = -0.1\n",
+        r"meta\.toml: \[sensor\] range_error: expected a number in \[0, 10000\] m",
+    ),
     (
         "[motion]\nrun_scale = -1\n",
-        r"meta\.toml: \[motion\] run_scale: expected a positive number, got -1\.0",
+        r"meta\.toml: \[motion\] run_scale: expected a number in \(0, 100\], got -1",
     ),
-    ("[motion]\ndelay_s = -0.5\n", r"meta\.toml: \[motion\] delay_s: expected a non-negative number"),
+    ("[motion]\ndelay_s = -0.5\n", r"meta\.toml: \[motion\] delay_s: expected a number in \[0, 3600\] s"),
     (
         "[start]\nx = 1\ny = 2\n",
         r"meta\.toml: \[start\]: expected x, y and heading together .*got only x and y",
     ),
-    ("[start]\nradius = -1\n", r"meta\.toml: \[start\] radius: expected a non-negative number"),
+    ("[start]\nradius = -1\n", r"meta\.toml: \[start\] radius: expected a number in \[0, 10000\] m"),
     (
         "[landmarks]\nz_bottom = 2\nz_top = 1\n",
         r"meta\.toml: \[landmarks\] z_top: expected >= landmark_z_bottom",

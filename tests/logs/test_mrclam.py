@@ -81,7 +81,7 @@ def test_tiny_dataset(tmp_path: Path) -> None:
         ),
         (
             {"Robot1_Measurement.dat": HEADER + "10.0 63 -2.0 0.5\n"},
-            r"Robot1_Measurement\.dat:5: expected a range >= 0, got -2\.0",
+            r"Robot1_Measurement\.dat:5: expected range a number in \[0, 10000\] m, got '-2\.0'",
         ),
         (
             {"Robot1_Groundtruth.dat": None},

@@ -186,7 +186,11 @@ def test_flip_reports_reversing_as_turn_round_run_turn_back() -> None:
         ({"turn_scale": math.inf}, r"turn_scale: expected a finite number"),
         ({"start": 1.0, "end": 0.0}, r"end: expected a time >= start \(1\.0\), got 0\.0"),
         ({"reverse": "flip"}, r"reverse: expected a ReverseMotion, got 'flip'"),
-        ({"max_interval": 1e-6, "end": 100.0}, r"max_interval: expected at most 10000000 reports"),
+        (
+            {"max_interval": 1e-6, "end": 100.0},
+            r"max_interval: expected at most 2000000 reports \(about 500 MB\), "
+            r"got 100000000 \(about 25,000 MB",
+        ),
     ],
 )
 def test_bad_arguments(kwargs: dict[str, Any], pattern: str) -> None:

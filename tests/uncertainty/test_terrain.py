@@ -112,9 +112,9 @@ def test_headings_stay_wrapped(rng: np.random.Generator) -> None:
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [
-        ({"translation_loss": 1.0}, r"translation_loss: expected a fraction in \[0, 1\), got 1.0"),
-        ({"rotation_loss": -0.1}, r"rotation_loss: expected a fraction in \[0, 1\), got -0.1"),
-        ({"translation_sd": -0.01}, r"translation_sd: expected a non-negative number, got -0.01"),
+        ({"translation_loss": 1.0}, r"translation_loss: expected a number in \[0, 1\), got 1.0"),
+        ({"rotation_loss": -0.1}, r"rotation_loss: expected a number in \[0, 1\), got -0.1"),
+        ({"translation_sd": -0.01}, r"translation_sd: expected a number in \[0, 10\], got -0.01"),
         ({"skitter_sd": float("nan")}, r"skitter_sd: expected a finite number, got nan"),
         ({"drift": float("inf")}, r"drift: expected a finite number, got inf"),
     ],
@@ -185,11 +185,11 @@ def _complete(**overrides: str) -> str:
         ),
         (
             _complete(translation_sd="-0.1"),
-            r"bad.toml: \[tile\] translation_sd: expected a non-negative number, got -0.1",
+            r"bad.toml: \[tile\] translation_sd: expected a number in \[0, 10\], got -0.1",
         ),
         (
             _complete(rotation_loss="1.5"),
-            r"bad.toml: \[tile\] rotation_loss: expected a fraction in \[0, 1\), got 1.5",
+            r"bad.toml: \[tile\] rotation_loss: expected a number in \[0, 1\), got 1.5",
         ),
         (_complete(drift="nan"), r"bad.toml: \[tile\] drift: expected a finite number, got nan"),
         (_complete(skitter='"much"'), r"bad.toml: \[tile\] skitter: expected a finite number, got 'much'"),

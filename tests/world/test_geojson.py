@@ -416,7 +416,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "negative position uncertainty",
         feature(2, position_uncertainty=-0.5),
         "features[2] (id 'pole') properties.position_uncertainty",
-        "expected a non-negative number, got -0.5",
+        "expected a number in [0, 1000] m, got -0.5",
     ),
     (
         "unknown strategy",

@@ -39,6 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, describe, load_toml, parse_json, read_text
+from aura_ums._validate import ANGLE, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, Range
 from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
 from aura_ums.camera._observe import CalibrationBounds
 from aura_ums.errors import FileFormatError, InputError
@@ -50,6 +51,36 @@ _DISTORTION_LENGTHS = (4, 5, 8, 12, 14)
 
 _INTRINSIC_KEYS = ("fx", "fy", "cx", "cy", "width", "height", "distortion")
 _ANGLES = ("pan", "tilt")
+#: Where a camera sits on the robot, metres from the robot's reference point.
+MOUNT_OFFSET = Range(-100.0, 100.0, "m")
+#: The physical range of every number of a camera file, by table and key (docs/formats.md
+#: lists them); the bounds of ``[calibration_bounds]`` are bounds on errors, >= 0.
+KEY_RANGES: dict[str, dict[str, Range]] = {
+    "intrinsics": {
+        "fx": FOCAL_LENGTH,
+        "fy": FOCAL_LENGTH,
+        "cx": PIXEL,
+        "cy": PIXEL,
+        "width": IMAGE_SIDE,
+        "height": IMAGE_SIDE,
+    },
+    "mount": {
+        "height": MOUNT_OFFSET,
+        "forward": MOUNT_OFFSET,
+        "left": MOUNT_OFFSET,
+        "pan": ANGLE,
+        "tilt": ANGLE,
+    },
+    "calibration_bounds": {
+        "fx": Range(0.0, FOCAL_LENGTH.high, "px"),
+        "fy": Range(0.0, FOCAL_LENGTH.high, "px"),
+        "cx": Range(0.0, PIXEL.high, "px"),
+        "cy": Range(0.0, PIXEL.high, "px"),
+        "height": Range(0.0, MOUNT_OFFSET.high, "m"),
+        "pan": Range(0.0, ANGLE.high, "rad"),
+        "tilt": Range(0.0, ANGLE.high, "rad"),
+    },
+}
 
 
 # ------------------------------------------------------------------------------ shared
@@ -61,6 +92,18 @@ def _number(value: object, source: str, where: str) -> float:
 
 def _integer(value: object, source: str, where: str) -> int:
     return Fields(source).integer(value, where, minimum=1)
+
+
+def _ranged(value: object, source: str, where: str, bounds: Range) -> float:
+    return Fields(source).ranged(value, where, bounds)
+
+
+def _side(value: object, source: str, where: str) -> int:
+    """Return an image's width or height: an integer in :data:`~aura_ums._validate.IMAGE_SIDE`."""
+    result = _integer(value, source, where)
+    if result > IMAGE_SIDE.high:
+        raise FileFormatError(source, where, f"expected at most {IMAGE_SIDE.high:g} px, got {result}")
+    return result
 
 
 def _distortion(values: Array, source: str, where: str) -> tuple[float, float, float, float, float]:
@@ -97,14 +140,16 @@ def _table(document: Mapping[str, object], name: str, source: str, *, required: 
     return Fields(source).table(document[name], f"[{name}]")
 
 
-def _angle(table: Mapping[str, object], name: str, source: str, where: str) -> float | None:
+def _angle(
+    table: Mapping[str, object], name: str, source: str, where: str, bounds: Range = ANGLE
+) -> float | None:
     radians, degrees = table.get(name), table.get(f"{name}_deg")
     if radians is not None and degrees is not None:
         raise FileFormatError(source, f"{where} {name}_deg", f"expected {name} or {name}_deg, got both")
     if degrees is not None:
-        return math.radians(_number(degrees, source, f"{where} {name}_deg"))
+        return Fields(source).ranged(degrees, f"{where} {name}_deg", bounds, scale=math.pi / 180.0)
     if radians is not None:
-        return _number(radians, source, f"{where} {name}")
+        return _ranged(radians, source, f"{where} {name}", bounds)
     return None
 
 
@@ -124,8 +169,11 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         raise FileFormatError(
             source, "[intrinsics]", f"expected keys {', '.join(missing)}, got none for them"
         )
-    fx, fy, cx, cy = (_number(table[key], source, f"[intrinsics] {key}") for key in ("fx", "fy", "cx", "cy"))
-    width, height = (_integer(table[key], source, f"[intrinsics] {key}") for key in ("width", "height"))
+    fx, fy, cx, cy = (
+        _ranged(table[key], source, f"[intrinsics] {key}", KEY_RANGES["intrinsics"][key])
+        for key in ("fx", "fy", "cx", "cy")
+    )
+    width, height = (_side(table[key], source, f"[intrinsics] {key}") for key in ("width", "height"))
     distortion = None
     if "distortion" in table:
         raw = table["distortion"]
@@ -144,7 +192,9 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
     _check_keys(table, ("height", "forward", "left", "pan", "pan_deg", "tilt", "tilt_deg"), source, "[mount]")
     if "height" not in table:
         raise FileFormatError(source, "[mount]", "expected key height, got none for it")
-    mount_values = _lengths_and_angles(table, ("height", "forward", "left"), source, "[mount]")
+    mount_values = _lengths_and_angles(
+        table, ("height", "forward", "left"), source, "[mount]", KEY_RANGES["mount"]
+    )
     try:
         mount = CameraMount(**mount_values)
     except InputError as exc:
@@ -158,7 +208,11 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         "[calibration_bounds]",
     )
     bound_values = _lengths_and_angles(
-        table, ("fx", "fy", "cx", "cy", "height"), source, "[calibration_bounds]"
+        table,
+        ("fx", "fy", "cx", "cy", "height"),
+        source,
+        "[calibration_bounds]",
+        KEY_RANGES["calibration_bounds"],
     )
     try:
         bounds = CalibrationBounds(**bound_values)
@@ -168,12 +222,16 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
 
 
 def _lengths_and_angles(
-    table: Mapping[str, object], keys: tuple[str, ...], source: str, where: str
+    table: Mapping[str, object],
+    keys: tuple[str, ...],
+    source: str,
+    where: str,
+    ranges: Mapping[str, Range],
 ) -> dict[str, float]:
-    """Read the plain numbers ``keys`` and the angles (pan, tilt; radians or ``*_deg``) of a table."""
-    values = {key: _number(table[key], source, f"{where} {key}") for key in keys if key in table}
+    """Read the numbers ``keys`` and the angles (pan, tilt; radians or ``*_deg``), in ``ranges``."""
+    values = {key: _ranged(table[key], source, f"{where} {key}", ranges[key]) for key in keys if key in table}
     for name in _ANGLES:
-        angle = _angle(table, name, source, where)
+        angle = _angle(table, name, source, where, ranges[name])
         if angle is not None:
             values[name] = angle
     return values
@@ -632,7 +690,13 @@ def _camera_from_filestorage(document: Mapping[str, object], source: str, mount:
     distortion = _distortion(d.ravel(), source, dkey)
     wkey, width = _find(document, "image_width", source)
     hkey, height = _find(document, "image_height", source)
-    size = (_integer(width, source, wkey), _integer(height, source, hkey))
+    size = (_side(width, source, wkey), _side(height, source, hkey))
+    for name, (row, col) in (("fx", (0, 0)), ("fy", (1, 1)), ("cx", (0, 2)), ("cy", (1, 2))):
+        bounds = KEY_RANGES["intrinsics"][name]
+        if not bounds.contains(float(k[row, col])):
+            raise FileFormatError(
+                source, f"{key} {name}", f"expected {bounds.text()}, got {float(k[row, col])!r}"
+            )
     try:
         intrinsics = CameraIntrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2], size[0], size[1], distortion)
     except InputError as exc:

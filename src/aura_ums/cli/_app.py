@@ -132,6 +132,10 @@ def simulate(
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     loaded = dataclasses.replace(loaded, settings=settings.over(loaded.settings))
+    try:
+        loaded.check_runs(runs)  # before spawning a generator per run
+    except AuraUmsError as exc:
+        raise fail(f"--{exc}") from None
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
     try:

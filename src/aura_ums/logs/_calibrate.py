@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import finite_float, positive_float
+from aura_ums._validate import ANGLE_ERROR, DELAY, FACTOR, LENGTH, Range, finite_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
@@ -33,6 +33,18 @@ from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, Terr
 _SENSOR_KEYS = ("bearing_error", "range_error", "range_fraction_low", "range_fraction_high")
 _MOTION_KEYS = ("delay_s", "run_scale", "turn_scale")
 _NOISE_KEYS = ("bearing_sd", "range_sd_fraction")
+#: The physical range of every number of a sensor calibration file (docs/formats.md lists them).
+KEY_RANGES: dict[str, Range] = {
+    "delay_s": DELAY,
+    "run_scale": FACTOR,
+    "turn_scale": FACTOR,
+    "bearing_error": ANGLE_ERROR,
+    "range_error": LENGTH,
+    "range_fraction_low": Range(0.0, 1.0, high_open=True),
+    "range_fraction_high": Range(0.0, 1.0, high_open=True),
+    "bearing_sd": ANGLE_ERROR,
+    "range_sd_fraction": Range(0.0, 10.0, low_open=True),
+}
 _KIND = "aura-ums/sensor-calibration"
 _T = TypeVar("_T")
 
@@ -272,7 +284,14 @@ def _build(
     values = reader.table(document[name], f"[{name}]")
     if set(values) != set(keys):
         raise reader.error(f"[{name}]", f"expected keys {list(keys)}, got {sorted(values)}")
-    numbers = {key: reader.number(values[key], key_path(f"[{name}]", key)) for key in keys}
+    numbers = {
+        key: (
+            reader.ranged(values[key], key_path(f"[{name}]", key), KEY_RANGES[key])
+            if key in KEY_RANGES
+            else reader.number(values[key], key_path(f"[{name}]", key))
+        )
+        for key in keys
+    }
     try:
         return make(**numbers)
     except InputError as exc:  # named "SensorBounds.bearing_error": name the key instead

@@ -34,8 +34,26 @@ from aura_ums._files import (
     read_text,
     scratch_path,
 )
+from aura_ums._validate import (
+    ANGLE,
+    ANGLE_ERROR,
+    ANGULAR_SPEED,
+    COORDINATE,
+    DELAY,
+    FACTOR,
+    HEIGHT,
+    LENGTH,
+    POSITION_UNCERTAINTY,
+    ROW_GAP,
+    SENSOR_OFFSET,
+    SPEED,
+    START_RADIUS,
+    TIME,
+    Range,
+)
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
@@ -74,32 +92,62 @@ _LANDMARK_COLUMNS = {
     "symbol": "text",
 }
 _GROUNDTRUTH_COLUMNS = {"time": "time", "x": "length", "y": "length", "heading": "angle"}
+#: The physical range of every numeric column (in SI, after the units), by column name:
+#: a name means the same in every file. docs/log-format.md lists them.
+COLUMN_RANGES: dict[str, Range] = {
+    "time": TIME,
+    "v": SPEED,
+    "omega": ANGULAR_SPEED,
+    "turn": ANGLE,
+    "run": LENGTH,
+    "bearing": ANGLE,
+    "range": LENGTH,
+    "bearing_error": ANGLE_ERROR,
+    "range_error": LENGTH,
+    "x": COORDINATE,
+    "y": COORDINATE,
+    "heading": ANGLE,
+    "position_uncertainty": POSITION_UNCERTAINTY,
+    "z_bottom": HEIGHT,
+    "z_top": HEIGHT,
+}
 
-# meta.toml: table -> key -> (LogMeta field, unit). The top-level table is "".
-_META_KEYS: dict[str, dict[str, tuple[str, str]]] = {
-    "": {"name": ("name", "text"), "terrain": ("terrain", "text"), "source": ("source", "text")},
+# meta.toml: table -> key -> (LogMeta field, unit, physical range in SI). The top-level table is "".
+_META_KEYS: dict[str, dict[str, tuple[str, str, Range | None]]] = {
+    "": {
+        "name": ("name", "text", None),
+        "terrain": ("terrain", "text", None),
+        "source": ("source", "text", None),
+    },
     "sensor": {
-        "bearing_error": ("bearing_error", "angle"),
-        "range_error": ("range_error", "length"),
-        "range_error_fraction": ("range_error_fraction", ""),
-        "forward": ("sensor_forward", "length"),
-        "left": ("sensor_left", "length"),
+        "bearing_error": ("bearing_error", "angle", ANGLE_ERROR),
+        "range_error": ("range_error", "length", LENGTH),
+        "range_error_fraction": ("range_error_fraction", "", Range(0.0, 10.0)),
+        "forward": ("sensor_forward", "length", SENSOR_OFFSET),
+        "left": ("sensor_left", "length", SENSOR_OFFSET),
     },
-    "motion": {"delay_s": ("delay_s", ""), "run_scale": ("run_scale", ""), "turn_scale": ("turn_scale", "")},
+    "motion": {
+        "delay_s": ("delay_s", "", DELAY),
+        "run_scale": ("run_scale", "", FACTOR),
+        "turn_scale": ("turn_scale", "", FACTOR),
+    },
     "start": {
-        "x": ("start.x", "length"),
-        "y": ("start.y", "length"),
-        "heading": ("start.heading", "angle"),
-        "radius": ("start_radius", "length"),
-        "heading_halfwidth": ("start_heading_halfwidth", "angle"),
+        "x": ("start.x", "length", COORDINATE),
+        "y": ("start.y", "length", COORDINATE),
+        "heading": ("start.heading", "angle", ANGLE),
+        "radius": ("start_radius", "length", START_RADIUS),
+        "heading_halfwidth": ("start_heading_halfwidth", "angle", Range(0.0, ANGLE.high, "rad")),
     },
-    "landmarks": {"z_bottom": ("landmark_z_bottom", "length"), "z_top": ("landmark_z_top", "length")},
+    "landmarks": {
+        "z_bottom": ("landmark_z_bottom", "length", HEIGHT),
+        "z_top": ("landmark_z_top", "length", HEIGHT),
+    },
 }
 _TABLES = ("units", *(table for table in _META_KEYS if table))
 _FIELD_PLACES = {
     target: (f"[{table}] {key}" if table else key)
     for table, keys in _META_KEYS.items()
-    for key, (target, _) in keys.items()
+    for key, (target, _, _) in keys.items()
 }
 _FIELD_PLACES["start"] = "[start]"
 
@@ -196,26 +244,35 @@ class _CsvFile:
                 row = int(np.argmax(bad))
                 cell = describe(self.cell(column, row))
                 self.fail_at(row, f"expected a finite number in column {column!r}, got {cell}")
-            fast: NDArray[np.float64] = values * factor
-            return fast
-        cells = self.cells[column]
-        try:
-            values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
-        except ValueError:
-            for row, cell in enumerate(cells):
-                try:
-                    float(cell)
-                except ValueError:
-                    self.fail_at(row, f"expected a number in column {column!r}, got {describe(cell)}")
-            raise  # pragma: no cover - the loop above finds the cell
-        values = values.reshape(-1)
-        bad = ~np.isfinite(values)
-        if optional:
-            bad &= np.array([cell != "" for cell in cells], dtype=bool)
-        if np.any(bad):
-            row = int(np.argmax(bad))
-            self.fail_at(row, f"expected a finite number in column {column!r}, got {describe(cells[row])}")
-        result: NDArray[np.float64] = values * factor
+            result: NDArray[np.float64] = values * factor
+        else:
+            cells = self.cells[column]
+            try:
+                values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
+            except ValueError:
+                for row, cell in enumerate(cells):
+                    try:
+                        float(cell)
+                    except ValueError:
+                        self.fail_at(row, f"expected a number in column {column!r}, got {describe(cell)}")
+                raise  # pragma: no cover - the loop above finds the cell
+            values = values.reshape(-1)
+            bad = ~np.isfinite(values)
+            if optional:
+                bad &= np.array([cell != "" for cell in cells], dtype=bool)
+            if np.any(bad):
+                row = int(np.argmax(bad))
+                self.fail_at(
+                    row, f"expected a finite number in column {column!r}, got {describe(cells[row])}"
+                )
+            result = values * factor
+        bounds = COLUMN_RANGES[column]
+        outside = ~(np.isnan(result) | _within(result, bounds))
+        if np.any(outside):
+            row = int(np.argmax(outside))
+            in_si = "" if factor == 1.0 else f" ({float(result[row]):g} {bounds.unit})"
+            cell = describe(self.cell(column, row))
+            self.fail_at(row, f"expected {bounds.text()} in column {column!r}, got {cell}{in_si}")
         return result
 
     def texts(self, column: str) -> list[str]:
@@ -249,9 +306,36 @@ class _CsvFile:
             )
         return time
 
+    def no_clock_jump(self, time: NDArray[np.float64]) -> None:
+        """Refuse a gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
+
+        A row's velocities hold until the next row, and a replay cuts the motion at least
+        every :data:`~aura_ums.logs._odometry.DEFAULT_MAX_INTERVAL` seconds: a gap of days
+        is a clock jump, and would become millions of steps.
+        """
+        gaps = np.diff(time)
+        jumps = gaps > ROW_GAP.high
+        if np.any(jumps):
+            row = int(np.argmax(jumps)) + 1
+            gap = float(gaps[row - 1])
+            steps = math.ceil(gap / DEFAULT_MAX_INTERVAL)
+            self.fail_at(
+                row,
+                f"expected at most {ROW_GAP.high:g} s after the previous row (line {self.lines[row - 1]}), "
+                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days; replayed, about {steps} steps "
+                f"of {DEFAULT_MAX_INTERVAL:g} s)",
+            )
+
     def need_rows(self) -> None:
         if not len(self.lines):
             self.fail("", "expected at least one data row, got none")
+
+
+def _within(values: NDArray[np.float64], bounds: Range) -> NDArray[np.bool_]:
+    above = values > bounds.low if bounds.low_open else values >= bounds.low
+    below = values < bounds.high if bounds.high_open else values <= bounds.high
+    result: NDArray[np.bool_] = above & below
+    return result
 
 
 def _given(values: NDArray[np.float64]) -> list[float | None]:
@@ -313,11 +397,11 @@ class _MetaReader:
         keys = _META_KEYS[table]
         self.fields.keys({key: value}, tuple(keys), f"[{table}]" if table else "")
         where = key_path(f"[{table}]" if table else "", key)
-        target, unit = keys[key]
-        if unit == "text":
+        target, unit, bounds = keys[key]
+        if bounds is None:
             values[target] = self.fields.string(value, where)
             return
-        values[target] = self.fields.number(value, where) * units.factor(unit)
+        values[target] = self.fields.ranged(value, where, bounds, scale=units.factor(unit))
 
 
 def load_log(folder: str | os.PathLike[str]) -> RobotLog:
@@ -442,6 +526,7 @@ def _read_odometry(path: Path, units: Units) -> Odometry:
     table = _CsvFile(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"))
     table.need_rows()
     time = table.times(units, strict=True)
+    table.no_clock_jump(time)
     return Odometry(time, table.numbers("v", units), table.numbers("omega", units))
 
 

@@ -20,14 +20,44 @@ from typing import NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import MAX_ROWS, read_text
+from aura_ums._validate import (
+    ANGLE,
+    ANGULAR_SPEED,
+    COORDINATE,
+    LENGTH,
+    ROW_GAP,
+    SPEED,
+    TIME,
+    Range,
+)
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._io import renumbered, write_log
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL
 
 #: Subjects 1-5 are the robots; 6-20 the landmarks.
 ROBOT_SUBJECTS = range(1, 6)
 CITATION = "Leung et al., IJRR 2011"
 LANDMARK_SYMBOL = "cylinder"
+#: Subjects and barcodes are small whole numbers.
+_NUMBER = Range(0, 1e6)
+#: The physical range of each column of the ``.dat`` files (docs/formats.md lists them).
+COLUMN_RANGES: dict[str, Range] = {
+    "subject": _NUMBER,
+    "barcode": _NUMBER,
+    "time": TIME,
+    "v": SPEED,
+    "omega": ANGULAR_SPEED,
+    "x": COORDINATE,
+    "y": COORDINATE,
+    # a landmark's position_uncertainty is 3 sd: at most 900 m, within POSITION_UNCERTAINTY
+    "x_sd": Range(0.0, 300.0, "m"),
+    "y_sd": Range(0.0, 300.0, "m"),
+    "range": LENGTH,
+    "bearing": ANGLE,
+    "heading": ANGLE,
+}
 
 
 class _DatFile:
@@ -37,16 +67,16 @@ class _DatFile:
         self.source = str(path)
         if not path.is_file():
             self.fail("", f"expected an MRCLAM data file ({', '.join(columns)}), got no such file")
-        try:
-            text = path.read_text(encoding="utf-8", errors="replace")
-        except OSError as exc:
-            self.fail("", f"expected a readable file, got {exc.strerror}")
+        # The same reader as every other file: size limit, UTF-8 with an optional BOM.
+        text = read_text(path, kind="MRCLAM data")
         lines: list[int] = []
         rows: list[list[float]] = []
         for number, line in enumerate(text.splitlines(), start=1):
             cells = line.split()
             if not cells or cells[0].startswith("#"):
                 continue
+            if len(rows) >= MAX_ROWS:
+                self.fail_at(number, f"expected at most {MAX_ROWS} data rows, got more")
             if len(cells) != len(columns):
                 self.fail_at(
                     number,
@@ -55,9 +85,13 @@ class _DatFile:
             try:
                 values = [float(cell) for cell in cells]
             except ValueError:
-                self.fail_at(number, f"expected numbers ({', '.join(columns)}), got {line.strip()!r}")
+                self.fail_at(number, f"expected numbers ({', '.join(columns)}), got {_shown(line)}")
             if not all(math.isfinite(value) for value in values):
-                self.fail_at(number, f"expected finite numbers, got {line.strip()!r}")
+                self.fail_at(number, f"expected finite numbers, got {_shown(line)}")
+            for name, cell, value in zip(columns, cells, values, strict=True):
+                bounds = COLUMN_RANGES[name]
+                if not bounds.contains(value):
+                    self.fail_at(number, f"expected {name} {bounds.text()}, got {_shown(cell)}")
             lines.append(number)
             rows.append(values)
         self.lines = np.array(lines, dtype=np.int64)
@@ -86,6 +120,31 @@ class _DatFile:
             )
         keep = np.concatenate((steps > 0.0, [True]))
         return self.data[keep], int(np.count_nonzero(~keep))
+
+    def no_clock_jump(self) -> None:
+        """Refuse a gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
+
+        Velocities hold until the next row: a gap of days is a clock jump, and a replay
+        would cut it into millions of steps.
+        """
+        gaps = np.diff(self.data[:, 0])
+        jumps = gaps > ROW_GAP.high
+        if np.any(jumps):
+            row = int(np.argmax(jumps)) + 1
+            gap = float(gaps[row - 1])
+            self.fail_at(
+                int(self.lines[row]),
+                f"expected at most {ROW_GAP.high:g} s after the previous row "
+                f"(line {int(self.lines[row - 1])}), "
+                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days; replayed, about "
+                f"{math.ceil(gap / DEFAULT_MAX_INTERVAL)} steps of {DEFAULT_MAX_INTERVAL:g} s)",
+            )
+
+
+def _shown(text: str) -> str:
+    """Quote a cell or line in a message, shortened."""
+    stripped = text.strip()
+    return repr(stripped if len(stripped) <= 60 else stripped[:57] + "...")
 
 
 def _dataset_label(folder: Path) -> str:
@@ -189,9 +248,9 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
             observations.append(LogObservation(time, str(subject), bearing, range=distance, line=int(number)))
     observations.sort(key=lambda item: item.time)  # stable: frames keep their order
 
-    odometry_rows, odometry_repeats = _DatFile(
-        folder / f"{prefix}Odometry.dat", ("time", "v", "omega")
-    ).increasing()
+    odometry_file = _DatFile(folder / f"{prefix}Odometry.dat", ("time", "v", "omega"))
+    odometry_file.no_clock_jump()
+    odometry_rows, odometry_repeats = odometry_file.increasing()
     truth_rows, truth_repeats = _DatFile(
         folder / f"{prefix}Groundtruth.dat", ("time", "x", "y", "heading")
     ).increasing()

@@ -14,8 +14,13 @@ from aura_ums.errors import InputError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import TurnAndRun
 
-#: More reports than this from one call is a mistake (a max_interval far too small).
-MAX_REPORTS = 10_000_000
+#: Longest time, seconds, one position report covers by default (a replay's step).
+DEFAULT_MAX_INTERVAL = 0.25
+#: Memory one position report takes (its PositionReport, TurnAndRun, floats and slot), bytes.
+REPORT_BYTES = 250
+#: Most reports from one call, from a memory budget of 500 MB (2 million: 139 hours of
+#: motion at the default interval); more is a mistake (a clock jump, an interval far too small).
+MAX_REPORTS = 500_000_000 // REPORT_BYTES
 
 
 class ReverseMotion(enum.Enum):
@@ -114,8 +119,9 @@ def report_times(
     total = float(pieces.sum())
     if total > MAX_REPORTS:
         raise InputError(
-            f"max_interval: expected at most {MAX_REPORTS} reports, got {total:.0f} "
-            f"(max_interval {max_interval!r} s over {end - start!r} s)"
+            f"max_interval: expected at most {MAX_REPORTS} reports (about {_megabytes(MAX_REPORTS)}), "
+            f"got {total:.0f} (about {_megabytes(total)}; max_interval {max_interval!r} s over "
+            f"{end - start!r} s)"
         )
     counts = pieces.astype(np.int64)
     gap_index = np.repeat(np.arange(len(gaps)), counts)
@@ -237,13 +243,17 @@ def odometry_report_arrays(
     return out_times, out_turns, out_runs
 
 
+def _megabytes(reports: float) -> str:
+    return f"{reports * REPORT_BYTES / 1e6:,.0f} MB"
+
+
 def odometry_to_commands(
     time: ArrayLike,
     v: ArrayLike,
     omega: ArrayLike,
     cut_times: ArrayLike = (),
     *,
-    max_interval: float = 0.25,
+    max_interval: float = DEFAULT_MAX_INTERVAL,
     delay_s: float = 0.0,
     run_scale: float = 1.0,
     turn_scale: float = 1.0,

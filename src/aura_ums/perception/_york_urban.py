@@ -7,13 +7,15 @@ perception benchmark and tests; images are read without OpenCV (:func:`read_gray
 
 from __future__ import annotations
 
-import csv
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import describe, load_csv
+from aura_ums._validate import PIXEL
 from aura_ums.errors import FileFormatError
 from aura_ums.perception._image import read_gray_image
 
@@ -34,33 +36,61 @@ class YorkUrbanImage:
     vertical: NDArray[np.bool_]
 
 
+_COLUMNS = ("image", "x1", "y1", "x2", "y2", "vp", "vertical")
+
+
+def _pixel(cell: str, column: str, source: str, line: int) -> float:
+    try:
+        value = float(cell)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and PIXEL.contains(value)):
+        raise FileFormatError(
+            source, "", f"expected {PIXEL.text()} in column {column!r}, got {describe(cell)}", line=line
+        )
+    return value
+
+
+def _choice(cell: str, column: str, allowed: tuple[str, ...], source: str, line: int) -> int:
+    if cell not in allowed:
+        raise FileFormatError(
+            source,
+            "",
+            f"expected one of {', '.join(allowed)} in column {column!r}, got {describe(cell)}",
+            line=line,
+        )
+    return int(cell)
+
+
 def york_urban_names(folder: Path) -> list[str]:
     """Names (``P...``) of the images in ``folder/images``, sorted."""
     return sorted(p.stem for p in (folder / "images").glob("P*.jpg"))
 
 
 def load_york_urban(folder: Path, names: list[str] | None = None) -> list[YorkUrbanImage]:
-    """Read images and segments from ``folder`` (``images/P*.jpg`` and ``segments.csv``)."""
-    table = folder / "segments.csv"
+    """Read images and segments from ``folder`` (``images/P*.jpg`` and ``segments.csv``).
+
+    ``segments.csv`` is read like every CSV of aura-ums (:func:`aura_ums._files.load_csv`:
+    UTF-8 with an optional BOM, size and row limits); coordinates are pixels in
+    :data:`~aura_ums._validate.PIXEL`, ``vp`` is 1, 2 or 3 and ``vertical`` 0 or 1.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file and the line of a malformed row, or an image that does not load.
+    """
+    table = load_csv(folder / "segments.csv", columns=_COLUMNS, required=_COLUMNS)
     rows: dict[str, list[tuple[float, float, float, float, int, int]]] = {}
-    try:
-        with table.open(newline="") as handle:
-            for line, row in enumerate(csv.DictReader(handle), start=2):
-                try:
-                    rows.setdefault(row["image"], []).append(
-                        (
-                            float(row["x1"]),
-                            float(row["y1"]),
-                            float(row["x2"]),
-                            float(row["y2"]),
-                            int(row["vp"]),
-                            int(row["vertical"]),
-                        )
-                    )
-                except (KeyError, TypeError, ValueError) as exc:
-                    raise FileFormatError(str(table), "", f"expected numbers, got {row}", line=line) from exc
-    except OSError as exc:
-        raise FileFormatError(str(table), "", f"expected a readable file, got {exc}") from exc
+    for line, cells in zip(table.lines, table.rows, strict=True):
+        row = dict(zip(table.header, cells, strict=True))
+        coordinates = tuple(_pixel(row[name], name, table.source, line) for name in ("x1", "y1", "x2", "y2"))
+        vp = _choice(row["vp"], "vp", ("1", "2", "3"), table.source, line)
+        vertical = _choice(row["vertical"], "vertical", ("0", "1"), table.source, line)
+        if not row["image"]:
+            raise FileFormatError(
+                table.source, "", "expected an image name in column 'image', got ''", line=line
+            )
+        rows.setdefault(row["image"], []).append((*coordinates, vp, vertical))  # type: ignore[arg-type]
     result = []
     for name in york_urban_names(folder) if names is None else names:
         data = np.array(rows.get(name, []), dtype=np.float64).reshape(-1, 6)

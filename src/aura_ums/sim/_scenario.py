@@ -39,7 +39,11 @@ says ``_deg``, radians otherwise; every other unit SI)::
     building_width = 15.0               # building_depth = 10.0; building_base = 0.0
 
 Frames are taken at the start, at the end of every command, and, with a frame spacing,
-every ``frame_spacing`` metres of commanded run along the route. Files that hold
+every ``frame_spacing`` metres of commanded run along the route. Every number has a
+physical range (:data:`KEY_RANGES`, listed in docs/formats.md), and the work a run
+implies (frames times pixels, clutter strips) is estimated before anything is allocated:
+a scenario above :data:`MAX_RUN_SECONDS` or :data:`MAX_RUN_BYTES` is refused, the
+message stating the estimate. Files that hold
 ``area_limit`` and ``missed_limit`` in a ``[lost]`` table (the earlier format) are read
 as before.
 """
@@ -56,7 +60,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, describe, load_toml
-from aura_ums._validate import finite_float, nonnegative_float, read_only
+from aura_ums._validate import (
+    ANGLE,
+    COORDINATE,
+    LENGTH,
+    START_RADIUS,
+    Range,
+    finite_float,
+    nonnegative_float,
+    read_only,
+)
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
@@ -103,6 +116,43 @@ _RENDER_KEYS = (
     "building_depth",
     "building_base",
 )
+#: The physical range of every number of a scenario file, by key (docs/formats.md lists them).
+KEY_RANGES: dict[str, Range] = {
+    "x": COORDINATE,
+    "y": COORDINATE,
+    "heading": ANGLE,
+    "position_radius": START_RADIUS,
+    "heading_halfwidth": Range(0.0, ANGLE.high, "rad"),
+    "turn": ANGLE,
+    "run": LENGTH,
+    "point": COORDINATE,
+    "frame_spacing": Range(0.0, LENGTH.high, "m", low_open=True),
+    "frame_rate": Range(0.0, 1000.0, "1/s", low_open=True),
+    "speed": Range(0.0, 100.0, "m/s", low_open=True),
+    "noise": Range(0.0, 255.0, "gray levels"),
+    "clutter": Range(0, 10_000_000, "strips"),
+    "clutter_lines": Range(0, 1_000_000, "lines"),
+    "pole_radius": Range(0.0, 100.0, "m", low_open=True),
+    "stripe_width": Range(0.0, 100.0, "m", low_open=True),
+    "building_width": Range(0.0, 1000.0, "m", low_open=True),
+    "building_depth": Range(0.0, 1000.0, "m", low_open=True),
+    "building_base": Range(0.0, 1000.0, "m"),
+}
+# The synthetic camera's costs, measured on one core with scenarios/paper_sidewalk.toml
+# (a 512 x 480 frame in 10 ms; 0.15 s with 4000 clutter strips; 45 MB of buffers): a frame
+# renders each pixel in about 40 ns and each clutter strip or line in about 35 us; the
+# camera keeps about 180 bytes a pixel, the scene about 400 a strip.
+_SECONDS_PER_PIXEL = 4e-8
+_SECONDS_PER_STRIP = 3.5e-5
+_BYTES_PER_PIXEL = 200
+_BYTES_PER_STRIP = 400
+#: Longest estimated time of one simulated run, seconds.
+MAX_RUN_SECONDS = 600.0
+#: Most estimated memory of one simulated run's camera and scene, bytes.
+MAX_RUN_BYTES = 4e9
+#: Most Monte Carlo runs of one call: each run's result stays in memory (about 20 kB).
+MAX_RUNS = 100_000
+_RUN_RESULT_BYTES = 20_000
 _SAMPLE_PREFIX = "sample:"
 _START_DRAWS = 100
 
@@ -227,10 +277,14 @@ class _Reader:
     def integer(self, value: object, where: str, minimum: int) -> int:
         return self.fields.integer(value, where, minimum)
 
+    def ranged(self, value: object, where: str, key: str, *, scale: float = 1.0) -> float:
+        """Return a number in the range of ``key`` (:data:`KEY_RANGES`)."""
+        return self.fields.ranged(value, where, KEY_RANGES[key], scale=scale)
+
     def point(self, value: object, where: str) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             raise self.fail(where, f"expected [x, y] in metres, got {describe(value)}")
-        return (self.number(value[0], f"{where}[0]"), self.number(value[1], f"{where}[1]"))
+        return (self.ranged(value[0], f"{where}[0]", "point"), self.ranged(value[1], f"{where}[1]", "point"))
 
     def angle(
         self, table: Mapping[str, object], name: str, where: str, *, required: bool, sep: str = " "
@@ -239,9 +293,9 @@ class _Reader:
         if radians is not None and degrees is not None:
             raise self.fail(f"{where}{sep}{name}_deg", f"expected {name} or {name}_deg, got both")
         if degrees is not None:
-            return math.radians(self.number(degrees, f"{where}{sep}{name}_deg"))
+            return self.ranged(degrees, f"{where}{sep}{name}_deg", name, scale=math.pi / 180.0)
         if radians is not None:
-            return self.number(radians, f"{where}{sep}{name}")
+            return self.ranged(radians, f"{where}{sep}{name}", name)
         if required:
             raise self.fail(
                 f"{where}{sep}{name}_deg", f"expected {name}_deg (or {name} in radians), got none"
@@ -359,6 +413,90 @@ class Scenario:
                     f"Scenario.frame_spacing: expected a positive number or None, got {spacing!r}"
                 )
             object.__setattr__(self, "frame_spacing", spacing)
+        self._refuse_too_much_work()
+
+    def frame_count(self) -> int:
+        """Return the number of frames a run takes, without cutting the route (see :meth:`legs`).
+
+        An upper bound by at most one frame per command (a leg ending within the tolerance
+        of a frame is not cut again).
+        """
+        if self.frame_spacing is None:
+            return len(self.commands) + 1
+        route = math.fsum(command.run for command in self.commands)
+        return int(min(math.ceil(route / self.frame_spacing), 2**62)) + len(self.commands) + 1
+
+    def estimate(self) -> tuple[float, float]:
+        """Return the estimated time (seconds) and memory (bytes) of one run of :meth:`simulate`.
+
+        From the synthetic camera's measured costs: pixels and clutter strips of every
+        frame, the camera's buffers and the scene's strips.
+
+        Examples
+        --------
+        >>> import pathlib
+        >>> scenario = Scenario.from_toml(pathlib.Path("scenarios") / "paper_sidewalk.toml")
+        >>> seconds, memory = scenario.estimate()
+        >>> round(seconds, 2), round(memory / 1e6)
+        (0.04, 49)
+        """
+        k = self.camera.intrinsics
+        pixels = float(k.width) * float(k.height)
+        strips = float(self.render.clutter) + float(self.render.clutter_lines)
+        frames = float(self.frame_count())
+        seconds = frames * (pixels * _SECONDS_PER_PIXEL + strips * _SECONDS_PER_STRIP)
+        memory = pixels * _BYTES_PER_PIXEL + float(self.render.clutter) * _BYTES_PER_STRIP
+        return seconds, memory
+
+    def _refuse_too_much_work(self) -> None:
+        seconds, memory = self.estimate()
+        if seconds <= MAX_RUN_SECONDS and memory <= MAX_RUN_BYTES:
+            return
+        k = self.camera.intrinsics
+        work = (
+            f"{self.frame_count()} frames of {k.width} x {k.height} px, {self.render.clutter} clutter "
+            f"strips and {self.render.clutter_lines} lines: about {seconds:.3g} s and "
+            f"{memory / 1e9:.3g} GB a run"
+        )
+        limits = f"at most {MAX_RUN_SECONDS:g} s and {MAX_RUN_BYTES / 1e9:g} GB a run"
+        # Name the input that makes the run too big: the one whose cost dominates.
+        frames = self.frame_count()
+        per_frame = seconds / frames
+        if memory > MAX_RUN_BYTES:
+            clutter = self.render.clutter * _BYTES_PER_STRIP > memory / 2
+            name = "Scenario.render.clutter" if clutter else "Scenario.camera"
+        elif self.frame_spacing is not None and per_frame * (len(self.commands) + 1) <= MAX_RUN_SECONDS:
+            name = "Scenario.frame_spacing"
+        elif frames * self.render.clutter * _SECONDS_PER_STRIP > seconds / 2:
+            name = "Scenario.render.clutter"
+        else:
+            name = "Scenario.camera"
+        raise InputError(f"{name}: expected {limits}, got {work}")
+
+    def check_runs(self, runs: object) -> int:
+        """Return ``runs`` checked: an integer in [1, ``MAX_RUNS``] (100,000), refused with the estimate.
+
+        Examples
+        --------
+        >>> import pathlib
+        >>> scenario = Scenario.from_toml(pathlib.Path("scenarios") / "paper_sidewalk.toml")
+        >>> scenario.check_runs(40)
+        40
+        >>> scenario.check_runs(10**9)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: runs: expected an integer in [1, 100000], got 1000000000 (about ... s ...)
+        """
+        if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
+            seconds, _ = self.estimate()
+            count = runs if isinstance(runs, int) and not isinstance(runs, bool) else 0
+            estimate = (
+                f" (about {count * seconds:.3g} s and {count * _RUN_RESULT_BYTES / 1e9:.3g} GB of results)"
+                if count > MAX_RUNS
+                else ""
+            )
+            raise InputError(f"runs: expected an integer in [1, {MAX_RUNS}], got {runs!r}{estimate}")
+        return runs
 
     # --- reading ---------------------------------------------------------------------------
 
@@ -412,20 +550,28 @@ class Scenario:
         spacing = _frame_spacing(document, reader)
         settings = _settings(document, reader)
         render = _render(reader.table(document, "render", required=False), reader)
-        return cls(
-            name,
-            description,
-            meadow_map,
-            terrain,
-            camera,
-            start,
-            commands,
-            landmark_ids,
-            spacing,
-            settings,
-            render,
-            reader.source,
-        )
+        try:
+            return cls(
+                name,
+                description,
+                meadow_map,
+                terrain,
+                camera,
+                start,
+                commands,
+                landmark_ids,
+                spacing,
+                settings,
+                render,
+                reader.source,
+            )
+        except InputError as exc:
+            field_name, _, message = str(exc).partition(": ")
+            where = {
+                "Scenario.render.clutter": "[render] clutter",
+                "Scenario.frame_spacing": "frame_spacing" if "frame_spacing" in document else "frame_rate",
+            }.get(field_name, field_name.removeprefix("Scenario."))
+            raise reader.fail(where, message) from None
 
     # --- using -----------------------------------------------------------------------------
 
@@ -622,9 +768,9 @@ def _start(table: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap) 
     for key in ("x", "y", "position_radius"):
         if key not in table:
             raise reader.fail(f"[start] {key}", "expected this key, got none")
-    values["x"] = reader.number(table["x"], "[start] x")
-    values["y"] = reader.number(table["y"], "[start] y")
-    radius = reader.nonnegative(table["position_radius"], "[start] position_radius")
+    values["x"] = reader.ranged(table["x"], "[start] x", "x")
+    values["y"] = reader.ranged(table["y"], "[start] y", "y")
+    radius = reader.ranged(table["position_radius"], "[start] position_radius", "position_radius")
     heading = reader.angle(table, "heading", "[start]", required=True)
     halfwidth = reader.angle(table, "heading_halfwidth", "[start]", required=True)
     if halfwidth < 0.0:
@@ -690,7 +836,7 @@ def _route(
         turn = reader.angle(item, "turn", place, required=False, sep=".")
         if "run" not in item:
             raise reader.fail(f"{place}.run", "expected the run in metres, got none")
-        commands.append(TurnAndRun(turn, reader.nonnegative(item["run"], f"{place}.run")))
+        commands.append(TurnAndRun(turn, reader.ranged(item["run"], f"{place}.run", "run")))
     return tuple(commands)
 
 
@@ -701,11 +847,11 @@ def _frame_spacing(document: Mapping[str, object], reader: _Reader) -> float | N
     if spacing is not None:
         if speed is not None:
             raise reader.fail("speed", "expected speed only with frame_rate, got it with frame_spacing")
-        return reader.positive(spacing, "frame_spacing")
+        return reader.ranged(spacing, "frame_spacing", "frame_spacing")
     if rate is not None:
         if speed is None:
             raise reader.fail("speed", "expected the speed (m/s) that goes with frame_rate, got none")
-        return reader.positive(speed, "speed") / reader.positive(rate, "frame_rate")
+        return reader.ranged(speed, "speed", "speed") / reader.ranged(rate, "frame_rate", "frame_rate")
     if speed is not None:
         raise reader.fail("speed", "expected speed only with frame_rate, got no frame_rate")
     return None
@@ -746,11 +892,13 @@ def _render(table: Mapping[str, object], reader: _Reader) -> RenderSettings:
         if key not in table:
             values[key] = getattr(default, key)
         elif key in ("clutter", "clutter_lines"):
-            values[key] = reader.integer(table[key], where, 0)
-        elif key in ("noise", "building_base"):
-            values[key] = reader.nonnegative(table[key], where)
+            count = reader.integer(table[key], where, 0)
+            bounds = KEY_RANGES[key]
+            if count > bounds.high:
+                raise reader.fail(where, f"expected at most {bounds.high:g} {bounds.unit}, got {count}")
+            values[key] = count
         else:
-            values[key] = reader.positive(table[key], where)
+            values[key] = reader.ranged(table[key], where, key)
     return RenderSettings(
         noise=float(values["noise"]),
         clutter=int(values["clutter"]),

@@ -9,7 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
+from aura_ums._validate import (
+    COORDINATE,
+    HEIGHT,
+    POSITION_UNCERTAINTY,
+    finite_float,
+    nonnegative_float,
+    points_array,
+    read_only,
+)
 from aura_ums.errors import InputError
 
 
@@ -63,14 +71,14 @@ class VerticalLineLandmark:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "id", _identifier(self.id, "id"))
-        for name in ("x", "y", "z_bottom", "z_top"):
-            object.__setattr__(self, name, finite_float(getattr(self, name), f"{self.id}.{name}"))
+        for name, bounds in (("x", COORDINATE), ("y", COORDINATE), ("z_bottom", HEIGHT), ("z_top", HEIGHT)):
+            object.__setattr__(self, name, bounds.check(getattr(self, name), f"{self.id}.{name}"))
         if self.z_top < self.z_bottom:
             raise InputError(f"{self.id}.z_top: expected >= z_bottom ({self.z_bottom}), got {self.z_top}")
         object.__setattr__(
             self,
             "position_uncertainty",
-            nonnegative_float(self.position_uncertainty, f"{self.id}.position_uncertainty"),
+            POSITION_UNCERTAINTY.check(self.position_uncertainty, f"{self.id}.position_uncertainty"),
         )
 
     @property
@@ -109,12 +117,12 @@ class PointLandmark:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "id", _identifier(self.id, "id"))
-        for name in ("x", "y", "z"):
-            object.__setattr__(self, name, finite_float(getattr(self, name), f"{self.id}.{name}"))
+        for name, bounds in (("x", COORDINATE), ("y", COORDINATE), ("z", HEIGHT)):
+            object.__setattr__(self, name, bounds.check(getattr(self, name), f"{self.id}.{name}"))
         object.__setattr__(
             self,
             "position_uncertainty",
-            nonnegative_float(self.position_uncertainty, f"{self.id}.position_uncertainty"),
+            POSITION_UNCERTAINTY.check(self.position_uncertainty, f"{self.id}.position_uncertainty"),
         )
 
     @property
@@ -163,6 +171,11 @@ class GroundLineLandmark:
         b = points_array(end, f"{ident}.end", min_rows=1)
         if a.shape != (1, 2) or b.shape != (1, 2):
             raise InputError(f"{ident}: expected start and end as single (x, y) points")
+        for name, point in (("start", a), ("end", b)):
+            if not (COORDINATE.contains(float(point[0, 0])) and COORDINATE.contains(float(point[0, 1]))):
+                raise InputError(
+                    f"{ident}.{name}: expected coordinates {COORDINATE.text()}, got {point[0].tolist()}"
+                )
         if np.array_equal(a, b):
             raise InputError(f"{ident}.end: expected a point distinct from start, got {b[0].tolist()}")
         object.__setattr__(self, "id", ident)
@@ -172,7 +185,7 @@ class GroundLineLandmark:
         object.__setattr__(
             self,
             "position_uncertainty",
-            nonnegative_float(position_uncertainty, f"{ident}.position_uncertainty"),
+            POSITION_UNCERTAINTY.check(position_uncertainty, f"{ident}.position_uncertainty"),
         )
 
     @property

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from types import MappingProxyType
 
@@ -12,11 +12,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import finite_float, float_array
+from aura_ums._validate import Range, float_array
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
 
-_FRACTIONS = ("translation_loss", "rotation_loss")
+_FRACTION = Range(0.0, 1.0, "", high_open=True)
+_SD = Range(0.0, 10.0, "")
 _ALTERNATE_UNITS = {"drift_deg_per_m": ("drift", math.pi / 180.0)}
 
 
@@ -24,24 +25,28 @@ _ALTERNATE_UNITS = {"drift_deg_per_m": ("drift", math.pi / 180.0)}
 class TerrainStats:
     """Slippage statistics of the robot on one terrain type (DESIGN §3).
 
+    Each field's physical range is in its metadata (``"range"``, an
+    ``aura_ums._validate.Range``) and :meth:`field_ranges`; a value outside it is an
+    error, not a statistic (a drift of 1e20 rad/m would make every map a full disk).
+
     Parameters
     ----------
     translation_loss : float
         Mean translational loss, fraction in [0, 1) (0.10: 20 m commanded, 18 m run).
     translation_inertial_loss : float
-        Fixed loss per move from acceleration and braking, metres, >= 0.
+        Fixed loss per move from acceleration and braking, metres, in [0, 10].
     translation_sd : float
-        Standard deviation of the translational error, fraction of the distance, >= 0.
+        Standard deviation of the translational error, fraction of the distance, in [0, 10].
     drift : float
-        Bound on the heading change per metre run, either side, rad/m, >= 0.
+        Bound on the heading change per metre run, either side, rad/m, in [0, 10].
     rotation_loss : float
         Mean rotational loss, fraction in [0, 1).
     rotation_sd : float
-        Standard deviation of the rotational error, fraction of the turn, >= 0.
+        Standard deviation of the rotational error, fraction of the turn, in [0, 10].
     skitter : float
-        Mean translation per radian turned, m/rad, >= 0.
+        Mean translation per radian turned, m/rad, in [0, 10].
     skitter_sd : float
-        Standard deviation of the skitter, m/rad, >= 0.
+        Standard deviation of the skitter, m/rad, in [0, 10].
 
     Examples
     --------
@@ -51,31 +56,42 @@ class TerrainStats:
     >>> TerrainStats(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: translation_loss: expected a fraction in [0, 1), got 1.0
+    aura_ums.errors.InputError: translation_loss: expected a number in [0, 1), got 1.0
+    >>> TerrainStats(0.1, 0.0, 0.0, 1e20, 0.0, 0.0, 0.0, 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: drift: expected a number in [0, 10] rad/m, got 1e+20
     """
 
-    translation_loss: float
-    translation_inertial_loss: float
-    translation_sd: float
-    drift: float
-    rotation_loss: float
-    rotation_sd: float
-    skitter: float
-    skitter_sd: float
+    translation_loss: float = field(metadata={"range": _FRACTION})
+    translation_inertial_loss: float = field(metadata={"range": Range(0.0, 10.0, "m")})
+    translation_sd: float = field(metadata={"range": _SD})
+    drift: float = field(metadata={"range": Range(0.0, 10.0, "rad/m")})
+    rotation_loss: float = field(metadata={"range": _FRACTION})
+    rotation_sd: float = field(metadata={"range": _SD})
+    skitter: float = field(metadata={"range": Range(0.0, 10.0, "m/rad")})
+    skitter_sd: float = field(metadata={"range": Range(0.0, 10.0, "m/rad")})
 
     def __post_init__(self) -> None:
-        for field in fields(self):
-            value = finite_float(getattr(self, field.name), field.name)
-            if field.name in _FRACTIONS and not 0.0 <= value < 1.0:
-                raise InputError(f"{field.name}: expected a fraction in [0, 1), got {value!r}")
-            if value < 0.0:
-                raise InputError(f"{field.name}: expected a non-negative number, got {value!r}")
-            object.__setattr__(self, field.name, value)
+        for item in fields(self):
+            bounds: Range = item.metadata["range"]
+            object.__setattr__(self, item.name, bounds.check(getattr(self, item.name), item.name))
 
     @classmethod
     def field_names(cls) -> tuple[str, ...]:
         """Return the names of the statistics, in declaration order."""
         return tuple(f.name for f in fields(cls))
+
+    @classmethod
+    def field_ranges(cls) -> dict[str, Range]:
+        """Return each statistic's physical range, in declaration order.
+
+        Examples
+        --------
+        >>> TerrainStats.field_ranges()["drift"].text()
+        'a number in [0, 10] rad/m'
+        """
+        return {f.name: f.metadata["range"] for f in fields(cls)}
 
     @classmethod
     def zero(cls) -> TerrainStats:

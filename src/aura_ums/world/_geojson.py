@@ -15,6 +15,7 @@ from typing import NoReturn
 import numpy as np
 
 from aura_ums._files import Fields, describe, load_json
+from aura_ums._validate import COORDINATE, HEIGHT, POSITION_UNCERTAINTY
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import (
@@ -193,7 +194,10 @@ class _Reader:
     def position(self, where: str, value: object) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
             self.fail(where, f"expected an [x, y] position in metres, got {_kind(value)}")
-        return (self.number(where, value[0]), self.number(where, value[1]))
+        return (
+            self.fields.ranged(value[0], where, COORDINATE),
+            self.fields.ranged(value[1], where, COORDINATE),
+        )
 
     def number(self, where: str, value: object) -> float:
         return self.fields.number(value, where)
@@ -206,13 +210,18 @@ class _Reader:
         self.check_keys(where, props, _COMMON_LANDMARK_KEYS + _CLASS_KEYS[klass])
 
         def required_number(key: str) -> float:
-            return self.fields.field(props, key, float, f"{where} properties")
+            value = self.fields.field(props, key, float, f"{where} properties")
+            if key.startswith("z"):
+                return self.fields.ranged(value, f"{where} properties.{key}", HEIGHT)
+            return value
 
         symbol = props.get("symbol", "")
         if not isinstance(symbol, str):
             self.fail(f"{where} properties.symbol", f"expected a string, got {_kind(symbol)}")
-        uncertainty = self.number(
-            f"{where} properties.position_uncertainty", props.get("position_uncertainty", 0.0)
+        uncertainty = self.fields.ranged(
+            props.get("position_uncertainty", 0.0),
+            f"{where} properties.position_uncertainty",
+            POSITION_UNCERTAINTY,
         )
         expected = _CLASS_GEOMETRY[klass]
         place = f"{where} geometry"

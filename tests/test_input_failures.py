@@ -1,0 +1,325 @@
+"""Issue 19, "every input checked": one case for each class of bad input that slipped through.
+
+Each case failed on the main branch before (a silent wrong result, a hang, a memory
+blow-up, a traceback or an error naming an internal place) and now gives a clean
+:class:`AuraUmsError` that names the file (and line or key) and states the range or the
+estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers are called.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs import load_log, read_mrclam
+from aura_ums.logs._odometry import report_times
+from aura_ums.perception._york_urban import load_york_urban
+from aura_ums.sim import Scenario
+from aura_ums.uncertainty import TerrainStats, TerrainTable, VerticalLineLandmark
+from aura_ums.world import MeadowMap, make_grid_world
+from tests.logs.test_mrclam import HEADER, TINY, tiny_dataset
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+LOG = {
+    "meta.toml": 'name = "tiny"\nterrain = "tile"\n[start]\nx = 0.0\ny = 0.0\nheading = 0.0\nradius = 0.5\n',
+    "landmarks.csv": "id,x,y,position_uncertainty\nA,3.0,0.0,0.1\nB,0.0,4.0,0.1\n",
+    "observations.csv": "time,landmark_id,bearing,range\n0.5,A,0.1,3.0\n1.0,B,1.5,4.0\n",
+    "odometry.csv": "time,v,omega\n0.0,0.5,0.0\n1.0,0.5,0.1\n2.0,0.0,0.0\n",
+}
+
+
+def log_folder(tmp_path: Path, **changes: str | bytes) -> Path:
+    folder = tmp_path / "log"
+    folder.mkdir()
+    for name, text in LOG.items():
+        data = changes.get(name.replace(".", "_"), text)
+        (folder / name).write_bytes(data if isinstance(data, bytes) else data.encode())
+    return folder
+
+
+def test_the_valid_log_loads(tmp_path: Path) -> None:
+    assert len(load_log(log_folder(tmp_path)).landmarks) == 2
+
+
+# --- absurd magnitudes: silent wrong results before, range errors now ------------------------
+
+
+def test_terrain_drift_1e20_is_refused(tmp_path: Path) -> None:
+    text = TerrainTable.default().to_toml()
+    drift = f"drift = {TerrainTable.default()['tile'].drift!r}"
+    path = tmp_path / "terrain.toml"
+    path.write_text(text.replace(drift, "drift = 1e20", 1))
+    with pytest.raises(
+        FileFormatError, match=r"terrain\.toml: \[tile\] drift: expected a number in \[0, 10\] rad/m"
+    ):
+        TerrainTable.from_toml(path)
+    with pytest.raises(InputError, match=r"drift: expected a number in \[0, 10\] rad/m, got 1e\+20"):
+        TerrainStats(0.1, 0.0, 0.0, 1e20, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_start_radius_1e15_is_refused(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path, meta_toml=LOG["meta.toml"].replace("radius = 0.5", "radius = 1e15"))
+    with pytest.raises(
+        FileFormatError, match=r"meta\.toml: \[start\] radius: expected a number in \[0, 10000\] m"
+    ):
+        load_log(folder)
+
+
+def test_start_radius_in_feet_states_the_value_in_metres(tmp_path: Path) -> None:
+    meta = LOG["meta.toml"].replace("radius = 0.5", "radius = 1e5") + '[units]\nlength = "ft"\n'
+    with pytest.raises(FileFormatError, match=r"radius: .* got 100000\.0 \(30480 m\)"):
+        load_log(log_folder(tmp_path, meta_toml=meta))
+
+
+def test_landmark_position_uncertainty_1e300_is_refused(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path, landmarks_csv="id,x,y,position_uncertainty\nA,3.0,0.0,1e300\nB,0,4,0\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"landmarks\.csv:2: expected a number in \[0, 1000\] m in column 'position_uncertainty'",
+    ):
+        load_log(folder)
+    with pytest.raises(InputError, match=r"pole\.position_uncertainty: expected a number in \[0, 1000\] m"):
+        VerticalLineLandmark("pole", 0.0, 0.0, 0.0, 1.0, position_uncertainty=1e300)
+
+
+def test_landmark_x_1e300_names_the_landmark_column_not_an_arena(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path, landmarks_csv="id,x,y\nA,1e300,0.0\nB,0.0,4.0\n")
+    with pytest.raises(
+        FileFormatError, match=r"landmarks\.csv:2: expected a number in \[-1e\+06, 1e\+06\] m in column 'x'"
+    ):
+        load_log(folder)
+
+
+def test_geojson_position_uncertainty_1e300_is_refused(tmp_path: Path) -> None:
+    document = make_grid_world(2, 2).to_geojson_dict()
+    features = document["features"]
+    assert isinstance(features, list)
+    landmark = next(item for item in features if "class" in item["properties"])
+    landmark["properties"]["position_uncertainty"] = 1e300
+    path = tmp_path / "world.geojson"
+    import json
+
+    path.write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError, match=r"world\.geojson: .*position_uncertainty: expected a number in \[0, 1000\] m"
+    ):
+        MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
+
+
+# --- tracebacks and hangs: v = 1e300 and a clock jump -----------------------------------------
+
+
+def test_odometry_speed_1e300_names_file_and_line(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path, odometry_csv="time,v,omega\n0.0,0.5,0.0\n1.0,1e300,0.1\n2.0,0,0\n")
+    with pytest.raises(
+        FileFormatError, match=r"odometry\.csv:3: expected a number in \[-100, 100\] m/s in column 'v'"
+    ):
+        load_log(folder)
+
+
+def test_a_clock_jump_is_refused_with_its_file_line_and_step_estimate(tmp_path: Path) -> None:
+    odometry = "time,v,omega\n0.0,0.5,0.0\n1.0,0.5,0.1\n2402000.0,0.0,0.0\n"
+    with pytest.raises(
+        FileFormatError,
+        match=r"odometry\.csv:4: expected at most 86400 s after the previous row \(line 3\), "
+        r"got a clock jump of 2\.402e\+06 s \(27\.8 days; replayed, about 9607996 steps of 0\.25 s\)",
+    ):
+        load_log(log_folder(tmp_path, odometry_csv=odometry))
+
+
+def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    odometry = HEADER + "9.0 0.1 0.0\n9.5 0.2 0.1\n2402009.5 0.0 0.0\n"
+    with pytest.raises(
+        FileFormatError, match=r"Robot1_Odometry\.dat:7: expected at most 86400 s .*27\.8 days"
+    ):
+        read_mrclam(tiny_dataset(tmp_path / "d", **{"Robot1_Odometry.dat": odometry}), 1)
+
+
+def test_too_many_reports_are_refused_before_allocating_with_the_estimate() -> None:
+    with pytest.raises(
+        InputError, match=r"expected at most 2000000 reports \(about 500 MB\), got 9608000 \(about 2,402 MB"
+    ):
+        report_times(np.empty(0), 0.0, 2_402_000.0, 0.25)
+
+
+def test_mrclam_values_out_of_range_name_the_column(tmp_path: Path) -> None:
+    landmarks = TINY["Landmark_Groundtruth.dat"] + "  8 \t 1e300 \t 2.0 \t 0.003 \t 0.0001\n"
+    with pytest.raises(
+        FileFormatError, match=r"Landmark_Groundtruth\.dat:7: expected x a number in \[-1e\+06, 1e\+06\] m"
+    ):
+        read_mrclam(tiny_dataset(tmp_path / "a", **{"Landmark_Groundtruth.dat": landmarks}), 1)
+    odometry = HEADER + "9.0 1e300 0.0\n12.0 0.0 0.0\n"
+    with pytest.raises(
+        FileFormatError, match=r"Robot1_Odometry\.dat:5: expected v a number in \[-100, 100\] m/s"
+    ):
+        read_mrclam(tiny_dataset(tmp_path / "b", **{"Robot1_Odometry.dat": odometry}), 1)
+
+
+# --- encodings: every reader reads UTF-8 with a BOM, and refuses other bytes cleanly ------------
+
+
+def test_an_excel_csv_with_a_bom_and_crlf_is_read(tmp_path: Path) -> None:
+    def excel(text: str) -> bytes:
+        return b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode()
+
+    folder = log_folder(
+        tmp_path,
+        odometry_csv=excel(LOG["odometry.csv"]),
+        landmarks_csv=excel(LOG["landmarks.csv"]),
+        observations_csv=excel(LOG["observations.csv"]),
+        meta_toml=excel(LOG["meta.toml"]),
+    )
+    log = load_log(folder)
+    assert [item.id for item in log.landmarks] == ["A", "B"]
+    assert log.odometry is not None
+    assert log.odometry.v.tolist() == [0.5, 0.5, 0.0]
+
+
+def test_mrclam_reads_a_bom_and_refuses_other_encodings_with_the_line(tmp_path: Path) -> None:
+    with_bom = {name: "\ufeff" + text for name, text in TINY.items()}
+    read, plain = (
+        read_mrclam(tiny_dataset(tmp_path / "bom", **with_bom), 1),
+        read_mrclam(tiny_dataset(tmp_path / "plain"), 1),
+    )
+    assert (read.landmarks, read.observations) == (plain.landmarks, plain.observations)
+    assert read.odometry is not None
+    assert plain.odometry is not None
+    assert read.odometry.v.tolist() == plain.odometry.v.tolist()
+    folder = tiny_dataset(tmp_path / "latin1")
+    (folder / "Robot1_Odometry.dat").write_bytes(HEADER.replace("format", "f\xe9rmat").encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=r"Robot1_Odometry\.dat:3: byte \d+: expected UTF-8 text, got the byte 0xe9"
+    ):
+        read_mrclam(folder, 1)
+
+
+def _york_urban(folder: Path, segments: bytes) -> Path:
+    import matplotlib.image
+
+    (folder / "images").mkdir(parents=True)
+    image = np.random.default_rng(19).integers(0, 255, (12, 16), dtype=np.uint8)
+    matplotlib.image.imsave(folder / "images" / "P0001.png", image, cmap="gray")
+    shutil.move(folder / "images" / "P0001.png", folder / "images" / "P0001.jpg")
+    (folder / "segments.csv").write_bytes(segments)
+    return folder
+
+
+YORK_SEGMENTS = "image,x1,y1,x2,y2,vp,vertical\nP0001,1.5,2.0,10.0,2.5,1,0\nP0001,3.0,1.0,3.5,9.0,2,1\n"
+
+
+def test_york_urban_reads_a_bom_and_refuses_other_encodings(tmp_path: Path) -> None:
+    [image] = load_york_urban(_york_urban(tmp_path / "bom", b"\xef\xbb\xbf" + YORK_SEGMENTS.encode()))
+    assert image.segments.tolist() == [[1.5, 2.0, 10.0, 2.5], [3.0, 1.0, 3.5, 9.0]]
+    assert image.vertical.tolist() == [False, True]
+    folder = _york_urban(tmp_path / "latin1", YORK_SEGMENTS.replace("P0001,3", "P\xe9,3").encode("latin-1"))
+    with pytest.raises(
+        FileFormatError, match=r"segments\.csv:3: byte \d+: expected UTF-8 text, got the byte 0xe9"
+    ):
+        load_york_urban(folder)
+    folder = _york_urban(tmp_path / "range", YORK_SEGMENTS.replace("10.0", "1e300").encode())
+    with pytest.raises(
+        FileFormatError, match=r"segments\.csv:2: expected a number in \[-100000, 100000\] px in column 'x2'"
+    ):
+        load_york_urban(folder)
+
+
+# --- counts limited from an estimate, before allocating -----------------------------------------
+
+
+def scenario_file(tmp_path: Path, old: str, new: str, camera: str | None = None) -> Path:
+    text = (REPOSITORY / "scenarios" / "paper_sidewalk.toml").read_text()
+    assert old in text
+    camera_text = (REPOSITORY / "scenarios" / "paper_camera.toml").read_text()
+    (tmp_path / "paper_camera.toml").write_text(camera if camera is not None else camera_text)
+    path = tmp_path / "walk.toml"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def test_scenario_clutter_1e8_is_refused(tmp_path: Path) -> None:
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 100000000")
+    with pytest.raises(
+        FileFormatError, match=r"walk\.toml: \[render\] clutter: expected at most 1e\+07 strips"
+    ):
+        Scenario.from_toml(path)
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 5000000")
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk\.toml: \[render\] clutter: expected at most 600 s and 4 GB a run, got 4 frames",
+    ):
+        Scenario.from_toml(path)
+
+
+def test_scenario_frame_spacing_1e_6_is_refused_with_the_estimate(tmp_path: Path) -> None:
+    path = scenario_file(tmp_path, "[start]\n", "frame_spacing = 1e-6\n\n[start]\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk\.toml: frame_spacing: expected at most 600 s and 4 GB a run, "
+        r"got 12192004 frames of 512 x 480 px",
+    ):
+        Scenario.from_toml(path)
+
+
+def test_scenario_start_radius_1e15_is_refused(tmp_path: Path) -> None:
+    path = scenario_file(tmp_path, "position_radius = 0.3048", "position_radius = 1e15")
+    with pytest.raises(
+        FileFormatError, match=r"\[start\] position_radius: expected a number in \[0, 10000\] m"
+    ):
+        Scenario.from_toml(path)
+
+
+def test_an_image_width_of_2e6_is_refused(tmp_path: Path) -> None:
+    camera = (
+        (REPOSITORY / "scenarios" / "paper_camera.toml").read_text().replace("width = 512", "width = 2000000")
+    )
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 40", camera=camera)
+    with pytest.raises(
+        FileFormatError, match=r"camera: .*\[intrinsics\] width: expected at most 20000 px, got 2000000"
+    ):
+        Scenario.from_toml(path)
+    with pytest.raises(FileFormatError, match=r"\[intrinsics\] width: expected at most 20000 px"):
+        load_camera(tmp_path / "paper_camera.toml")
+    opencv = tmp_path / "calib.json"
+    opencv.write_text(
+        '{"image_width": 2000000, "image_height": 480, "camera_matrix": {"type_id": "opencv-matrix", '
+        '"rows": 3, "cols": 3, "dt": "d", "data": [500, 0, 320, 0, 500, 240, 0, 0, 1]}, '
+        '"distortion_coefficients": {"type_id": "opencv-matrix", "rows": 1, "cols": 4, "dt": "d", '
+        '"data": [0, 0, 0, 0]}}'
+    )
+    with pytest.raises(FileFormatError, match=r"calib\.json: image_width: expected at most 20000 px"):
+        load_opencv_calibration(opencv, CameraMount(1.0))
+
+
+def test_a_camera_too_big_to_render_is_refused_with_the_estimate(tmp_path: Path) -> None:
+    camera = (
+        (REPOSITORY / "scenarios" / "paper_camera.toml")
+        .read_text()
+        .replace("width = 512", "width = 20000")
+        .replace("height = 480", "height = 20000")
+    )
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 40", camera=camera)
+    with pytest.raises(
+        FileFormatError, match=r"walk\.toml: camera: expected at most 600 s and 4 GB a run, got .* 80 GB"
+    ):
+        Scenario.from_toml(path)
+
+
+def test_monte_carlo_runs_are_limited_with_the_estimate() -> None:
+    scenario = Scenario.from_toml(REPOSITORY / "scenarios" / "paper_sidewalk.toml")
+    assert scenario.check_runs(100) == 100
+    with pytest.raises(
+        InputError,
+        match=r"runs: expected an integer in \[1, 100000\], got 1000000000 \(about .* s and 2e\+04 GB",
+    ):
+        scenario.check_runs(10**9)
+    with pytest.raises(InputError, match=r"runs: expected an integer in \[1, 100000\], got 0$"):
+        scenario.check_runs(0)
+    seconds, memory = scenario.estimate()
+    assert 0.0 < seconds < 1.0
+    assert math.isclose(memory, 512 * 480 * 200 + 40 * 400)
