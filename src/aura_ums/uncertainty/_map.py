@@ -33,6 +33,7 @@ from aura_ums.geometry import (
     HeadingWedge,
     Pose,
     outer_disk,
+    points_in_convex,
     polygon_area,
     wrap_angle,
 )
@@ -248,6 +249,85 @@ class SpatialUncertaintyMap:
         if len(slices) > cap:
             slices = capped(slices, cap, max(len(vertices), 3))
         return SpatialUncertaintyMap._sliced(slices, self.center, wedge.center, cells, cap, polygon)
+
+    @classmethod
+    def from_slices(
+        cls,
+        slices: Sequence[HeadingSlice],
+        center: ArrayLike,
+        wedge: HeadingWedge,
+        *,
+        slice_width: float,
+        max_slices: int,
+    ) -> SpatialUncertaintyMap:
+        """Build a sliced map from its parts (validated), as :attr:`slices` and the summary give them.
+
+        The wedge is kept as given (a saved map is restored bit for bit); it must hold
+        every slice's interval, and ``center`` must lie in some slice's polygon.
+
+        Parameters
+        ----------
+        slices : sequence of HeadingSlice
+            At least one and at most ``max_slices``, ordered by ``lo`` (radians in
+            [0, 2 pi)), each ``width`` in [0, 2 pi].
+        center : array_like, shape (2,)
+            Most probable position, metres.
+        wedge : HeadingWedge
+            The summary wedge; its centre is the most probable heading.
+        slice_width : float
+            The grid's cell width, radians, in (0, 2 pi].
+        max_slices : int
+            Cap on the slice count, >= 1.
+
+        Examples
+        --------
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, 0.1).with_slices()
+        >>> again = SpatialUncertaintyMap.from_slices(
+        ...     start.slices, start.center, start.wedge, slice_width=start.slice_width, max_slices=48)
+        >>> again.contains(Pose(0.1, 0.1, 0.05)), len(again.slices) == len(start.slices)
+        (True, True)
+        >>> SpatialUncertaintyMap.from_slices([], (0, 0), start.wedge, slice_width=0.1, max_slices=4)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: slices: expected 1 to 4 heading slices, got 0
+        """
+        width = finite_float(slice_width, "slice_width")
+        if not 0.0 < width <= 2.0 * math.pi:
+            raise InputError(f"slice_width: expected radians in (0, 2 pi], got {width!r}")
+        cap = integer_at_least(max_slices, "max_slices", 1)
+        if not isinstance(wedge, HeadingWedge):
+            raise InputError(f"wedge: expected a HeadingWedge, got {type(wedge).__name__}")
+        if not 1 <= len(slices) <= cap:
+            raise InputError(f"slices: expected 1 to {cap} heading slices, got {len(slices)}")
+        pieces: list[Slice] = []
+        for index, piece in enumerate(slices):
+            if not isinstance(piece, HeadingSlice) or not isinstance(piece.polygon, ConvexPolygon):
+                raise InputError(f"slices[{index}]: expected a HeadingSlice, got {type(piece).__name__}")
+            lo = finite_float(piece.lo, f"slices[{index}].lo")
+            span = finite_float(piece.width, f"slices[{index}].width")
+            if not 0.0 <= lo < 2.0 * math.pi or not 0.0 <= span <= 2.0 * math.pi:
+                raise InputError(
+                    f"slices[{index}]: expected lo in [0, 2 pi) and width in [0, 2 pi], got {lo!r}, {span!r}"
+                )
+            if pieces and lo < pieces[-1].lo:
+                raise InputError(f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {pieces[-1].lo!r}")
+            if not (wedge.contains(lo) and wedge.contains(lo + span)):
+                raise InputError(f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}")
+            pieces.append(Slice(lo, lo + span, piece.polygon.vertices))
+        point = points_array(center, "center", min_rows=1)
+        if point.shape != (1, 2):
+            raise InputError(f"center: expected one (x, y) point, got shape {point.shape}")
+        if not any(points_in_convex(p.vertices, point, 1e-6)[0] for p in pieces):
+            raise InputError(f"center: expected a point inside a slice's polygon, got {point[0].tolist()}")
+        result = object.__new__(cls)
+        _set_polygon(result, None)
+        _set_center(result, read_only(point[0].copy()))
+        _set_wedge(result, wedge)
+        _set_pose(result, None)
+        _set_slices(result, tuple(pieces))
+        _set_cells(result, cell_count(width))
+        _set_max_slices(result, cap)
+        return result
 
     def without_slices(self) -> SpatialUncertaintyMap:
         """Return the product map of this map's summary (its polygon and wedge); itself when a product."""
