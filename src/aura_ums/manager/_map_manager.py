@@ -297,11 +297,14 @@ class UncertaintyMapManager:
         if settings.robust:
             cap = settings.envelope_max_vertices
             # The envelope's own lost state and recovery are never read: limits off, no envelope.
+            # It stays a product map: the fallback needs containment more than tightness, and
+            # a sliced envelope would double a sliced manager's cost.
             envelope_settings = dataclasses.replace(
                 settings,
                 robust=False,
                 area_limit=None,
                 max_vertices=settings.max_vertices if cap is None else cap,
+                slice_width=None,
             )
             self._envelope = UncertaintyMapManager(initial_map, meadow_map, table, envelope_settings)
 
@@ -478,7 +481,7 @@ class UncertaintyMapManager:
                 if reason is None or reason.inconsistent:
                     recent.append(reason is not None)
             if sum(recent) >= self._settings.relocalize_after:
-                self._map = self._reseed(wide, [o.observation for o in outcomes])
+                self._map = _in_form(self._reseed(wide, [o.observation for o in outcomes]), self._settings)
                 self._relocalizations += 1
                 recent.clear()
                 relocalized = True

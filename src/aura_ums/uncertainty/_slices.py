@@ -26,7 +26,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, points_in_convex, simplify_outer
+from aura_ums import _native
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, points_in_convex
 
 Array = NDArray[np.float64]
 
@@ -161,24 +162,34 @@ def distribute(pieces: Sequence[tuple[float, float, Array]], cells: int, max_ver
             else:
                 held[2].append(vertices)
                 found[cell] = (min(held[0], lo), max(held[1], hi), held[2])
-    result = []
-    for cell in sorted(found):
-        lo, hi, polygons = found[cell]
-        result.append(Slice(lo, hi, merged(polygons, max_vertices)))
-    return tuple(result)
+    cells_in_order = sorted(found)
+    hulls = merged_all([found[cell][2] for cell in cells_in_order], max_vertices)
+    return tuple(
+        Slice(found[cell][0], found[cell][1], hull) for cell, hull in zip(cells_in_order, hulls, strict=True)
+    )
 
 
-def merged(polygons: Sequence[Array], max_vertices: int) -> Array:
-    """Return the convex hull of polygons (one of them itself), capped at ``max_vertices`` (outer)."""
-    if len(polygons) == 1:
-        return polygons[0]
-    first = polygons[0]
-    if all(p is first for p in polygons):
-        return first
-    hull = convex_hull(np.concatenate(polygons))
-    if len(hull) > max_vertices:
-        hull = simplify_outer(hull, max_vertices)
-    return hull
+def merged_all(groups: Sequence[Sequence[Array]], max_vertices: int) -> list[Array]:
+    """Return, for each group of polygons, their convex hull capped at ``max_vertices`` (outer).
+
+    A group of one polygon (or of one polygon several times) is that polygon; the others
+    go through one call of the merging kernel.
+    """
+    result: list[Array | None] = []
+    points: list[Array] = []
+    counts: list[int] = []
+    for polygons in groups:
+        first = polygons[0]
+        if all(p is first for p in polygons):
+            result.append(first)
+            continue
+        result.append(None)
+        points += polygons
+        counts.append(sum(len(p) for p in polygons))
+    if not counts:
+        return [r for r in result if r is not None]
+    hulls = iter(_native.merge_groups(np.concatenate(points), counts, max(max_vertices, 3)))
+    return [next(hulls) if r is None else r for r in result]
 
 
 def capped(slices: tuple[Slice, ...], max_slices: int, max_vertices: int) -> tuple[Slice, ...]:
@@ -198,13 +209,11 @@ def capped(slices: tuple[Slice, ...], max_slices: int, max_vertices: int) -> tup
     if count <= max_slices:
         return slices
     size = math.ceil(count / max_slices)
-    result = []
-    for start in range(0, count, size):
-        group = slices[start : start + size]
-        result.append(
-            Slice(group[0].lo, max(s.hi for s in group), merged([s.vertices for s in group], max_vertices))
-        )
-    return tuple(result)
+    groups = [slices[start : start + size] for start in range(0, count, size)]
+    hulls = merged_all([[s.vertices for s in group] for group in groups], max_vertices)
+    return tuple(
+        Slice(group[0].lo, max(s.hi for s in group), hull) for group, hull in zip(groups, hulls, strict=True)
+    )
 
 
 def unwrapped_near(heading: float, lo: float) -> float:
@@ -274,7 +283,7 @@ def summary_wedge(slices: Sequence[Slice], heading: float) -> HeadingWedge:
 
 def summary_polygon(slices: Sequence[Slice]) -> Array:
     """Return the convex hull of every slice's polygon (counter-clockwise, metres)."""
-    return merged([s.vertices for s in slices], 1 << 30)
+    return merged_all([[s.vertices for s in slices]], sum(len(s.vertices) for s in slices))[0]
 
 
 def contains(slices: Sequence[Slice], points: Array, headings: Array, tolerance: float) -> NDArray[np.bool_]:
