@@ -8,7 +8,8 @@ None``) and with sliced maps (``slice_width``, default 2 degrees; more widths wi
 wedge width, and median microseconds per frame (growth since the previous frame and the
 frame's reductions; on this machine, under whatever else runs on it).
 
-    .venv/bin/python benchmarks/bench_sliced.py [--widths 2,4] [--slice-vertices 16] [--logs mrclam6:2,mrclam7:3]
+    .venv/bin/python benchmarks/bench_sliced.py [--widths 2,4] [--slice-vertices 16] \
+        [--logs mrclam6:2,mrclam7:3]
 
 The sliced maps keep ``max_vertices`` per slice (``--slice-vertices``, default the settings'
 default); the product map keeps the default.
@@ -27,10 +28,20 @@ from aura_ums.manager import ManagerSettings
 from aura_ums.uncertainty import LandmarkClass
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
-LOGS = [("mrclam6", 1), ("mrclam6", 2), ("mrclam7", 1), ("mrclam7", 2), ("mrclam7", 3), ("mrclam7", 4), ("mrclam7", 5)]
+LOGS = [
+    ("mrclam6", 1),
+    ("mrclam6", 2),
+    ("mrclam7", 1),
+    ("mrclam7", 2),
+    ("mrclam7", 3),
+    ("mrclam7", 4),
+    ("mrclam7", 5),
+]
 
 
-def options(calibration: Calibration, landmark_class: LandmarkClass, settings: ManagerSettings) -> ReplayOptions:
+def options(
+    calibration: Calibration, landmark_class: LandmarkClass, settings: ManagerSettings
+) -> ReplayOptions:
     return ReplayOptions(
         settings=settings,
         landmark_class=landmark_class,
@@ -46,7 +57,10 @@ def main() -> None:
     parser.add_argument("--logs", default="", help="dataset:robot pairs, comma-separated (default: all)")
     parser.add_argument("--max-slices", type=int, default=ManagerSettings().max_slices)
     parser.add_argument(
-        "--slice-vertices", type=int, default=ManagerSettings().max_vertices, help="max_vertices of the sliced maps"
+        "--slice-vertices",
+        type=int,
+        default=ManagerSettings().max_vertices,
+        help="max_vertices of the sliced maps",
     )
     args = parser.parse_args()
     if not DATA.is_dir():
@@ -64,7 +78,9 @@ def main() -> None:
             (
                 f"sliced {width:g}deg",
                 ManagerSettings(
-                    slice_width=math.radians(width), max_slices=args.max_slices, max_vertices=args.slice_vertices
+                    slice_width=math.radians(width),
+                    max_slices=args.max_slices,
+                    max_vertices=args.slice_vertices,
                 ),
             )
         )
@@ -80,7 +96,8 @@ def main() -> None:
                 envelope = [s.envelope_inside for s in result.steps if s.envelope_inside is not None]
                 envelope_rate = sum(envelope) / len(envelope) if envelope else math.nan
                 print(
-                    f"{name}:{robot:<4d} {landmark_class.value:5s} {label:13s} {result.containment_rate:7.4f} "
+                    f"{name}:{robot:<4d} {landmark_class.value:5s} {label:13s} "
+                    f"{result.containment_rate:7.4f} "
                     f"{envelope_rate:7.4f} {result.median_area_m2:9.4g} {result.median_wedge_width_rad:8.3f} "
                     f"{result.median_update_us:9.1f} {result.relocalizations:6d} {wall:7.1f}",
                     flush=True,

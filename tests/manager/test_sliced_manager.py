@@ -1,15 +1,16 @@
-"""The manager with heading-sliced maps: the setting decides the map's form; save and resume keep the slices."""
+"""The manager with heading-sliced maps: the setting decides its form; saving keeps the slices."""
 
 from __future__ import annotations
 
 import json
 import math
+from typing import Any
 
 import pytest
 
 from aura_ums.errors import FileFormatError
 from aura_ums.manager import ManagerSettings, UncertaintyMapManager
-from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
+from aura_ums.uncertainty import DEFAULT_MAX_SLICES, Pose, SpatialUncertaintyMap
 from tests.manager.test_map_manager import (
     POLE_NORTH,
     START,
@@ -26,7 +27,7 @@ from tests.manager.test_map_manager import (
 WIDTH = math.radians(2.0)
 
 
-def sliced_manager(**settings: object) -> UncertaintyMapManager:
+def sliced_manager(**settings: Any) -> UncertaintyMapManager:
     return manager_for(slice_width=WIDTH, max_slices=30, **settings)
 
 
@@ -50,7 +51,9 @@ def test_a_sliced_manager_keeps_the_truth_and_is_no_looser() -> None:
         step = manager.update(board_with(*reports, observations=observations), now=3.0)
         assert step.outcomes[0].accepted
     # The envelope, the fallback, stays a product map.
-    assert sliced.map.is_sliced and sliced.envelope_map is not None and not sliced.envelope_map.is_sliced
+    assert sliced.map.is_sliced
+    assert sliced.envelope_map is not None
+    assert not sliced.envelope_map.is_sliced
     assert sliced.map.area <= product.map.area * 1.01
 
 
@@ -88,6 +91,8 @@ def test_a_corrupt_slice_is_refused_naming_its_place() -> None:
 
 
 def test_settings_of_slices_are_checked() -> None:
+    assert ManagerSettings().max_slices == DEFAULT_MAX_SLICES
+    assert ManagerSettings().slice_width is None  # the paper's product map unless asked
     with pytest.raises(ValueError, match=r"slice_width: expected a number in \(0, 2 pi\] or none"):
         ManagerSettings(slice_width=0.0)
     with pytest.raises(ValueError, match="max_slices: expected an integer >= 1"):

@@ -7,8 +7,8 @@ when aura-ums is imported: the C one when the extension was built, unless the en
 sets ``AURA_UMS_NATIVE=0``; the numpy reference otherwise (:data:`NATIVE`).
 
 Only the layer that owns a kernel calls it, as ``_native.<kernel>``: ``uncertainty`` the
-growth, the reductions and the slices' merging, ``expecter`` its points, ``schemas`` the polygon distance. This
-package imports nothing of aura-ums but ``geometry``.
+growth, the reductions and the slices' merging, ``expecter`` its points, ``schemas`` the
+polygon distance. This package imports nothing of aura-ums but ``geometry``.
 """
 
 import os

@@ -54,7 +54,9 @@ def merge_groups_reference(points: Array, counts: Sequence[int], max_vertices: i
     [[0.0, 0.0]]
     """
     if any(count < 1 for count in counts) or sum(counts) != len(points):
-        raise ValueError(f"counts: expected group sizes adding up to the {len(points)} rows, got {list(counts)}")
+        raise ValueError(
+            f"counts: expected group sizes adding up to the {len(points)} rows, got {list(counts)}"
+        )
     if max_vertices < 3:
         raise ValueError(f"max_vertices: expected at least 3, got {max_vertices}")
     hulls = []

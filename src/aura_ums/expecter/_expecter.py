@@ -233,7 +233,7 @@ def _points(
     width: float,
     rises: tuple[float, ...],
 ) -> _native.ExpectedPoints | None:
-    """The kernel's points for one polygon and heading interval (``full``: every heading)."""
+    """Return the kernel's points for one polygon and heading interval (``full``: every heading)."""
     mount = expecter.camera.mount
     return _native.expecter_points(
         vertices,
@@ -259,7 +259,7 @@ def _sliced_points(
     uncertainty: float,
     rises: tuple[float, ...],
 ) -> _native.ExpectedPoints | None:
-    """The points of every slice of a sliced map and their joint box (None: behind from every slice).
+    """Return the points of every slice of a sliced map and their joint box (None: behind from all).
 
     Every pose of the map lies in some slice, and each slice's points span every projection
     from its poses (the method above, with the slice's polygon and interval for ``P`` and

@@ -249,7 +249,7 @@ def encode_observation(observation: Observation) -> dict[str, object]:
 
 
 def encode_map(uncertainty_map: SpatialUncertaintyMap) -> dict[str, object]:
-    """Return a map as a JSON object: vertices, centre and wedge (and a sliced map's slices), every float exact."""
+    """Return a map as a JSON object: vertices, centre, wedge (and slices), every float exact."""
     wedge = uncertainty_map.wedge
     data: dict[str, object] = {
         "vertices": uncertainty_map.polygon.vertices.tolist(),

@@ -223,7 +223,8 @@ relocalize_after (2), got 1
         64,
         SettingInfo("Cap on the map polygon's vertices: fewer is faster and looser", "", int, low=3),
     )
-    # slice_width and max_slices default to what SpatialUncertaintyMap.with_slices takes.
+    # max_slices defaults to what SpatialUncertaintyMap.with_slices takes (tests/manager/
+    # test_sliced_manager.py holds them equal).
     slice_width: float | None = _setting(
         None,
         SettingInfo(

@@ -205,7 +205,8 @@ class SpatialUncertaintyMap:
             lo = (wedge.center - wedge.cw) % (2.0 * math.pi)
             return (HeadingSlice(self.polygon, lo, wedge.width),)
         return tuple(
-            HeadingSlice(ConvexPolygon._trusted(piece.vertices), piece.lo, piece.hi - piece.lo) for piece in slices
+            HeadingSlice(ConvexPolygon._trusted(piece.vertices), piece.lo, piece.hi - piece.lo)
+            for piece in slices
         )
 
     def with_slices(
@@ -310,9 +311,13 @@ class SpatialUncertaintyMap:
                     f"slices[{index}]: expected lo in [0, 2 pi) and width in [0, 2 pi], got {lo!r}, {span!r}"
                 )
             if pieces and lo < pieces[-1].lo:
-                raise InputError(f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {pieces[-1].lo!r}")
+                raise InputError(
+                    f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {pieces[-1].lo!r}"
+                )
             if not (wedge.contains(lo) and wedge.contains(lo + span)):
-                raise InputError(f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}")
+                raise InputError(
+                    f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}"
+                )
             pieces.append(Slice(lo, lo + span, piece.polygon.vertices))
         point = points_array(center, "center", min_rows=1)
         if point.shape != (1, 2):
@@ -584,7 +589,9 @@ class SpatialUncertaintyMap:
                 picked = chosen == index
                 piece = slices[int(index)]
                 rows[picked, :2] = ConvexPolygon._trusted(piece.vertices).sample(int(picked.sum()), rng)
-                rows[picked, 2] = wrap_angle(piece.lo + rng.uniform(0.0, 1.0, int(picked.sum())) * (piece.hi - piece.lo))
+                rows[picked, 2] = wrap_angle(
+                    piece.lo + rng.uniform(0.0, 1.0, int(picked.sum())) * (piece.hi - piece.lo)
+                )
             return rows
         positions = self.polygon.sample(count, rng)
         wedge = self.wedge
@@ -604,9 +611,9 @@ class SpatialUncertaintyMap:
 _set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon | None], None] = SpatialUncertaintyMap.__dict__[
     "_polygon"
 ].__set__
-_set_slices: Callable[[SpatialUncertaintyMap, tuple[Slice, ...] | None], None] = SpatialUncertaintyMap.__dict__[
-    "_slices"
-].__set__
+_set_slices: Callable[[SpatialUncertaintyMap, tuple[Slice, ...] | None], None] = (
+    SpatialUncertaintyMap.__dict__["_slices"].__set__
+)
 _set_cells: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__["_cells"].__set__
 _set_max_slices: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__[
     "_max_slices"

@@ -9,17 +9,16 @@ its result becomes a map.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
-from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
 from aura_ums.errors import InputError
 from aura_ums.geometry import HeadingWedge
-from aura_ums.uncertainty._slices import Slice, clamp_into, home_slice
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -30,6 +29,7 @@ from aura_ums.uncertainty._landmarks import (
     RangeBearingObservation,
     VerticalLineLandmark,
 )
+from aura_ums.uncertainty._slices import Slice, clamp_into, home_slice
 
 if TYPE_CHECKING:
     from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -166,10 +166,8 @@ def reduce_checked(
         return _reduce_sliced(prior, slices, observation, landmark, max_vertices)
     wedge = prior.wedge
     center_x, center_y = prior.center.tolist()
-    found = _kernel(
-        prior.polygon.vertices, center_x, center_y, wedge.center, wedge.cw, wedge.ccw, observation, landmark,
-        max_vertices,
-    )  # fmt: skip
+    kernel, arguments = _kernel_call(observation, landmark, max_vertices)
+    found = kernel(prior.polygon.vertices, center_x, center_y, wedge.center, wedge.cw, wedge.ccw, *arguments)
     if isinstance(found, int):
         return _REASONS[found]
     raw, lo, width, x, y, area_before, area_after = found
@@ -182,18 +180,13 @@ def reduce_checked(
     return reduced, area_before, area_after
 
 
-def _kernel(
-    vertices: NDArray[np.float64],
-    center_x: float,
-    center_y: float,
-    heading: float,
-    cw: float,
-    ccw: float,
-    observation: Observation,
-    landmark: Landmark,
-    max_vertices: int,
-) -> RawReduction | int:
-    """Call the reduction kernel of the observation's class on one polygon and wedge."""
+#: A reduction kernel with its observation's arguments: called on (vertices, centre x, centre
+#: y, wedge centre, cw, ccw) of one polygon and wedge.
+_Call = tuple[Callable[..., "RawReduction | int"], tuple[float | int, ...]]
+
+
+def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int) -> _Call:
+    """Return the reduction kernel of the observation's class and its arguments after the wedge."""
     forward, left = observation.sensor_offset
     if isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
         landmark, (VerticalLineLandmark, PointLandmark)
@@ -202,20 +195,20 @@ def _kernel(
             r_min, r_max, piece = observation.range_min, observation.range_max, SECTOR_PIECE
         else:
             r_min, r_max, piece = 0.0, math.inf, CONE_PIECE
-        return _native.reduce_cone(
-            vertices, center_x, center_y, heading, cw, ccw, forward, left, landmark.x,
-            landmark.y, landmark.position_uncertainty, observation.bearing, observation.bearing_error, r_min,
-            r_max, piece, max_vertices,
+        return _native.reduce_cone, (
+            forward, left, landmark.x, landmark.y, landmark.position_uncertainty, observation.bearing,
+            observation.bearing_error, r_min, r_max, piece, max_vertices,
         )  # fmt: skip
     if isinstance(observation, GroundLineObservation) and isinstance(landmark, GroundLineLandmark):
         (start_x, start_y), (end_x, end_y) = landmark.start.tolist(), landmark.end.tolist()
-        return _native.reduce_strip(
-            vertices, center_x, center_y, heading, cw, ccw, forward, left, start_x, start_y,
-            end_x, end_y, landmark.position_uncertainty, observation.offset, observation.offset_error,
-            observation.angle, observation.angle_error, max_vertices,
+        return _native.reduce_strip, (
+            forward, left, start_x, start_y, end_x, end_y, landmark.position_uncertainty, observation.offset,
+            observation.offset_error, observation.angle, observation.angle_error, max_vertices,
         )  # fmt: skip
     # The callers refused every other pairing.
-    raise InputError(f"observation: expected a known pairing, got {type(observation).__name__}")  # pragma: no cover
+    raise InputError(
+        f"observation: expected a known pairing, got {type(observation).__name__}"
+    )  # pragma: no cover
 
 
 def narrowed(arc_lo: float, arc_width: float, lo: float, hi: float) -> tuple[float, float]:
@@ -269,19 +262,27 @@ def _reduce_sliced(
     kept: list[Slice] = []
     centers: list[tuple[float, float]] = []
     first_reason = -1
+    kernel, arguments = _kernel_call(observation, landmark, max_vertices)
     for piece in slices:
-        middle = clamp_into(heading, piece.lo, piece.hi)
-        found = _kernel(
-            piece.vertices, center_x, center_y, middle, middle - piece.lo, max(0.0, piece.hi - middle),
-            observation, landmark, max_vertices,
-        )  # fmt: skip
+        piece_lo, piece_hi = piece.lo, piece.hi
+        middle = clamp_into(heading, piece_lo, piece_hi)
+        found = kernel(
+            piece.vertices,
+            center_x,
+            center_y,
+            middle,
+            middle - piece_lo,
+            max(0.0, piece_hi - middle),
+            *arguments,
+        )
         if isinstance(found, int):
             if first_reason < 0:
                 first_reason = found
             continue
         raw, lo, width, x, y, _, _ = found
-        new_lo, new_hi = narrowed(lo, width, piece.lo, piece.hi)
-        kept.append(Slice(new_lo, new_hi, np.frombuffer(raw, _FLOAT64).reshape(-1, 2)))
+        if width < piece_hi - piece_lo:
+            piece_lo, piece_hi = narrowed(lo, width, piece_lo, piece_hi)
+        kept.append(Slice(piece_lo, piece_hi, np.frombuffer(raw, _FLOAT64).reshape(-1, 2)))
         centers.append((x, y))
     if not kept:
         return _REASONS[first_reason]

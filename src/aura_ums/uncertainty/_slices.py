@@ -127,7 +127,9 @@ def split_product(vertices: Array, lo: float, width: float, cells: int) -> tuple
     return distribute([(lo, lo + width, vertices)], cells, len(vertices))
 
 
-def distribute(pieces: Sequence[tuple[float, float, Array]], cells: int, max_vertices: int) -> tuple[Slice, ...]:
+def distribute(
+    pieces: Sequence[tuple[float, float, Array]], cells: int, max_vertices: int
+) -> tuple[Slice, ...]:
     """Put heading intervals with polygons onto the grid, one slice per covered cell.
 
     A piece ``(a, b, vertices)`` (radians, unwrapped, ``a <= b``; ``b - a >= 2 pi`` is every
