@@ -282,7 +282,7 @@ class UncertaintyMapManager:
         self._joint_sector = settings.joint_sector
         self._max_vertices = settings.max_vertices
         self._envelope_factor = settings.envelope_factor
-        self._map = initial_map = _in_form(initial_map, settings)
+        self._map = _in_form(initial_map, settings)
         self._map_time: float | None = None
         self._consumed = 0
         self._state = ManagerState.NOMINAL

@@ -143,31 +143,33 @@ def distribute(
         Ordered by ``lo``; each slice's interval inside its cell.
     """
     step = _TWO_PI / cells
-    found: dict[int, tuple[float, float, list[Array]]] = {}
-    for a, b, vertices in pieces:
-        if b - a >= _TWO_PI:
-            first, last, a, b = 0, cells - 1, 0.0, _TWO_PI
-        else:
-            first = math.floor(a / step)
-            last = max(first, math.ceil(b / step) - 1)
-        for k in range(first, last + 1):
-            cell = k % cells
-            shift = (k - cell) * step
-            lo = max(a, k * step) - shift
-            hi = min(b, (k + 1) * step) - shift
-            # Rounding must not leave the cell, nor turn the interval inside out.
-            lo = min(max(lo, cell * step), (cell + 1) * step)
-            hi = min(max(hi, lo), (cell + 1) * step)
-            held = found.get(cell)
-            if held is None:
-                found[cell] = (lo, hi, [vertices])
-            else:
-                held[2].append(vertices)
-                found[cell] = (min(held[0], lo), max(held[1], hi), held[2])
-    cells_in_order = sorted(found)
-    hulls = merged_all([found[cell][2] for cell in cells_in_order], max_vertices)
+    starts = np.array([a for a, _, _ in pieces])
+    stops = np.array([b for _, b, _ in pieces])
+    every = stops - starts >= _TWO_PI
+    starts[every], stops[every] = 0.0, _TWO_PI
+    first = np.floor(starts / step).astype(np.int64)
+    last = np.maximum(first, np.ceil(stops / step).astype(np.int64) - 1)
+    # One row per (piece, cell it meets): k the cell's unwrapped index.
+    spans = last - first + 1
+    owner = np.repeat(np.arange(len(pieces)), spans)
+    k = np.repeat(first - np.cumsum(spans) + spans, spans) + np.arange(int(spans.sum()))
+    cell = k % cells
+    shift = (k - cell) * step
+    cell_lo, cell_hi = cell * step, (cell + 1) * step
+    # Rounding must not leave the cell, nor turn the interval inside out.
+    lo = np.minimum(np.maximum(np.maximum(starts[owner], k * step) - shift, cell_lo), cell_hi)
+    hi = np.minimum(np.maximum(np.minimum(stops[owner], (k + 1) * step) - shift, lo), cell_hi)
+    occupied, where = np.unique(cell, return_inverse=True)
+    lows = np.full(len(occupied), np.inf)
+    highs = np.full(len(occupied), -np.inf)
+    np.minimum.at(lows, where, lo)
+    np.maximum.at(highs, where, hi)
+    groups: list[list[Array]] = [[] for _ in range(len(occupied))]
+    for slot, index in zip(where.tolist(), owner.tolist(), strict=True):
+        groups[slot].append(pieces[index][2])
+    hulls = merged_all(groups, max_vertices)
     return tuple(
-        Slice(found[cell][0], found[cell][1], hull) for cell, hull in zip(cells_in_order, hulls, strict=True)
+        Slice(low, high, hull) for low, high, hull in zip(lows.tolist(), highs.tolist(), hulls, strict=True)
     )
 
 
