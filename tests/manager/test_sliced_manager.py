@@ -10,7 +10,8 @@ import pytest
 
 from aura_ums.errors import FileFormatError
 from aura_ums.manager import ManagerSettings, UncertaintyMapManager
-from aura_ums.uncertainty import DEFAULT_MAX_SLICES, Pose, SpatialUncertaintyMap
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
+from aura_ums.uncertainty._slices import DEFAULT_MAX_SLICES
 from tests.manager.test_map_manager import (
     POLE_NORTH,
     START,

@@ -26,12 +26,10 @@ from aura_ums.uncertainty._landmarks import (
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import FOOT, TurnAndRun
 from aura_ums.uncertainty._reduce import Reduction
-from aura_ums.uncertainty._slices import DEFAULT_MAX_SLICES, DEFAULT_SLICE_WIDTH, HeadingSlice
+from aura_ums.uncertainty._slices import HeadingSlice
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 
 __all__ = [
-    "DEFAULT_MAX_SLICES",
-    "DEFAULT_SLICE_WIDTH",
     "FOOT",
     "BearingObservation",
     "ContainmentResult",

@@ -220,10 +220,10 @@ def narrowed(arc_lo: float, arc_width: float, lo: float, hi: float) -> tuple[flo
 
     Examples
     --------
-    >>> narrowed(0.15 - 2 * math.pi, 0.02, 0.1, 0.2)     # any winding of the arc
-    (0.15, 0.17)
-    >>> narrowed(0.05, 0.1, 0.1, 0.2)                    # cut to the slice
-    (0.1, 0.15000000000000002)
+    >>> [round(h, 9) for h in narrowed(0.15 - 2 * math.pi, 0.02, 0.1, 0.2)]   # any winding
+    [0.15, 0.17]
+    >>> [round(h, 9) for h in narrowed(0.05, 0.1, 0.1, 0.2)]                  # cut to the slice
+    [0.1, 0.15]
     """
     span = hi - lo
     if arc_width >= span:

@@ -120,7 +120,7 @@ def split_product(vertices: Array, lo: float, width: float, cells: int) -> tuple
     --------
     >>> point = np.zeros((1, 2))
     >>> [(round(s.lo, 3), round(s.hi, 3)) for s in split_product(point, -0.1, 0.3, 36)]
-    [(0.0, 0.174), (0.174, 0.2), (6.183, 6.283)]
+    [(0.0, 0.175), (0.175, 0.2), (6.183, 6.283)]
     >>> len(split_product(point, 0.0, 7.0, 36))    # every heading: every cell
     36
     """
