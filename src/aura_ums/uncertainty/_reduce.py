@@ -222,8 +222,8 @@ def narrowed(arc_lo: float, arc_width: float, lo: float, hi: float) -> tuple[flo
     --------
     >>> [round(h, 9) for h in narrowed(0.15 - 2 * math.pi, 0.02, 0.1, 0.2)]   # any winding
     [0.15, 0.17]
-    >>> [round(h, 9) for h in narrowed(0.05, 0.1, 0.1, 0.2)]                  # cut to the slice
-    [0.1, 0.15]
+    >>> [round(h, 9) for h in narrowed(0.05, 0.08, 0.1, 0.2)]                 # cut to the slice
+    [0.1, 0.13]
     """
     span = hi - lo
     if arc_width >= span:
