@@ -7,13 +7,13 @@ when aura-ums is imported: the C one when the extension was built, unless the en
 sets ``AURA_UMS_NATIVE=0``; the numpy reference otherwise (:data:`NATIVE`).
 
 Only the layer that owns a kernel calls it, as ``_native.<kernel>``: ``uncertainty`` the
-growth and the reductions, ``expecter`` its points, ``schemas`` the polygon distance. This
-package imports nothing of aura-ums but ``geometry``.
+growth, the reductions and the slices' merging, ``expecter`` its points, ``schemas`` the
+polygon distance. This package imports nothing of aura-ums but ``geometry``.
 """
 
 import os
 
-from aura_ums._native import _distance, _expecter, _growth, _reduce
+from aura_ums._native import _distance, _expecter, _growth, _reduce, _slices
 from aura_ums._native._expecter import ExpectedPoints
 from aura_ums._native._extension import BUILT
 from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bounds
@@ -37,6 +37,7 @@ reduce_cone: ConeKernel = _reduce.reduce_cone_compiled if NATIVE else _reduce.re
 reduce_strip: StripKernel = _reduce.reduce_strip_compiled if NATIVE else _reduce.reduce_strip_reference
 expecter_points = _expecter.expecter_points_compiled if NATIVE else _expecter.expecter_points_reference
 polygon_distance = _distance.polygon_distance_compiled if NATIVE else _distance.polygon_distance_reference
+merge_groups = _slices.merge_groups_compiled if NATIVE else _slices.merge_groups_reference
 
 __all__ = [
     "BUILT",
@@ -53,6 +54,7 @@ __all__ = [
     "cap_inside",
     "expecter_points",
     "grow_commands",
+    "merge_groups",
     "motion_bounds",
     "polygon_distance",
     "reduce_cone",

@@ -178,5 +178,6 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 
 #endif

@@ -1,6 +1,6 @@
 /*
  * The extension module aura_ums._native._kernels: the kernels of growth.c, reduce.c,
- * expecter.c and distance.c, and the constants of kernels.h, exported so that a test can
+ * expecter.c, distance.c and slices.c, and the constants of kernels.h, exported so that a test can
  * check them against their Python twins.
  */
 #include "kernels.h"
@@ -26,6 +26,9 @@ static PyMethodDef methods[] = {
      "x_min, y_min, x_max, y_max)"},
     {"polygon_distance", (PyCFunction)(void (*)(void))polygon_distance, METH_FASTCALL,
      "polygon_distance(vertices, ax, ay, bx, by) -> distance from the convex polygon to the segment [a, b]"},
+    {"merge_groups", (PyCFunction)(void (*)(void))merge_groups, METH_FASTCALL,
+     "merge_groups(points, counts, max_vertices) -> tuple of vertex bytes: for each group of counts[i] "
+     "consecutive rows of the (n, 2) float64 points, their convex hull with the outer vertex cap"},
     {NULL, NULL, 0, NULL},
 };
 

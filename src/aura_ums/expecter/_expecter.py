@@ -34,6 +34,11 @@ the extremes of a projection over a convex set are attained at its extreme point
 those are actual poses (a vertex of the map with an end of the wedge, or a point of the
 landmark's own set).
 
+A heading-sliced map (``SpatialUncertaintyMap.is_sliced``) is a union of such product
+sets, one per slice: its window is the bounding window of the slices' windows, each made as
+above from the slice's polygon and interval, so it holds every projection too, and a slice
+keeps only the positions possible at its own headings.
+
 The geometry, from the map's vertices to the normalized points and their box, is one
 kernel of ``aura_ums._native`` (:func:`~aura_ums._native.expecter_points`, compiled when the
 C extension was built, its numpy reference otherwise); here the landmark and the mount
@@ -192,23 +197,15 @@ def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) 
     ends, heights = _landmark_geometry(landmark)
     camera = expecter.camera
     mount, k = camera.mount, camera.intrinsics
-    wedge = map.wedge
-    full = wedge.is_full_circle
-    found = _native.expecter_points(
-        map.polygon.vertices,
-        ends,
-        landmark.position_uncertainty,
-        _DISK_SIDES,
-        full,
-        0.0 if full else wedge.center - wedge.cw,
-        0.0 if full else wedge.width,
-        _ARC_STEP,
-        expecter._rotation,
-        mount.forward,
-        mount.left,
-        tuple(height - mount.height for height in heights),
-        _CUT_PLANE,
-    )
+    rises = tuple(height - mount.height for height in heights)
+    if map.is_sliced:
+        found = _sliced_points(expecter, map, ends, landmark.position_uncertainty, rises)
+    else:
+        wedge = map.wedge
+        found = _points(
+            expecter, map.polygon.vertices, ends, landmark.position_uncertainty,
+            wedge.is_full_circle, wedge.center - wedge.cw, wedge.width, rises,
+        )  # fmt: skip
     if found is None:
         return None
     if k.distortion is None:
@@ -223,6 +220,70 @@ def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) 
         _outward(float(v[0]), -1.0),
         _outward(float(u[1]), 1.0),
         _outward(float(v[1]), 1.0),
+    )
+
+
+def _points(
+    expecter: Expecter,
+    vertices: Array,
+    ends: tuple[tuple[float, float], ...],
+    uncertainty: float,
+    full: bool,
+    lo: float,
+    width: float,
+    rises: tuple[float, ...],
+) -> _native.ExpectedPoints | None:
+    """Return the kernel's points for one polygon and heading interval (``full``: every heading)."""
+    mount = expecter.camera.mount
+    return _native.expecter_points(
+        vertices,
+        ends,
+        uncertainty,
+        _DISK_SIDES,
+        full,
+        0.0 if full else lo,
+        0.0 if full else width,
+        _ARC_STEP,
+        expecter._rotation,
+        mount.forward,
+        mount.left,
+        rises,
+        _CUT_PLANE,
+    )
+
+
+def _sliced_points(
+    expecter: Expecter,
+    map: SpatialUncertaintyMap,
+    ends: tuple[tuple[float, float], ...],
+    uncertainty: float,
+    rises: tuple[float, ...],
+) -> _native.ExpectedPoints | None:
+    """Return the points of every slice of a sliced map and their joint box (None: behind from all).
+
+    Every pose of the map lies in some slice, and each slice's points span every projection
+    from its poses (the method above, with the slice's polygon and interval for ``P`` and
+    ``W``): so the box of all the slices' boxes spans every projection from the map, and
+    is the bounding window of the per-slice windows.
+    """
+    found: list[_native.ExpectedPoints] = []
+    for piece in map.slices:
+        full = piece.width >= 2.0 * math.pi
+        points = _points(
+            expecter, piece.polygon.vertices, ends, uncertainty, full, piece.lo, piece.width, rises
+        )
+        if points is not None:
+            found.append(points)
+    if not found:
+        return None
+    if len(found) == 1:
+        return found[0]
+    return _native.ExpectedPoints(
+        np.concatenate([f.points for f in found]),
+        min(f.x_min for f in found),
+        min(f.y_min for f in found),
+        max(f.x_max for f in found),
+        max(f.y_max for f in found),
     )
 
 

@@ -23,6 +23,7 @@ from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
     BearingObservation,
     GroundLineObservation,
+    HeadingSlice,
     Observation,
     RangeBearingObservation,
     SpatialUncertaintyMap,
@@ -162,23 +163,8 @@ class Reader:
         collinear vertices stay, and the wedge centre is not wrapped again (re-wrapping a
         centre already in (-pi, pi] can move it by one unit in the last place).
         """
-        data = self.mapping(value, where, ("vertices", "center", "wedge"))
-        rows = self.array(data["vertices"], f"{where}.vertices")
-        if not rows:
-            self.fail(f"{where}.vertices", "expected at least one vertex, got none")
-        points: list[tuple[float, float]] = []
-        for k, row in enumerate(rows):
-            place = f"{where}.vertices[{k}]"
-            pair = self.array(row, place)
-            if len(pair) != 2:
-                self.fail(place, f"expected [x, y], got {len(pair)} numbers")
-            points.append((self.number(pair[0], f"{place}[0]"), self.number(pair[1], f"{place}[1]")))
-        vertices = np.array(points, dtype=np.float64)
-        try:
-            ConvexPolygon(vertices)  # validates; it would drop collinear vertices the map kept
-        except InputError as exc:
-            self.fail(f"{where}.vertices", str(exc))
-        polygon = ConvexPolygon._trusted(vertices)
+        data = self.mapping(value, where, ("vertices", "center", "wedge"), optional=("slices",))
+        polygon = self.polygon(data["vertices"], f"{where}.vertices")
         center_list = self.array(data["center"], f"{where}.center")
         if len(center_list) != 2:
             self.fail(f"{where}.center", f"expected [x, y], got {len(center_list)} numbers")
@@ -198,10 +184,54 @@ class Reader:
             )
         except InputError as exc:
             self.fail(f"{where}.wedge", str(exc))
+        if "slices" in data:
+            return self._sliced_map(data["slices"], f"{where}.slices", center, wedge)
         try:
             return SpatialUncertaintyMap.from_polygon(polygon, center, wedge)
         except InputError as exc:
             self.fail(f"{where}.center", str(exc))
+
+    def polygon(self, value: object, where: str) -> ConvexPolygon:
+        """Decode a polygon's vertex list, bit for bit (collinear vertices kept)."""
+        rows = self.array(value, where)
+        if not rows:
+            self.fail(where, "expected at least one vertex, got none")
+        points: list[tuple[float, float]] = []
+        for k, row in enumerate(rows):
+            place = f"{where}[{k}]"
+            pair = self.array(row, place)
+            if len(pair) != 2:
+                self.fail(place, f"expected [x, y], got {len(pair)} numbers")
+            points.append((self.number(pair[0], f"{place}[0]"), self.number(pair[1], f"{place}[1]")))
+        vertices = np.array(points, dtype=np.float64)
+        try:
+            ConvexPolygon(vertices)  # validates; it would drop collinear vertices the map kept
+        except InputError as exc:
+            self.fail(where, str(exc))
+        return ConvexPolygon._trusted(vertices)
+
+    def _sliced_map(
+        self, value: object, where: str, center: tuple[float, float], wedge: HeadingWedge
+    ) -> SpatialUncertaintyMap:
+        """Decode the slices written by :func:`encode_map` and build the sliced map."""
+        data = self.mapping(value, where, ("slice_width", "max_slices", "pieces"))
+        width = self.number(data["slice_width"], f"{where}.slice_width")
+        cap = self.integer(data["max_slices"], f"{where}.max_slices", 1)
+        pieces: list[HeadingSlice] = []
+        for k, item in enumerate(self.array(data["pieces"], f"{where}.pieces")):
+            place = f"{where}.pieces[{k}]"
+            piece = self.mapping(item, place, ("lo", "width", "vertices"))
+            pieces.append(
+                HeadingSlice(
+                    self.polygon(piece["vertices"], f"{place}.vertices"),
+                    self.number(piece["lo"], f"{place}.lo"),
+                    self.number(piece["width"], f"{place}.width"),
+                )
+            )
+        try:
+            return SpatialUncertaintyMap.from_slices(pieces, center, wedge, slice_width=width, max_slices=cap)
+        except InputError as exc:
+            self.fail(where, str(exc))
 
 
 def encode_command(command: TurnAndRun) -> dict[str, float]:
@@ -219,13 +249,23 @@ def encode_observation(observation: Observation) -> dict[str, object]:
 
 
 def encode_map(uncertainty_map: SpatialUncertaintyMap) -> dict[str, object]:
-    """Return a map as a JSON object: vertices, centre and wedge, every float exact."""
+    """Return a map as a JSON object: vertices, centre, wedge (and slices), every float exact."""
     wedge = uncertainty_map.wedge
-    return {
+    data: dict[str, object] = {
         "vertices": uncertainty_map.polygon.vertices.tolist(),
         "center": uncertainty_map.center.tolist(),
         "wedge": {"center": wedge.center, "cw": wedge.cw, "ccw": wedge.ccw},
     }
+    if uncertainty_map.is_sliced:
+        data["slices"] = {
+            "slice_width": uncertainty_map.slice_width,
+            "max_slices": uncertainty_map.max_slices,
+            "pieces": [
+                {"lo": piece.lo, "width": piece.width, "vertices": piece.polygon.vertices.tolist()}
+                for piece in uncertainty_map.slices
+            ],
+        }
+    return data
 
 
 def _found(table: Mapping[str, object], key: str) -> str:

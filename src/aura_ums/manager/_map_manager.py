@@ -282,7 +282,7 @@ class UncertaintyMapManager:
         self._joint_sector = settings.joint_sector
         self._max_vertices = settings.max_vertices
         self._envelope_factor = settings.envelope_factor
-        self._map = initial_map
+        self._map = _in_form(initial_map, settings)
         self._map_time: float | None = None
         self._consumed = 0
         self._state = ManagerState.NOMINAL
@@ -297,11 +297,14 @@ class UncertaintyMapManager:
         if settings.robust:
             cap = settings.envelope_max_vertices
             # The envelope's own lost state and recovery are never read: limits off, no envelope.
+            # It stays a product map: the fallback needs containment more than tightness, and
+            # a sliced envelope would double a sliced manager's cost.
             envelope_settings = dataclasses.replace(
                 settings,
                 robust=False,
                 area_limit=None,
                 max_vertices=settings.max_vertices if cap is None else cap,
+                slice_width=None,
             )
             self._envelope = UncertaintyMapManager(initial_map, meadow_map, table, envelope_settings)
 
@@ -478,7 +481,7 @@ class UncertaintyMapManager:
                 if reason is None or reason.inconsistent:
                     recent.append(reason is not None)
             if sum(recent) >= self._settings.relocalize_after:
-                self._map = self._reseed(wide, [o.observation for o in outcomes])
+                self._map = _in_form(self._reseed(wide, [o.observation for o in outcomes]), self._settings)
                 self._relocalizations += 1
                 recent.clear()
                 relocalized = True
@@ -619,7 +622,7 @@ class UncertaintyMapManager:
         """
         if not isinstance(new_map, SpatialUncertaintyMap):
             raise InputError(f"new_map: expected a SpatialUncertaintyMap, got {type(new_map).__name__}")
-        self._map = new_map
+        self._map = _in_form(new_map, self._settings)
         self._relocalizations += 1
         self._recent.clear()  # the inconsistencies were the old map's
         self._state, self._lost_reason = ManagerState.NOMINAL, ""
@@ -964,6 +967,13 @@ class UncertaintyMapManager:
 #: What a saved document lacking a setting ran with: one by one before joint reductions,
 #: without an envelope before outlier recovery; the defaults otherwise.
 _BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False)
+
+
+def _in_form(uncertainty_map: SpatialUncertaintyMap, settings: ManagerSettings) -> SpatialUncertaintyMap:
+    """Return the map sliced as ``settings.slice_width`` says (None: the product map)."""
+    if settings.slice_width is None:
+        return uncertainty_map.without_slices()
+    return uncertainty_map.with_slices(settings.slice_width, settings.max_slices)
 
 
 def _widened(observation: Observation, factor: float) -> Observation:

@@ -223,6 +223,32 @@ relocalize_after (2), got 1
         64,
         SettingInfo("Cap on the map polygon's vertices: fewer is faster and looser", "", int, low=3),
     )
+    # max_slices defaults to what SpatialUncertaintyMap.with_slices takes (tests/manager/
+    # test_sliced_manager.py holds them equal).
+    slice_width: float | None = _setting(
+        None,
+        SettingInfo(
+            "Width of the global heading grid's cells of a heading-sliced map, which keeps a "
+            "polygon of positions per heading interval (none: the paper's product map, one "
+            "polygon for every heading)",
+            "rad",
+            float,
+            low=0.0,
+            high=_TWO_PI,
+            low_open=True,
+            nullable=True,
+            off_flag="--product-map",
+        ),
+    )
+    max_slices: int = _setting(
+        48,
+        SettingInfo(
+            "Cap on a sliced map's slice count: beyond it neighbours merge (fewer is faster and looser)",
+            "",
+            int,
+            low=1,
+        ),
+    )
     robust: bool = _setting(
         True,
         SettingInfo(
@@ -300,7 +326,8 @@ relocalize_after (2), got 1
         ...
         aura_ums.errors.InputError: ManagerSettings.sigma: expected a field of ManagerSettings \
 (sigmas, area_limit, missed_limit, lost_window_scale, joint_above, joint_sector, max_vertices, \
-robust, envelope_factor, envelope_max_vertices, relocalize_after, relocalize_window), got 'sigma'
+slice_width, max_slices, robust, envelope_factor, envelope_max_vertices, relocalize_after, \
+relocalize_window), got 'sigma'
         """
         report = _fail if fail is None else fail
         if not isinstance(data, Mapping):

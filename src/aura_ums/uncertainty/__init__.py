@@ -26,6 +26,7 @@ from aura_ums.uncertainty._landmarks import (
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import FOOT, TurnAndRun
 from aura_ums.uncertainty._reduce import Reduction
+from aura_ums.uncertainty._slices import HeadingSlice
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "ContainmentResult",
     "GroundLineLandmark",
     "GroundLineObservation",
+    "HeadingSlice",
     "Landmark",
     "LandmarkClass",
     "MotionBounds",

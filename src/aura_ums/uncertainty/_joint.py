@@ -8,6 +8,9 @@ wedge is split into sectors no wider than ``sector``, the map restricted to each
 is reduced by every observation in turn, and the result is the convex hull of what the
 sectors keep, with the smallest wedge (inside the prior's) that holds their headings.
 
+A sliced map (:meth:`SpatialUncertaintyMap.with_slices`) is reduced slice by slice already:
+its slices are the sectors (``sector`` is not used) and the result stays sliced.
+
 Soundness follows from the single reductions': a true pose's heading lies in some
 sector, whose reductions keep the pose; the hull and the covering wedge only add. Every
 sector's result lies inside the prior, so their hull does too. The hull may have more
@@ -115,7 +118,9 @@ def reduce_jointly(
     wedge = prior.wedge
     lo, width = wedge.center - wedge.cw, min(wedge.width, _TWO_PI)
     count = max(1, math.ceil(width / width_limit - 1e-9))
-    if count == 1:
+    if count == 1 or prior.is_sliced:
+        # A sliced map's slices are its sectors: each is reduced by every observation in
+        # turn, and a slice that disagrees with one drops out.
         found = _in_turn(prior, pairs, cap)
         if isinstance(found, str):
             area = prior.area

@@ -1,4 +1,11 @@
-"""The spatial uncertainty map: a convex polygon of positions and a compass wedge of headings."""
+"""The spatial uncertainty map: a convex polygon of positions and a compass wedge of headings.
+
+A map is either a *product* (the paper's: every position of the polygon with every heading
+of the wedge) or *sliced* (``_slices``): a convex polygon of positions per interval of a
+fixed global heading grid, which keeps the coupling of position and heading that a long run
+creates. The polygon and the wedge of a sliced map are its summary: the hull of the slices'
+polygons and the smallest wedge holding their intervals.
+"""
 
 from __future__ import annotations
 
@@ -11,13 +18,44 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums import _native
-from aura_ums._validate import float_array, nonnegative_float, points_array, read_only
+from aura_ums._validate import (
+    finite_float,
+    float_array,
+    integer_at_least,
+    nonnegative_float,
+    points_array,
+    read_only,
+)
 from aura_ums.errors import InputError
-from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, Pose, outer_disk, wrap_angle
+from aura_ums.geometry import (
+    POSITION_TOLERANCE,
+    ConvexPolygon,
+    HeadingWedge,
+    Pose,
+    outer_disk,
+    points_in_convex,
+    polygon_area,
+    wrap_angle,
+)
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._reduce import Reduced, Reduction, reduce_checked, reduce_map
+from aura_ums.uncertainty._slices import (
+    DEFAULT_MAX_SLICES,
+    DEFAULT_SLICE_WIDTH,
+    HeadingSlice,
+    Slice,
+    capped,
+    cell_count,
+    clamp_into,
+    distribute,
+    home_slice,
+    split_product,
+    summary_polygon,
+    summary_wedge,
+)
+from aura_ums.uncertainty._slices import contains as slices_contain
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _START_DISK_SIDES = 16
@@ -52,12 +90,19 @@ class SpatialUncertaintyMap:
     True
     """
 
-    polygon: ConvexPolygon
+    # The polygon; for a sliced map the hull of its slices, built on first use (a frame's
+    # growth and reductions each make a map, and only the last one's summary is read).
+    _polygon: ConvexPolygon | None = field(repr=False, compare=False)
     center: NDArray[np.float64]
     wedge: HeadingWedge
     # The most probable pose, built on first use: the Expecter, the schemas and the
     # manager's meadow lookups ask for it several times per frame.
     _pose: Pose | None = field(init=False, repr=False, compare=False)
+    # The slices of a sliced map (None: a product map), the grid's cell count and the cap
+    # on the slice count.
+    _slices: tuple[Slice, ...] | None = field(init=False, repr=False, compare=False)
+    _cells: int = field(init=False, repr=False, compare=False)
+    _max_slices: int = field(init=False, repr=False, compare=False)
 
     def __init__(self, polygon: ConvexPolygon, center: ArrayLike, wedge: HeadingWedge) -> None:
         if not isinstance(polygon, ConvexPolygon):
@@ -69,10 +114,13 @@ class SpatialUncertaintyMap:
             raise InputError(f"center: expected one (x, y) point, got shape {point.shape}")
         if not polygon.contains(point, tolerance=1e-6)[0]:
             raise InputError(f"center: expected a point inside the polygon, got {point[0].tolist()}")
-        object.__setattr__(self, "polygon", polygon)
+        object.__setattr__(self, "_polygon", polygon)
         object.__setattr__(self, "center", read_only(point[0].copy()))
         object.__setattr__(self, "wedge", wedge)
         object.__setattr__(self, "_pose", None)
+        object.__setattr__(self, "_slices", None)
+        object.__setattr__(self, "_cells", 0)
+        object.__setattr__(self, "_max_slices", 0)
 
     @classmethod
     def _trusted(
@@ -85,7 +133,212 @@ class SpatialUncertaintyMap:
         _set_center(result, center)
         _set_wedge(result, wedge)
         _set_pose(result, None)
+        _set_slices(result, None)
+        _set_cells(result, 0)
+        _set_max_slices(result, 0)
         return result
+
+    @classmethod
+    def _sliced(
+        cls,
+        slices: tuple[Slice, ...],
+        center: NDArray[np.float64],
+        heading: float,
+        cells: int,
+        max_slices: int,
+        polygon: ConvexPolygon | None = None,
+    ) -> SpatialUncertaintyMap:
+        """Build a sliced map; ``heading`` (radians, any winding) is clamped into the slices' wedge."""
+        result = object.__new__(cls)
+        center.setflags(write=False)
+        _set_polygon(result, polygon)
+        _set_center(result, center)
+        _set_wedge(result, summary_wedge(slices, heading))
+        _set_pose(result, None)
+        _set_slices(result, slices)
+        _set_cells(result, cells)
+        _set_max_slices(result, max_slices)
+        return result
+
+    @property
+    def polygon(self) -> ConvexPolygon:
+        """Possible positions (metres, world frame); for a sliced map the hull of its slices."""
+        polygon = self._polygon
+        if polygon is None:
+            slices = self._slices
+            assert slices is not None  # only a sliced map defers its polygon
+            polygon = ConvexPolygon._trusted(summary_polygon(slices))
+            _set_polygon(self, polygon)
+        return polygon
+
+    @property
+    def is_sliced(self) -> bool:
+        """Whether the map keeps heading slices (else it is the paper's product map)."""
+        return self._slices is not None
+
+    @property
+    def slice_width(self) -> float | None:
+        """Width of the heading grid's cells, radians; None for a product map."""
+        return None if self._slices is None else 2.0 * math.pi / self._cells
+
+    @property
+    def max_slices(self) -> int | None:
+        """Cap on the slice count; None for a product map."""
+        return None if self._slices is None else self._max_slices
+
+    @property
+    def slices(self) -> tuple[HeadingSlice, ...]:
+        """The map as heading slices, ordered by heading: one (the polygon and wedge) for a product map.
+
+        Every pose of the map lies in some slice: its position in the slice's polygon and
+        its heading in the slice's interval.
+
+        Examples
+        --------
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, math.radians(3))
+        >>> len(start.slices), len(start.with_slices(math.radians(2)).slices)
+        (1, 4)
+        """
+        slices = self._slices
+        if slices is None:
+            wedge = self.wedge
+            lo = (wedge.center - wedge.cw) % (2.0 * math.pi)
+            return (HeadingSlice(self.polygon, lo, wedge.width),)
+        return tuple(
+            HeadingSlice(ConvexPolygon._trusted(piece.vertices), piece.lo, piece.hi - piece.lo)
+            for piece in slices
+        )
+
+    def with_slices(
+        self, slice_width: float = DEFAULT_SLICE_WIDTH, max_slices: int = DEFAULT_MAX_SLICES
+    ) -> SpatialUncertaintyMap:
+        """Return this map as a sliced map: one slice per heading cell the wedge covers.
+
+        The pose set is the same (a product map's polygon at every covered cell's part of
+        the wedge); growth and reductions then act slice by slice, keeping position and
+        heading coupled. A sliced map is returned as it is when its grid and cap are these,
+        else first taken back to its summary.
+
+        Parameters
+        ----------
+        slice_width : float
+            Widest grid cell, radians, in (0, 2 pi]; the grid has a whole number of cells,
+            the first starting at heading 0.
+        max_slices : int
+            Cap on the slice count (>= 1): beyond it neighbours merge (an outer bound).
+
+        Examples
+        --------
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, math.radians(5))
+        >>> sliced = start.with_slices(math.radians(2))
+        >>> sliced.is_sliced, len(sliced.slices), sliced.area == start.area
+        (True, 6, True)
+        >>> len(start.with_slices(math.radians(2), max_slices=1).slices)   # capped: one slice
+        1
+        """
+        width = finite_float(slice_width, "slice_width")
+        if not 0.0 < width <= 2.0 * math.pi:
+            raise InputError(f"slice_width: expected radians in (0, 2 pi], got {width!r}")
+        cap = integer_at_least(max_slices, "max_slices", 1)
+        cells = cell_count(width)
+        if self._slices is not None and self._cells == cells and self._max_slices == cap:
+            return self
+        wedge = self.wedge
+        polygon = self.polygon
+        vertices = polygon.vertices
+        slices = split_product(vertices, wedge.center - wedge.cw, wedge.width, cells)
+        if len(slices) > cap:
+            slices = capped(slices, cap, max(len(vertices), 3))
+        return SpatialUncertaintyMap._sliced(slices, self.center, wedge.center, cells, cap, polygon)
+
+    @classmethod
+    def from_slices(
+        cls,
+        slices: Sequence[HeadingSlice],
+        center: ArrayLike,
+        wedge: HeadingWedge,
+        *,
+        slice_width: float,
+        max_slices: int,
+    ) -> SpatialUncertaintyMap:
+        """Build a sliced map from its parts (validated), as :attr:`slices` and the summary give them.
+
+        The wedge is kept as given (a saved map is restored bit for bit); it must hold
+        every slice's interval, and ``center`` must lie in some slice's polygon.
+
+        Parameters
+        ----------
+        slices : sequence of HeadingSlice
+            At least one and at most ``max_slices``, ordered by ``lo`` (radians in
+            [0, 2 pi)), each ``width`` in [0, 2 pi].
+        center : array_like, shape (2,)
+            Most probable position, metres.
+        wedge : HeadingWedge
+            The summary wedge; its centre is the most probable heading.
+        slice_width : float
+            The grid's cell width, radians, in (0, 2 pi].
+        max_slices : int
+            Cap on the slice count, >= 1.
+
+        Examples
+        --------
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, 0.1).with_slices()
+        >>> again = SpatialUncertaintyMap.from_slices(
+        ...     start.slices, start.center, start.wedge, slice_width=start.slice_width, max_slices=48)
+        >>> again.contains(Pose(0.1, 0.1, 0.05)), len(again.slices) == len(start.slices)
+        (True, True)
+        >>> SpatialUncertaintyMap.from_slices([], (0, 0), start.wedge, slice_width=0.1, max_slices=4)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: slices: expected 1 to 4 heading slices, got 0
+        """
+        width = finite_float(slice_width, "slice_width")
+        if not 0.0 < width <= 2.0 * math.pi:
+            raise InputError(f"slice_width: expected radians in (0, 2 pi], got {width!r}")
+        cap = integer_at_least(max_slices, "max_slices", 1)
+        if not isinstance(wedge, HeadingWedge):
+            raise InputError(f"wedge: expected a HeadingWedge, got {type(wedge).__name__}")
+        if not 1 <= len(slices) <= cap:
+            raise InputError(f"slices: expected 1 to {cap} heading slices, got {len(slices)}")
+        pieces: list[Slice] = []
+        for index, piece in enumerate(slices):
+            if not isinstance(piece, HeadingSlice) or not isinstance(piece.polygon, ConvexPolygon):
+                raise InputError(f"slices[{index}]: expected a HeadingSlice, got {type(piece).__name__}")
+            lo = finite_float(piece.lo, f"slices[{index}].lo")
+            span = finite_float(piece.width, f"slices[{index}].width")
+            if not 0.0 <= lo < 2.0 * math.pi or not 0.0 <= span <= 2.0 * math.pi:
+                raise InputError(
+                    f"slices[{index}]: expected lo in [0, 2 pi) and width in [0, 2 pi], got {lo!r}, {span!r}"
+                )
+            if pieces and lo < pieces[-1].lo:
+                raise InputError(
+                    f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {pieces[-1].lo!r}"
+                )
+            if not (wedge.contains(lo) and wedge.contains(lo + span)):
+                raise InputError(
+                    f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}"
+                )
+            pieces.append(Slice(lo, lo + span, piece.polygon.vertices))
+        point = points_array(center, "center", min_rows=1)
+        if point.shape != (1, 2):
+            raise InputError(f"center: expected one (x, y) point, got shape {point.shape}")
+        if not any(points_in_convex(p.vertices, point, 1e-6)[0] for p in pieces):
+            raise InputError(f"center: expected a point inside a slice's polygon, got {point[0].tolist()}")
+        result = object.__new__(cls)
+        _set_polygon(result, None)
+        _set_center(result, read_only(point[0].copy()))
+        _set_wedge(result, wedge)
+        _set_pose(result, None)
+        _set_slices(result, tuple(pieces))
+        _set_cells(result, cell_count(width))
+        _set_max_slices(result, cap)
+        return result
+
+    def without_slices(self) -> SpatialUncertaintyMap:
+        """Return the product map of this map's summary (its polygon and wedge); itself when a product."""
+        if self._slices is None:
+            return self
+        return SpatialUncertaintyMap._trusted(self.polygon, self.center, self.wedge)
 
     @classmethod
     def from_pose(cls, pose: Pose, position_radius: float, heading_halfwidth: float) -> SpatialUncertaintyMap:
@@ -190,6 +443,8 @@ class SpatialUncertaintyMap:
         values: list[float] = []
         for command in commands:
             values += (command.turn, command.run)
+        if self._slices is not None:
+            return _grow_sliced(self, self._slices, values, terrain, sigmas, max_vertices)
         wedge, (x, y) = self.wedge, self.center.tolist()
         grown = _native.grow_commands(
             self.polygon.vertices,
@@ -310,30 +565,58 @@ class SpatialUncertaintyMap:
             scalar = xs.ndim == 0
         shape = xs.shape
         points = np.column_stack([xs.reshape(-1), ys.reshape(-1)])
-        inside = self.polygon.contains(points, tolerance=POSITION_TOLERANCE)
-        inside &= np.asarray(self.wedge.contains(hs.reshape(-1)), dtype=bool)
+        if self._slices is not None:
+            inside = slices_contain(self._slices, points, hs.reshape(-1), POSITION_TOLERANCE)
+        else:
+            inside = self.polygon.contains(points, tolerance=POSITION_TOLERANCE)
+            inside &= np.asarray(self.wedge.contains(hs.reshape(-1)), dtype=bool)
         if scalar:
             return bool(inside[0])
         return inside.reshape(shape)
 
     def sample_poses(self, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
-        """Draw ``count`` poses uniformly from the map: rows of x (m), y (m), heading (rad)."""
+        """Draw ``count`` poses uniformly from the map: rows of x (m), y (m), heading (rad).
+
+        A sliced map draws a slice for each pose with a chance proportional to its area times
+        its heading width (a small floor keeps degenerate slices possible), then a pose in it.
+        """
+        slices = self._slices
+        if slices is not None:
+            weights = np.array([(polygon_area(s.vertices) + 1e-12) * (s.hi - s.lo + 1e-12) for s in slices])
+            chosen = rng.choice(len(slices), size=count, p=weights / weights.sum())
+            rows = np.empty((count, 3))
+            for index in np.unique(chosen):
+                picked = chosen == index
+                piece = slices[int(index)]
+                rows[picked, :2] = ConvexPolygon._trusted(piece.vertices).sample(int(picked.sum()), rng)
+                rows[picked, 2] = wrap_angle(
+                    piece.lo + rng.uniform(0.0, 1.0, int(picked.sum())) * (piece.hi - piece.lo)
+                )
+            return rows
         positions = self.polygon.sample(count, rng)
         wedge = self.wedge
         headings = wrap_angle(wedge.center - wedge.cw + rng.uniform(0.0, 1.0, count) * wedge.width)
         return np.column_stack([positions, headings])
 
     def __repr__(self) -> str:
+        sliced = "" if self._slices is None else f", slices={len(self._slices)}"
         return (
             f"SpatialUncertaintyMap(center=({self.center[0]:.4g}, {self.center[1]:.4g}), "
             f"area={self.area:.4g} m^2, vertices={self.polygon.vertex_count}, "
-            f"heading={self.wedge.center:.4g} rad -{self.wedge.cw:.3g}/+{self.wedge.ccw:.3g})"
+            f"heading={self.wedge.center:.4g} rad -{self.wedge.cw:.3g}/+{self.wedge.ccw:.3g}{sliced})"
         )
 
 
 # Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
-_set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon], None] = SpatialUncertaintyMap.__dict__[
-    "polygon"
+_set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon | None], None] = SpatialUncertaintyMap.__dict__[
+    "_polygon"
+].__set__
+_set_slices: Callable[[SpatialUncertaintyMap, tuple[Slice, ...] | None], None] = (
+    SpatialUncertaintyMap.__dict__["_slices"].__set__
+)
+_set_cells: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__["_cells"].__set__
+_set_max_slices: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__[
+    "_max_slices"
 ].__set__
 _set_center: Callable[[SpatialUncertaintyMap, NDArray[np.float64]], None] = SpatialUncertaintyMap.__dict__[
     "center"
@@ -344,3 +627,48 @@ _set_wedge: Callable[[SpatialUncertaintyMap, HeadingWedge], None] = SpatialUncer
 _set_pose: Callable[[SpatialUncertaintyMap, Pose | None], None] = SpatialUncertaintyMap.__dict__[
     "_pose"
 ].__set__
+
+
+def _grow_sliced(
+    current: SpatialUncertaintyMap,
+    slices: tuple[Slice, ...],
+    values: list[float],
+    terrain: TerrainStats,
+    sigmas: float,
+    max_vertices: int,
+) -> SpatialUncertaintyMap:
+    """Grow each slice over its own headings, then put the grown slices back on the grid.
+
+    Each slice is a product map of its polygon and interval, grown as such (sound for its
+    poses); its grown interval is cut at the grid's cells, and each cell takes the hull of
+    the polygons that reach it. The most probable pose grows in the slice that holds its
+    heading, as a product map's does.
+    """
+    x, y = current.center.tolist()
+    heading = current.wedge.center
+    home = home_slice(slices, heading)
+    pieces: list[tuple[float, float, NDArray[np.float64]]] = []
+    center = current.center
+    new_heading = heading
+    for index, piece in enumerate(slices):
+        middle = clamp_into(heading, piece.lo, piece.hi) if index == home else 0.5 * (piece.lo + piece.hi)
+        grown = _native.grow_commands(
+            piece.vertices,
+            x,
+            y,
+            middle,
+            middle - piece.lo,
+            max(0.0, piece.hi - middle),
+            terrain,
+            sigmas,
+            values,
+            max_vertices,
+        )
+        pieces.append((grown.heading - grown.cw, grown.heading + grown.ccw, grown.vertices))
+        if index == home:
+            center, new_heading = np.array([grown.x, grown.y]), grown.heading
+    cells, cap = current._cells, current._max_slices
+    grid = distribute(pieces, cells, max_vertices)
+    if len(grid) > cap:
+        grid = capped(grid, cap, max_vertices)
+    return SpatialUncertaintyMap._sliced(grid, center, new_heading, cells, cap)

@@ -1,0 +1,109 @@
+"""Heading-sliced map vs the paper's product map, side by side on every development log.
+
+Calibrated on MRCLAM Dataset 6 robot 1 (motion and sensor bounds), then every development
+log -- Dataset 6 robots 1 and 2, Dataset 7 robots 1 to 5 -- is replayed in Class I (bearings)
+and Class II (range and bearing) with the product map (``ManagerSettings.slice_width =
+None``) and with sliced maps (``slice_width``, default 2 degrees; more widths with
+``--widths``). Per run: containment of the ground truth, median map area, median heading
+wedge width, and median microseconds per frame (growth since the previous frame and the
+frame's reductions; on this machine, under whatever else runs on it).
+
+    .venv/bin/python benchmarks/bench_sliced.py [--widths 2,4] [--slice-vertices 16] \
+        [--logs mrclam6:2,mrclam7:3]
+
+The sliced maps keep ``max_vertices`` per slice (``--slice-vertices``, default the settings'
+default); the product map keeps the default.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+from aura_ums.logs import ReplayOptions, RobotLog, calibrate_logs, read_mrclam, replay_log
+from aura_ums.logs._calibrate import Calibration
+from aura_ums.manager import ManagerSettings
+from aura_ums.uncertainty import LandmarkClass
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+LOGS = [
+    ("mrclam6", 1),
+    ("mrclam6", 2),
+    ("mrclam7", 1),
+    ("mrclam7", 2),
+    ("mrclam7", 3),
+    ("mrclam7", 4),
+    ("mrclam7", 5),
+]
+
+
+def options(
+    calibration: Calibration, landmark_class: LandmarkClass, settings: ManagerSettings
+) -> ReplayOptions:
+    return ReplayOptions(
+        settings=settings,
+        landmark_class=landmark_class,
+        working=calibration.working,
+        envelope=calibration.envelope,
+        motion=calibration.motion,
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--widths", default="2", help="slice widths in degrees, comma-separated")
+    parser.add_argument("--logs", default="", help="dataset:robot pairs, comma-separated (default: all)")
+    parser.add_argument("--max-slices", type=int, default=ManagerSettings().max_slices)
+    parser.add_argument(
+        "--slice-vertices",
+        type=int,
+        default=ManagerSettings().max_vertices,
+        help="max_vertices of the sliced maps",
+    )
+    args = parser.parse_args()
+    if not DATA.is_dir():
+        print(f"development data not found at {DATA}: nothing to compare")
+        return
+    chosen = LOGS
+    if args.logs:
+        chosen = [(name, int(robot)) for name, robot in (item.split(":") for item in args.logs.split(","))]
+    calibration = calibrate_logs([read_mrclam(DATA / "mrclam6", 1)])
+    table = calibration.terrain_table()
+    variants: list[tuple[str, ManagerSettings]] = [("product", ManagerSettings(slice_width=None))]
+    for text in args.widths.split(","):
+        width = float(text)
+        variants.append(
+            (
+                f"sliced {width:g}deg",
+                ManagerSettings(
+                    slice_width=math.radians(width),
+                    max_slices=args.max_slices,
+                    max_vertices=args.slice_vertices,
+                ),
+            )
+        )
+    print(f"{'log':12s} {'class':5s} {'map':13s} {'inside':>7s} {'env in':>7s} {'area m2':>9s} "
+          f"{'head rad':>8s} {'us/frame':>9s} {'relocs':>6s} {'wall s':>7s}")  # fmt: skip
+    for name, robot in chosen:
+        log: RobotLog = read_mrclam(DATA / name, robot)
+        for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
+            for label, settings in variants:
+                start = time.perf_counter()
+                result = replay_log(log, table, options(calibration, landmark_class, settings))
+                wall = time.perf_counter() - start
+                envelope = [s.envelope_inside for s in result.steps if s.envelope_inside is not None]
+                envelope_rate = sum(envelope) / len(envelope) if envelope else math.nan
+                print(
+                    f"{name}:{robot:<4d} {landmark_class.value:5s} {label:13s} "
+                    f"{result.containment_rate:7.4f} "
+                    f"{envelope_rate:7.4f} {result.median_area_m2:9.4g} {result.median_wedge_width_rad:8.3f} "
+                    f"{result.median_update_us:9.1f} {result.relocalizations:6d} {wall:7.1f}",
+                    flush=True,
+                )
+    print("inside: containment of the ground truth in the working map; env in: in the envelope map")
+
+
+if __name__ == "__main__":
+    main()
