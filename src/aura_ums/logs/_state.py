@@ -65,7 +65,7 @@ class ReplayState:
     >>> log = synthetic_log(np.random.default_rng(3), duration=20.0)
     >>> table = TerrainTable({"floor": TerrainTable.default()["tile"]})
     >>> whole = replay_log(log, table)
-    >>> half = replay_log(log, table, until=10.0)
+    >>> half = replay_log(log, table, until=10.0, save_state=True)
     >>> saved = ReplayState.from_json(half.state.to_json())
     >>> rest = replay_log(log, table, resume=saved)
     >>> rest.steps[-1].map.polygon.vertices.tobytes() == whole.steps[-1].map.polygon.vertices.tobytes()
