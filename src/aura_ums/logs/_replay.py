@@ -140,6 +140,8 @@ class ReplayStep:
         Whether the working map was re-seeded from the envelope at this step.
     envelope_inside : bool or None
         Whether ``truth`` is inside the envelope map (None without truth or envelope).
+    excluded : int
+        Observations the relaxed intersection excluded at this step (``relaxed_q > 0``).
     """
 
     time: float
@@ -152,6 +154,7 @@ class ReplayStep:
     state: ManagerState
     relocalized: bool = False
     envelope_inside: bool | None = None
+    excluded: int = 0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -229,6 +232,9 @@ class ReplayResult:
                 "inconsistent_observations": self.inconsistent_observations,
                 "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
+                "relaxed_q": self.options.settings.relaxed_q,
+                "relaxed_window": self.options.settings.relaxed_window,
+                "excluded_observations": sum(s.excluded for s in self.steps),
                 "median_update_us": self.median_update_us,
             }
         )
@@ -439,6 +445,7 @@ def replay_log(log: RobotLog, table: TerrainTable, options: ReplayOptions | None
                 step.state,
                 step.relocalized,
                 envelope_inside,
+                len(step.excluded),
             )
         )
     return ReplayResult(

@@ -1,0 +1,190 @@
+"""An outer bound of the union of maps: the hull of their polygons and the union of their wedges."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.errors import InputError
+from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
+from aura_ums.uncertainty._map import SpatialUncertaintyMap
+
+_TWO_PI = 2.0 * math.pi
+
+
+def union_of_maps(
+    maps: Sequence[SpatialUncertaintyMap], *, max_vertices: int = DEFAULT_MAX_VERTICES
+) -> SpatialUncertaintyMap:
+    """Return one map holding every pose of every map given (an outer bound of their union).
+
+    The polygon is an outer bound of the convex hull of the maps' polygons: the polygon of
+    their supporting lines in ``max_vertices`` fixed directions (exact at the hull's
+    vertices, a thin bulge over each hull edge, at most ``max_vertices`` vertices, at a
+    fixed cost); the wedge is the shortest arc of headings that
+    holds every map's wedge (the full circle when no arc shorter than a turn does). The
+    first map is the primary one: its centre and most probable heading are kept. Only the
+    maps' ``polygon``, ``wedge`` and ``center`` are read.
+
+    Parameters
+    ----------
+    maps : sequence of SpatialUncertaintyMap
+        At least one map. A single map is returned as it is.
+    max_vertices : int
+        Cap on the hull's vertex count (>= 3).
+
+    Returns
+    -------
+    SpatialUncertaintyMap
+        Contains every pose (position in a polygon, heading in that map's wedge) of every
+        map; positions and headings combine freely (a product set, hence an outer bound).
+
+    Raises
+    ------
+    InputError
+        For an empty sequence, an item that is not a map, or ``max_vertices < 3``.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose
+    >>> east = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 3.0), 1.0, 0.1)
+    >>> west = SpatialUncertaintyMap.from_pose(Pose(4.0, 0.0, -3.0), 1.0, 0.1)
+    >>> both = union_of_maps([east, west])
+    >>> both.contains(Pose(2.0, 0.0, math.pi)), round(both.wedge.width, 4)   # across the seam
+    (True, 0.4832)
+    >>> both.most_probable_pose() == east.most_probable_pose()
+    True
+    >>> union_of_maps([east]) is east                  # one map: itself
+    True
+    >>> union_of_maps([])
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: maps: expected at least one SpatialUncertaintyMap, got none
+    """
+    if isinstance(max_vertices, bool) or not isinstance(max_vertices, int) or max_vertices < 3:
+        raise InputError(f"max_vertices: expected an integer >= 3, got {max_vertices!r}")
+    items = list(maps)
+    if not items:
+        raise InputError("maps: expected at least one SpatialUncertaintyMap, got none")
+    for position, item in enumerate(items):
+        if not isinstance(item, SpatialUncertaintyMap):
+            raise InputError(f"maps[{position}]: expected a SpatialUncertaintyMap, got {type(item).__name__}")
+    primary = items[0]
+    if len(items) == 1:
+        return primary
+    polygon = _support_hull([item.polygon.vertices for item in items], max_vertices)
+    wedge = union_of_wedges([item.wedge for item in items], primary.wedge.center)
+    return SpatialUncertaintyMap._trusted(polygon, primary.center.copy(), wedge)
+
+
+def union_of_wedges(wedges: Sequence[HeadingWedge], center: float) -> HeadingWedge:
+    """Return the shortest wedge holding every wedge given, with ``center`` (inside one of them).
+
+    The union's clockwise end is the clockwise end of one of the wedges: from each, the
+    arc counter-clockwise that reaches the far end of every other wedge is measured, and
+    the shortest is kept. A wedge that holds that end strictly inside would need a whole
+    turn: such a start loses.
+
+    Examples
+    --------
+    >>> a, b = HeadingWedge(0.0, 0.1, 0.1), HeadingWedge(1.0, 0.1, 0.1)
+    >>> w = union_of_wedges([a, b], 0.0)
+    >>> round(w.cw, 6), round(w.ccw, 6)
+    (0.1, 1.1)
+    >>> union_of_wedges([a, HeadingWedge.full_circle()], 0.0).is_full_circle
+    True
+    """
+    if any(wedge.is_full_circle for wedge in wedges):
+        return HeadingWedge.full_circle(center)
+    starts = np.array([wedge.center - wedge.cw for wedge in wedges]) % _TWO_PI
+    widths = np.array([wedge.width for wedge in wedges])
+    # offsets[k, i]: how far counter-clockwise of wedge k's start wedge i starts.
+    offsets = (starts[None, :] - starts[:, None]) % _TWO_PI
+    reach = (offsets + widths[None, :]).max(axis=1)
+    best = int(np.argmin(reach))
+    width = float(reach[best])
+    if width >= _TWO_PI:
+        return HeadingWedge.full_circle(center)
+    cw = float((center - starts[best]) % _TWO_PI)
+    if cw > width:
+        # Rounding put the centre a hair outside: clamp to the nearer end.
+        cw = width if cw - width < _TWO_PI - cw else 0.0
+    return HeadingWedge(center, cw, width - cw)
+
+
+def _support_hull(vertex_arrays: Sequence[NDArray[np.float64]], count: int) -> ConvexPolygon:
+    """Return the polygon of the supporting lines of all the points in ``count`` fixed directions.
+
+    Directions ``2 pi k / count`` from +x, the same for every call: the result holds every
+    point (each line is pushed out by a margin above rounding) and taking it twice changes
+    nothing, so repeated unions never creep. It is exact at the points' extreme vertices
+    and bulges by a thin triangle over each hull edge between two sampled directions.
+    A fixed cost, one matrix product, whatever the number of points.
+    """
+    points = np.concatenate(vertex_arrays, axis=0)
+    directions = _DIRECTIONS[count]
+    support = (points @ directions.transposed).max(axis=0)
+    scale = max(float(np.abs(points).max()), 1.0)
+    support += _MARGIN * scale
+    following = support[directions.following]
+    # Lines n_k . x = h_k and n_k+1 . x = h_k+1 meet at one corner.
+    corners = np.empty((count, 2))
+    corners[:, 0] = support * directions.x_of_own - following * directions.x_of_next
+    corners[:, 1] = following * directions.y_of_next - support * directions.y_of_own
+    # A point extreme in several directions gives several corners within rounding: keep one.
+    step = np.abs(corners - corners[directions.preceding]).max(axis=1)
+    distinct = corners[step > _MERGE * scale]
+    if not len(distinct):
+        distinct = corners[:1]
+    return ConvexPolygon._trusted(np.ascontiguousarray(distinct))
+
+
+@dataclass(frozen=True, slots=True)
+class _Fan:
+    """``count`` unit normals evenly spaced from +x, and the coefficients of their corners."""
+
+    transposed: NDArray[np.float64]
+    following: NDArray[np.intp]
+    preceding: NDArray[np.intp]
+    x_of_own: NDArray[np.float64]
+    x_of_next: NDArray[np.float64]
+    y_of_own: NDArray[np.float64]
+    y_of_next: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, count: int) -> _Fan:
+        angles = np.arange(count) * (2.0 * math.pi / count)
+        normals = np.column_stack([np.cos(angles), np.sin(angles)])
+        index = np.arange(count)
+        following, preceding = (index + 1) % count, (index - 1) % count
+        after = normals[following]
+        det = normals[0, 0] * after[0, 1] - normals[0, 1] * after[0, 0]
+        # Cramer's rule for n . x = h, m . x = g: x = (h m_y - g n_y) / det, y = (g n_x - h m_x) / det.
+        return cls(
+            np.ascontiguousarray(normals.T),
+            following,
+            preceding,
+            after[:, 1] / det,
+            normals[:, 1] / det,
+            after[:, 0] / det,
+            normals[:, 0] / det,
+        )
+
+
+class _Fans(dict[int, _Fan]):
+    """The fan of each direction count, built on first use."""
+
+    def __missing__(self, count: int) -> _Fan:
+        fan = self[count] = _Fan.of(count)
+        return fan
+
+
+_DIRECTIONS = _Fans()
+#: Outward push of each supporting line, relative to the coordinates' size: above rounding.
+_MARGIN = 1e-12
+#: Corners closer than this (relative) are one.
+_MERGE = 1e-9
