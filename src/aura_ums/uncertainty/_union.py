@@ -120,26 +120,35 @@ def _support_hull(vertex_arrays: Sequence[NDArray[np.float64]], count: int) -> C
     """Return the polygon of the supporting lines of all the points in ``count`` fixed directions.
 
     Directions ``2 pi k / count`` from +x, the same for every call: the result holds every
-    point (each line is pushed out by a margin above rounding) and taking it twice changes
-    nothing, so repeated unions never creep. It is exact at the points' extreme vertices
-    and bulges by a thin triangle over each hull edge between two sampled directions.
+    point (each line is pushed out by a margin, ``4 * _NEAR`` of the coordinates' size) and
+    taking it twice adds only that margin, so repeated unions do not creep. It touches the
+    points' extreme vertices (but for the margin) and bulges by a thin triangle over each
+    hull edge between two sampled directions.
     A fixed cost, one matrix product, whatever the number of points.
     """
     points = np.concatenate(vertex_arrays, axis=0)
     directions = _DIRECTIONS[count]
     support = (points @ directions.transposed).max(axis=0)
     scale = max(float(np.abs(points).max()), 1.0)
-    support += _MARGIN * scale
+    near = _NEAR * scale
+    support += 4.0 * near
     following = support[directions.following]
     # Lines n_k . x = h_k and n_k+1 . x = h_k+1 meet at one corner.
     corners = np.empty((count, 2))
     corners[:, 0] = support * directions.x_of_own - following * directions.x_of_next
     corners[:, 1] = following * directions.y_of_next - support * directions.y_of_own
-    # A point extreme in several directions gives several corners within rounding: keep one.
-    step = np.abs(corners - corners[directions.preceding]).max(axis=1)
-    distinct = corners[step > _MERGE * scale]
-    if not len(distinct):
-        distinct = corners[:1]
+    # A point extreme in several directions gives a fan of corners a hair apart, and such
+    # short edges have directions too noisy to test points against: keep one corner of
+    # each run within ``near`` of the last one kept. What that cuts off lies within
+    # 2 sqrt(2) near of the next line, and every point is 4 near inside it.
+    kept = [corners[0].tolist()]
+    for x, y in corners[1:].tolist():
+        last_x, last_y = kept[-1]
+        if abs(x - last_x) > near or abs(y - last_y) > near:
+            kept.append([x, y])
+    if len(kept) > 1 and abs(kept[-1][0] - kept[0][0]) <= near and abs(kept[-1][1] - kept[0][1]) <= near:
+        kept.pop()
+    distinct = np.array(kept, dtype=np.float64)
     return ConvexPolygon._trusted(np.ascontiguousarray(distinct))
 
 
@@ -184,7 +193,7 @@ class _Fans(dict[int, _Fan]):
 
 
 _DIRECTIONS = _Fans()
-#: Outward push of each supporting line, relative to the coordinates' size: above rounding.
-_MARGIN = 1e-12
-#: Corners closer than this (relative) are one.
-_MERGE = 1e-9
+#: Corners closer than this, relative to the coordinates' size, are one; each supporting line
+#: is pushed out by four times as much. Well above rounding, so that no edge is short enough
+#: for its direction to be noise.
+_NEAR = 1e-6
