@@ -1,4 +1,4 @@
-"""The q-relaxed intersection: the truth stays inside when at most q of any N consecutive sightings are wrong."""
+"""The q-relaxed intersection: the truth stays inside when at most q of any N consecutive are wrong."""
 
 from __future__ import annotations
 
@@ -90,7 +90,7 @@ def drive(
         truth = Pose(truth.x + 1.0, truth.y, truth.heading)
         board.post_report(PositionReport(float(k), STRIDE))
         moved = SpatialUncertaintyMap.from_polygon(
-            before.polygon.translated(1.0, 0.0), before.center + (1.0, 0.0), before.wedge
+            before.polygon.translated(1.0, 0.0), before.center + np.array([1.0, 0.0]), before.wedge
         )
         for index, pole in enumerate(POLES):
             seen = bearing(truth, truth.x, truth.y, pole) + rng.uniform(-0.9, 0.9) * ERROR
