@@ -179,6 +179,24 @@ class UncertaintyMapManager:
     re-localized: re-seeded from the envelope map, reduced by the update's observations
     under their typical bounds. The same code runs in simulation, in replay and live.
 
+    Wrong landmarks (with :attr:`ManagerSettings.relaxed_q` ``= q > 0``): a misidentified
+    landmark can be consistent with both maps and still wrong; a gate cannot see it. The
+    working map (and the envelope) is then a *q-relaxed intersection* over the last
+    ``relaxed_window = N`` sightings (observations that passed the checks above):
+    branches, each a map and the sightings of the window it excludes, at most q. Each
+    sighting reduces every branch (one it empties dies) and spawns from each branch with
+    fewer than q exclusions a copy that excludes it; when an excluded sighting leaves the
+    window, its branch merges into the one with the same exclusions minus it (hull of the
+    polygons, union of the wedges: :func:`~aura_ums.uncertainty.union_of_maps`). The map
+    reported is the outer bound of every branch, with the centre and most probable heading
+    of the branch with the fewest exclusions. Guarantee: the truth stays inside whenever at
+    most q of any N consecutive sightings are wrong (and the growth and the right
+    sightings' bounds hold). A sighting every surviving branch excludes is *excluded*
+    (:attr:`ManagerStep.excluded`; :attr:`RejectReason.EXCLUDED` when so on arrival, not an
+    inconsistency). Only when every branch dies does the consistency gate apply, and
+    with it re-localization. The cost: up to ``sum(C(N, k), k <= q)`` branches, each
+    grown and reduced. ``relaxed_q = 0`` runs the single map exactly as before.
+
     Lost detection (the paper: "if no landmarks are recognized even though several have
     been predicted, the robot would declare itself lost, stop, and then start searching
     larger windows"): after an update the state is :attr:`ManagerState.LOST` when the

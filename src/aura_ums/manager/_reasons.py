@@ -8,9 +8,11 @@ import enum
 class RejectReason(enum.StrEnum):
     """Why an observation did not reduce the map.
 
-    The first three are checks the manager makes before any reduction; the others are the
-    reductions' own: no pose of the map agrees with the observation (an *inconsistent*
-    observation, most likely a misidentified landmark). Each value is the text the
+    The first three are checks the manager makes before any reduction; the next five are
+    the reductions' own: no pose of the map agrees with the observation (an *inconsistent*
+    observation, most likely a misidentified landmark). :attr:`EXCLUDED` is the relaxed
+    intersection's (``ManagerSettings.relaxed_q > 0``): the map kept no pose that agrees
+    with it, but tolerated it as one of its wrong ones. Each value is the text the
     reductions and earlier versions wrote, so counts keyed by reason read the same in
     JSON and CSV (a ``StrEnum`` member is its value wherever a string is expected).
 
