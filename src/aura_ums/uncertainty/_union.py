@@ -141,15 +141,27 @@ def _support_hull(vertex_arrays: Sequence[NDArray[np.float64]], count: int) -> C
     # short edges have directions too noisy to test points against: keep one corner of
     # each run within ``near`` of the last one kept. What that cuts off lies within
     # 2 sqrt(2) near of the next line, and every point is 4 near inside it.
+    step = np.abs(corners - corners[directions.preceding]).max(axis=1)
+    starts = step > near
+    starts[0] = True
+    first = np.maximum.accumulate(np.where(starts, directions.index, 0))
+    # Commonly every corner is within ``near`` of its run's first: keep the runs' firsts.
+    runs_hold = np.abs(corners - corners[first]).max() <= near
+    distinct = corners[starts] if runs_hold else _thinned(corners, near)
+    last, head = distinct[-1], distinct[0]
+    if len(distinct) > 1 and abs(last[0] - head[0]) <= near and abs(last[1] - head[1]) <= near:
+        distinct = distinct[:-1]
+    return ConvexPolygon._trusted(np.ascontiguousarray(distinct))
+
+
+def _thinned(corners: NDArray[np.float64], near: float) -> NDArray[np.float64]:
+    """Keep each corner farther than ``near`` (either coordinate) from the last one kept."""
     kept = [corners[0].tolist()]
     for x, y in corners[1:].tolist():
         last_x, last_y = kept[-1]
         if abs(x - last_x) > near or abs(y - last_y) > near:
             kept.append([x, y])
-    if len(kept) > 1 and abs(kept[-1][0] - kept[0][0]) <= near and abs(kept[-1][1] - kept[0][1]) <= near:
-        kept.pop()
-    distinct = np.array(kept, dtype=np.float64)
-    return ConvexPolygon._trusted(np.ascontiguousarray(distinct))
+    return np.array(kept, dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,6 +169,7 @@ class _Fan:
     """``count`` unit normals evenly spaced from +x, and the coefficients of their corners."""
 
     transposed: NDArray[np.float64]
+    index: NDArray[np.intp]
     following: NDArray[np.intp]
     preceding: NDArray[np.intp]
     x_of_own: NDArray[np.float64]
@@ -175,6 +188,7 @@ class _Fan:
         # Cramer's rule for n . x = h, m . x = g: x = (h m_y - g n_y) / det, y = (g n_x - h m_x) / det.
         return cls(
             np.ascontiguousarray(normals.T),
+            index,
             following,
             preceding,
             after[:, 1] / det,
