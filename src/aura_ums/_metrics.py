@@ -220,6 +220,35 @@ _TABLE: tuple[MetricKey, ...] = (
     ),
     _key("relocalizations", "count", _K.COUNT, (REPLAY,), "Times the envelope re-seeded the working map."),
     _key(
+        "relaxed_q",
+        "count",
+        _K.COUNT,
+        (SIMULATE, REPLAY),
+        "Wrong observations the relaxed intersection tolerates among any relaxed_window consecutive ones.",
+    ),
+    _key(
+        "relaxed_window",
+        "count",
+        _K.COUNT,
+        (SIMULATE, REPLAY),
+        "Consecutive observations (N) over which relaxed_q wrong ones are tolerated.",
+    ),
+    _key(
+        "excluded_observations",
+        "count",
+        _K.COUNT,
+        (SIMULATE, REPLAY),
+        "Observations the relaxed intersection excluded: every branch it kept counted them as wrong "
+        "(always 0 with relaxed_q = 0).",
+    ),
+    _key(
+        "injected_observations",
+        "count",
+        _K.COUNT,
+        (SIMULATE,),
+        "Wrong observations the simulator injected (the scenario's inject_wrong_rate).",
+    ),
+    _key(
         "median_update_us",
         "µs",
         _K.NUMBER,

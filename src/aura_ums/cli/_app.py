@@ -147,7 +147,15 @@ def simulate(
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = Metrics(
-        {"scenario": loaded.name, "runs": runs, "seed": seed, "prune": prune, **summarize_runs(results)}
+        {
+            "scenario": loaded.name,
+            "runs": runs,
+            "seed": seed,
+            "prune": prune,
+            "relaxed_q": loaded.settings.relaxed_q,
+            "relaxed_window": loaded.settings.relaxed_window,
+            **summarize_runs(results),
+        }
     )
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)

@@ -169,6 +169,8 @@ class ReplayStep:
         Whether the working map was re-seeded from the envelope at this step.
     envelope_inside : bool or None
         Whether ``truth`` is inside the envelope map (None without truth or envelope).
+    excluded : int
+        Observations the relaxed intersection excluded at this step (``relaxed_q > 0``).
     """
 
     time: float
@@ -181,6 +183,7 @@ class ReplayStep:
     state: ManagerState
     relocalized: bool = False
     envelope_inside: bool | None = None
+    excluded: int = 0
 
 
 def _flags(values: Sequence[bool | None]) -> NDArray[np.int8]:
@@ -213,6 +216,8 @@ class ReplayTrace:
         Index of the manager's state into ``tuple(ManagerState)`` (:attr:`states` gives them).
     relocalized : ndarray of bool, shape (n,)
         Whether the working map was re-seeded from the envelope at the step.
+    excluded : ndarray of int64, shape (n,)
+        Observations the relaxed intersection excluded at the step (``relaxed_q > 0``).
     """
 
     time: NDArray[np.float64]
@@ -226,6 +231,7 @@ class ReplayTrace:
     update_us: NDArray[np.float64]
     state: NDArray[np.int8]
     relocalized: NDArray[np.bool_]
+    excluded: NDArray[np.int64]
 
     def __len__(self) -> int:
         return len(self.time)
@@ -245,6 +251,7 @@ class ReplayTrace:
             np.zeros(count),
             np.zeros(count, dtype=np.int8),
             np.zeros(count, dtype=bool),
+            np.zeros(count, dtype=np.int64),
         )
 
     @classmethod
@@ -268,6 +275,7 @@ class ReplayTrace:
             trace.update_us[index] = step.update_us
             trace.state[index] = _STATES.index(step.state)
             trace.relocalized[index] = step.relocalized
+            trace.excluded[index] = step.excluded
         trace.inside[:] = _flags([step.inside for step in steps])
         trace.envelope_inside[:] = _flags([step.envelope_inside for step in steps])
         return trace
@@ -356,6 +364,7 @@ class ReplayResult:
         trace = self.trace
         inside = trace.inside.tolist()
         envelope = trace.envelope_inside.tolist()
+        excluded = trace.excluded.tolist()
         return tuple(
             ReplayStep(
                 time,
@@ -368,6 +377,7 @@ class ReplayResult:
                 state,
                 relocalized,
                 None if envelope[index] < 0 else bool(envelope[index]),
+                excluded[index],
             )
             for index, (time, step_map, accepted, rejected, update_us, state, relocalized) in enumerate(
                 zip(
@@ -437,6 +447,9 @@ class ReplayResult:
                 "inconsistent_observations": self.inconsistent_observations,
                 "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
+                "relaxed_q": self.options.settings.relaxed_q,
+                "relaxed_window": self.options.settings.relaxed_window,
+                "excluded_observations": int(self.trace.excluded.sum()),
                 "median_update_us": self.median_update_us,
             }
         )
@@ -727,6 +740,7 @@ def replay_log(
             trace.rejected[index] = len(step.rejected)
             trace.state[index] = _STATES.index(step.state)
             trace.relocalized[index] = step.relocalized
+            trace.excluded[index] = len(step.excluded)
             judge.add(index, step.map, step.envelope_map)
             if keep_maps:
                 maps.append(step.map)

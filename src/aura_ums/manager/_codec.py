@@ -20,6 +20,7 @@ import numpy as np
 from aura_ums._files import Fields, describe, parse_json
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.manager._relaxed import Branch, RelaxedState, Sighting
 from aura_ums.uncertainty import (
     BearingObservation,
     GroundLineObservation,
@@ -270,3 +271,56 @@ def encode_map(uncertainty_map: SpatialUncertaintyMap) -> dict[str, object]:
 
 def _found(table: Mapping[str, object], key: str) -> str:
     return describe(table[key], "json") if key in table else "nothing"
+
+
+def encode_relaxed(state: RelaxedState) -> dict[str, object]:
+    """Return the relaxed intersection's branches and window as a JSON object, every float exact."""
+    return {
+        "branches": [
+            {"excluded": sorted(branch.excluded), "map": encode_map(branch.map)} for branch in state.branches
+        ],
+        "window": [
+            {"serial": sighting.serial, "observation": encode_observation(sighting.observation)}
+            for sighting in state.window
+        ],
+        "reported": sorted(state.reported),
+        "next_serial": state.next_serial,
+    }
+
+
+def decode_relaxed(reader: Reader, value: object, where: str, q: int, window: int) -> RelaxedState:
+    """Decode what :func:`encode_relaxed` wrote, checked against ``q`` and ``window`` (N)."""
+    data = reader.mapping(value, where, ("branches", "window", "reported", "next_serial"))
+    next_serial = reader.integer(data["next_serial"], f"{where}.next_serial")
+    sightings: list[Sighting] = []
+    for k, item in enumerate(reader.array(data["window"], f"{where}.window")):
+        place = f"{where}.window[{k}]"
+        entry = reader.mapping(item, place, ("serial", "observation"))
+        serial = reader.integer(entry["serial"], f"{place}.serial")
+        if serial >= next_serial or (sightings and serial <= sightings[-1].serial):
+            reader.fail(f"{place}.serial", f"expected increasing serials below next_serial, got {serial}")
+        sightings.append(Sighting(serial, reader.observation(entry["observation"], f"{place}.observation")))
+    if len(sightings) > window:
+        reader.fail(
+            f"{where}.window", f"expected at most {window} sightings (relaxed_window), got {len(sightings)}"
+        )
+    serials = {sighting.serial for sighting in sightings}
+
+    def serial_set(item: object, place: str, most: int) -> frozenset[int]:
+        found = frozenset(reader.integer(x, f"{place}[{k}]") for k, x in enumerate(reader.array(item, place)))
+        if not found <= serials or len(found) > most:
+            reader.fail(place, f"expected at most {most} serials of the window, got {sorted(found)}")
+        return found
+
+    branches: list[Branch] = []
+    for k, item in enumerate(reader.array(data["branches"], f"{where}.branches")):
+        place = f"{where}.branches[{k}]"
+        entry = reader.mapping(item, place, ("excluded", "map"))
+        excluded = serial_set(entry["excluded"], f"{place}.excluded", q)
+        if any(branch.excluded == excluded for branch in branches):
+            reader.fail(f"{place}.excluded", f"expected a set no other branch has, got {sorted(excluded)}")
+        branches.append(Branch(excluded, reader.uncertainty_map(entry["map"], f"{place}.map")))
+    if not branches:
+        reader.fail(f"{where}.branches", "expected at least one branch, got none")
+    reported = serial_set(data["reported"], f"{where}.reported", len(serials))
+    return RelaxedState(tuple(branches), tuple(sightings), reported, next_serial)

@@ -15,9 +15,11 @@ import shapely
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import FileFormatError, InputError, OutsideMapError, UnknownLandmarkError
+from aura_ums.manager import _relaxed
 from aura_ums.manager._blackboard import Blackboard, PositionReport
-from aura_ums.manager._codec import Reader, dump_document, encode_map
+from aura_ums.manager._codec import Reader, decode_relaxed, dump_document, encode_map, encode_relaxed
 from aura_ums.manager._reasons import RejectReason
+from aura_ums.manager._relaxed import Branch, RelaxedState
 from aura_ums.manager._settings import ManagerSettings
 from aura_ums.uncertainty import (
     BearingObservation,
@@ -57,13 +59,16 @@ class ObservationOutcome:
     observation : BearingObservation or RangeBearingObservation or GroundLineObservation
         The observation taken from the identified landmark buffer.
     accepted : bool
-        True when the map was reduced by it (a consistent reduction).
+        True when the map was reduced by it (a consistent reduction; with
+        ``relaxed_q > 0``: some branch of the relaxed intersection kept it).
     reason : RejectReason or None
         Why it was rejected; None when accepted.
     area_before, area_after : float
         Area of the map's polygon before and after, square metres (equal when rejected).
+        With ``relaxed_q > 0``: of the primary branch (the fewest exclusions), the tight map.
     wedge_width_before, wedge_width_after : float
-        Width of the heading wedge before and after, radians (equal when rejected).
+        Width of the heading wedge before and after, radians (equal when rejected); with
+        ``relaxed_q > 0``, of the primary branch.
     """
 
     observation: Observation
@@ -99,6 +104,13 @@ class ManagerStep:
         then the re-seeded one).
     envelope_map : SpatialUncertaintyMap or None
         The envelope map after the update (None without :attr:`ManagerSettings.robust`).
+    excluded : tuple of observations
+        The observations that became *excluded* in this update (``relaxed_q > 0``): every
+        branch of the relaxed intersection still held counts it among its wrong ones, so
+        no pose of the map had to agree with it. Each is reported once, in the update
+        where that first holds (it may have arrived in an earlier one); one excluded on
+        arrival also has the outcome :attr:`RejectReason.EXCLUDED`. Always empty with
+        ``relaxed_q = 0``.
     """
 
     time: float
@@ -109,6 +121,7 @@ class ManagerStep:
     grown_reports: int
     relocalized: bool = False
     envelope_map: SpatialUncertaintyMap | None = None
+    excluded: tuple[Observation, ...] = ()
 
     @property
     def accepted(self) -> tuple[ObservationOutcome, ...]:
@@ -165,6 +178,24 @@ class UncertaintyMapManager:
     wrong (the paper's "a landmark shown to be incorrect", seen from the other side) and
     re-localized: re-seeded from the envelope map, reduced by the update's observations
     under their typical bounds. The same code runs in simulation, in replay and live.
+
+    Wrong landmarks (with :attr:`ManagerSettings.relaxed_q` ``= q > 0``): a misidentified
+    landmark can be consistent with both maps and still wrong; a gate cannot see it. The
+    working map (and the envelope) is then a *q-relaxed intersection* over the last
+    ``relaxed_window = N`` sightings (observations that passed the checks above):
+    branches, each a map and the sightings of the window it excludes, at most q. Each
+    sighting reduces every branch (one it empties dies) and spawns from each branch with
+    fewer than q exclusions a copy that excludes it; when an excluded sighting leaves the
+    window, its branch merges into the one with the same exclusions minus it (hull of the
+    polygons, union of the wedges: :func:`~aura_ums.uncertainty.union_of_maps`). The map
+    reported is the outer bound of every branch, with the centre and most probable heading
+    of the branch with the fewest exclusions. Guarantee: the truth stays inside whenever at
+    most q of any N consecutive sightings are wrong (and the growth and the right
+    sightings' bounds hold). A sighting every surviving branch excludes is *excluded*
+    (:attr:`ManagerStep.excluded`; :attr:`RejectReason.EXCLUDED` when so on arrival, not an
+    inconsistency). Only when every branch dies does the consistency gate apply, and
+    with it re-localization. The cost: up to ``sum(C(N, k), k <= q)`` branches, each
+    grown and reduced. ``relaxed_q = 0`` runs the single map exactly as before.
 
     Lost detection (the paper: "if no landmarks are recognized even though several have
     been predicted, the robot would declare itself lost, stop, and then start searching
@@ -232,6 +263,7 @@ class UncertaintyMapManager:
         "_consumed",
         "_envelope",
         "_envelope_factor",
+        "_excluded",
         "_grown",
         "_joint_above",
         "_joint_sector",
@@ -244,6 +276,7 @@ class UncertaintyMapManager:
         "_only_terrain",
         "_recent",
         "_rejected",
+        "_relaxed",
         "_relocalizations",
         "_settings",
         "_sigmas",
@@ -283,6 +316,9 @@ class UncertaintyMapManager:
         self._max_vertices = settings.max_vertices
         self._envelope_factor = settings.envelope_factor
         self._map = _in_form(initial_map, settings)
+        # The branches of the relaxed intersection; None with relaxed_q = 0 (one map, the gate).
+        self._relaxed: RelaxedState | None = RelaxedState.start(self._map) if settings.relaxed_q else None
+        self._excluded = 0
         self._map_time: float | None = None
         self._consumed = 0
         self._state = ManagerState.NOMINAL
@@ -369,6 +405,16 @@ class UncertaintyMapManager:
     def grown_reports(self) -> int:
         """Position reports grown into the map since construction."""
         return self._grown
+
+    @property
+    def excluded_count(self) -> int:
+        """Observations excluded by the relaxed intersection since construction (see :class:`ManagerStep`)."""
+        return self._excluded
+
+    @property
+    def branch_count(self) -> int:
+        """Branches of the relaxed intersection the map is the outer bound of (1 with ``relaxed_q = 0``)."""
+        return 1 if self._relaxed is None else len(self._relaxed.branches)
 
     @property
     def inconsistent_count(self) -> int:
@@ -460,28 +506,30 @@ class UncertaintyMapManager:
         reports = blackboard.reports_until(time, start=self._consumed)
         index = self._consumed + len(reports)
         outcomes: list[ObservationOutcome] = []
-        current, map_time = self._advance(reports, pending, outcomes)
+        excluded: list[Observation] = []
+        current, map_time, branches = self._advance(reports, pending, outcomes, excluded)
         outer = self._envelope
         if outer is not None:
             twins = self._twins(pending, envelope)
             # The envelope's outcomes are never reported: not recording them saves a record
             # (and a rejected map's area) per observation.
-            wide, wide_time = outer._advance(reports, twins, None)
+            wide, wide_time, wide_branches = outer._advance(reports, twins, None, None)
 
         # Commit: nothing above changed the manager or the blackboard.
         identified.drain(time)  # exactly ``pending``: single-threaded by contract
         grown = len(reports)
-        found = self._commit(current, index, map_time, outcomes)
+        found = self._commit(current, index, map_time, outcomes, branches, len(excluded))
         relocalized = False
         if outer is not None:
-            outer._commit(wide, index, wide_time, ())
+            outer._commit(wide, index, wide_time, (), wide_branches, 0)
             recent = self._recent
             for outcome in outcomes:
                 reason = outcome.reason
-                if reason is None or reason.inconsistent:
-                    recent.append(reason is not None)
+                # EXCLUDED met the map and was absorbed by the relaxed intersection: not inconsistent.
+                if reason is None or reason.reached_reduction:
+                    recent.append(reason is not None and reason.inconsistent)
             if sum(recent) >= self._settings.relocalize_after:
-                self._map = _in_form(self._reseed(wide, [o.observation for o in outcomes]), self._settings)
+                self._reseed_from(wide, [o.observation for o in outcomes])
                 self._relocalizations += 1
                 recent.clear()
                 relocalized = True
@@ -495,6 +543,7 @@ class UncertaintyMapManager:
             grown,
             relocalized,
             None if outer is None else outer._map,
+            tuple(excluded),
         )
 
     def _advance(
@@ -502,12 +551,16 @@ class UncertaintyMapManager:
         reports: Sequence[PositionReport],
         pending: Sequence[Observation],
         outcomes: list[ObservationOutcome] | None,
-    ) -> tuple[SpatialUncertaintyMap, float | None]:
+        excluded: list[Observation] | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None, RelaxedState | None]:
         """Grow by ``reports`` and reduce by ``pending`` in time order, changing nothing.
 
-        Returns the map and its time, to commit. What became of each observation is
-        appended to ``outcomes`` (None: not recorded).
+        Returns the map, its time and the relaxed intersection's branches (None with
+        ``relaxed_q = 0``), to commit. What became of each observation is appended to
+        ``outcomes``, and the observations newly excluded to ``excluded`` (None: not recorded).
         """
+        if self._relaxed is not None:
+            return self._advance_relaxed(self._relaxed, reports, pending, outcomes, excluded)
         current, map_time = self._map, self._map_time
         index = 0
         first = 0
@@ -527,7 +580,165 @@ class UncertaintyMapManager:
             else:
                 current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
             first = last
-        return self._grow(current, reports, index, len(reports), map_time)
+        current, map_time = self._grow(current, reports, index, len(reports), map_time)
+        return current, map_time, None
+
+    def _advance_relaxed(
+        self,
+        state: RelaxedState,
+        reports: Sequence[PositionReport],
+        pending: Sequence[Observation],
+        outcomes: list[ObservationOutcome] | None,
+        excluded: list[Observation] | None,
+    ) -> tuple[SpatialUncertaintyMap, float | None, RelaxedState]:
+        """:meth:`_advance` for the branches of the relaxed intersection (``relaxed_q > 0``)."""
+        map_time = self._map_time
+        index = 0
+        first = 0
+        while first < len(pending):
+            instant = pending[first].time
+            last = first + 1
+            while last < len(pending) and pending[last].time == instant:
+                last += 1
+            stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
+            state, map_time = self._grow_branches(state, reports, index, stop, map_time)
+            index = stop
+            state = self._relax_instant(state, pending[first:last], map_time, outcomes, joint=True)
+            state, fresh = _relaxed.newly_excluded(state)
+            if excluded is not None:
+                excluded += fresh
+            first = last
+        state, map_time = self._grow_branches(state, reports, index, len(reports), map_time)
+        return _relaxed.outer_map(state, self._max_vertices), map_time, state
+
+    def _grow_branches(
+        self,
+        state: RelaxedState,
+        reports: Sequence[PositionReport],
+        start: int,
+        stop: int,
+        map_time: float | None,
+    ) -> tuple[RelaxedState, float | None]:
+        """Grow every branch by ``reports[start:stop]``; return them and the last report's time."""
+        if start == stop:
+            return state, map_time
+        state = _relaxed.grow(state, lambda m: self._grow(m, reports, start, stop, map_time)[0])
+        return state, reports[stop - 1].time
+
+    def _relax_instant(
+        self,
+        state: RelaxedState,
+        observations: Sequence[Observation],
+        map_time: float | None,
+        outcomes: list[ObservationOutcome] | None,
+        *,
+        joint: bool,
+    ) -> RelaxedState:
+        """Reduce the branches by the observations of one instant (the relaxed intersection).
+
+        The sightings enter the window in chunks of at most ``relaxed_window`` (so that no
+        window holds more than the guarantee speaks of). When every branch dies, the
+        chunk meets the consistency gate instead, branch by branch, as with ``relaxed_q = 0``.
+        """
+        settings = self._settings
+        checked = [self._landmark_for(observation, map_time) for observation in observations]
+        before = state.primary
+        verdicts: dict[int, ObservationOutcome] = {}
+        sightings = [
+            (position, observation, found)
+            for position, (observation, found) in enumerate(zip(observations, checked, strict=True))
+            if not isinstance(found, RejectReason)
+        ]
+        span = settings.relaxed_window
+        for start in range(0, len(sightings), span):
+            chunk = sightings[start : start + span]
+            pairs = [(observation, landmark) for _, observation, landmark in chunk]
+            state, serials = _relaxed.admit(state, [o for o, _ in pairs], span, self._max_vertices)
+            prior = state.primary
+
+            def reduce(
+                current: SpatialUncertaintyMap,
+                keep: Sequence[int],
+                pairs: list[tuple[Observation, Landmark]] = pairs,
+            ) -> SpatialUncertaintyMap | None:
+                # Jointly only with every sighting of the chunk: a copy excluding some is a
+                # looser hypothesis, and the joint reduction's cost grows with the wedge.
+                together = joint and len(keep) == len(pairs)
+                return self._reduce_all(current, [pairs[index] for index in keep], joint=together)
+
+            relaxed = _relaxed.relax(state, serials, settings.relaxed_q, reduce)
+            if relaxed is not None:
+                state = relaxed
+                after = state.primary
+                everywhere = frozenset.intersection(*(branch.excluded for branch in state.branches))
+                for (position, observation, _), serial in zip(chunk, serials, strict=True):
+                    dropped = serial in everywhere
+                    verdicts[position] = ObservationOutcome(
+                        observation,
+                        not dropped,
+                        RejectReason.EXCLUDED if dropped else None,
+                        prior.area,
+                        prior.area if dropped else after.area,
+                        prior.wedge.width,
+                        prior.wedge.width if dropped else after.wedge.width,
+                    )
+                continue
+            # Every branch died: the gate, branch by branch; the primary's outcomes are reported.
+            gated: list[Branch] = []
+            for rank, branch in enumerate(state.branches):
+                record: list[ObservationOutcome] | None = [] if rank == 0 else None
+                if joint:
+                    reduced = self._reduce_instant(branch.map, [o for o, _ in pairs], map_time, record)
+                else:
+                    reduced = branch.map
+                    for observation, landmark in pairs:
+                        reduced = self._reduce(reduced, observation, landmark, record)
+                gated.append(Branch(branch.excluded, reduced))
+                if record is not None:
+                    for (position, _, _), outcome in zip(chunk, record, strict=True):
+                        verdicts[position] = outcome
+            state = dataclasses.replace(state, branches=tuple(gated))
+        if outcomes is not None:
+            area, width = before.area, before.wedge.width
+            for position, (observation, found) in enumerate(zip(observations, checked, strict=True)):
+                if isinstance(found, RejectReason):
+                    outcomes.append(ObservationOutcome(observation, False, found, area, area, width, width))
+                else:
+                    outcomes.append(verdicts[position])
+        return state
+
+    def _reduce_all(
+        self,
+        current: SpatialUncertaintyMap,
+        pairs: Sequence[tuple[Observation, Landmark]],
+        *,
+        joint: bool,
+    ) -> SpatialUncertaintyMap | None:
+        """Reduce by every pair (jointly when the wedge is wide); None when no pose agrees with all.
+
+        A reduction that cuts nothing returns the map it was given (the very object): the
+        relaxed intersection then spawns no copy that would merely repeat it.
+        """
+        if (
+            joint
+            and len(pairs) >= 2
+            and self._joint_above is not None
+            and current.wedge.width > self._joint_above
+        ):
+            together = reduce_jointly(
+                current, pairs, sector=self._joint_sector, max_vertices=self._max_vertices
+            )
+            if together.consistent:
+                return together.map
+        for observation, landmark in pairs:
+            found = current._reduce_checked(observation, landmark, self._max_vertices)
+            if isinstance(found, str):
+                return None
+            reduced, area_before, area_after = found
+            # Inside the prior with its area (> 0) and its wedge's width: the same set.
+            if not (0.0 < area_before == area_after and reduced.wedge.width == current.wedge.width):
+                current = reduced
+        return current
 
     def _commit(
         self,
@@ -535,10 +746,14 @@ class UncertaintyMapManager:
         index: int,
         map_time: float | None,
         outcomes: Sequence[ObservationOutcome],
+        branches: RelaxedState | None,
+        excluded: int,
     ) -> bool:
         """Take what :meth:`_advance` returned; return whether an observation reduced the map."""
         self._grown += index - self._consumed
         self._map, self._consumed, self._map_time = current, index, map_time
+        self._relaxed = branches
+        self._excluded += excluded
         found = False
         for outcome in outcomes:
             reason = outcome.reason
@@ -572,6 +787,22 @@ class UncertaintyMapManager:
                     f"t={ours.time!r} (the drained observation's twin), got {twin!r}"
                 )
         return list(envelope)
+
+    def _reseed_from(self, envelope_map: SpatialUncertaintyMap, observations: Sequence[Observation]) -> None:
+        """Re-seed the map from the envelope map and the update's observations (their typical bounds).
+
+        With ``relaxed_q > 0`` the branches restart from the envelope map with an empty
+        window, and the observations go through the relaxed intersection one by one.
+        """
+        state = self._relaxed
+        if state is None:
+            self._map = _in_form(self._reseed(envelope_map, observations), self._settings)
+            return
+        state = RelaxedState.start(_in_form(envelope_map, self._settings), state.next_serial)
+        for observation in observations:
+            state = self._relax_instant(state, [observation], None, None, joint=False)
+        self._relaxed = state
+        self._map = _relaxed.outer_map(state, self._max_vertices)
 
     def _reseed(
         self, envelope_map: SpatialUncertaintyMap, observations: Sequence[Observation]
@@ -623,6 +854,8 @@ class UncertaintyMapManager:
         if not isinstance(new_map, SpatialUncertaintyMap):
             raise InputError(f"new_map: expected a SpatialUncertaintyMap, got {type(new_map).__name__}")
         self._map = _in_form(new_map, self._settings)
+        if self._relaxed is not None:
+            self._relaxed = RelaxedState.start(self._map, self._relaxed.next_serial)
         self._relocalizations += 1
         self._recent.clear()  # the inconsistencies were the old map's
         self._state, self._lost_reason = ManagerState.NOMINAL, ""
@@ -833,6 +1066,14 @@ class UncertaintyMapManager:
         True
         """
         outer = self._envelope
+        # Written only with relaxed_q > 0: documents of the gate alone read as they always did.
+        relaxed: dict[str, object] = (
+            {} if self._relaxed is None else {"relaxed": encode_relaxed(self._relaxed)}
+        )
+        if outer is not None and outer._relaxed is not None:
+            envelope_relaxed = {"relaxed": encode_relaxed(outer._relaxed)}
+        else:
+            envelope_relaxed = {}
         return dump_document(
             _KIND,
             {
@@ -846,11 +1087,13 @@ class UncertaintyMapManager:
                     "rejected": {reason.value: count for reason, count in self._rejected.items()},
                     "grown_reports": self._grown,
                     "relocalizations": self._relocalizations,
+                    **({"excluded": self._excluded} if self._relaxed is not None else {}),
                 },
                 "settings": self._settings.to_dict(),
                 "envelope": None
                 if outer is None
-                else {"map": encode_map(outer._map), "recent": list(self._recent)},
+                else {"map": encode_map(outer._map), "recent": list(self._recent), **envelope_relaxed},
+                **relaxed,
             },
         )
 
@@ -901,7 +1144,10 @@ class UncertaintyMapManager:
         reader = Reader(source)
         keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
         data = reader.mapping(
-            reader.document(text, _KIND), "", (*keys, "counters", "settings"), optional=("envelope",)
+            reader.document(text, _KIND),
+            "",
+            (*keys, "counters", "settings"),
+            optional=("envelope", "relaxed"),
         )
         settings = ManagerSettings.from_dict(
             reader.mapping(data["settings"], "settings"),
@@ -921,8 +1167,13 @@ class UncertaintyMapManager:
             reader.fail("state", f"expected one of {[s.value for s in ManagerState]}, got {state!r}")
         manager._lost_reason = reader.string(data["lost_reason"], "lost_reason")
         counters = reader.mapping(
-            data["counters"], "counters", ("accepted", "rejected", "grown_reports", "relocalizations")
+            data["counters"],
+            "counters",
+            ("accepted", "rejected", "grown_reports", "relocalizations"),
+            optional=("excluded",),
         )
+        if "excluded" in counters:
+            manager._excluded = reader.integer(counters["excluded"], "counters.excluded")
         manager._relocalizations = reader.integer(counters["relocalizations"], "counters.relocalizations")
         manager._accepted = reader.integer(counters["accepted"], "counters.accepted")
         manager._grown = reader.integer(counters["grown_reports"], "counters.grown_reports")
@@ -934,8 +1185,20 @@ class UncertaintyMapManager:
             except ValueError:
                 reader.fail(place, f"expected one of {[r.value for r in RejectReason]}, got {key!r}")
             manager._rejected[reason] = reader.integer(count, place)
+        manager._relaxed = manager._restore_relaxed(reader, data.get("relaxed"), "relaxed")
         manager._restore_envelope(reader, data.get("envelope"))
         return manager
+
+    def _restore_relaxed(self, reader: Reader, value: object, where: str) -> RelaxedState | None:
+        """Decode the relaxed intersection's state: present exactly when ``relaxed_q > 0``."""
+        settings = self._settings
+        if not settings.relaxed_q:
+            if value is not None:
+                reader.fail(where, "expected none (settings.relaxed_q is 0), got a value")
+            return None
+        if value is None:
+            reader.fail(where, "expected the branches (settings.relaxed_q > 0), got none")
+        return decode_relaxed(reader, value, where, settings.relaxed_q, settings.relaxed_window)
 
     def _restore_envelope(self, reader: Reader, value: object) -> None:
         """Restore the envelope map and the recent inconsistencies saved by :meth:`to_json`."""
@@ -946,8 +1209,9 @@ class UncertaintyMapManager:
             return
         if value is None:
             reader.fail("envelope", "expected the envelope map (settings.robust is true), got none")
-        data = reader.mapping(value, "envelope", ("map", "recent"))
+        data = reader.mapping(value, "envelope", ("map", "recent"), optional=("relaxed",))
         outer._map = reader.uncertainty_map(data["map"], "envelope.map")
+        outer._relaxed = outer._restore_relaxed(reader, data.get("relaxed"), "envelope.relaxed")
         outer._map_time, outer._consumed = self._map_time, self._consumed
         recent = reader.array(data["recent"], "envelope.recent")
         window = self._settings.relocalize_window
@@ -966,7 +1230,7 @@ class UncertaintyMapManager:
 
 #: What a saved document lacking a setting ran with: one by one before joint reductions,
 #: without an envelope before outlier recovery; the defaults otherwise.
-_BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False)
+_BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False, relaxed_q=0)
 
 
 def _in_form(uncertainty_map: SpatialUncertaintyMap, settings: ManagerSettings) -> SpatialUncertaintyMap:

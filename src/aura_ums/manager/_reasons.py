@@ -8,15 +8,19 @@ import enum
 class RejectReason(enum.StrEnum):
     """Why an observation did not reduce the map.
 
-    The first three are checks the manager makes before any reduction; the others are the
-    reductions' own: no pose of the map agrees with the observation (an *inconsistent*
-    observation, most likely a misidentified landmark). Each value is the text the
+    The first three are checks the manager makes before any reduction; the next five are
+    the reductions' own: no pose of the map agrees with the observation (an *inconsistent*
+    observation, most likely a misidentified landmark). :attr:`EXCLUDED` is the relaxed
+    intersection's (``ManagerSettings.relaxed_q > 0``): the map kept no pose that agrees
+    with it, but tolerated it as one of its wrong ones. Each value is the text the
     reductions and earlier versions wrote, so counts keyed by reason read the same in
     JSON and CSV (a ``StrEnum`` member is its value wherever a string is expected).
 
     Examples
     --------
     >>> RejectReason.STALE.inconsistent, RejectReason.NO_POSITION.inconsistent
+    (False, True)
+    >>> RejectReason.EXCLUDED.inconsistent, RejectReason.EXCLUDED.reached_reduction
     (False, True)
     >>> RejectReason("unknown landmark id")          # from its value, as saved
     <RejectReason.UNKNOWN_LANDMARK: 'unknown landmark id'>
@@ -42,11 +46,24 @@ class RejectReason(enum.StrEnum):
     NO_HEADING_FOR_LINE = "no heading of the map is consistent with the observed line angle"
     #: No position of the map is at the observed offset from a ground line (Class III).
     NO_LINE_OFFSET = "no position of the map is at the observed offset from the line"
+    #: The relaxed intersection (``relaxed_q > 0``) kept no pose that agrees with it: every
+    #: hypothesis the manager still holds counts it among its at most ``relaxed_q`` wrong ones.
+    EXCLUDED = "excluded by the relaxed intersection: every pose kept counts it as wrong"
 
     @property
     def inconsistent(self) -> bool:
-        """Whether it is a reduction's: no pose of the map agrees (the consistency gate)."""
+        """Whether it is a reduction's: no pose of the map agrees (the consistency gate).
+
+        :attr:`EXCLUDED` is not: the relaxed intersection tolerated it as one of its wrong
+        observations, the map stayed sound without a re-localization.
+        """
+        return self not in _NOT_INCONSISTENT
+
+    @property
+    def reached_reduction(self) -> bool:
+        """Whether the observation passed the manager's checks and met the map (not a check's rejection)."""
         return self not in _CHECKS
 
 
 _CHECKS = frozenset({RejectReason.STALE, RejectReason.UNKNOWN_LANDMARK, RejectReason.CLASS_MISMATCH})
+_NOT_INCONSISTENT = _CHECKS | {RejectReason.EXCLUDED}

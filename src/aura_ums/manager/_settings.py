@@ -283,6 +283,20 @@ relocalize_after (2), got 1
     relocalize_window: int = _setting(
         1, SettingInfo("Observations remembered for relocalize_after", "", int, low=1)
     )
+    relaxed_q: int = _setting(
+        0,
+        SettingInfo(
+            "Wrong observations tolerated among any relaxed_window consecutive ones: the map keeps "
+            "the poses consistent with all but at most this many of the latest (0: every one trusted)",
+            "",
+            int,
+            low=0,
+        ),
+    )
+    relaxed_window: int = _setting(
+        10,
+        SettingInfo("Consecutive observations over which relaxed_q wrong ones are tolerated", "", int, low=1),
+    )
 
     def __post_init__(self) -> None:
         values = _checked({f.name: getattr(self, f.name) for f in _FIELDS}, _fail)
@@ -327,7 +341,7 @@ relocalize_after (2), got 1
         aura_ums.errors.InputError: ManagerSettings.sigma: expected a field of ManagerSettings \
 (sigmas, area_limit, missed_limit, lost_window_scale, joint_above, joint_sector, max_vertices, \
 slice_width, max_slices, robust, envelope_factor, envelope_max_vertices, relocalize_after, \
-relocalize_window), got 'sigma'
+relocalize_window, relaxed_q, relaxed_window), got 'sigma'
         """
         report = _fail if fail is None else fail
         if not isinstance(data, Mapping):
@@ -360,6 +374,9 @@ def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
         raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")
+    allowed, span = checked["relaxed_q"], checked["relaxed_window"]
+    if isinstance(allowed, int) and isinstance(span, int) and allowed > 0 and span <= allowed:
+        raise fail("relaxed_window", f"expected an integer > relaxed_q ({allowed}), got {span}")
     return checked
 
 

@@ -27,6 +27,7 @@ edge at a building's corner has none) or half the strip width (Class III).
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import enum
 import math
 import statistics
@@ -40,14 +41,19 @@ from numpy.typing import NDArray
 from aura_ums._metrics import Metrics
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
+from aura_ums.geometry import wrap_angle
 from aura_ums.manager import Blackboard, ManagerState, PositionReport, RejectReason, UncertaintyMapManager
 from aura_ums.schemas import Frame, Pilot, SchemaManager, SchemaManagerState, StepReport
 from aura_ums.sim._scenario import Scenario, waypoints_array
 from aura_ums.sim._scene import CORNER_MATCH_DISTANCE
 from aura_ums.uncertainty import (
+    BearingObservation,
     GroundLineLandmark,
+    GroundLineObservation,
+    Observation,
     PointLandmark,
     Pose,
+    RangeBearingObservation,
     SpatialUncertaintyMap,
     TurnAndRun,
     VerticalLineLandmark,
@@ -61,6 +67,8 @@ _LOOK_TURN = math.radians(15.0)
 #: Frames in a row spent looking around while lost before the run gives up.
 _MAX_LOOK_FRAMES = 12
 _LOOK_PATTERN = (1.0, -2.0, 1.0)
+#: Radians by which a wrong identification's bearing turns when no other landmark of its class exists.
+_WRONG_TURN = 3.0
 
 
 class PerceptionMode(enum.Enum):
@@ -109,6 +117,10 @@ class FrameRecord:
         perception matched, ``(u1, v1, u2, v2)`` full-image pixels: a line finder's segment
         (Class I and III); a point as ``(u, v, u, v)`` (a Class II interest point, or the
         centroid of a Class I region, the point its observation uses). Empty by default.
+    injected : int
+        Identifications of the frame made wrong (the scenario's ``inject_wrong_rate``).
+    excluded : int
+        Observations the manager's relaxed intersection excluded in the frame.
     """
 
     index: int
@@ -127,6 +139,8 @@ class FrameRecord:
     state: ManagerState
     frame_ms: float
     detections: tuple[tuple[str, tuple[float, float, float, float]], ...] = ()
+    injected: int = 0
+    excluded: int = 0
 
     @property
     def area_before(self) -> float:
@@ -427,8 +441,11 @@ class _Loop:
         else:
             scale = self.manager.window_scale if self.prune else 1.0
         report = self.schemas.step(Frame(now, image, grown.map, window_scale=scale))
+        injected = 0
         if not self.prune:
             self.board.identified.drain(until=now)
+        elif self.scenario.inject_wrong_rate > 0.0:
+            injected = self._inject(now)
         after = self.manager.update(self.board, now=now, missed_in_a_row=report.consecutive_missed)
         elapsed = 1000.0 * (_time.perf_counter() - started)
         windows = tuple((r.landmark_id, r.window) for r in report.schemas if r.window is not None)
@@ -452,9 +469,27 @@ class _Loop:
                 state=after.state,
                 frame_ms=elapsed,
                 detections=_detections(report),
+                injected=injected,
+                excluded=len(grown.excluded) + len(after.excluded),
             )
         )
         self.next_index += 1
+
+    def _inject(self, now: float) -> int:
+        """Make each identification up to ``now`` wrong with the scenario's rate; return how many.
+
+        Draws from the camera's generator only when the rate is positive, so runs without
+        injection are the runs they always were.
+        """
+        buffer = self.board.identified
+        rng = self.camera_rng
+        made = 0
+        for observation in buffer.drain(until=now):
+            if rng.random() < self.scenario.inject_wrong_rate:
+                observation = _wrong(observation, self.scenario.meadow_map, rng)
+                made += 1
+            buffer.post(observation)
+        return made
 
     def save(self) -> LoopState:
         return LoopState(
@@ -492,9 +527,24 @@ def _detections(report: StepReport) -> tuple[tuple[str, tuple[float, float, floa
     return tuple(found)
 
 
-def _with_map(scenario: Scenario, world: MeadowMap) -> Scenario:
-    import dataclasses
+def _wrong(observation: Observation, world: MeadowMap, rng: np.random.Generator) -> Observation:
+    """Return a misidentification: another landmark of the class, else the bearing (angle) turned 3 rad."""
+    others = [
+        record.id
+        for record in world.landmarks
+        if record.landmark.landmark_class is observation.landmark_class
+        and record.id != observation.landmark_id
+    ]
+    if others:
+        return dataclasses.replace(observation, landmark_id=others[int(rng.integers(len(others)))])
+    if isinstance(observation, GroundLineObservation):
+        return dataclasses.replace(observation, angle=wrap_angle(observation.angle + _WRONG_TURN))
+    if isinstance(observation, (BearingObservation, RangeBearingObservation)):
+        return dataclasses.replace(observation, bearing=wrap_angle(observation.bearing + _WRONG_TURN))
+    raise InputError(f"observation: expected an observation of Class I, II or III, got {observation!r}")
 
+
+def _with_map(scenario: Scenario, world: MeadowMap) -> Scenario:
     return dataclasses.replace(scenario, meadow_map=world, landmark_ids=())
 
 
@@ -605,7 +655,9 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
     ``median_wedge_width_rad``, ``landmark_detection_rate`` (matches per searched window;
     None when no window was searched), ``inconsistent_observations`` (observations the
     manager rejected), ``accepted_observations``, ``median_frame_ms``, ``frames``,
-    ``runs_lost`` (runs that declared themselves lost), ``runs_completed``.
+    ``runs_lost`` (runs that declared themselves lost), ``runs_completed``,
+    ``injected_observations`` (identifications made wrong), ``excluded_observations``
+    (observations the relaxed intersection excluded).
 
     Examples
     --------
@@ -632,5 +684,7 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
             "frames": len(records),
             "runs_lost": sum(result.ever_lost for result in results),
             "runs_completed": sum(result.completed for result in results),
+            "injected_observations": sum(r.injected for r in records),
+            "excluded_observations": sum(r.excluded for r in records),
         }
     )

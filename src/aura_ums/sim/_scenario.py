@@ -13,6 +13,7 @@ says ``_deg``, radians otherwise; every other unit SI)::
                                         # for every landmark (default: each landmark's own)
     frame_spacing = 1.0                 # optional: metres of commanded run between frames
     # or: frame_rate = 2.0 (frames per second) with speed = 0.5 (m/s)
+    inject_wrong_rate = 0.0             # optional: share of identifications made wrong (0 to 1)
 
     [start]                             # the believed start: centre and bounds
     x = 0.0
@@ -90,6 +91,7 @@ _TOP_KEYS = (
     "confirm_frames",
     "frame_spacing",
     "frame_rate",
+    "inject_wrong_rate",
     "speed",
     "start",
     "route",
@@ -341,6 +343,12 @@ class Scenario:
         The map manager's settings: when to declare the robot lost, outlier recovery, ...
     render : RenderSettings
         Settings of the synthetic scene and camera.
+    inject_wrong_rate : float
+        Share, in [0, 1], of the identifications posted that the loop makes wrong before the
+        manager sees them (each by chance): the landmark's id swapped for another of its
+        class, or, with none, the bearing (a line's angle) turned by 3 rad. A
+        misidentification no gate can tell from a good one when the map agrees with it;
+        for testing outlier handling (:attr:`ManagerSettings.relaxed_q`). 0: none.
     source : str
         The file it was read from (``""`` when built in code).
 
@@ -380,6 +388,7 @@ class Scenario:
     settings: ManagerSettings = field(default_factory=ManagerSettings)
     render: RenderSettings = RenderSettings()
     source: str = ""
+    inject_wrong_rate: float = 0.0
 
     def __post_init__(self) -> None:
         for name, kind in (
@@ -413,6 +422,10 @@ class Scenario:
                     f"Scenario.frame_spacing: expected a positive number or None, got {spacing!r}"
                 )
             object.__setattr__(self, "frame_spacing", spacing)
+        rate = finite_float(self.inject_wrong_rate, "Scenario.inject_wrong_rate")
+        if not 0.0 <= rate <= 1.0:
+            raise InputError(f"Scenario.inject_wrong_rate: expected a number in [0, 1], got {rate!r}")
+        object.__setattr__(self, "inject_wrong_rate", rate)
         self._refuse_too_much_work()
 
     def frame_count(self) -> int:
@@ -550,6 +563,9 @@ class Scenario:
         spacing = _frame_spacing(document, reader)
         settings = _settings(document, reader)
         render = _render(reader.table(document, "render", required=False), reader)
+        rate = reader.nonnegative(document.get("inject_wrong_rate", 0.0), "inject_wrong_rate")
+        if rate > 1.0:
+            raise reader.fail("inject_wrong_rate", f"expected a number in [0, 1], got {rate!r}")
         try:
             return cls(
                 name,
@@ -564,6 +580,7 @@ class Scenario:
                 settings,
                 render,
                 reader.source,
+                rate,
             )
         except InputError as exc:
             field_name, _, message = str(exc).partition(": ")

@@ -28,6 +28,7 @@ from aura_ums.uncertainty._motion import FOOT, TurnAndRun
 from aura_ums.uncertainty._reduce import Reduction
 from aura_ums.uncertainty._slices import HeadingSlice
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
+from aura_ums.uncertainty._union import union_of_maps, union_of_wedges
 
 __all__ = [
     "FOOT",
@@ -54,4 +55,6 @@ __all__ = [
     "motion_bounds",
     "reduce_jointly",
     "simulate_containment",
+    "union_of_maps",
+    "union_of_wedges",
 ]

@@ -1,0 +1,185 @@
+"""The q-relaxed intersection: branches of the map, each excluding at most q of the latest N sightings.
+
+A *sighting* is an observation that passed the manager's checks and met the map; each gets
+a serial number. The window holds the latest ``N`` sightings. A *branch* is a map and the
+set of sightings of the window it excludes (at most ``q``): its map holds the poses
+consistent with every sighting but those (and, after merges, an outer bound of that).
+
+- A new sighting reduces every branch (a branch it empties dies) and, from each branch
+  with fewer than ``q`` exclusions, spawns a copy that excludes it (unless the reduction
+  left the branch as it was: the copy would add nothing).
+- When an excluded sighting leaves the window, its branch merges into the branch with the
+  same set minus it (an outer bound: hull of polygons, union of headings), or takes its
+  place.
+- Growth applies to every branch; the reported map is the outer bound of all branches.
+
+Guarantee: the truth stays inside whenever at most ``q`` of any ``N`` consecutive
+sightings are wrong (and the growth and the correct sightings' bounds hold). Invariant,
+by induction over sightings: some branch whose excluded set is a subset of the window's
+wrong sightings holds the truth. Growth keeps it; a departing sighting only merges (an
+outer bound) into a branch whose set is still such a subset; a correct arrival reduces it
+soundly; a wrong arrival finds it with fewer than ``q`` exclusions (the window before the
+arrival held at most ``q - 1`` wrong ones), so its copy excluding the arrival exists, or
+the reduction left it unchanged. Any two branches may also merge into the intersection of
+their sets (the same argument); nothing here needs it, since ``q`` and ``N`` bound the
+branch count by the sum of ``C(N, k)`` for ``k <= q``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from aura_ums.uncertainty import Observation, SpatialUncertaintyMap, union_of_maps
+
+#: Reduce a map by the sightings of an instant at these indices; None when no pose agrees.
+Reducer = Callable[[SpatialUncertaintyMap, Sequence[int]], SpatialUncertaintyMap | None]
+
+
+@dataclass(frozen=True, slots=True)
+class Branch:
+    """One hypothesis of the relaxed intersection: the sightings it excludes, and its map."""
+
+    excluded: frozenset[int]
+    map: SpatialUncertaintyMap
+
+
+@dataclass(frozen=True, slots=True)
+class Sighting:
+    """A sighting of the window: its serial number and the observation."""
+
+    serial: int
+    observation: Observation
+
+
+@dataclass(frozen=True, slots=True)
+class RelaxedState:
+    """The branches, the window of the latest sightings, and which of them were reported excluded.
+
+    ``branches`` is never empty and is kept in :func:`_order`: the first is the primary
+    one (fewest exclusions; among equals, the latest exclusions first), whose centre and
+    most probable heading the reported map takes.
+    """
+
+    branches: tuple[Branch, ...]
+    window: tuple[Sighting, ...]
+    reported: frozenset[int]
+    next_serial: int
+
+    @classmethod
+    def start(cls, uncertainty_map: SpatialUncertaintyMap, next_serial: int = 0) -> RelaxedState:
+        """Return one branch excluding nothing, an empty window."""
+        return cls((Branch(frozenset(), uncertainty_map),), (), frozenset(), next_serial)
+
+    @property
+    def primary(self) -> SpatialUncertaintyMap:
+        """The map of the branch with the fewest exclusions."""
+        return self.branches[0].map
+
+
+def _order(branch: Branch) -> tuple[int, tuple[int, ...]]:
+    return len(branch.excluded), tuple(sorted(-serial for serial in branch.excluded))
+
+
+def _sorted(branches: Sequence[Branch]) -> tuple[Branch, ...]:
+    return tuple(sorted(branches, key=_order))
+
+
+def grow(
+    state: RelaxedState, grow_map: Callable[[SpatialUncertaintyMap], SpatialUncertaintyMap]
+) -> RelaxedState:
+    """Return the state with every branch's map grown by ``grow_map``."""
+    return dataclasses.replace(
+        state, branches=tuple(Branch(branch.excluded, grow_map(branch.map)) for branch in state.branches)
+    )
+
+
+def admit(
+    state: RelaxedState, observations: Sequence[Observation], window: int, max_vertices: int
+) -> tuple[RelaxedState, tuple[int, ...]]:
+    """Slide the window to make room for ``observations`` (at most ``window``), then append them.
+
+    Every sighting that leaves merges the branches excluding it into the branches with
+    the same set minus it. Returns the state and the new sightings' serials.
+    """
+    kept = list(state.window)
+    branches = list(state.branches)
+    reported = state.reported
+    while kept and len(kept) + len(observations) > window:
+        leaving = kept.pop(0).serial
+        reported = reported - {leaving}
+        if any(leaving in branch.excluded for branch in branches):
+            branches = _merged(branches, leaving, max_vertices)
+    serials = tuple(range(state.next_serial, state.next_serial + len(observations)))
+    kept += [Sighting(serial, observation) for serial, observation in zip(serials, observations, strict=True)]
+    return (
+        RelaxedState(_sorted(branches), tuple(kept), reported, state.next_serial + len(observations)),
+        serials,
+    )
+
+
+def _merged(branches: Sequence[Branch], leaving: int, max_vertices: int) -> list[Branch]:
+    """Merge each branch excluding ``leaving`` into the one with the same set minus it."""
+    by_set: dict[frozenset[int], SpatialUncertaintyMap] = {
+        branch.excluded: branch.map for branch in branches if leaving not in branch.excluded
+    }
+    for branch in branches:
+        if leaving in branch.excluded:
+            target = branch.excluded - {leaving}
+            there = by_set.get(target)
+            by_set[target] = (
+                branch.map if there is None else union_of_maps([there, branch.map], max_vertices=max_vertices)
+            )
+    return [Branch(excluded, uncertainty_map) for excluded, uncertainty_map in by_set.items()]
+
+
+def relax(state: RelaxedState, serials: Sequence[int], q: int, reduce: Reducer) -> RelaxedState | None:
+    """Return the state after an instant's sightings (``serials``, already admitted); None if all die.
+
+    Each branch with ``k`` exclusions has a child for each subset of the new sightings of
+    at most ``q - k`` items: the branch reduced by the others, excluding the subset. A
+    child whose reduction is empty dies; a child whose map is that of a child with a
+    smaller set (the reduction changed nothing) adds nothing and is dropped.
+    """
+    count = len(serials)
+    children: list[Branch] = []
+    for branch in state.branches:
+        room = q - len(branch.excluded)
+        made: list[tuple[frozenset[int], SpatialUncertaintyMap]] = []
+        for size in range(min(room, count) + 1):
+            for dropped in itertools.combinations(range(count), size):
+                keep = [index for index in range(count) if index not in dropped]
+                reduced = reduce(branch.map, keep) if keep else branch.map
+                if reduced is None:
+                    continue
+                excluded = branch.excluded | {serials[index] for index in dropped}
+                if any(other is reduced and smaller <= excluded for smaller, other in made):
+                    continue
+                made.append((excluded, reduced))
+                children.append(Branch(excluded, reduced))
+    if not children:
+        return None
+    return dataclasses.replace(state, branches=_sorted(children))
+
+
+def newly_excluded(state: RelaxedState) -> tuple[RelaxedState, tuple[Observation, ...]]:
+    """Return the sightings that every branch now excludes and were not reported yet.
+
+    A sighting of the window is *excluded* when every surviving branch counts it among
+    its exclusions: no pose the manager still keeps had to agree with it. Until it
+    leaves the window no branch including it can come back (children only add
+    exclusions), so each is reported once.
+    """
+    common = frozenset.intersection(*(branch.excluded for branch in state.branches))
+    fresh = common - state.reported
+    if not fresh:
+        return state, ()
+    found = tuple(sighting.observation for sighting in state.window if sighting.serial in fresh)
+    return dataclasses.replace(state, reported=state.reported | fresh), found
+
+
+def outer_map(state: RelaxedState, max_vertices: int) -> SpatialUncertaintyMap:
+    """Return the outer bound of every branch's map, the primary branch's centre and heading kept."""
+    return union_of_maps([branch.map for branch in state.branches], max_vertices=max_vertices)

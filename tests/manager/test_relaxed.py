@@ -1,0 +1,260 @@
+"""The q-relaxed intersection: the truth stays inside when at most q of any N consecutive are wrong."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.expecter import PerceptualStrategy
+from aura_ums.geometry import ConvexPolygon
+from aura_ums.manager import (
+    Blackboard,
+    ManagerSettings,
+    ManagerStep,
+    PositionReport,
+    RejectReason,
+    UncertaintyMapManager,
+)
+from aura_ums.uncertainty import (
+    BearingObservation,
+    Observation,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainTable,
+    TurnAndRun,
+    VerticalLineLandmark,
+)
+from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
+
+FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
+POLES = (
+    VerticalLineLandmark("north_west", 4.0, 9.0, 0.0, 4.0),
+    VerticalLineLandmark("north_east", 16.0, 8.0, 0.0, 4.0),
+    VerticalLineLandmark("south", 10.0, -7.0, 0.0, 4.0),
+    VerticalLineLandmark("far_east", 26.0, 1.0, 0.0, 4.0),
+)
+WORLD = MeadowMap(
+    [
+        Meadow(
+            "floor",
+            ConvexPolygon([(-5, -10), (30, -10), (30, 12), (-5, 12)]),
+            "floor",
+            tuple(p.id for p in POLES),
+        )
+    ],
+    [LandmarkRecord(pole, PerceptualStrategy.LINE_FINDER, {}, 50.0, 0.5) for pole in POLES],
+)
+START_POSE = Pose(2.0, 0.0, 0.0)
+START = SpatialUncertaintyMap.from_pose(START_POSE, 0.6, 0.15)
+STRIDE = TurnAndRun(0.0, 1.0)
+ERROR = 0.02
+
+
+def bearing(pose: Pose, x: float, y: float, pole: VerticalLineLandmark) -> float:
+    return math.atan2(pole.y - y, pole.x - x) - pose.heading
+
+
+def wrong_bearing(truth: Pose, around: SpatialUncertaintyMap, pole: VerticalLineLandmark) -> float | None:
+    """The bearing seen from the vertex of ``around`` that makes it most wrong, if wrong by > 2 bounds.
+
+    Seen from a position the map still holds, it is consistent with the map: a gate cannot
+    tell it from a good one. It excludes the truth.
+    """
+    true = bearing(truth, truth.x, truth.y, pole)
+    best, worst = None, 0.0
+    for x, y in around.polygon.vertices.tolist():
+        seen = bearing(truth, x, y, pole)
+        off = abs(math.remainder(seen - true, 2 * math.pi))
+        if off > worst:
+            best, worst = seen, off
+    return best if worst > 2.5 * ERROR else None
+
+
+def drive(
+    settings: ManagerSettings, rng: np.random.Generator, steps: int, wrong_per_step: int
+) -> tuple[list[ManagerStep], list[Pose], list[bool]]:
+    """Walk east a metre a step seeing every pole; the first ``wrong_per_step`` sightings made wrong.
+
+    Returns the steps, the true poses and, per sighting in order, whether it was wrong.
+    """
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, settings)
+    board = Blackboard()
+    truth, results, truths, wrong = START_POSE, [], [], []
+    for k in range(1, steps + 1):
+        before = manager.map
+        truth = Pose(truth.x + 1.0, truth.y, truth.heading)
+        board.post_report(PositionReport(float(k), STRIDE))
+        moved = SpatialUncertaintyMap.from_polygon(
+            before.polygon.translated(1.0, 0.0), before.center + np.array([1.0, 0.0]), before.wedge
+        )
+        for index, pole in enumerate(POLES):
+            seen = bearing(truth, truth.x, truth.y, pole) + rng.uniform(-0.9, 0.9) * ERROR
+            made_wrong = False
+            if index < wrong_per_step:
+                fake = wrong_bearing(truth, moved, pole)
+                if fake is not None:
+                    seen, made_wrong = fake, True
+            wrong.append(made_wrong)
+            board.identified.post(BearingObservation(pole.id, float(k), seen, ERROR))
+        results.append(manager.update(board, now=float(k)))
+        truths.append(truth)
+    return results, truths, wrong
+
+
+def at_most(wrong: list[bool], q: int, n: int) -> bool:
+    """Whether at most ``q`` of any ``n`` consecutive sightings are wrong."""
+    flags = np.asarray(wrong, dtype=int)
+    if len(flags) < n:
+        return int(flags.sum()) <= q
+    return bool(np.convolve(flags, np.ones(n, dtype=int), mode="valid").max() <= q)
+
+
+@pytest.mark.parametrize(("q", "window", "wrong_per_step"), [(1, 4, 1), (2, 4, 2), (2, 8, 1)])
+@pytest.mark.parametrize("seed", range(6))
+def test_the_truth_stays_inside_when_at_most_q_of_any_n_are_wrong(
+    q: int, window: int, wrong_per_step: int, seed: int
+) -> None:
+    settings = ManagerSettings(relaxed_q=q, relaxed_window=window)
+    # Four sightings a step, the first ones wrong: one a step is one in any four and two in
+    # any eight; two a step are two in any four.
+    steps, truths, wrong = drive(settings, np.random.default_rng(seed), 10, wrong_per_step)
+    assert at_most(wrong, q, window)
+    assert sum(wrong) >= 8 * wrong_per_step
+    for step, truth in zip(steps, truths, strict=True):
+        assert step.map.contains(truth), (step.time, step.map, truth)
+        assert not step.relocalized
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_without_relaxation_the_same_wrong_sightings_remove_the_truth(seed: int) -> None:
+    # The test above can fail: the gate alone (q = 0) loses the truth to the same injection.
+    steps, truths, wrong = drive(ManagerSettings(), np.random.default_rng(seed), 10, 1)
+    assert any(wrong)
+    assert not all(step.map.contains(truth) for step, truth in zip(steps, truths, strict=True))
+    assert all(not step.excluded for step in steps)
+
+
+def test_with_more_wrong_than_q_the_guarantee_is_not_claimed() -> None:
+    # Two wrong in every four break q = 1, N = 4: the map may lose the truth (and here does).
+    lost = 0
+    for seed in range(6):
+        steps, truths, wrong = drive(
+            ManagerSettings(relaxed_q=1, relaxed_window=4), np.random.default_rng(seed), 10, 2
+        )
+        assert not at_most(wrong, 1, 4)
+        lost += not all(step.map.contains(truth) for step, truth in zip(steps, truths, strict=True))
+    assert lost > 0
+
+
+def test_excluded_observations_are_reported_once_and_counted() -> None:
+    settings = ManagerSettings(relaxed_q=1, relaxed_window=4)
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, settings)
+    board = Blackboard()
+    truth = START_POSE
+    seen_ids: list[int] = []
+    for k in range(1, 7):
+        truth = Pose(truth.x + 1.0, truth.y, truth.heading)
+        board.post_report(PositionReport(float(k), STRIDE))
+        for pole in POLES:
+            board.identified.post(
+                BearingObservation(pole.id, float(k), bearing(truth, truth.x, truth.y, pole), ERROR)
+            )
+        if k == 4:
+            # The pole behind: no branch agrees, every one that would include it dies.
+            board.identified.post(
+                BearingObservation("south", float(k), bearing(truth, truth.x, truth.y, POLES[2]) + 3.0, ERROR)
+            )
+        step = manager.update(board, now=float(k))
+        seen_ids += [id(o) for o in step.excluded]
+        if k == 4:
+            assert step.rejected[0].reason is RejectReason.EXCLUDED
+            assert not step.rejected[0].accepted
+            assert step.excluded == (step.rejected[0].observation,)
+    assert len(seen_ids) == len(set(seen_ids)) == manager.excluded_count == 1
+    assert manager.rejected_counts == {RejectReason.EXCLUDED: 1}
+    assert manager.relocalizations == 0
+    assert manager.inconsistent_count == 0
+
+
+def test_q_zero_is_one_branch_and_the_branch_count_stays_bounded() -> None:
+    steps, _, _ = drive(ManagerSettings(), np.random.default_rng(1), 4, 0)
+    assert all(not s.excluded for s in steps)
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, ManagerSettings(relaxed_q=2, relaxed_window=5))
+    assert manager.branch_count == 1
+    board = Blackboard()
+    truth = START_POSE
+    for k in range(1, 8):
+        truth = Pose(truth.x + 1.0, truth.y, truth.heading)
+        board.post_report(PositionReport(float(k), STRIDE))
+        for pole in POLES:
+            board.identified.post(
+                BearingObservation(pole.id, float(k), bearing(truth, truth.x, truth.y, pole), ERROR)
+            )
+        manager.update(board, now=float(k))
+        assert manager.branch_count <= 1 + 5 + 10  # C(5, 0) + C(5, 1) + C(5, 2)
+
+
+def test_a_saved_relaxed_manager_goes_on_exactly_as_the_original() -> None:
+    settings = ManagerSettings(relaxed_q=1, relaxed_window=5)
+    rng = np.random.default_rng(4)
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, settings)
+    board = Blackboard()
+    truth = START_POSE
+    copy: UncertaintyMapManager | None = None
+    copy_board: Blackboard | None = None
+    for k in range(1, 9):
+        truth = Pose(truth.x + 1.0, truth.y + 0.1, truth.heading)
+        observations: list[Observation] = [
+            BearingObservation(
+                pole.id, float(k), bearing(truth, truth.x, truth.y, pole) + rng.uniform(-0.01, 0.01), ERROR
+            )
+            for pole in POLES
+        ]
+        for target, target_board in ((manager, board), (copy, copy_board)):
+            if target is None or target_board is None:
+                continue
+            target_board.post_report(PositionReport(float(k), STRIDE))
+            for observation in observations:
+                target_board.identified.post(observation)
+            target.update(target_board, now=float(k))
+        if k == 4:
+            copy = UncertaintyMapManager.from_json(manager.to_json(), WORLD, FLOOR)
+            copy_board = Blackboard.from_json(board.to_json())
+            assert copy.to_json() == manager.to_json()
+            assert copy.branch_count == manager.branch_count > 1
+    assert copy is not None
+    assert copy.to_json() == manager.to_json()
+    assert copy.map.polygon.vertices.tobytes() == manager.map.polygon.vertices.tobytes()
+
+
+def test_a_saved_document_must_match_its_settings() -> None:
+    relaxed = UncertaintyMapManager(START, WORLD, FLOOR, ManagerSettings(relaxed_q=1, relaxed_window=3))
+    text = relaxed.to_json()
+    plain = UncertaintyMapManager(START, WORLD, FLOOR).to_json()
+    assert '"relaxed"' in text
+    assert '"relaxed"' not in plain
+    without = json.loads(text)
+    del without["relaxed"]
+    with pytest.raises(
+        FileFormatError, match=r"relaxed: expected the branches \(settings.relaxed_q > 0\), got none"
+    ):
+        UncertaintyMapManager.from_json(json.dumps(without), WORLD, FLOOR)
+    broken = text.replace('"excluded": []', '"excluded": [7]', 1)
+    with pytest.raises(
+        FileFormatError, match=r"relaxed.branches\[0\].excluded: expected at most 1 serials of the window"
+    ):
+        UncertaintyMapManager.from_json(broken, WORLD, FLOOR)
+
+
+def test_the_window_must_be_longer_than_q() -> None:
+    with pytest.raises(
+        InputError, match=r"ManagerSettings.relaxed_window: expected an integer > relaxed_q \(3\), got 3"
+    ):
+        ManagerSettings(relaxed_q=3, relaxed_window=3)
+    assert ManagerSettings(relaxed_q=0, relaxed_window=1).relaxed_window == 1
+    assert dataclasses.replace(ManagerSettings(), relaxed_q=1).relaxed_window == 10
