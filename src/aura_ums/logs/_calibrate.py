@@ -725,7 +725,7 @@ def calibrate_logs(
     the ``quantile`` of |bearing error|; the working range bound is relative to the
     measured range plus absolute, ``fraction * range + range_error`` on each side: the
     fractions are the ``(1 - quantile) / 2`` and ``(1 + quantile) / 2`` quantiles of the
-    relative range error, and ``range_error`` the median |range error| of the shortest
+    relative range error, and ``range_error`` the median absolute range error of the shortest
     tenth of the ranges (so that short ranges never get a zero-width bound). The envelope
     bounds cover every relative error seen, times ``envelope_margin``, plus the absolute
     part times ``envelope_margin``. The filters' noise (:class:`FilterNoise`) is the standard deviation

@@ -415,7 +415,7 @@ class GroundTruth:
         Seconds, > 0 (``math.inf`` for no limit): the longest interval between two rows
         that :meth:`at` interpolates across. Times strictly inside a longer interval are a
         gap in the record (a lost motion-capture track, say) and get no pose; default
-        :data:`DEFAULT_MAX_TRUTH_GAP`.
+        0.5 s.
 
     Examples
     --------
