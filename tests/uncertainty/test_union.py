@@ -77,3 +77,19 @@ def test_bad_arguments_are_refused() -> None:
         union_of_maps([one, "map"])  # type: ignore[list-item]
     with pytest.raises(InputError, match=r"max_vertices: expected an integer >= 3, got 2"):
         union_of_maps([one], max_vertices=2)
+
+
+def test_the_union_of_sliced_maps_keeps_their_slices_and_every_pose() -> None:
+    rng = np.random.default_rng(7)
+    east = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.3), 0.5, 0.2).with_slices(math.radians(4.0))
+    west = SpatialUncertaintyMap.from_pose(Pose(3.0, 1.0, 1.2), 0.4, 0.1)
+    union = union_of_maps([east, west])
+    assert union.is_sliced
+    for member in (east, west):
+        for x, y, heading in member.sample_poses(300, rng).tolist():
+            assert union.contains(x, y, heading)
+    # Sliced, the union keeps position and heading coupled: a pose with east's position and
+    # west's heading lies in the product hull but not in the union.
+    assert union.polygon.contains(np.array([[0.0, 0.0]]))[0]
+    assert not union.contains(0.0, 0.0, 1.2)
+    assert union.area <= union_of_maps([east.without_slices(), west]).area + 1e-9

@@ -13,6 +13,7 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
+from aura_ums.uncertainty._slices import capped, distribute, split_product
 
 _TWO_PI = 2.0 * math.pi
 
@@ -42,6 +43,8 @@ def union_of_maps(
     SpatialUncertaintyMap
         Contains every pose (position in a polygon, heading in that map's wedge) of every
         map; positions and headings combine freely (a product set, hence an outer bound).
+        When the first map is heading-sliced, the union is sliced on its grid: each cell
+        holds the hull of every map's positions at its headings.
 
     Raises
     ------
@@ -76,9 +79,34 @@ def union_of_maps(
     primary = items[0]
     if len(items) == 1:
         return primary
+    if primary.is_sliced:
+        return _sliced_union(primary, items, max_vertices)
     polygon = _support_hull([item.polygon.vertices for item in items], max_vertices)
     wedge = union_of_wedges([item.wedge for item in items], primary.wedge.center)
     return SpatialUncertaintyMap._trusted(polygon, primary.center.copy(), wedge)
+
+
+def _sliced_union(
+    primary: SpatialUncertaintyMap, items: Sequence[SpatialUncertaintyMap], max_vertices: int
+) -> SpatialUncertaintyMap:
+    """The union on the first map's heading grid: each cell the hull of every map's positions there.
+
+    A product map among them is cut onto the grid first (its polygon in every cell its
+    wedge meets). Each cell then holds every pose any map held at its headings: an outer
+    bound, as tight as the grid allows; the slice cap merges neighbours, as growth does.
+    """
+    cells, cap = primary._cells, primary._max_slices
+    pieces: list[tuple[float, float, NDArray[np.float64]]] = []
+    for item in items:
+        slices = item._slices
+        if slices is None or item._cells != cells:
+            wedge = item.wedge
+            slices = split_product(item.polygon.vertices, wedge.center - wedge.cw, wedge.width, cells)
+        pieces += [(piece.lo, piece.hi, piece.vertices) for piece in slices]
+    grid = distribute(pieces, cells, max_vertices)
+    if len(grid) > cap:
+        grid = capped(grid, cap, max_vertices)
+    return SpatialUncertaintyMap._sliced(grid, primary.center.copy(), primary.wedge.center, cells, cap)
 
 
 def union_of_wedges(wedges: Sequence[HeadingWedge], center: float) -> HeadingWedge:
