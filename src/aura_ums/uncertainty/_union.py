@@ -89,7 +89,7 @@ def union_of_maps(
 def _sliced_union(
     primary: SpatialUncertaintyMap, items: Sequence[SpatialUncertaintyMap], max_vertices: int
 ) -> SpatialUncertaintyMap:
-    """The union on the first map's heading grid: each cell the hull of every map's positions there.
+    """Return the union on the first map's heading grid: each cell the hull of the positions there.
 
     A product map among them is cut onto the grid first (its polygon in every cell its
     wedge meets). Each cell then holds every pose any map held at its headings: an outer
