@@ -117,12 +117,14 @@ def test_readme_commands_run_as_printed_on_the_shipped_sample(
         result = runner.invoke(app, args)
         assert result.exit_code == 0, (words, result.output)
         ran.append(args[0])
-    assert ran == ["figures", "simulate", "calibrate", "replay", "compare"]
+    assert ran == ["figures", "simulate", "calibrate", "replay", "compare", "replay"]
     assert sorted(p.name for p in (clone / "cal").iterdir()) == ["terrain.sensors.toml", "terrain.toml"]
     metrics = json.loads((clone / "r2.json").read_text(encoding="utf-8"))
     assert metrics["containment_rate"] == 1.0  # the synthetic sample's errors are within its bounds
     assert list((clone / "out").glob("*.png"))
     assert json.loads((clone / "m.json").read_text(encoding="utf-8"))["runs_completed"] == 2
+    # the sliced, relaxed replay through the virtual camera: a window row per observation and method
+    assert (clone / "r2-windows.csv").read_text(encoding="utf-8").count("\n") > 3
     assert list((clone / "report" / "figures").glob("figure3*.png"))
 
 
