@@ -8,7 +8,7 @@ import enum
 import operator
 import types
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import shapely
@@ -563,23 +563,15 @@ class UncertaintyMapManager:
             return self._advance_relaxed(self._relaxed, reports, pending, outcomes, excluded)
         current, map_time = self._map, self._map_time
         index = 0
-        first = 0
-        while first < len(pending):
-            instant = pending[first].time
-            last = first + 1
-            while last < len(pending) and pending[last].time == instant:
-                last += 1
-            stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
-            current, map_time = self._grow(current, reports, index, stop, map_time)
-            index = stop
-            if last - first == 1:
-                observation = pending[first]
+        for start, index, instant in _instants(reports, pending):
+            current, map_time = self._grow(current, reports, start, index, map_time)
+            if len(instant) == 1:
+                observation = instant[0]
                 current = self._reduce(
                     current, observation, self._landmark_for(observation, map_time), outcomes
                 )
             else:
-                current = self._reduce_instant(current, pending[first:last], map_time, outcomes)
-            first = last
+                current = self._reduce_instant(current, instant, map_time, outcomes)
         current, map_time = self._grow(current, reports, index, len(reports), map_time)
         return current, map_time, None
 
@@ -594,20 +586,12 @@ class UncertaintyMapManager:
         """:meth:`_advance` for the branches of the relaxed intersection (``relaxed_q > 0``)."""
         map_time = self._map_time
         index = 0
-        first = 0
-        while first < len(pending):
-            instant = pending[first].time
-            last = first + 1
-            while last < len(pending) and pending[last].time == instant:
-                last += 1
-            stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
-            state, map_time = self._grow_branches(state, reports, index, stop, map_time)
-            index = stop
-            state = self._relax_instant(state, pending[first:last], map_time, outcomes, joint=True)
+        for start, index, instant in _instants(reports, pending):
+            state, map_time = self._grow_branches(state, reports, start, index, map_time)
+            state = self._relax_instant(state, instant, map_time, outcomes, joint=True)
             state, fresh = _relaxed.newly_excluded(state)
             if excluded is not None:
                 excluded += fresh
-            first = last
         state, map_time = self._grow_branches(state, reports, index, len(reports), map_time)
         return _relaxed.outer_map(state, self._max_vertices), map_time, state
 
@@ -1231,6 +1215,27 @@ class UncertaintyMapManager:
 #: What a saved document lacking a setting ran with: one by one before joint reductions,
 #: without an envelope before outlier recovery; the defaults otherwise.
 _BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False, relaxed_q=0)
+
+
+def _instants(
+    reports: Sequence[PositionReport], pending: Sequence[Observation]
+) -> Iterator[tuple[int, int, Sequence[Observation]]]:
+    """Yield each instant of ``pending`` (time order) after the reports to grow by before it.
+
+    Each item is ``(start, stop, observations)``: the reports ``start:stop`` end at or
+    before the instant, and ``observations`` are those of ``pending`` sharing its time.
+    """
+    index = 0
+    first = 0
+    while first < len(pending):
+        instant = pending[first].time
+        last = first + 1
+        while last < len(pending) and pending[last].time == instant:
+            last += 1
+        stop = bisect.bisect_right(reports, instant, lo=index, key=_report_time)
+        yield index, stop, pending[first:last]
+        index = stop
+        first = last
 
 
 def _in_form(uncertainty_map: SpatialUncertaintyMap, settings: ManagerSettings) -> SpatialUncertaintyMap:
