@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import tracemalloc
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from aura_ums.logs import (
     replay_log,
     synthetic_log,
 )
-from aura_ums.uncertainty import LandmarkClass, TerrainTable
+from aura_ums.uncertainty import LandmarkClass, TerrainTable, TurnAndRun
 from tests.logs.log_helpers import long_odometry_log
 
 FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
@@ -106,3 +107,18 @@ def test_a_replay_that_fails_leaves_the_old_csv_and_no_scratch(tmp_path: Path) -
     assert target.read_text(encoding="utf-8") == "old\n"
     assert sorted(path.name for path in tmp_path.iterdir()) == ["folder", "steps.csv"]
     assert [path.name for path in onto_a_folder.iterdir()] == ["keep"]
+
+
+def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
+    from aura_ums.logs._replay import _contains
+    from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
+
+    sliced = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 0.5, 0.3).with_slices(math.radians(4.0))
+    grown = sliced.grow(TurnAndRun(0.0, 3.0), TerrainTable.default()["tile"])
+    # In the hull of the slices and the summary wedge, but not in the slice of its heading:
+    # the far end of the run at the wedge's edge, where only the straight-ahead slice reaches.
+    x, y, heading = 3.0, 0.0, grown.wedge.center + 0.95 * grown.wedge.ccw
+    assert grown.polygon.contains(np.array([[x, y]]))[0] and grown.wedge.contains(heading)
+    assert not grown.contains(x, y, heading)
+    poses = np.array([[x, y, heading]] * 2)
+    assert _contains([grown, grown.without_slices()], poses).tolist() == [0, 1]

@@ -823,10 +823,14 @@ def _contains(maps: Sequence[SpatialUncertaintyMap], poses: NDArray[np.float64])
     result = np.zeros(len(maps), dtype=np.int8)
     batched: list[int] = []
     for index, step_map in enumerate(maps):
-        vertices = step_map.polygon.vertices
-        if 3 <= len(vertices) <= _BATCHED_VERTICES and step_map.polygon.area > 0.0:
+        # A sliced map is judged by its slices (its polygon and wedge are only their summary).
+        if (
+            not step_map.is_sliced
+            and 3 <= len(step_map.polygon.vertices) <= _BATCHED_VERTICES
+            and (step_map.polygon.area > 0.0)
+        ):
             batched.append(index)
-        else:  # a point, a segment, or a huge polygon: its own test
+        else:  # a sliced map, a point, a segment, or a huge polygon: its own test
             x, y, heading = poses[index].tolist()
             result[index] = step_map.contains(x, y, heading)
     if not batched:
