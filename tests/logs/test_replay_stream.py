@@ -118,7 +118,8 @@ def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
     # In the hull of the slices and the summary wedge, but not in the slice of its heading:
     # the far end of the run at the wedge's edge, where only the straight-ahead slice reaches.
     x, y, heading = 3.0, 0.0, grown.wedge.center + 0.95 * grown.wedge.ccw
-    assert grown.polygon.contains(np.array([[x, y]]))[0] and grown.wedge.contains(heading)
+    assert grown.polygon.contains(np.array([[x, y]]))[0]
+    assert grown.wedge.contains(heading)
     assert not grown.contains(x, y, heading)
     poses = np.array([[x, y, heading]] * 2)
     assert _contains([grown, grown.without_slices()], poses).tolist() == [0, 1]
