@@ -137,7 +137,7 @@ _TABLE: tuple[MetricKey, ...] = (
         "",
         _K.TEXT,
         (COMPARE_ROW, CAMERA_ROW, WINDOWS_CSV),
-        "aura-ums, EKF, PF (particles), or a method of yours; for windows: aura-ums, "
+        "aura-ums, EKF, PF (particles), codac, or a method of yours; for windows: aura-ums, "
         "EKF 3-sigma box or disk model.",
     ),
     _key("frames", "count", _K.COUNT, (SIMULATE,), "Frames of all runs (one command and one image each)."),
@@ -209,7 +209,8 @@ _TABLE: tuple[MetricKey, ...] = (
         "count",
         _K.COUNT,
         (SIMULATE, REPLAY, COMPARE_ROW),
-        "Observations rejected, all reasons together (ours: the manager; a filter: its gate).",
+        "Observations rejected, all reasons together (ours: the manager; a filter: its gate; "
+        "codac: its re-initialisations).",
     ),
     _key(
         "rejected_by_reason",

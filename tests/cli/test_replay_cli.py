@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -94,9 +95,39 @@ def test_calibrate_replay_and_compare(log_folder: Path, tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     rows = strict_json(table.read_text())
     assert set(rows) == set(written_by("compare"))
-    assert [row["method"] for row in rows["methods"]] == ["aura-ums", "EKF", "PF (50)"]
+    assert [row["method"] for row in rows["methods"]] == ["aura-ums", "EKF", "PF (50)", "codac"]
     for row in rows["methods"]:
         assert set(row) == set(written_by("compare (per method)"))
+    assert rows["methods"][3]["containment_rate"] == 1.0
+
+
+def test_compare_without_codac_leaves_its_row_out_with_a_note(
+    log_folder: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    terrain = tmp_path / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    monkeypatch.setitem(sys.modules, "codac", None)  # an import of codac now fails
+    table = tmp_path / "compare.json"
+    result = runner.invoke(
+        app,
+        [
+            "compare",
+            str(log_folder),
+            "--terrain",
+            str(terrain),
+            "--particles",
+            "20",
+            "--metrics-json",
+            str(table),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert "note: no codac row: Codac is not installed (pip install aura-ums[codac])" in result.output
+    assert [row["method"] for row in strict_json(table.read_text())["methods"]] == [
+        "aura-ums",
+        "EKF",
+        "PF (20)",
+    ]
 
 
 def test_replay_names_a_missing_terrain_file(log_folder: Path, tmp_path: Path) -> None:

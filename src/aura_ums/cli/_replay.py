@@ -14,6 +14,7 @@ from aura_ums.cli._common import (
     Quiet,
     SettingOptions,
     console,
+    err_console,
     fail,
     manager_options,
     progress_bar,
@@ -365,10 +366,14 @@ def compare(
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
-    """Print our map next to an EKF and a particle filter on the same log (99% regions)."""
+    """Print our map next to an EKF, a particle filter (99% regions) and a Codac box on the same log.
+
+    The Codac row needs the codac extra (pip install aura-ums[codac]); without it, it is left out.
+    """
     import numpy as np
 
     from aura_ums import Metrics
+    from aura_ums.baselines import codac_available
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
     from aura_ums.uncertainty import TerrainTable
@@ -408,6 +413,13 @@ def compare(
                     f"`aura-ums calibrate` (--sensors) or from calibration logs (--noise-from), got {where}"
                 )
             bearing_sd, range_sd = noise.bearing_sd, noise.range_sd_fraction
+        with_codac = codac_available()
+        if not with_codac:
+            err_console.print(
+                "note: no codac row: Codac is not installed (pip install aura-ums[codac])",
+                markup=False,
+                highlight=False,
+            )
         with progress_bar(f"{safe_name(log.meta.name)}: frames x methods", quiet=quiet) as advance:
             rows = compare_on_log(
                 log,
@@ -417,11 +429,13 @@ def compare(
                 range_sd_fraction=max(range_sd, 1e-3),
                 rng=np.random.default_rng(seed),
                 particles=particles,
+                codac=with_codac,
                 progress=advance,
             )
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
-    grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters")
+    boxes = ", the Codac box" if with_codac else ""
+    grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters{boxes}")
     for column in (
         "method",
         "truth inside",

@@ -1,4 +1,4 @@
-"""The spatial uncertainty map next to an EKF and a particle filter, on the same log."""
+"""The spatial uncertainty map next to an EKF, a particle filter and (optionally) a Codac box, on one log."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 
 from aura_ums._metrics import Metrics
 from aura_ums._validate import finite_float
-from aura_ums.baselines import Estimator, ExtendedKalmanFilter, ParticleFilter
+from aura_ums.baselines import CodacLocalizer, Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.logs._replay import (
@@ -39,10 +39,10 @@ class MethodSummary:
     Attributes
     ----------
     method : str
-        ``"aura-ums"``, ``"EKF"``, ``"PF (n)"``, or the name of one of ``others``.
+        ``"aura-ums"``, ``"EKF"``, ``"PF (n)"``, ``"codac"``, or the name of one of ``others``.
     containment_rate : float
         Fraction of the steps whose ground truth is inside the method's region (our map;
-        the filters' 99% regions).
+        the filters' 99% regions; the Codac box).
     median_area_m2 : float
         Median area of the position region, m^2.
     median_wedge_width_rad : float
@@ -55,7 +55,8 @@ class MethodSummary:
         Median microseconds per step (growth or prediction since the previous step, and
         the step's observations).
     inconsistent_observations : int
-        Observations rejected (our gate; the filters' Mahalanobis gates).
+        Observations rejected (our gate; the filters' Mahalanobis gates); for the Codac
+        box, its re-initialisations (:attr:`~aura_ums.baselines.CodacLocalizer.reinitialisations`).
 
     Examples
     --------
@@ -139,9 +140,10 @@ def compare_on_log(
     particles: int = 1000,
     probability: float = 0.99,
     others: Mapping[str, Callable[[Pose], Estimator]] | None = None,
+    codac: bool = False,
     progress: Callable[[int, int], None] | None = None,
 ) -> tuple[MethodSummary, ...]:
-    """Run our map, an EKF and a particle filter over the same log and judge each against ground truth.
+    """Run our map, an EKF, a particle filter (and a Codac box) over one log; judge each against its truth.
 
     All three see the same position reports (those :func:`replay_log` grows by), the same
     terrain statistics and the same observations, step by step. The filters start from
@@ -149,6 +151,10 @@ def compare_on_log(
     ``bearing_sd`` (rad) and ``range_sd_fraction`` (of the range) as their measurement
     noise (:func:`filter_settings`), and gate at 99.9%; their region is the
     ``probability`` confidence region.
+    With ``codac``, a :class:`~aura_ums.baselines.CodacLocalizer` joins as the row
+    ``"codac"``: it starts from our start bounds (a box around our start disk and wedge),
+    bounds the commands at our ``settings.sigmas`` and runs its relaxed intersection with our
+    ``settings.relaxed_q`` and ``settings.relaxed_window``, on our working sensor bounds.
     Your own estimators join through ``others``: each is built from the start pose and
     stepped, timed and judged exactly as the EKF is.
 
@@ -175,6 +181,8 @@ def compare_on_log(
         and returning an :class:`~aura_ums.baselines.Estimator` (a filter of yours;
         :meth:`ConfidenceRegion.gaussian <aura_ums.baselines.ConfidenceRegion.gaussian>`
         gives a Gaussian one its region). Its start spread and noise are its own.
+    codac : bool
+        Add the Codac row (needs the ``codac`` extra: :func:`~aura_ums.baselines.codac_available`).
     progress : callable or None
         Called as ``progress(done, total)`` as the work advances: after each frame of our
         replay, then after each filter's pass (``total`` is the frames times the methods);
@@ -183,12 +191,15 @@ def compare_on_log(
     Returns
     -------
     tuple of MethodSummary
-        Ours, the EKF's, the particle filter's, then one per entry of ``others``.
+        Ours, the EKF's, the particle filter's, the Codac box's (with ``codac``), then one
+        per entry of ``others``.
 
     Raises
     ------
     InputError
         For a bad argument or a log without ground truth.
+    MissingDependencyError
+        With ``codac`` when Codac is not installed.
 
     Examples
     --------
@@ -199,6 +210,11 @@ def compare_on_log(
     ...                       rng=np.random.default_rng(0), particles=200)
     >>> [row.method for row in rows], rows[0].containment_rate
     (['aura-ums', 'EKF', 'PF (200)'], 1.0)
+    >>> rows = compare_on_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}),
+    ...                       bearing_sd=0.006, range_sd_fraction=0.012,
+    ...                       rng=np.random.default_rng(0), particles=200, codac=True)
+    >>> rows[3].method, rows[3].containment_rate, rows[3].inconsistent_observations
+    ('codac', 1.0, 0)
 
     A filter of your own, here a second EKF that trusts its bearings ten times more:
 
@@ -220,10 +236,12 @@ def compare_on_log(
     r_sd = finite_float(range_sd_fraction, "range_sd_fraction")
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
-    extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})"})
+    if not isinstance(codac, bool):
+        raise InputError(f"codac: expected True or False, got {codac!r}")
+    extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})", *(("codac",) if codac else ())})
     if progress is not None and not callable(progress):
         raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
-    methods = 3 + len(extra)
+    methods = 3 + int(codac) + len(extra)
 
     def tick(done: int, frames: int) -> None:
         if progress is not None:
@@ -244,6 +262,17 @@ def compare_on_log(
             ParticleFilter(start_pose, rng, particles=particles, gate_probability=0.999, **common),
         ),
     ]
+    if codac:
+        settings = opts.settings
+        box = CodacLocalizer(
+            start_pose,
+            position_halfwidth=log.meta.start_radius,
+            heading_halfwidth=log.meta.start_heading_halfwidth,
+            sigmas=settings.sigmas,
+            q=settings.relaxed_q,
+            window=settings.relaxed_window,
+        )
+        filters.append(("codac", box))
     for name, factory in extra:
         built = factory(start_pose)
         if not isinstance(built, Estimator):
