@@ -47,7 +47,7 @@ _report_time = operator.attrgetter("time")
 _LINEAGES_KEPT = 256
 #: Anchors one map keeps: the newest and older ones spread over anchor_span, thinned
 #: so that their ages stay roughly in geometric progression.
-_ANCHORS_KEPT = 5
+_ANCHORS_KEPT = 3
 
 
 @dataclass(frozen=True, slots=True)
