@@ -109,7 +109,7 @@ def test_anchor_growth_contains_every_bounded_truth(
     grown = grow_from_anchor(anchor, composite, stats, 3.0, 64)
     start = anchor.sample_poses(300, rng)
     truth = _truth(start, commands, stats, rng, 3.0)
-    inside = grown.contains(truth[:, 0], truth[:, 1], truth[:, 2])
+    inside = np.asarray(grown.contains(truth[:, 0], truth[:, 1], truth[:, 2]))
     assert inside.all()
 
 
@@ -128,7 +128,7 @@ def test_monte_carlo_containment_over_composites() -> None:
         )
         grown = grow_from_anchor(anchor, Composite().extended(commands, stats), stats, 3.0, 64)
         truth = _truth(anchor.sample_poses(500, rng), commands, stats, rng, 3.0)
-        outside += int((~grown.contains(truth[:, 0], truth[:, 1], truth[:, 2])).sum())
+        outside += int((~np.asarray(grown.contains(truth[:, 0], truth[:, 1], truth[:, 2]))).sum())
     assert outside == 0
 
 
@@ -191,7 +191,7 @@ def test_the_intersection_of_grown_anchors_keeps_every_pose_they_share(
     wider = grow_from_anchor(start, Composite().extended(commands, looser), looser, 3.0, 64)
     both = intersect_maps(older, [wider], 64)
     truth = _truth(start.sample_poses(300, rng), commands, stats, rng, 3.0)
-    assert both.contains(truth[:, 0], truth[:, 1], truth[:, 2]).all()
+    assert np.asarray(both.contains(truth[:, 0], truth[:, 1], truth[:, 2])).all()
     assert both.area <= older.area + 1e-9
     assert both.is_sliced == sliced
 
