@@ -187,3 +187,29 @@ def test_horizons_shorter_than_a_move_are_refused() -> None:
     log = synthetic_log(np.random.default_rng(0), duration=30.0)
     with pytest.raises(InputError, match=r"horizons: expected seconds, each >= move \(0\.5\)"):
         calibrate_logs([log], horizons=(0.25, 1.0))
+
+
+def test_anchor_calibration_scales_by_the_mean_and_says_what_it_is_for() -> None:
+    log = synthetic_log(np.random.default_rng(0), duration=120.0)
+    calibration = calibrate_logs([log], anchor=True)
+    stats = calibration.stats
+    assert calibration.anchor
+    assert (stats.translation_loss, stats.rotation_loss, stats.skitter) == (0.0, 0.0, 0.0)
+    assert "growth from an anchor" in calibration.sensors_toml()
+    assert "growth move by move" in calibrate_logs([log]).sensors_toml()
+    # The bound was fitted to cover the quantile at every horizon; the check grows the same way.
+    for check in calibration.checks:
+        assert check.containment >= 0.97
+
+
+@pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
+def test_mrclam_anchor_bound_holds_at_every_horizon_and_grows_sublinearly() -> None:
+    log = read_mrclam(MRCLAM, 1)
+    anchored = {c.horizon: c for c in calibrate_logs([log], anchor=True).checks}
+    per_move = {c.horizon: c for c in calibrate_logs([log]).checks}
+    for check in anchored.values():
+        # A point start: the truth's own millimetres count; the fit covers 0.99 of the windows.
+        assert check.containment >= 0.98
+    for horizon in (10.0, 30.0):
+        assert anchored[horizon].heading_bound < 0.5 * per_move[horizon].heading_bound
+        assert anchored[horizon].position_bound < 0.6 * per_move[horizon].position_bound

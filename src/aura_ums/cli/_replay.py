@@ -160,6 +160,14 @@ def calibrate(
         ),
     ] = None,
     max_truth_gap: _MaxTruthGap = None,
+    anchor: Annotated[
+        bool,
+        typer.Option(
+            "--anchor/--per-move",
+            help="Fit the terrain statistics for growth from an anchor (replay --anchor-growth) "
+            "or move by move.",
+        ),
+    ] = False,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
@@ -185,9 +193,11 @@ def calibrate(
                 if advance is not None:
                     advance(len(logs), len(log_dirs))
         if horizons:
-            calibration = calibrate_logs(logs, quantile=quantile, move=move, horizons=tuple(horizons))
+            calibration = calibrate_logs(
+                logs, quantile=quantile, move=move, horizons=tuple(horizons), anchor=anchor
+            )
         else:  # calibrate_logs' default horizons
-            calibration = calibrate_logs(logs, quantile=quantile, move=move)
+            calibration = calibrate_logs(logs, quantile=quantile, move=move, anchor=anchor)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     write_text(out_target, calibration.terrain_table().to_toml())

@@ -28,7 +28,15 @@ from aura_ums._files import Fields, key_path, load_toml
 from aura_ums._validate import ANGLE_ERROR, DELAY, FACTOR, LENGTH, Range, finite_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
-from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
+from aura_ums.uncertainty import (
+    Composite,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainStats,
+    TerrainTable,
+    TurnAndRun,
+    grow_from_anchor,
+)
 
 _SENSOR_KEYS = ("bearing_error", "range_error", "range_fraction_low", "range_fraction_high")
 _MOTION_KEYS = ("delay_s", "run_scale", "turn_scale")
@@ -46,6 +54,8 @@ KEY_RANGES: dict[str, Range] = {
     "range_sd_fraction": Range(0.0, 10.0, low_open=True),
 }
 _KIND = "aura-ums/sensor-calibration"
+#: How the sensors file's header names the growth the terrain statistics are for.
+_GROWTH_WORDS = {False: "move by move", True: "from an anchor (replay --anchor-growth)"}
 _T = TypeVar("_T")
 
 
@@ -205,6 +215,9 @@ class Calibration:
         How the growth bound holds over each horizon on the calibration logs.
     motion_windows, observations : int
         Samples the fit used (moving windows over all horizons; observations).
+    anchor : bool
+        Whether :attr:`stats` are for growth from an anchor (``ManagerSettings.anchor_growth``)
+        rather than move by move.
     """
 
     terrain: str
@@ -219,6 +232,7 @@ class Calibration:
     checks: tuple[HorizonCheck, ...]
     motion_windows: int
     observations: int
+    anchor: bool = False
 
     def terrain_table(self) -> TerrainTable:
         """Return a one-terrain table holding :attr:`stats` under :attr:`terrain`."""
@@ -241,6 +255,7 @@ class Calibration:
         """Return motion calibration, sensor bounds and filter noise as TOML (:func:`load_sensors`)."""
         lines = [
             f"# aura-ums sensor calibration: quantile {self.quantile!r}, moves of {self.move!r} s,",
+            f"# terrain statistics for growth {_GROWTH_WORDS[self.anchor]},",
             f"# {self.motion_windows} motion windows, {self.observations} observations.",
             "# Growth bound against the truth over each horizon (calibration logs):",
             *(f"# {line}" for line in self.report().splitlines()),
@@ -525,6 +540,119 @@ def _fit_run(windows: Sequence[_Windows], gain: float, q: float, sigmas: float) 
     return high, loss, (1.0 - loss - floor) / sigmas
 
 
+#: Metres: the fixed distances per move tried for growth from an anchor (0, 0.05, ..., 1.5).
+_ANCHOR_REACH = np.linspace(0.0, 1.5, 31)
+#: The turn bands (radians per radian turned) and skitters (metres per radian) tried for it.
+_ANCHOR_BANDS = np.linspace(0.0, 1.0, 51)
+
+
+def _position_errors(
+    moves: Sequence[_Moves], length: int, run_gain: float, turn_gain: float
+) -> NDArray[np.float64]:
+    """Return, per window of ``length`` valid moves, the distance between true and nominal displacement (m).
+
+    Both are taken in their own start frame: the true one in the true start heading's, the
+    nominal one (each move's scaled run along the middle of its scaled turn) in the
+    nominal heading's. The windows are those of :func:`_windows`, in its order.
+    """
+    parts: list[NDArray[np.float64]] = []
+    for m in moves:
+        if len(m.run) < length:
+            continue
+        whole = _window_sums((~m.valid).astype(np.float64), length) == 0.0
+        turn = np.where(m.valid, m.turn, 0.0) * turn_gain
+        run = np.where(m.valid, m.run, 0.0) * run_gain
+        heading = np.concatenate(([0.0], np.cumsum(turn)))
+        middle = heading[:-1] + turn / 2.0
+        nominal = np.concatenate(([0.0], np.cumsum(run * np.exp(1j * middle))))
+        pose = np.nan_to_num(m.pose)
+        true = pose[:, 0] + 1j * pose[:, 1]
+        starts = np.arange(len(m.run) - length + 1)
+        ours = (nominal[starts + length] - nominal[starts]) * np.exp(-1j * heading[starts])
+        theirs = (true[starts + length] - true[starts]) * np.exp(-1j * pose[starts, 2])
+        parts.append(np.abs(theirs - ours)[whole])
+    return np.concatenate(parts) if parts else np.empty(0)
+
+
+def _smallest_rate(
+    errors: Sequence[NDArray[np.float64]],
+    per_turn: Sequence[NDArray[np.float64]],
+    reach: Sequence[NDArray[np.float64]],
+    band: float,
+    q: float,
+) -> float:
+    """Return the least rate ``r`` whose ``band * turn + r * reach`` covers each horizon's ``q`` quantile."""
+    rate = 0.0
+    for error, turn, distance in zip(errors, per_turn, reach, strict=True):
+        if error.size:
+            need = np.maximum(error - band * turn, 0.0) / np.maximum(distance, 1e-3)
+            rate = max(rate, float(np.quantile(need, q)))
+    return rate
+
+
+def _fit_anchor(
+    windows: Sequence[_Windows],
+    position_errors: Sequence[NDArray[np.float64]],
+    run_gain: float,
+    turn_gain: float,
+    q: float,
+    sigmas: float,
+) -> TerrainStats:
+    """Return statistics whose anchor bounds cover the ``q`` quantile of every horizon's errors.
+
+    The heading bound is ``band * S + drift * (L + L0)`` and the position bound ``p * (L +
+    L0) + s * S`` (:func:`~aura_ums.uncertainty.anchor_bounds`), with ``L`` and ``S`` the
+    scaled path and turning. For each ``L0`` and band (and skitter ``s``), the rates are the
+    smallest that cover; the choice kept has the smallest bounds relative to the errors,
+    each horizon weighing the same.
+    """
+    heading_errors = [np.abs(w.heading - turn_gain * w.turn) for w in windows]
+    turning = [turn_gain * w.abs_turn for w in windows]
+    paths = [run_gain * w.run for w in windows]
+    mean_heading = [float(np.mean(e)) + 1e-9 if e.size else 1.0 for e in heading_errors]
+    mean_position = [float(np.mean(e)) + 1e-9 if e.size else 1.0 for e in position_errors]
+
+    def cost(band: float, rate: float, reach: list[NDArray[np.float64]], scale: list[float]) -> float:
+        return sum(
+            float(np.mean(band * turn + rate * distance)) / mean
+            for turn, distance, mean in zip(turning, reach, scale, strict=True)
+            if turn.size
+        )
+
+    best: tuple[float, float, float, float, float, float] | None = None
+    for offset in _ANCHOR_REACH.tolist():
+        reach = [path + offset for path in paths]
+        heading = min(
+            (
+                (cost(b, r, reach, mean_heading), b, r)
+                for b in _ANCHOR_BANDS.tolist()
+                for r in (_smallest_rate(heading_errors, turning, reach, b, q),)
+            ),
+        )
+        position = min(
+            (
+                (cost(s, r, reach, mean_position), s, r)
+                for s in _ANCHOR_BANDS.tolist()
+                for r in (_smallest_rate(position_errors, turning, reach, s, q),)
+            ),
+        )
+        total = heading[0] + position[0]
+        if best is None or total < best[0]:
+            best = (total, offset, heading[1], heading[2], position[1], position[2])
+    assert best is not None  # _ANCHOR_REACH is not empty
+    _, offset, band, drift, skitter, rate = best
+    return TerrainStats(
+        translation_loss=0.0,
+        translation_inertial_loss=offset,
+        translation_sd=min(rate / sigmas, 10.0),
+        drift=min(drift, 10.0),
+        rotation_loss=0.0,
+        rotation_sd=band / sigmas,
+        skitter=0.0,
+        skitter_sd=skitter / sigmas,
+    )
+
+
 @dataclass(frozen=True, slots=True)
 class HorizonCheck:
     """How the calibrated growth bound holds over one horizon (a row of the calibration report).
@@ -572,6 +700,7 @@ def horizon_checks(
     move: float = 0.5,
     sigmas: float = 3.0,
     stride: float = 1.0,
+    anchor: bool = False,
 ) -> tuple[HorizonCheck, ...]:
     """Check growth bounds against logs with ground truth over each horizon.
 
@@ -598,6 +727,9 @@ def horizon_checks(
         Seconds, > 0.
     sigmas : float
         Standard deviations the growth bounds, > 0.
+    anchor : bool
+        Grow from the start pose once by the composite of the window's moves
+        (:func:`~aura_ums.uncertainty.grow_from_anchor`) rather than move by move.
 
     Returns
     -------
@@ -639,13 +771,18 @@ def horizon_checks(
             x, y, heading = m.pose[first]
             if not m.valid[first]:
                 continue
-            grown = SpatialUncertaintyMap.from_pose(Pose(float(x), float(y), float(heading)), 0.0, 0.0)
+            start = SpatialUncertaintyMap.from_pose(Pose(float(x), float(y), float(heading)), 0.0, 0.0)
+            grown, composite = start, Composite()
             for done in range(1, min(longest, len(commands) - first) + 1):
                 index = first + done - 1
                 if not m.valid[index]:
                     break
-                for command in commands[index]:
-                    grown = grown.grow(command, stats, sigmas=sigma)
+                if anchor:
+                    composite = composite.extended(commands[index], stats)
+                    grown = grow_from_anchor(start, composite, stats, sigma, 64)
+                else:
+                    for command in commands[index]:
+                        grown = grown.grow(command, stats, sigmas=sigma)
                 for row, length in zip(rows, lengths, strict=True):
                     if length == done:
                         row.append(_judge(grown, m.pose[index + 1]))
@@ -696,6 +833,7 @@ def calibrate_logs(
     sigmas: float = 3.0,
     envelope_margin: float = 1.25,
     max_delay: float = 1.0,
+    anchor: bool = False,
 ) -> Calibration:
     """Estimate terrain statistics, motion delay and scales, and sensor bounds from logs.
 
@@ -720,6 +858,17 @@ def calibrate_logs(
 
     Windows slower than 0.02 m/s do not fit drift or runs. :attr:`Calibration.checks`
     then grows a point map over every window and reports how the bound holds.
+
+    **Motion from an anchor** (``anchor=True``, for ``ManagerSettings.anchor_growth``): the
+    map grows once by the composite of the moves since its last correction
+    (:func:`~aura_ums.uncertainty.anchor_bounds`), so the statistics bound a window's
+    accumulated error as one move: the scales are the least-squares factors (no losses),
+    and for each fixed distance ``L0`` per move (``translation_inertial_loss``) and turn band
+    the drift is the smallest whose bound ``band * S + drift * (L + L0)`` covers the
+    ``quantile`` of the heading errors at every horizon; likewise ``sigmas *
+    translation_sd * (L + L0) + sigmas * skitter_sd * S`` for the position errors (in the
+    frame of the true start heading). ``L0``, the turn band and the skitter kept give the
+    smallest bounds, each horizon weighing the same.
 
     **Sensors** (every observation inside the ground truth): the working bearing bound is
     the ``quantile`` of |bearing error|; the working range bound is relative to the
@@ -748,6 +897,8 @@ def calibrate_logs(
         >= 1.
     max_delay : float
         Seconds, >= 0.
+    anchor : bool
+        Fit the statistics for growth from an anchor rather than move by move.
 
     Returns
     -------
@@ -800,10 +951,10 @@ def calibrate_logs(
 
     delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, _DELAY_STEP), step)
     moves = [_moves(log, delay, step) for log in logs]
-    windows = [_windows(moves, max(1, round(h / step))) for h in spans]
+    raw = [_windows(moves, max(1, round(h / step))) for h in spans]
     windows = [
         _Windows(*(getattr(w, f)[w.run > _MOVING * h] for f in _Windows.__slots__))
-        for w, h in zip(windows, spans, strict=True)
+        for w, h in zip(raw, spans, strict=True)
     ]
     counted = sum(int(w.run.size) for w in windows)
     if windows[0].run.size < 10:
@@ -817,21 +968,29 @@ def calibrate_logs(
     turn_gain = _gain(
         np.concatenate([m.heading for m in moves])[valid], np.concatenate([m.turn for m in moves])[valid]
     )
-    turn_band, drift = _fit_turn_and_drift(windows, turn_gain, q)
-    run_scale, translation_loss, translation_sd = _fit_run(windows, run_gain, q, sigma)
-    turn_scale, rotation_loss, rotation_sd = _band_stats(turn_gain, turn_band, sigma)
-    stats = TerrainStats(
-        translation_loss=translation_loss,
-        translation_inertial_loss=0.0,
-        translation_sd=translation_sd,
-        drift=drift,
-        rotation_loss=rotation_loss,
-        rotation_sd=rotation_sd,
-        skitter=0.0,
-        skitter_sd=0.0,
+    if anchor:
+        errors = [_position_errors(moves, max(1, round(h / step)), run_gain, turn_gain) for h in spans]
+        errors = [e[w_all.run > _MOVING * h] for e, w_all, h in zip(errors, raw, spans, strict=True)]
+        stats = _fit_anchor(windows, errors, run_gain, turn_gain, q, sigma)
+        motion = MotionCalibration(delay, run_gain, turn_gain)
+    else:
+        turn_band, drift = _fit_turn_and_drift(windows, turn_gain, q)
+        run_scale, translation_loss, translation_sd = _fit_run(windows, run_gain, q, sigma)
+        turn_scale, rotation_loss, rotation_sd = _band_stats(turn_gain, turn_band, sigma)
+        stats = TerrainStats(
+            translation_loss=translation_loss,
+            translation_inertial_loss=0.0,
+            translation_sd=translation_sd,
+            drift=drift,
+            rotation_loss=rotation_loss,
+            rotation_sd=rotation_sd,
+            skitter=0.0,
+            skitter_sd=0.0,
+        )
+        motion = MotionCalibration(delay, run_scale, turn_scale)
+    checks = horizon_checks(
+        logs, stats, motion, quantile=q, horizons=spans, move=step, sigmas=sigma, anchor=anchor
     )
-    motion = MotionCalibration(delay, run_scale, turn_scale)
-    checks = horizon_checks(logs, stats, motion, quantile=q, horizons=spans, move=step, sigmas=sigma)
 
     bearing_errors, range_errors, range_measured = _observation_errors(logs)
     if bearing_errors.size < 10:
@@ -856,6 +1015,7 @@ def calibrate_logs(
         checks,
         counted,
         int(bearing_errors.size),
+        anchor,
     )
 
 

@@ -23,6 +23,7 @@ from aura_ums.manager._relaxed import Branch, RelaxedState
 from aura_ums.manager._settings import ManagerSettings
 from aura_ums.uncertainty import (
     BearingObservation,
+    Composite,
     GroundLineObservation,
     Landmark,
     Observation,
@@ -32,6 +33,8 @@ from aura_ums.uncertainty import (
     TerrainStats,
     TerrainTable,
     TurnAndRun,
+    grow_from_anchor,
+    intersect_maps,
     reduce_jointly,
 )
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
@@ -39,6 +42,21 @@ from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 _KIND = "aura-ums/uncertainty-map-manager"
 
 _report_time = operator.attrgetter("time")
+
+#: Grown maps whose anchors the manager remembers (the relaxed intersection grows one per branch).
+_LINEAGES_KEPT = 256
+#: Anchors one map keeps: the newest and older ones spread over anchor_span, thinned
+#: so that their ages stay roughly in geometric progression.
+_ANCHORS_KEPT = 3
+
+
+@dataclass(frozen=True, slots=True)
+class _Anchor:
+    """A map the truth was in at ``time`` (s), and the moves since then as one composite."""
+
+    map: SpatialUncertaintyMap
+    time: float
+    composite: Composite
 
 
 class ManagerState(enum.Enum):
@@ -259,6 +277,8 @@ class UncertaintyMapManager:
 
     __slots__ = (
         "_accepted",
+        "_anchor_growth",
+        "_anchor_span",
         "_area_limit",
         "_consumed",
         "_envelope",
@@ -267,6 +287,9 @@ class UncertaintyMapManager:
         "_grown",
         "_joint_above",
         "_joint_sector",
+        "_latest",
+        "_latest_committed",
+        "_lineages",
         "_lost_reason",
         "_map",
         "_map_time",
@@ -315,6 +338,16 @@ class UncertaintyMapManager:
         self._joint_sector = settings.joint_sector
         self._max_vertices = settings.max_vertices
         self._envelope_factor = settings.envelope_factor
+        self._anchor_growth = settings.anchor_growth
+        self._anchor_span = settings.anchor_span
+        # Each map the anchored growth made -> (that map, its anchors). A map found here
+        # grows on from its anchors; keyed by identity, so the relaxed intersection's
+        # branches each keep theirs.
+        self._lineages: dict[int, tuple[SpatialUncertaintyMap, tuple[_Anchor, ...]]] = {}
+        # The last map the anchored growth made, in this update and as committed: a map it
+        # does not know is that one reduced (single map only), so it keeps its anchors.
+        self._latest: SpatialUncertaintyMap | None = None
+        self._latest_committed: SpatialUncertaintyMap | None = None
         self._map = _in_form(initial_map, settings)
         # The branches of the relaxed intersection; None with relaxed_q = 0 (one map, the gate).
         self._relaxed: RelaxedState | None = RelaxedState.start(self._map) if settings.relaxed_q else None
@@ -559,6 +592,7 @@ class UncertaintyMapManager:
         ``relaxed_q = 0``), to commit. What became of each observation is appended to
         ``outcomes``, and the observations newly excluded to ``excluded`` (None: not recorded).
         """
+        self._latest = self._latest_committed  # an update that raised made nothing
         if self._relaxed is not None:
             return self._advance_relaxed(self._relaxed, reports, pending, outcomes, excluded)
         current, map_time = self._map, self._map_time
@@ -736,6 +770,7 @@ class UncertaintyMapManager:
         """Take what :meth:`_advance` returned; return whether an observation reduced the map."""
         self._grown += index - self._consumed
         self._map, self._consumed, self._map_time = current, index, map_time
+        self._latest_committed = self._latest
         self._relaxed = branches
         self._excluded += excluded
         found = False
@@ -779,6 +814,7 @@ class UncertaintyMapManager:
         window, and the observations go through the relaxed intersection one by one.
         """
         state = self._relaxed
+        self._latest = self._latest_committed = None  # the old anchors may have lost the truth
         if state is None:
             self._map = _in_form(self._reseed(envelope_map, observations), self._settings)
             return
@@ -838,6 +874,7 @@ class UncertaintyMapManager:
         if not isinstance(new_map, SpatialUncertaintyMap):
             raise InputError(f"new_map: expected a SpatialUncertaintyMap, got {type(new_map).__name__}")
         self._map = _in_form(new_map, self._settings)
+        self._latest = self._latest_committed = None  # the old anchors may have lost the truth
         if self._relaxed is not None:
             self._relaxed = RelaxedState.start(self._map, self._relaxed.next_serial)
         self._relocalizations += 1
@@ -878,6 +915,10 @@ class UncertaintyMapManager:
             terrain = self._only_terrain = self._table[self._meadow_map.meadows[0].terrain]
         if terrain is not None:
             commands = [reports[index].command for index in range(start, stop)]
+            if self._anchor_growth:
+                since = reports[start].time if map_time is None else map_time
+                now = reports[stop - 1].time
+                return self._grow_anchored(current, since, now, commands, terrain), now
             return (
                 current._grow_many(commands, terrain, self._sigmas, self._max_vertices),
                 reports[stop - 1].time,
@@ -887,6 +928,45 @@ class UncertaintyMapManager:
             current = self._grow_one(current, report.command)
             map_time = report.time
         return current, map_time
+
+    def _grow_anchored(
+        self,
+        current: SpatialUncertaintyMap,
+        since: float,
+        now: float,
+        commands: Sequence[TurnAndRun],
+        terrain: TerrainStats,
+    ) -> SpatialUncertaintyMap:
+        """Grow each anchor of ``current`` (at ``since``, s) to ``now`` by ``commands``; intersect.
+
+        ``current`` is a map this growth made (its anchors go on), or the last one it made,
+        reduced (its anchors go on, and ``current`` joins them), or any other map (a start,
+        a re-seed, a branch of the relaxed intersection): its own only anchor. Each anchor
+        held the truth, so each grown anchor does, and so does their intersection; an old
+        anchor's fixed per-move distance is paid once, however many corrections followed it.
+        """
+        lineages = self._lineages
+        entry = lineages.get(id(current))
+        if entry is not None and entry[0] is current:
+            anchors = _thinned(entry[1], now, self._anchor_span)
+        else:
+            anchors = ()
+            latest = self._latest
+            if self._relaxed is None and latest is not None:
+                kept = lineages.get(id(latest))
+                if kept is not None and kept[0] is latest:
+                    anchors = kept[1]
+            anchors = _thinned((*anchors, _Anchor(current, since, Composite())), now, self._anchor_span)
+        anchors = tuple(_Anchor(a.map, a.time, a.composite.extended(commands, terrain)) for a in anchors)
+        sigmas, cap = self._sigmas, self._max_vertices
+        grown = [grow_from_anchor(a.map, a.composite, terrain, sigmas, cap) for a in reversed(anchors)]
+        result = intersect_maps(grown[0], grown[1:], cap)
+        lineages.pop(id(result), None)
+        lineages[id(result)] = (result, anchors)
+        if len(lineages) > _LINEAGES_KEPT:
+            del lineages[next(iter(lineages))]
+        self._latest = result
+        return result
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
         pose = current.most_probable_pose()
@@ -1215,6 +1295,22 @@ class UncertaintyMapManager:
 #: What a saved document lacking a setting ran with: one by one before joint reductions,
 #: without an envelope before outlier recovery; the defaults otherwise.
 _BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False, relaxed_q=0)
+
+
+def _thinned(anchors: tuple[_Anchor, ...], now: float, span: float) -> tuple[_Anchor, ...]:
+    """Keep the newest anchor and at most a few older ones of at most ``span`` seconds, spread in age.
+
+    Beyond the count, the anchor dropped is the one whose neighbours are closest in time
+    relative to the older neighbour's age: what is kept spreads roughly geometrically.
+    """
+    kept = [a for a in anchors[:-1] if now - a.time <= span] + [anchors[-1]]
+    while len(kept) > _ANCHORS_KEPT:
+        gaps = [
+            (kept[i + 1].time - kept[i - 1].time) / max(now - kept[i - 1].time, 1e-9)
+            for i in range(1, len(kept) - 1)
+        ]
+        del kept[1 + gaps.index(min(gaps))]
+    return tuple(kept)
 
 
 def _instants(

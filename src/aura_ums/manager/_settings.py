@@ -249,6 +249,29 @@ relocalize_after (2), got 1
             low=1,
         ),
     )
+    anchor_growth: bool = _setting(
+        False,
+        SettingInfo(
+            "Grow the map from the last corrected map (the anchor), once by the composite of the "
+            "moves since then, with the terrain statistics read at that scale, as calibrate "
+            "--anchor fits them (off: the paper's growth, move by move; a map of several "
+            "meadows always grows move by move)",
+            "",
+            bool,
+            off_flag="--per-move-growth",
+        ),
+    )
+    anchor_span: float = _setting(
+        30.0,
+        SettingInfo(
+            "Longest time an anchor of the anchored growth is kept: the longest time without "
+            "correction the terrain statistics were calibrated for",
+            "s",
+            float,
+            low=0.0,
+            low_open=True,
+        ),
+    )
     robust: bool = _setting(
         True,
         SettingInfo(
@@ -340,8 +363,8 @@ relocalize_after (2), got 1
         ...
         aura_ums.errors.InputError: ManagerSettings.sigma: expected a field of ManagerSettings \
 (sigmas, area_limit, missed_limit, lost_window_scale, joint_above, joint_sector, max_vertices, \
-slice_width, max_slices, robust, envelope_factor, envelope_max_vertices, relocalize_after, \
-relocalize_window, relaxed_q, relaxed_window), got 'sigma'
+slice_width, max_slices, anchor_growth, anchor_span, robust, envelope_factor, envelope_max_vertices, \
+relocalize_after, relocalize_window, relaxed_q, relaxed_window), got 'sigma'
         """
         report = _fail if fail is None else fail
         if not isinstance(data, Mapping):

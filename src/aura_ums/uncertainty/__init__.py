@@ -11,6 +11,7 @@ from aura_ums.uncertainty._checks import (
     simulate_containment,
 )
 from aura_ums.uncertainty._growth import MotionBounds, motion_bounds
+from aura_ums.uncertainty._horizon import Composite, anchor_bounds, grow_from_anchor, intersect_maps
 from aura_ums.uncertainty._joint import reduce_jointly
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
@@ -33,6 +34,7 @@ from aura_ums.uncertainty._union import union_of_maps, union_of_wedges
 __all__ = [
     "FOOT",
     "BearingObservation",
+    "Composite",
     "ContainmentResult",
     "GroundLineLandmark",
     "GroundLineObservation",
@@ -51,7 +53,10 @@ __all__ = [
     "TightnessResult",
     "TurnAndRun",
     "VerticalLineLandmark",
+    "anchor_bounds",
+    "grow_from_anchor",
     "growth_tightness",
+    "intersect_maps",
     "motion_bounds",
     "reduce_jointly",
     "simulate_containment",
