@@ -21,10 +21,12 @@ over time on one log (``--figure``). ``--write-docs`` writes both into docs/ (re
 images/real_logs_windows.png) and the tables into README.md and docs/real-logs.md, between
 their ``bench_real_logs`` markers. Settings of either map are
 options: ``--set KEY=VALUE`` for both, ``--product KEY=VALUE`` / ``--sliced KEY=VALUE`` for one
-(fields of ``ManagerSettings``; ``none``, ``true``, ``false`` or a number).
+(fields of ``ManagerSettings``; ``none``, ``true``, ``false`` or a number). ``--from-json FILE``
+replays nothing: it prints (and with ``--write-docs`` writes) the tables of an earlier run.
 
     MPLBACKEND=Agg .venv/bin/python benchmarks/bench_real_logs.py --write-docs
     MPLBACKEND=Agg .venv/bin/python benchmarks/bench_real_logs.py --sliced relaxed_q=1 --logs mrclam7:3
+    .venv/bin/python benchmarks/bench_real_logs.py --from-json docs/real-logs.json --write-docs
 """
 
 from __future__ import annotations
@@ -39,10 +41,12 @@ import re
 import shlex
 import subprocess
 import sys
+import textwrap
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -506,24 +510,64 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--write-docs", action="store_true", help="write the tables, JSON and figure into README and docs/"
     )
+    parser.add_argument(
+        "--from-json", type=Path, help="no replay: the tables (and --write-docs) from a JSON this wrote"
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress display")
     args = parser.parse_args(argv)
+    drawn: Run | None = None
+    if args.from_json is not None:
+        doc: dict[str, Any] = json.loads(args.from_json.read_text(encoding="utf-8"))
+    else:
+        command = "MPLBACKEND=Agg .venv/bin/python benchmarks/bench_real_logs.py " + shlex.join(
+            argv if argv is not None else sys.argv[1:]
+        )
+        measured = measure_all(args, command.strip())
+        if measured is None:
+            return 0
+        doc, drawn = measured
+    runs = runs_of(doc)
+    methods = table_methods(int(doc["particles"]))
+    summary, per_log, measured_on = summary_table(runs, methods), log_table(runs, methods), provenance(doc)
+    print(summary)
+    print(per_log)
+    print(measured_on + "\n")
+    json_path = FIGURES_JSON if args.write_docs and args.json is None else args.json
+    if json_path is not None and args.from_json is None:
+        json_path.parent.mkdir(parents=True, exist_ok=True)
+        json_path.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+        print(f"wrote {json_path}", file=sys.stderr)
+    figure_path = FIGURE if args.write_docs and args.figure is None else args.figure
+    if figure_path is not None and drawn is not None:
+        draw(drawn, figure_path)
+        print(f"wrote {figure_path}", file=sys.stderr)
+    elif figure_path is not None and args.from_json is None:
+        print(f"no figure: {':'.join(map(str, args.figure_log))} Class {args.figure_class} was not replayed")
+    if args.write_docs:
+        write_docs(summary, per_log, measured_on, doc["settings"])
+        print(f"wrote {README.name} and {DOCS_PAGE.relative_to(ROOT)}", file=sys.stderr)
+    return 0
+
+
+def measure_all(args: argparse.Namespace, command: str) -> tuple[dict[str, Any], Run | None] | None:
+    """Calibrate, run every chosen log and class; return the JSON document and the run to draw.
+
+    None (said on stdout) when the calibration log is not there.
+    """
     found = development_logs(args.data)
     if args.calibrate not in found:
         print(f"development data not found ({':'.join(map(str, args.calibrate))} under {args.data}): skipped")
-        return 0
+        return None
     chosen: list[LogId] = args.logs or [log for log in found if log != args.calibrate]
-    missing = [log for log in chosen if log not in found]
+    missing = [f"{dataset}:{robot}" for dataset, robot in chosen if (dataset, robot) not in found]
     if missing:
-        print(f"no such logs under {args.data}: {', '.join(f'{d}:{r}' for d, r in missing)}", file=sys.stderr)
-        return 2
+        raise SystemExit(f"no such logs under {args.data}: {', '.join(missing)}")
     try:
         maps = map_settings(dict(args.set), dict(args.product), dict(args.sliced))
         camera = load_camera(args.camera)
         calibration = calibrate_logs([read_mrclam(args.data / args.calibrate[0], args.calibrate[1])])
     except AuraUmsError as exc:
-        print(exc, file=sys.stderr)
-        return 2
+        raise SystemExit(str(exc)) from None
     classes = [LandmarkClass.VERTICAL_LINE if c == "I" else LandmarkClass.POINT for c in args.classes]
     runs: list[Run] = []
     drawn: Run | None = None
@@ -539,66 +583,79 @@ def main(argv: Sequence[str] | None = None) -> int:
                 if (dataset, robot) == args.figure_log and landmark_class.value == args.figure_class:
                     drawn = run
                 print(f"{run.log} Class {landmark_class.value}: done", file=sys.stderr, flush=True)
-    methods = table_methods(args.particles)
-    command = "MPLBACKEND=Agg .venv/bin/python benchmarks/bench_real_logs.py " + shlex.join(
-        argv if argv is not None else sys.argv[1:]
-    )
-    summary, per_log = summary_table(runs, methods), log_table(runs, methods)
-    info = machine()
-    dataset, robot = args.calibrate
-    measured = (
-        f"Calibrated on {dataset} robot {robot}, replayed on {len(chosen)} other robots: "
-        f"`{command.strip()}` on {info['cpu']} ({info['cores']} cores, shared with other work), "
-        f"commit {info['commit']}, {datetime.date.today().isoformat()}.\n"
-    )
-    print(summary)
-    print(per_log)
-    print(measured)
-    json_path = FIGURES_JSON if args.write_docs and args.json is None else args.json
-    if json_path is not None:
-        doc = document(
-            runs, maps, calibration, calibrated_on=f"{dataset}:{robot}", camera=args.camera,
-            particles=args.particles, seed=args.seed, command=command.strip(),
-        )  # fmt: skip
-        json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        print(f"wrote {json_path}", file=sys.stderr)
-    figure_path = FIGURE if args.write_docs and args.figure is None else args.figure
-    if figure_path is not None and drawn is not None:
-        draw(drawn, figure_path)
-        print(f"wrote {figure_path}", file=sys.stderr)
-    elif figure_path is not None:
-        print(f"no figure: {':'.join(map(str, args.figure_log))} Class {args.figure_class} was not replayed")
-    if args.write_docs:
-        write_docs(summary, per_log, measured, maps)
-        print(f"wrote {README.name} and {DOCS_PAGE.relative_to(ROOT)}", file=sys.stderr)
-    return 0
+    calibrated_on = ":".join(map(str, args.calibrate))
+    doc = document(
+        runs, maps, calibration, calibrated_on=calibrated_on, camera=args.camera, particles=args.particles,
+        seed=args.seed, command=command,
+    )  # fmt: skip
+    return doc, drawn
 
 
-def write_docs(summary: str, per_log: str, measured: str, maps: Mapping[str, ManagerSettings]) -> None:
+def runs_of(doc: Mapping[str, Any]) -> list[Run]:
+    """The runs of a JSON document (:func:`document`), without their window series."""
+    return [
+        Run(
+            run["log"],
+            LandmarkClass(run["landmark_class"]),
+            tuple(Metrics(row) for row in run["methods"]),
+            (),
+        )
+        for run in doc["runs"]
+    ]
+
+
+def provenance(doc: Mapping[str, Any]) -> str:
+    """One paragraph: what was calibrated on and replayed, when, by which command, on what machine."""
+    info = doc["machine"]
+    load = info.get("load_average")
+    busy = f", load average {load[0]:.1f}" if isinstance(load, list | tuple) and load else ""
+    logs = len({run["log"] for run in doc["runs"]})
+    dataset, _, robot = str(doc["calibrated_on"]).partition(":")
+    return textwrap.fill(
+        f"Calibrated on {dataset} robot {robot}, replayed on {logs} other robots, {doc['date'][:10]}: "
+        f"`{doc['command']}` at commit {info['commit']} on {info['cpu']} ({info['cores']} cores, "
+        f"shared with other work{busy}; the µs are this machine's under that load).",
+        width=96,
+        break_on_hyphens=False,
+        break_long_words=False,
+    )
+
+
+def write_docs(
+    summary: str, per_log: str, measured: str, maps: Mapping[str, Mapping[str, SettingValue]]
+) -> None:
     """Put the tables between the ``bench_real_logs`` markers of README.md and docs/real-logs.md."""
     settings = "".join(
-        f"- {name}: " + ", ".join(f"`{key}={value}`" for key, value in _changed(chosen).items()) + "\n"
+        f"- {name}: "
+        + ", ".join(f"`{key}={_shown(value)}`" for key, value in _changed(chosen).items())
+        + "\n"
         for name, chosen in maps.items()
     )
-    readme = replace_block(README.read_text(encoding="utf-8"), "bench_real_logs", f"{summary}\n{measured}")
+    readme = replace_block(README.read_text(encoding="utf-8"), "bench_real_logs", f"{summary}\n{measured}\n")
     README.write_text(readme, encoding="utf-8")
     page = DOCS_PAGE.read_text(encoding="utf-8")
-    page = replace_block(page, "bench_real_logs", f"{summary}\n{measured}\n{settings}")
+    page = replace_block(page, "bench_real_logs", f"{summary}\n{measured}\n\n{settings}")
     DOCS_PAGE.write_text(replace_block(page, "bench_real_logs per log", per_log), encoding="utf-8")
+
+
+def _shown(value: SettingValue) -> str:
+    """A setting as the options take it: none, true, false or a number (4 significant digits)."""
+    if value is None or isinstance(value, bool):
+        return str(value).lower()
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def _prefixed(stage: Stage, prefix: str) -> Stage:
     return lambda name: stage(f"{prefix}: {name}")
 
 
-def _changed(settings: ManagerSettings) -> dict[str, SettingValue]:
+def _changed(settings: Mapping[str, SettingValue]) -> dict[str, SettingValue]:
     """The fields that differ from ManagerSettings' defaults (slice_width always shown)."""
     defaults = ManagerSettings().to_dict()
     return {
         key: value
-        for key, value in settings.to_dict().items()
-        if key == "slice_width" or value != defaults[key]
+        for key, value in settings.items()
+        if key == "slice_width" or value != defaults.get(key, value)
     }
 
 

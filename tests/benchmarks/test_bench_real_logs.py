@@ -151,3 +151,42 @@ def test_development_logs_are_found_by_their_files(tmp_path: Path) -> None:
         for robot in robots:
             (tmp_path / dataset / f"Robot{robot}_Odometry.dat").write_text("", encoding="utf-8")
     assert bench.development_logs(tmp_path) == [("set_a", 1), ("set_a", 2), ("set_b", 3)]
+
+
+def test_the_tables_come_back_the_same_from_the_json(runs: list[bench.Run], calibration: Calibration) -> None:
+    doc = bench.document(
+        runs, bench.map_settings({}, {}, {}), calibration, calibrated_on="synthetic:1",
+        camera=Path("camera.toml"), particles=PARTICLES, seed=0, command="bench --write-docs",
+    )  # fmt: skip
+    again = bench.runs_of(json.loads(json.dumps(doc)))
+    methods = bench.table_methods(PARTICLES)
+    assert bench.summary_table(again, methods) == bench.summary_table(runs, methods)
+    assert bench.log_table(again, methods) == bench.log_table(runs, methods)
+    said = bench.provenance(doc)
+    assert said.startswith("Calibrated on synthetic robot 1, replayed on 1 other robots")
+    assert "`bench --write-docs`" in said
+
+
+def test_write_docs_fills_the_blocks_of_the_readme_and_the_page(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    readme, page = tmp_path / "README.md", tmp_path / "real-logs.md"
+    readme.write_text("# r\n<!-- bench_real_logs -->\nold\n<!-- /bench_real_logs -->\n", encoding="utf-8")
+    page.write_text(
+        "<!-- bench_real_logs -->\n<!-- /bench_real_logs -->\n"
+        "<!-- bench_real_logs per log -->\nold\n<!-- /bench_real_logs per log -->\n",
+        encoding="utf-8",
+    )
+    monkeypatch.setattr(bench, "README", readme)
+    monkeypatch.setattr(bench, "DOCS_PAGE", page)
+    settings = {name: s.to_dict() for name, s in bench.map_settings({}, {}, {"relaxed_q": 1}).items()}
+    bench.write_docs("SUMMARY\n", "PER LOG\n", "MEASURED", settings)
+    assert readme.read_text(encoding="utf-8") == (
+        "# r\n<!-- bench_real_logs -->\nSUMMARY\n\nMEASURED\n<!-- /bench_real_logs -->\n"
+    )
+    text = page.read_text(encoding="utf-8")
+    assert "- product map: `slice_width=none`\n" in text
+    assert (
+        "- sliced map: `slice_width=0.06981`, `relaxed_q=1`\n" in text or "sliced map: `slice_width=" in text
+    )
+    assert "<!-- bench_real_logs per log -->\nPER LOG\n<!-- /bench_real_logs per log -->" in text
