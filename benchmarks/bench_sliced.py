@@ -22,10 +22,10 @@ import math
 import time
 from pathlib import Path
 
-from aura_ums.logs import ReplayOptions, RobotLog, calibrate_logs, read_mrclam, replay_log
-from aura_ums.logs._calibrate import Calibration
+from aura_ums.logs import RobotLog, calibrate_logs, read_mrclam, replay_log
 from aura_ums.manager import ManagerSettings
 from aura_ums.uncertainty import LandmarkClass
+from bench_real_logs import replay_options
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 LOGS = [
@@ -37,18 +37,6 @@ LOGS = [
     ("mrclam7", 4),
     ("mrclam7", 5),
 ]
-
-
-def options(
-    calibration: Calibration, landmark_class: LandmarkClass, settings: ManagerSettings
-) -> ReplayOptions:
-    return ReplayOptions(
-        settings=settings,
-        landmark_class=landmark_class,
-        working=calibration.working,
-        envelope=calibration.envelope,
-        motion=calibration.motion,
-    )
 
 
 def main() -> None:
@@ -91,7 +79,7 @@ def main() -> None:
         for landmark_class in (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT):
             for label, settings in variants:
                 start = time.perf_counter()
-                result = replay_log(log, table, options(calibration, landmark_class, settings))
+                result = replay_log(log, table, replay_options(calibration, landmark_class, settings))
                 wall = time.perf_counter() - start
                 envelope = [s.envelope_inside for s in result.steps if s.envelope_inside is not None]
                 envelope_rate = sum(envelope) / len(envelope) if envelope else math.nan
