@@ -238,7 +238,7 @@ def test_without_images(sim: Sim, tmp_path: Path) -> None:
 def test_detections_are_drawn_as_segments(sim: Sim) -> None:
     from foxglove import messages as fm
 
-    from aura_ums.export._writer import frame_annotations
+    from aura_ums.export._messages import frame_annotations
 
     record = SimpleNamespace(
         windows=(("pole", ImageWindow(10.0, 20.0, 50.0, 40.0)),),
