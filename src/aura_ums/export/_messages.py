@@ -528,7 +528,7 @@ def window_annotations(
                     metadata=_metadata(
                         landmark_id=row.landmark_id,
                         method=row.method,
-                        inside="" if row.inside is None else ("yes" if row.inside else "no"),
+                        inside="not judged" if row.inside is None else ("yes" if row.inside else "no"),
                     ),
                 )
             )
