@@ -117,6 +117,17 @@ class _LiveView:
             raise InputError(f"timeout: expected a finite number of seconds >= 0 or None, got {timeout!r}")
         return self._server.wait_for_client(timeout)
 
+    def wait_while_watched(self, timeout: float | None = None) -> bool:
+        """Block while a client is subscribed; False when ``timeout`` seconds pass first.
+
+        :meth:`close` stops the server at once, dropping what a client has not read yet:
+        wait here first to let it read to the end (and look at the last frame) until it
+        disconnects. ``None`` waits as long as it takes.
+        """
+        if timeout is not None and (not 0.0 <= timeout < math.inf):
+            raise InputError(f"timeout: expected a finite number of seconds >= 0 or None, got {timeout!r}")
+        return self._server.wait_while_watched(timeout)
+
     def _scene(self, channels: SimulationChannels | ReplayChannels, ns: int) -> None:
         """Publish the static scene at the first message; again on a topic subscribed to later."""
         fresh = self._server.subscribed_since(channels.static_topics)
@@ -127,7 +138,7 @@ class _LiveView:
             channels.scene(ns, sorted(fresh))
 
     def close(self) -> None:
-        """Stop the server; clients are disconnected. Closing twice does nothing."""
+        """Stop the server at once; clients are disconnected. Closing twice does nothing."""
         self._server.stop()
 
     def __enter__(self) -> Self:

@@ -23,15 +23,30 @@ _POLL = 0.1
 
 
 class _Subscriptions(ServerListener):
-    """Records the topics clients subscribe to (called on the server's threads)."""
+    """Records the topics clients subscribe to, and who still watches (called on the server's threads)."""
 
     def __init__(self) -> None:
         self.first = threading.Event()
         self.topics: collections.deque[str] = collections.deque()
+        self._lock = threading.Lock()
+        self._active: set[tuple[int, int]] = set()
 
     def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        with self._lock:
+            self._active.add((client.id, channel.id))
         self.topics.append(channel.topic)
         self.first.set()
+
+    def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
+        # also called for each subscription of a client that disconnects
+        with self._lock:
+            self._active.discard((client.id, channel.id))
+
+    @property
+    def watched(self) -> bool:
+        """Whether some client is subscribed to some channel."""
+        with self._lock:
+            return bool(self._active)
 
 
 class LiveServer:
@@ -84,6 +99,16 @@ class LiveServer:
             if left <= 0.0:
                 return False
             self._listener.first.wait(min(_POLL, left))
+        return True
+
+    def wait_while_watched(self, timeout: float | None) -> bool:
+        """Block while a client is subscribed (True once none is), or ``timeout`` seconds (False)."""
+        deadline = math.inf if timeout is None else time.monotonic() + timeout
+        while self._listener.watched:
+            left = deadline - time.monotonic()
+            if left <= 0.0:
+                return False
+            time.sleep(min(_POLL, left))
         return True
 
     def subscribed_since(self, topics: Iterable[str]) -> set[str]:
