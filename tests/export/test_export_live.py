@@ -115,11 +115,17 @@ def watched(log: Any) -> Watched:
                 published_when_first_seen = view.published
                 seen_first.set()
         result, windows = _joined(thread, out)
-        # the last messages, still on their way when the replay returned
-        while client.pump(0.5):
-            pass
-        messages += client.take()
+        # the last messages, still on their way when the replay returned: up to the last step's metrics
+        _read_until(client, messages, "/metrics", len(result.trace))
     return Watched(channels, messages, result.steps, windows.rows, published_when_first_seen)
+
+
+def _read_until(client: LiveClient, messages: list[Received], topic: str, count: int) -> None:
+    """Read until ``count`` messages of ``topic`` have come (each step's or frame's metrics come last)."""
+    deadline = time.monotonic() + WAIT
+    while sum(1 for m in messages if m.topic == topic) < count and time.monotonic() < deadline:
+        client.pump(0.2)
+        messages += client.take()
 
 
 def _on(watched: Watched, topic: str) -> list[Received]:
@@ -256,13 +262,17 @@ def test_runs_follow_each_other_on_the_time_line_and_a_late_subscriber_gets_the_
             seen.append(record)
 
         runs = [run_scenario(scenario, rng, after_frame=hook) for rng in np.random.default_rng(0).spawn(2)]
-        client.subscribe({"/landmarks"})  # after both runs: the scene is sent again with the next frame
-        while client.pump(0.5):
-            pass
-        view.frame(seen[-1])
-        while client.pump(0.5):
-            pass
-        messages = client.take()
+        messages: list[Received] = []
+        _read_until(client, messages, "/metrics", len(seen))
+        client.subscribe({"/landmarks"})  # after both runs: the scene comes again with a next frame
+        again = 0
+        deadline = time.monotonic() + WAIT
+        while not any(m.topic == "/landmarks" for m in messages) and time.monotonic() < deadline:
+            view.frame(seen[-1])
+            again += 1
+            _read_until(client, messages, "/metrics", len(seen) + again)
+        view.frame(seen[-1])  # once only: not with the frame after
+        _read_until(client, messages, "/metrics", len(seen) + again + 1)
     assert "/landmarks" in channels
     metrics = [m for m in messages if m.topic == "/metrics"]
     frames = sum(len(r.records) for r in runs)
