@@ -238,7 +238,7 @@ def test_without_images(sim: Sim, tmp_path: Path) -> None:
 def test_detections_are_drawn_as_segments(sim: Sim) -> None:
     from foxglove import messages as fm
 
-    from aura_ums.export._writer import frame_annotations
+    from aura_ums.export._messages import frame_annotations
 
     record = SimpleNamespace(
         windows=(("pole", ImageWindow(10.0, 20.0, 50.0, 40.0)),),
@@ -466,3 +466,27 @@ def test_images_are_checked_before_writing(sim: Sim, tmp_path: Path) -> None:
     too_many = dataclasses.replace(sim.result, images=(*sim.result.images, sim.result.images[0]))
     with pytest.raises(InputError, match=r"result\.images: expected at most \d+ images, got \d+"):
         write_simulation_mcap(tmp_path / "bad.mcap", sim.scenario, too_many)
+
+
+def test_a_sliced_replay_draws_its_slices_stacked_by_heading(tmp_path: Path) -> None:
+    from aura_ums.logs import ReplayOptions, replay_log, synthetic_log
+    from aura_ums.manager import ManagerSettings
+    from aura_ums.uncertainty import LandmarkClass, TerrainTable
+
+    log = synthetic_log(np.random.default_rng(3), duration=10.0)
+    table = TerrainTable({"floor": TerrainTable.default()["tile"]})
+    options = ReplayOptions(settings=ManagerSettings(slice_width=0.05), landmark_class=LandmarkClass.POINT)
+    replay = replay_log(log, table, options)
+    messages = read_messages(write_replay_mcap(tmp_path / "sliced.mcap", replay))
+    assert len(messages["/map/slices"]) == len(replay.steps)
+    assert max(len(step.map.slices) for step in replay.steps) > 1
+    for step, message in zip(replay.steps, messages["/map/slices"], strict=True):
+        lines = only_entity(message)["lines"]
+        pieces = step.map.slices
+        assert len(lines) == len(pieces) >= 1
+        for index, (line, piece) in enumerate(zip(lines, pieces, strict=True)):
+            np.testing.assert_allclose(points_xy(line), piece.polygon.vertices, atol=1e-12)
+            assert {round(p["z"], 9) for p in line["points"]} == {round(0.05 * (index + 1), 9)}
+    # a product map has no slices: no channel
+    plain = replay_log(log, table, ReplayOptions(landmark_class=LandmarkClass.POINT))
+    assert "/map/slices" not in mcap_channels(write_replay_mcap(tmp_path / "plain.mcap", plain))

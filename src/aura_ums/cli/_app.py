@@ -19,7 +19,17 @@ from aura_ums.cli._common import (
     manager_options,
     progress_bar,
 )
-from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mcap_option
+from aura_ums.cli._interop import (
+    LIVE_DEFAULTS,
+    MCAP_HELP,
+    Live,
+    LiveHost,
+    LivePort,
+    LiveRate,
+    live_simulation,
+    rosbag_command,
+    write_simulation_mcap_option,
+)
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, staged, write_text
 from aura_ums.cli._replay import calibrate, compare, replay
@@ -104,13 +114,18 @@ def simulate(
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
     mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+    live: Live = False,
+    live_host: LiveHost = LIVE_DEFAULTS.host,
+    live_port: LivePort = LIVE_DEFAULTS.port,
+    live_rate: LiveRate = LIVE_DEFAULTS.rate,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     settings: SettingOptions = NO_OPTIONS,
 ) -> None:
     """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics.
 
-    The map manager's options override the scenario's [manager] table.
+    The map manager's options override the scenario's [manager] table. With --live, each
+    run is streamed to Foxglove as it computes, one after another.
     """
     import numpy as np
 
@@ -138,10 +153,12 @@ def simulate(
         raise fail(f"--{exc}") from None
     generators = np.random.default_rng(seed).spawn(runs)
     results = []
+    watch = live_simulation(loaded, live=live, host=live_host, port=live_port, rate=live_rate)
     try:
-        with progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
+        with watch as view, progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
+            after_frame = None if view is None else view.frame
             for done, rng in enumerate(generators, start=1):
-                results.append(run_scenario(loaded, rng, prune=prune))
+                results.append(run_scenario(loaded, rng, prune=prune, after_frame=after_frame))
                 if advance is not None:
                     advance(done, runs)
     except AuraUmsError as exc:

@@ -1,22 +1,27 @@
-"""Interoperability commands: ``aura-ums import rosbag`` (a ROS bag to a log folder) and ``--mcap``.
+"""Interoperability: ``aura-ums import rosbag`` (a ROS bag to a log folder), ``--mcap`` and ``--live``.
 
 The command functions are plain typer callbacks that the application registers
-(``import_app.command("rosbag")(rosbag_command)``); the ``--mcap`` helpers are called by
-the commands that run a scenario or replay a log.
+(``import_app.command("rosbag")(rosbag_command)``); the ``--mcap`` and ``--live`` helpers
+are called by the commands that run a scenario or replay a log.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager, nullcontext, suppress
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, TypeVar
 
 import typer
 
-from aura_ums.cli._common import Quiet, fail, print_log_summary, progress_bar
+from aura_ums.cli._common import Quiet, err_console, fail, print_log_summary, progress_bar
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, resolved, wrote
+from aura_ums.export import LiveOptions
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayResult
+    from aura_ums.camera import Camera
+    from aura_ums.export import LiveReplay, LiveSimulation
+    from aura_ums.logs import ReplayOptions, ReplayResult, RobotLog, WindowReport
     from aura_ums.sim import Scenario
 
 
@@ -115,15 +120,139 @@ def write_simulation_mcap_option(
     return target.path
 
 
-def write_replay_mcap_option(target: Target, replay: ReplayResult, *, quiet: bool) -> Path:
-    """Write a replay as MCAP (whole or not at all); says where, or ``error: ...`` and exits with code 2."""
+def write_replay_mcap_option(
+    target: Target, replay: ReplayResult, *, quiet: bool, windows: WindowReport | None = None
+) -> Path:
+    """Write a replay (and its windows) as MCAP, whole or not at all; says where, or exits with code 2."""
     from aura_ums.errors import AuraUmsError
     from aura_ums.export import write_replay_mcap
 
     try:
         with progress_bar(f"{target.path.name}: steps", quiet=quiet) as advance:
-            write_replay_mcap(resolved(target.path), replay, progress=advance)
+            write_replay_mcap(resolved(target.path), replay, windows=windows, progress=advance)
     except AuraUmsError as exc:
         raise fail(f"{target.option}: {exc}") from None
     wrote(target.path, " (open it in Foxglove)")
     return target.path
+
+
+# --- live view, for the commands that run or replay (``--live``) ------------------------------
+
+#: The defaults of ``--live-host``, ``--live-port`` and ``--live-rate``: the library's.
+LIVE_DEFAULTS = LiveOptions()
+
+#: ``--live``: stream to Foxglove while computing.
+Live = Annotated[
+    bool,
+    typer.Option(
+        "--live",
+        help="Stream the map, truth, windows, image and metrics to Foxglove over WebSocket while "
+        "computing (needs aura-ums[foxglove]); waits for Foxglove to connect first (docs/interop.md).",
+    ),
+]
+#: ``--live-host``: the address the live server listens on.
+LiveHost = Annotated[
+    str,
+    typer.Option("--live-host", help="Address the --live server listens on (0.0.0.0: every interface)."),
+]
+#: ``--live-port``: its port.
+LivePort = Annotated[
+    int, typer.Option("--live-port", help="Port of the --live server (Foxglove's default; 0: any free port).")
+]
+#: ``--live-rate``: its pace.
+LiveRate = Annotated[
+    float,
+    typer.Option(
+        "--live-rate",
+        help="Pace of --live, times the run's own clock: 1 as recorded, 10 ten times faster, "
+        "0 as fast as computed.",
+    ),
+]
+
+
+def _live_options(host: str, port: int, rate: float) -> LiveOptions:
+    from aura_ums.errors import InputError
+
+    try:
+        return LiveOptions(host, port, rate)
+    except InputError as exc:  # "port: expected ...": named as the option given
+        raise fail(f"--live-{exc}") from None
+
+
+_View = TypeVar("_View", "LiveSimulation", "LiveReplay")
+
+
+@contextmanager
+def _serving(start: Callable[[], _View], what: str) -> Iterator[_View]:
+    """Start a live view, say where to connect, wait for a client; at the end, wait until it leaves.
+
+    The computation runs inside; after it the server stays while a client is subscribed
+    (it reads to the end and shows the last frame): a disconnect, or a Ctrl-C, stops it,
+    and the command goes on to print and write its results.
+    """
+    from aura_ums.errors import AuraUmsError, MissingDependencyError
+
+    try:
+        view = start()
+    except MissingDependencyError as exc:
+        raise fail(f"--live: {exc}") from None
+    except AuraUmsError as exc:  # a port in use, an address refused: "port: ...", "host: ..."
+        raise fail(f"--live-{exc}") from None
+    with view:
+        _note(
+            f"live: serving on {view.url}; in Foxglove: Open connection, Foxglove WebSocket, {view.url} "
+            "(waiting for it to subscribe; Ctrl-C to stop)"
+        )
+        view.wait_for_client()
+        _note(f"live: a client subscribed; streaming the {what}")
+        yield view
+        _note(
+            f"live: streamed {view.published} {what}; the view stays until Foxglove disconnects "
+            "(Ctrl-C to stop it)"
+        )
+        # a Ctrl-C here ends the view, not the command: its results are still to be printed and written
+        with suppress(KeyboardInterrupt):
+            view.wait_while_watched()
+        _note("live: server stopped")
+
+
+def _note(text: str) -> None:
+    err_console.print(text, highlight=False, markup=False)
+
+
+def live_simulation(
+    scenario: Scenario, *, live: bool, host: str, port: int, rate: float
+) -> AbstractContextManager[LiveSimulation | None]:
+    """With ``--live``, a live view of the scenario's runs (its ``frame`` is ``after_frame``); else None.
+
+    The view starts and waits for a client when entered, and stops when left. Errors (the
+    extra missing, the port in use) print ``error: --live...: ...`` and exit with code 2.
+    """
+    if not live:
+        return nullcontext(None)
+    from aura_ums.export import serve_simulation
+
+    options = _live_options(host, port, rate)
+    return _serving(lambda: serve_simulation(scenario, options), "frames")
+
+
+def live_replay(
+    log: RobotLog,
+    replay_options: ReplayOptions,
+    camera: Camera | None,
+    *,
+    live: bool,
+    host: str,
+    port: int,
+    rate: float,
+) -> AbstractContextManager[LiveReplay | None]:
+    """With ``--live``, a live view of the log's replay (its ``step`` is ``after_step``); else None.
+
+    As :func:`live_simulation`; with ``camera``, the windows are streamed too.
+    """
+    if not live:
+        return nullcontext(None)
+    from aura_ums.export import serve_replay
+
+    options = _live_options(host, port, rate)
+    return _serving(lambda: serve_replay(log, replay_options, camera=camera, options=options), "steps")

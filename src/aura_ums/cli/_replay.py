@@ -19,6 +19,7 @@ from aura_ums.cli._common import (
     manager_options,
     progress_bar,
 )
+from aura_ums.cli._interop import LIVE_DEFAULTS, Live, LiveHost, LivePort, LiveRate, live_replay
 from aura_ums.cli._outputs import (
     Overwrite,
     Source,
@@ -254,6 +255,10 @@ def replay(
         float | None,
         typer.Option("--until", help="Stop after the last frame at or before this log time, in s."),
     ] = None,
+    live: Live = False,
+    live_host: LiveHost = LIVE_DEFAULTS.host,
+    live_port: LivePort = LIVE_DEFAULTS.port,
+    live_rate: LiveRate = LIVE_DEFAULTS.rate,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
@@ -264,7 +269,8 @@ def replay(
 
     With --resume the replay continues where a --save-state left it (its settings are the
     saved ones) and reports the frames after it; it ends with exactly the map of a
-    replay run in one go.
+    replay run in one go. With --live, the replay is streamed to Foxglove as it computes
+    (with --camera, its windows too, on a blank image: logs carry no images).
     """
     from aura_ums import Metrics
     from aura_ums.camera import load_camera
@@ -305,17 +311,20 @@ def replay(
         keep_maps = plot is not None or mcap is not None
         # The per-step CSV is streamed, through a scratch file renamed onto it whole.
         steps_path = None if csv_target is None else resolved(csv_target.path)
-        with progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
-            if camera is None:
+        lens = None if camera is None else load_camera(camera)
+        watch = live_replay(log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate)
+        with watch as view, progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
+            if lens is None:
                 result = replay_log(
                     log, table, options, keep_maps=keep_maps, steps_csv=steps_path, progress=advance,
                     until=until, resume=saved, save_state=save_state is not None,
+                    after_step=None if view is None else view.step,
                 )  # fmt: skip
             else:
                 result, windows = replay_windows(
-                    log, table, load_camera(camera), options, margin=window_margin, keep_maps=keep_maps,
+                    log, table, lens, options, margin=window_margin, keep_maps=keep_maps,
                     steps_csv=steps_path, progress=advance, until=until, resume=saved,
-                    save_state=save_state is not None,
+                    save_state=save_state is not None, after_step=None if view is None else view.step,
                 )  # fmt: skip
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
@@ -335,7 +344,7 @@ def replay(
     if mcap_target is not None:
         from aura_ums.cli._interop import write_replay_mcap_option
 
-        write_replay_mcap_option(mcap_target, result, quiet=quiet)
+        write_replay_mcap_option(mcap_target, result, quiet=quiet, windows=windows)
 
 
 def _draw(result: ReplayResult, target: Target) -> None:

@@ -17,12 +17,13 @@ from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
 
 if TYPE_CHECKING:
     from aura_ums.export._types import ReplayLike
+    from aura_ums.logs import WindowReport
     from aura_ums.sim import RunResult, Scenario
 
 _EXTRA = "install aura-ums[foxglove]"
 
 
-def _require(module: str, purpose: str) -> None:
+def require(module: str, purpose: str) -> None:
     """Import ``module`` or raise :class:`MissingDependencyError` naming the extra to install."""
     try:
         importlib.import_module(module)
@@ -59,6 +60,9 @@ def write_simulation_mcap(
       polygon after the frame (red when lost) and before its reductions, as closed lines;
     - ``/map/wedge`` (``foxglove.SceneUpdate``, per frame): the heading wedge as a fan from
       the map's centre;
+    - ``/map/slices`` (``foxglove.SceneUpdate``, per frame, only when the maps are
+      heading-sliced): each slice's polygon, stacked above the ground in heading order and
+      coloured by heading;
     - ``/map/center``, ``/truth`` (``foxglove.SceneUpdate``, per frame): arrows at the map's
       centre (along the wedge's centre) and at the true pose;
     - ``/camera/image`` (``foxglove.RawImage`` ``mono8``, per frame with an image, frame
@@ -66,7 +70,8 @@ def write_simulation_mcap(
     - ``/camera/annotations`` (``foxglove.ImageAnnotations``, per frame): each expectation
       window as a rectangle labelled with its landmark id, green when found, red when not,
       and the detections' line segments;
-    - ``/metrics`` (JSON, schema ``aura_ums.SimulationMetrics``, per frame): ``area_m2``,
+    - ``/metrics`` (JSON, schema ``aura_ums.SimulationMetrics``, per frame): ``run`` (1),
+      ``frame``, ``time``, ``area_m2``,
       ``area_before_m2``, ``wedge_width_rad``, ``inside`` (0/1), ``accepted``, ``rejected``,
       ``windows``, ``found``, ``lost`` (0/1), ``frame_ms``: plot them in Foxglove's Plot panel.
 
@@ -129,7 +134,7 @@ def write_simulation_mcap(
     if not isinstance(camera_topic_images, bool):
         raise InputError(f"camera_topic_images: expected a bool, got {camera_topic_images!r}")
     _check_progress(progress)
-    _require("foxglove.channels", "writing MCAP")
+    require("foxglove.channels", "writing MCAP")
     from aura_ums.export._writer import write_simulation
 
     return write_simulation(target, scenario, result, camera_topic_images, progress)
@@ -141,17 +146,27 @@ def _check_progress(progress: object) -> None:
 
 
 def write_replay_mcap(
-    path: str | Path, replay: ReplayLike, *, progress: Callable[[int, int], None] | None = None
+    path: str | Path,
+    replay: ReplayLike,
+    *,
+    windows: WindowReport | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Write a log replay to an MCAP file that Foxglove opens, and return its path.
 
     Channels (frame ``"world"``): ``/landmarks`` (once, the log's landmarks: cylinders
-    from ``z_bottom`` to ``z_top``, spheres when they have no height), ``/map/polygon``,
-    ``/map/wedge``, ``/map/center`` (per step, as for :func:`write_simulation_mcap`),
-    ``/truth`` (per step, only when the log has ground truth; a step without it deletes the
-    arrow) and ``/metrics`` (JSON, schema ``aura_ums.ReplayMetrics``: ``area_m2``,
+    from ``z_bottom`` to ``z_top``, spheres when they have no height; for a
+    :class:`~aura_ums.logs.ReplayResult`, ``/meadows`` too, the replay's arena),
+    ``/map/polygon``, ``/map/wedge``, ``/map/center`` (per step, as for
+    :func:`write_simulation_mcap`; ``/map/slices`` when the maps are sliced), ``/truth``
+    (per step, only when the log has ground truth; a step without it deletes the arrow) and
+    ``/metrics`` (JSON, schema ``aura_ums.ReplayMetrics``: ``area_m2``,
     ``wedge_width_rad``, ``inside`` (0/1, null without truth), ``accepted``, ``rejected``,
-    ``lost``, ``update_us``). Log times are the log's times in nanoseconds (>= 0).
+    ``lost``, ``update_us``, ...). With ``windows``, ``/camera/annotations`` per step draws
+    each observation's windows (ours green when the measured pixel fell inside, red when
+    not; the EKF's box orange, the disk model's violet) and the measured pixels, over a
+    blank ``/camera/image`` of the camera's size (logs carry no images). Log times are the
+    log's times in nanoseconds (>= 0).
 
     Parameters
     ----------
@@ -162,6 +177,9 @@ def write_replay_mcap(
         The replay: ``replay.log.meta.name``, ``replay.log.landmarks`` and ``replay.steps``
         are read (each step's ``time``, ``map``, ``truth``, ``inside``, ``accepted``,
         ``rejected``, ``update_us`` and ``state``).
+    windows : aura_ums.logs.WindowReport or None
+        The windows of the same replay (:func:`aura_ums.logs.replay_windows`), drawn on
+        the camera topics at their steps' times.
     progress : callable or None
         Called as ``progress(done, total)`` after each step written.
 
@@ -174,7 +192,8 @@ def write_replay_mcap(
     MissingDependencyError
         When ``foxglove-sdk`` is not installed.
     InputError
-        For a replay without steps, or with a negative time.
+        For a replay without steps, or with a negative time, or ``windows`` that are not a
+        :class:`~aura_ums.logs.WindowReport`.
     FileFormatError
         When the file cannot be written.
 
@@ -201,10 +220,15 @@ def write_replay_mcap(
         if not hasattr(replay, name):
             raise InputError(f"replay: expected a ReplayResult (with .{name}), got {type(replay).__name__}")
     _check_progress(progress)
-    _require("foxglove.channels", "writing MCAP")
+    if windows is not None:
+        from aura_ums.logs import WindowReport
+
+        if not isinstance(windows, WindowReport):
+            raise InputError(f"windows: expected a WindowReport or None, got {type(windows).__name__}")
+    require("foxglove.channels", "writing MCAP")
     from aura_ums.export._writer import write_replay
 
-    return write_replay(target, replay, progress)
+    return write_replay(target, replay, windows, progress)
 
 
 def mcap_channels(path: str | Path) -> dict[str, str]:
@@ -231,7 +255,7 @@ def mcap_channels(path: str | Path) -> dict[str, str]:
     aura_ums.errors.FileFormatError: ...not.mcap: expected an MCAP file, got ...
     """
     source = _path(path)
-    _require("mcap.reader", "reading MCAP")
+    require("mcap.reader", "reading MCAP")
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
 

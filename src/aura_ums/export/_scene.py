@@ -6,6 +6,7 @@ be checked on its own.
 
 from __future__ import annotations
 
+import colorsys
 import math
 from collections.abc import Mapping
 from types import MappingProxyType
@@ -23,6 +24,8 @@ WEDGE_MIN_RADIUS = 1.0
 _WEDGE_REACH = 0.5
 #: Largest angle (rad) between two consecutive points of a drawn arc.
 ARC_STEP = math.radians(5.0)
+#: Metres between two drawn heading slices stacked above the ground, and below the first.
+SLICE_STEP = 0.05
 
 #: RGBA (each in [0, 1]) of the meadow fill per terrain name; other terrains use
 #: ``_OTHER_TERRAIN_COLOR``. Read-only.
@@ -64,6 +67,32 @@ def yaw_quaternion(heading: float) -> tuple[float, float, float, float]:
     """
     h = finite_float(heading, "heading")
     return (0.0, 0.0, math.sin(h / 2.0), math.cos(h / 2.0))
+
+
+def heading_color(heading: float) -> tuple[float, float, float, float]:
+    """Return the RGBA colour of a heading (rad): a full-saturation hue, red at 0, once round the wheel.
+
+    Examples
+    --------
+    >>> heading_color(0.0)
+    (1.0, 0.0, 0.0, 1.0)
+    >>> heading_color(2.0 * math.pi) == heading_color(0.0)       # a whole turn: the same colour
+    True
+    """
+    hue = (finite_float(heading, "heading") / (2.0 * math.pi)) % 1.0
+    r, g, b = colorsys.hsv_to_rgb(hue, 1.0, 1.0)
+    return (r, g, b, 1.0)
+
+
+def slice_height(index: int) -> float:
+    """Return the height (m) at which heading slice ``index`` (0-based, in heading order) is drawn.
+
+    Examples
+    --------
+    >>> slice_height(0), slice_height(3)
+    (0.05, 0.2)
+    """
+    return SLICE_STEP * (index + 1)
 
 
 def wedge_radius(center: ArrayLike, vertices: ArrayLike) -> float:

@@ -567,6 +567,7 @@ def replay_log(
     until: float | None = None,
     resume: ReplayState | None = None,
     save_state: bool = False,
+    after_step: Callable[[ReplayStep], None] | None = None,
 ) -> ReplayResult:
     """Run the uncertainty map manager over a log, frame by frame, and judge it against ground truth.
 
@@ -623,6 +624,10 @@ def replay_log(
     save_state : bool
         Record where the replay stopped (:attr:`ReplayResult.state`, the manager's and
         blackboard's JSON, which grows with the log), to save and resume from.
+    after_step : callable or None
+        Called after each step, in time order, with its :class:`ReplayStep` (the map, the
+        truth judged against it at once), to watch a replay while it computes (the live
+        view). Its time is not counted in ``update_us``.
 
     Returns
     -------
@@ -666,6 +671,8 @@ def replay_log(
         raise InputError(f"save_state: expected True or False, got {save_state!r}")
     if progress is not None and not callable(progress):
         raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
+    if after_step is not None and not callable(after_step):
+        raise InputError(f"after_step: expected a callable or None, got {type(after_step).__name__}")
     stop = math.inf if until is None else finite_float(until, "until")
     if resume is not None and not isinstance(resume, ReplayState):
         raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")
@@ -746,6 +753,8 @@ def replay_log(
                 maps.append(step.map)
             if judge.full():
                 writer.write(trace, *judge.flush())
+            if after_step is not None:
+                after_step(_step_now(trace, index, step.map, step.envelope_map))
             if progress is not None:
                 progress(first + index + 1, int(frame_times.size))
         writer.write(trace, *judge.flush())
@@ -768,6 +777,29 @@ def replay_log(
         manager.relocalizations,
         tuple(maps) if keep_maps else None,
         state,
+    )
+
+
+def _step_now(
+    trace: ReplayTrace,
+    index: int,
+    working: SpatialUncertaintyMap,
+    envelope: SpatialUncertaintyMap | None,
+) -> ReplayStep:
+    """Return step ``index`` as it stands, its truth judged now (the trace judges it later, in a batch)."""
+    truth = trace.truth_pose(index)
+    return ReplayStep(
+        float(trace.time[index]),
+        working,
+        truth,
+        None if truth is None else bool(working.contains(truth)),
+        int(trace.accepted[index]),
+        int(trace.rejected[index]),
+        float(trace.update_us[index]),
+        _STATES[int(trace.state[index])],
+        bool(trace.relocalized[index]),
+        None if truth is None or envelope is None else bool(envelope.contains(truth)),
+        int(trace.excluded[index]),
     )
 
 

@@ -40,6 +40,7 @@ from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
+    ReplayStep,
     log_meadow_map,
     meta_bounds,
     observation_for,
@@ -276,6 +277,7 @@ def replay_windows(
     until: float | None = None,
     resume: ReplayState | None = None,
     save_state: bool = False,
+    after_step: Callable[[ReplayStep, tuple[WindowRow, ...]], None] | None = None,
 ) -> tuple[ReplayResult, WindowReport]:
     """Replay a log and judge, for each real observation, the image windows of three methods.
 
@@ -308,6 +310,9 @@ def replay_windows(
         Half-width of the EKF's box in standard deviations, > 0.
     keep_maps, steps_csv, progress, until, resume, save_state
         As for :func:`replay_log`.
+    after_step : callable or None
+        As for :func:`replay_log`, called as ``after_step(step, rows)`` with the step's
+        window rows too (one per observation of the frame and method).
 
     Returns
     -------
@@ -360,12 +365,29 @@ def replay_windows(
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
 
+    if after_step is not None and not callable(after_step):
+        raise InputError(f"after_step: expected a callable or None, got {type(after_step).__name__}")
     judge = _Judge(log, table, camera, opts, pixels, box_sigmas, b_sd, r_sd, bounds)
+    forward = None if after_step is None else _with_rows(after_step, judge)
     result = replay_log(
         log, table, opts, before_frame=judge, keep_maps=keep_maps, steps_csv=steps_csv, progress=progress,
-        until=until, resume=resume, save_state=save_state,
+        until=until, resume=resume, save_state=save_state, after_step=forward,
     )  # fmt: skip
     return result, WindowReport(camera, pixels, tuple(judge.rows))
+
+
+def _with_rows(
+    after_step: Callable[[ReplayStep, tuple[WindowRow, ...]], None], judge: _Judge
+) -> Callable[[ReplayStep], None]:
+    """Return the replay's ``after_step`` that hands on each step with the window rows judged for it."""
+    shown = 0
+
+    def forward(step: ReplayStep) -> None:
+        nonlocal shown
+        rows, shown = tuple(judge.rows[shown:]), len(judge.rows)
+        after_step(step, rows)
+
+    return forward
 
 
 class _Judge:

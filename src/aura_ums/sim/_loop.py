@@ -32,6 +32,7 @@ import enum
 import math
 import statistics
 import time as _time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -411,7 +412,8 @@ class _Loop:
     def done(self) -> bool:
         return self.next_index > 0 and (self.leg >= len(self.legs) or self.look_frames >= _MAX_LOOK_FRAMES)
 
-    def step(self, keep: list[NDArray[np.uint8]] | None) -> None:
+    def step(self, keep: list[NDArray[np.uint8]] | None) -> NDArray[np.uint8]:
+        """Run one frame, record it, and return its image."""
         index = self.next_index
         now = index * _FRAME_PERIOD
         command: TurnAndRun | None = None
@@ -474,6 +476,7 @@ class _Loop:
             )
         )
         self.next_index += 1
+        return image
 
     def _inject(self, now: float) -> int:
         """Make each identification up to ``now`` wrong with the scenario's rate; return how many.
@@ -558,6 +561,7 @@ def run_scenario(
     resume_from: LoopState | None = None,
     world: MeadowMap | None = None,
     keep_images: bool = False,
+    after_frame: Callable[[FrameRecord, NDArray[np.uint8]], None] | None = None,
 ) -> RunResult:
     """Drive a scenario's route through the closed loop, frame by frame (see the module notes).
 
@@ -581,6 +585,10 @@ def run_scenario(
         The world the camera sees, when it differs from the map (moved landmarks).
     keep_images : bool
         Keep the frames' images in :attr:`RunResult.images` (frames of this call only).
+    after_frame : callable or None
+        Called after each frame of this call, in order, as ``after_frame(record, image)``:
+        the frame's :class:`FrameRecord` and its grayscale image (read-only), to watch a
+        run while it computes (the live view). Its time is not counted in ``frame_ms``.
 
     Returns
     -------
@@ -614,6 +622,8 @@ def run_scenario(
         isinstance(stop_after, bool) or not isinstance(stop_after, int) or stop_after < 1
     ):
         raise InputError(f"stop_after: expected an integer >= 1 or None, got {stop_after!r}")
+    if after_frame is not None and not callable(after_frame):
+        raise InputError(f"after_frame: expected a callable or None, got {type(after_frame).__name__}")
     if resume_from is not None:
         if not isinstance(resume_from, LoopState):
             raise InputError(f"resume_from: expected a LoopState, got {type(resume_from).__name__}")
@@ -633,7 +643,9 @@ def run_scenario(
                 loop.hits,
                 tuple(images or ()),
             )
-        loop.step(images)
+        image = loop.step(images)
+        if after_frame is not None:
+            after_frame(loop.records[-1], image)
     completed = loop.leg >= len(loop.legs)
     return RunResult(
         scenario.name,
