@@ -556,7 +556,9 @@ def _observations(
         bearing_error = bounds.bearing_error if row.bearing_error is None else row.bearing_error
         measured = row.range
         if bearing_only or measured is None:
-            found.append(BearingObservation._trusted(row.landmark_id, row.time, row.bearing, bearing_error, offset))
+            found.append(
+                BearingObservation._trusted(row.landmark_id, row.time, row.bearing, bearing_error, offset)
+            )
             continue
         if row.range_error is not None:
             low, high = max(0.0, measured - row.range_error), measured + row.range_error

@@ -281,7 +281,12 @@ class BearingObservation:
 
     @classmethod
     def _trusted(
-        cls, landmark_id: str, time: float, bearing: float, bearing_error: float, sensor_offset: tuple[float, float]
+        cls,
+        landmark_id: str,
+        time: float,
+        bearing: float,
+        bearing_error: float,
+        sensor_offset: tuple[float, float],
     ) -> BearingObservation:
         """Build from values the library checked already (a log's rows): a long replay builds two per row."""
         observation = object.__new__(cls)
@@ -352,7 +357,8 @@ class RangeBearingObservation:
 _OBSERVATION_FIELDS = ("landmark_id", "time", "bearing", "bearing_error", "sensor_offset")
 _BEARING_SETTERS = tuple(BearingObservation.__dict__[name].__set__ for name in _OBSERVATION_FIELDS)
 _RANGE_BEARING_SETTERS = tuple(
-    RangeBearingObservation.__dict__[name].__set__ for name in (*_OBSERVATION_FIELDS, "range_min", "range_max")
+    RangeBearingObservation.__dict__[name].__set__
+    for name in (*_OBSERVATION_FIELDS, "range_min", "range_max")
 )
 
 
