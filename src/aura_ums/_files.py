@@ -454,7 +454,7 @@ def parse_csv(
     for number, cells in zip(numbers[1:], parsed[1:], strict=True):
         if len(cells) != len(header):
             raise FileFormatError(source, "", f"expected {len(header)} cells, got {len(cells)}", line=number)
-        rows.append(tuple(cell.strip() for cell in cells))
+        rows.append(tuple(map(str.strip, cells)))
     return CsvTable(source, header, numbers[0], tuple(rows), tuple(numbers[1:]))
 
 
@@ -705,10 +705,17 @@ def read_csv_floats(
                 return None
         except OSError:
             return None
+        try:
+            # Rows are at most the line breaks plus one: the values are written in place, never
+            # held twice (as blocks and as their concatenation).
+            capacity = 1 + sum(piece.count(b"\n") for piece in iter(lambda: handle.read(block_bytes), b""))
+            handle.seek(0)
+        except OSError:
+            return None
         header: CsvFloats | None = None
         header_text = ""
-        values: list[NDArray[np.float64]] = []
-        lines: list[NDArray[np.int64]] = []
+        values = np.empty((0, 0))
+        lines = np.empty(0, dtype=np.int64)
         rows = 0
         lines_before = 0  # lines of the file before the block
         carry = b""
@@ -743,6 +750,8 @@ def read_csv_floats(
                 if header is None:
                     return None
                 header_text = text.splitlines()[header.header_line - 1]
+                values = np.empty((capacity, len(header.header)))
+                lines = np.empty(capacity, dtype=np.int64)
                 found = header.lines
                 parsed = header.values
             else:
@@ -759,21 +768,16 @@ def read_csv_floats(
                     return None
                 found = table.lines - 1
                 parsed = table.values
+            if rows + len(found) > capacity:  # the file grew since its line breaks were counted
+                return None
+            values[rows : rows + len(found)] = parsed
+            lines[rows : rows + len(found)] = found + lines_before
             rows += len(found)
-            values.append(parsed)
-            lines.append(found + lines_before)
             lines_before += block.count(b"\n")
             if not chunk:
                 break
     assert header is not None  # the first block parsed, or None was returned
-    return CsvFloats(
-        source,
-        header.header,
-        header.header_line,
-        np.concatenate(values) if len(values) > 1 else values[0],
-        np.concatenate(lines) if len(lines) > 1 else lines[0],
-        None,
-    )
+    return CsvFloats(source, header.header, header.header_line, values[:rows], lines[:rows], None)
 
 
 # --- typed values --------------------------------------------------------------------------

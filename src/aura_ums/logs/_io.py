@@ -245,7 +245,8 @@ class _CsvFile:
                 row = int(np.argmax(bad))
                 cell = describe(self.cell(column, row))
                 self.fail_at(row, f"expected a finite number in column {column!r}, got {cell}")
-            result: NDArray[np.float64] = values * factor
+            # No copy in SI already (x * 1.0 is x): a long log's columns are large.
+            result: NDArray[np.float64] = values if factor == 1.0 else values * factor
         else:
             cells = self.cells[column]
             try:
