@@ -39,6 +39,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -95,6 +96,20 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
     print(json.dumps(figures))
 
 
+def _older_inputs(folder: Path, sensors: Path) -> Path:
+    """Make the log and sensors file readable by a tree older than the sensor offset and the noise table.
+
+    The log's ``[sensor] forward`` and ``left`` are 0.0 (the default those trees assumed) and
+    a replay does not read the sensors file's ``[noise]`` (compare does): both are dropped.
+    """
+    meta = folder / "meta.toml"
+    kept = [line for line in meta.read_text().splitlines() if line not in ("forward = 0.0", "left = 0.0")]
+    meta.write_text("\n".join(kept) + "\n")
+    older = sensors.with_name("older.sensors.toml")
+    older.write_text(re.sub(r"\n\[noise\]\n(?:[^\[\n].*\n?|\n)*", "\n", sensors.read_text()))
+    return older
+
+
 def _replay(src: str | None, folder: Path, terrain: Path, sensors: Path, out: Path) -> dict[str, float]:
     env = dict(os.environ)
     if src is not None:
@@ -129,9 +144,10 @@ def main() -> None:
               f"{'ms/1000 rows':>13} {'load peak MB':>13} {'peak MB':>8} {'containment':>11}")  # fmt: skip
         for rows in args.rows:
             folder = make_long_log(work / f"log-{rows}", rows, frame_every=args.frame_every)
+            read_by = sensors if args.src is None else _older_inputs(folder, sensors)
             out = work / f"out-{rows}"
             out.mkdir()
-            figures = _replay(args.src, folder, terrain, sensors, out)
+            figures = _replay(args.src, folder, terrain, read_by, out)
             print(
                 f"{rows:>9} {figures['steps']:>7} {figures['load_s']:>7.2f} {figures['update_s']:>9.2f} "
                 f"{figures['total_s']:>8.2f} {1e6 * figures['total_s'] / rows:>13.2f} "
@@ -141,6 +157,8 @@ def main() -> None:
             )
             for path in (*folder.iterdir(), *out.iterdir()):
                 path.unlink()
+            if read_by != sensors:
+                read_by.unlink()
 
 
 if __name__ == "__main__":
