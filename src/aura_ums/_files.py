@@ -659,12 +659,13 @@ def read_csv_floats(
 
     The file is read ``block_bytes`` at a time, each block cut after its last line break,
     so the text of a large file is never in memory whole: only the values and the line
-    numbers grow with it. The result is :func:`parse_csv_floats` of the whole text (hence
-    exactly what :func:`parse_csv` and ``float()`` give); None whenever that would be None,
-    and also for a file that is missing, unreadable, larger than ``max_bytes`` or not
-    ASCII: the caller then reads it with :func:`read_text` and :func:`parse_csv`, whose
-    messages say what is wrong. The result holds no text (:meth:`CsvFloats.cell` reads the
-    file again, for a message).
+    numbers grow with it. Each block is read by :func:`parse_csv_floats` below the header,
+    so the result is exactly what :func:`parse_csv` and ``float()`` of every cell give; None
+    whenever a block's is None (at least whenever that of the whole text would be), and for
+    a file that is missing, unreadable, larger than ``max_bytes`` or not ASCII: the caller
+    then reads it with :func:`read_text` and :func:`parse_csv`, whose messages say what is
+    wrong. The result holds no text (:meth:`CsvFloats.cell` reads the file again, for a
+    message).
 
     Parameters
     ----------
