@@ -62,6 +62,7 @@ __all__ = [
     "parse_json",
     "parse_toml",
     "read_bytes",
+    "read_csv_floats",
     "read_text",
     "scratch_path",
     "write_text_atomic",
@@ -71,6 +72,8 @@ __all__ = [
 MAX_BYTES = 64 * 1024 * 1024
 #: Most data rows of a CSV file (two million: hours of 100 Hz odometry).
 MAX_ROWS = 2_000_000
+#: Bytes :func:`read_csv_floats` reads at a time: what a large CSV file costs in memory beyond its values.
+CSV_BLOCK_BYTES = 4 * 1024 * 1024
 
 Syntax = Literal["toml", "json"]
 T = TypeVar("T")
@@ -413,8 +416,7 @@ def parse_csv(
     numbers: list[int] = []
     lines: list[str] = []
     for number, line in enumerate(body.splitlines(), start=1):
-        stripped = line.strip()
-        if stripped and not stripped.startswith("#"):
+        if _is_row(line):
             if len(lines) > most:
                 raise FileFormatError(source, "", f"expected at most {most} data rows, got more", line=number)
             numbers.append(number)
@@ -452,7 +454,7 @@ def parse_csv(
     for number, cells in zip(numbers[1:], parsed[1:], strict=True):
         if len(cells) != len(header):
             raise FileFormatError(source, "", f"expected {len(header)} cells, got {len(cells)}", line=number)
-        rows.append(tuple(cell.strip() for cell in cells))
+        rows.append(tuple(map(str.strip, cells)))
     return CsvTable(source, header, numbers[0], tuple(rows), tuple(numbers[1:]))
 
 
@@ -487,8 +489,10 @@ class CsvFloats:
         Every cell as a float (``float(cell)``).
     lines : ndarray of int64, shape (rows,)
         1-based line of each row.
-    text : str
-        The text parsed (to quote a cell in a message: :meth:`cell`).
+    text : str or None
+        The text parsed (to quote a cell in a message: :meth:`cell`); None when it was read
+        from the file ``source`` block by block (:func:`read_csv_floats`), which
+        :meth:`cell` then reads again.
     """
 
     source: str
@@ -496,14 +500,15 @@ class CsvFloats:
     header_line: int
     values: NDArray[np.float64]
     lines: NDArray[np.int64]
-    text: str
+    text: str | None
 
     def __len__(self) -> int:
         return len(self.lines)
 
     def cell(self, row: int, column: str) -> str:
         """Return the stripped text of one cell (row index from 0), as :func:`parse_csv` gives it."""
-        line = self.text.splitlines()[int(self.lines[row]) - 1]
+        text = self.text if self.text is not None else read_text(self.source, kind="CSV")
+        line = text.removeprefix(_BOM).splitlines()[int(self.lines[row]) - 1]
         return line.split(",")[self.header.index(column)].strip()
 
 
@@ -633,6 +638,147 @@ def parse_csv_floats(
     if values.shape != (rows, len(header)):
         return None
     return CsvFloats(source, header, head + 1, values, lines, body)
+
+
+def _is_row(line: str) -> bool:
+    """Whether a line of CSV text is a row (the header or data): not blank, not a ``#`` comment."""
+    stripped = line.strip()
+    return bool(stripped) and not stripped.startswith("#")
+
+
+def read_csv_floats(
+    path: str | os.PathLike[str],
+    *,
+    columns: Sequence[str],
+    required: Sequence[str] = (),
+    max_rows: int | None = None,
+    max_bytes: int | None = None,
+    block_bytes: int = CSV_BLOCK_BYTES,
+) -> CsvFloats | None:
+    r"""Read a CSV file of numbers only block by block (:func:`parse_csv_floats`); None when it cannot.
+
+    The file is read ``block_bytes`` at a time, each block cut after its last line break,
+    so the text of a large file is never in memory whole: only the values and the line
+    numbers grow with it. Each block is read by :func:`parse_csv_floats` below the header,
+    so the result is exactly what :func:`parse_csv` and ``float()`` of every cell give; None
+    whenever a block's is None (at least whenever that of the whole text would be), and for
+    a file that is missing, unreadable, larger than ``max_bytes`` or not ASCII: the caller
+    then reads it with :func:`read_text` and :func:`parse_csv`, whose messages say what is
+    wrong. The result holds no text (:meth:`CsvFloats.cell` reads the file again, for a
+    message).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    columns, required, max_rows, max_bytes
+        As for :func:`parse_csv`.
+    block_bytes : int
+        Bytes read at a time, >= 1.
+
+    Returns
+    -------
+    CsvFloats or None
+        The header, the values and the line of each row; None to read it with :func:`parse_csv`.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "o.csv"
+    >>> _ = path.write_bytes(b"\xef\xbb\xbf# odometry\ntime,v\n0.5, 1.0\n\n1.5,2e-1\n2.5,3\n")
+    >>> table = read_csv_floats(path, columns=("time", "v"), block_bytes=8)
+    >>> table.header, table.values.tolist(), table.lines.tolist(), table.cell(1, "v")
+    (('time', 'v'), [[0.5, 1.0], [1.5, 0.2], [2.5, 3.0]], [3, 5, 6], '2e-1')
+    >>> _ = path.write_bytes(b"time,v\n0.5,\n")
+    >>> read_csv_floats(path, columns=("time", "v")) is None   # an empty cell: parse_csv says more
+    True
+    """
+    source = str(path)
+    limit = _limit(max_bytes, MAX_BYTES)
+    most = _limit(max_rows, MAX_ROWS)
+    try:
+        handle = open(path, "rb")  # noqa: SIM115 - closed below, on every path
+    except (OSError, ValueError):
+        return None
+    with handle:
+        try:
+            if os.fstat(handle.fileno()).st_size > limit:
+                return None
+        except OSError:
+            return None
+        try:
+            # Rows are at most the line breaks plus one: the values are written in place, never
+            # held twice (as blocks and as their concatenation).
+            capacity = 1 + sum(piece.count(b"\n") for piece in iter(lambda: handle.read(block_bytes), b""))
+            handle.seek(0)
+        except OSError:
+            return None
+        header: CsvFloats | None = None
+        header_text = ""
+        values = np.empty((0, 0))
+        lines = np.empty(0, dtype=np.int64)
+        rows = 0
+        lines_before = 0  # lines of the file before the block
+        carry = b""
+        first = True
+        while True:
+            try:
+                chunk = handle.read(block_bytes)
+            except OSError:
+                return None
+            data = carry + chunk
+            if chunk:
+                cut = data.rfind(b"\n") + 1
+                if cut == 0:  # no line break yet: read on
+                    carry = data
+                    continue
+                block, carry = data[:cut], data[cut:]
+            else:
+                block, carry = data, b""
+            if first:
+                block = block.removeprefix(_BOM.encode("utf-8"))
+                first = False
+            if not block.isascii():
+                return None
+            text = block.decode("ascii")
+            if header is None:
+                if chunk and not any(_is_row(line) for line in text.splitlines()):
+                    carry = block + carry  # comments and blank lines only: the header is further on
+                    continue
+                header = parse_csv_floats(
+                    text, source, columns=columns, required=required, max_rows=most, max_bytes=limit
+                )
+                if header is None:
+                    return None
+                header_text = text.splitlines()[header.header_line - 1]
+                values = np.empty((capacity, len(header.header)))
+                lines = np.empty(capacity, dtype=np.int64)
+                found = header.lines
+                parsed = header.values
+            else:
+                # The header again before the block: the block's rows read as they would below it.
+                table = parse_csv_floats(
+                    f"{header_text}\n{text}",
+                    source,
+                    columns=columns,
+                    required=required,
+                    max_rows=most - rows,
+                    max_bytes=limit,
+                )
+                if table is None or table.header_line != 1:
+                    return None
+                found = table.lines - 1
+                parsed = table.values
+            if rows + len(found) > capacity:  # the file grew since its line breaks were counted
+                return None
+            values[rows : rows + len(found)] = parsed
+            lines[rows : rows + len(found)] = found + lines_before
+            rows += len(found)
+            lines_before += block.count(b"\n")
+            if not chunk:
+                break
+    assert header is not None  # the first block parsed, or None was returned
+    return CsvFloats(source, header.header, header.header_line, values[:rows], lines[:rows], None)
 
 
 # --- typed values --------------------------------------------------------------------------

@@ -23,6 +23,7 @@ from aura_ums.geometry import (
     simplify_outer,
 )
 from aura_ums.geometry._convex import convexity_defect
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
 
 SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
 
@@ -330,3 +331,12 @@ def test_shapely_round_trip_and_equality() -> None:
     assert square != square.translated(0.1, 0.0)
     with pytest.raises(InputError, match=r"expected a non-empty shapely geometry"):
         ConvexPolygon.from_shapely(shapely.Polygon())
+
+
+def test_a_sliver_whose_triangles_round_below_zero_is_still_sampled() -> None:
+    # A disk of radius 2.2e-16 m a metre from the origin: its fan triangles round to signed
+    # areas of both signs (found by hypothesis through union_of_maps).
+    sliver = SpatialUncertaintyMap.from_pose(Pose(0.0, 1.0, 0.0), 2.220446049250313e-16, 0.0).polygon
+    points = sliver.sample(50, np.random.default_rng(0))
+    assert points.shape == (50, 2)
+    assert np.all(sliver.contains(points, tolerance=1e-9))

@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from aura_ums import HeadingWedge, InputError
-from aura_ums.geometry import wrap_angle
+from aura_ums.geometry import wedges_contain, wrap_angle
 
 angles = st.floats(min_value=-4 * math.pi, max_value=4 * math.pi, allow_nan=False)
 extents = st.floats(min_value=0.0, max_value=3.5, allow_nan=False)
@@ -146,3 +146,26 @@ def test_restored_validates_as_the_constructor_does(
 ) -> None:
     with pytest.raises(InputError, match=message):
         HeadingWedge._restored(center, cw, ccw)
+
+
+@given(st.lists(st.tuples(angles, extents, extents, angles), min_size=1, max_size=20))
+def test_many_wedges_at_once_say_what_each_says(cases: list[tuple[float, float, float, float]]) -> None:
+    wedges = [HeadingWedge(center, cw, ccw) for center, cw, ccw, _ in cases]
+    bounds = np.array([(w.center, w.cw, w.ccw) for w in wedges])
+    # Headings on the edges too, where the tolerance decides.
+    for headings in (
+        np.array([heading for *_, heading in cases]),
+        np.array([w.center - w.cw for w in wedges]),
+        np.array([w.center + w.ccw + 1e-9 for w in wedges]),
+    ):
+        expected = [_one_by_one(w, h) for w, h in zip(wedges, headings.tolist(), strict=True)]
+        assert wedges_contain(bounds, headings).tolist() == expected
+        assert [w.contains(h) for w, h in zip(wedges, headings.tolist(), strict=True)] == expected
+
+
+def _one_by_one(wedge: HeadingWedge, heading: float) -> bool:
+    """The wedge test for one heading, in Python floats: offset from lo within the width."""
+    if wedge.cw + wedge.ccw >= 2 * math.pi:
+        return True
+    offset = float(np.mod(heading - (wedge.center - wedge.cw), 2 * math.pi))
+    return offset <= wedge.width + 1e-9 or offset >= 2 * math.pi - 1e-9

@@ -19,7 +19,7 @@ from aura_ums.geometry._convex import (
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
 from aura_ums.geometry._pose import Pose
-from aura_ums.geometry._wedge import HeadingWedge
+from aura_ums.geometry._wedge import HeadingWedge, wedges_contain
 from aura_ums.geometry._window import UNBOUNDED_PIXELS, ImageWindow
 
 __all__ = [
@@ -45,5 +45,6 @@ __all__ = [
     "regular_polygon",
     "simplify_outer",
     "subtended_arc",
+    "wedges_contain",
     "wrap_angle",
 ]

@@ -224,15 +224,16 @@ class ConvexPolygon:
         v = self.vertices
         if self.vertex_count == 1:
             return np.repeat(v, count, axis=0)
-        if self.area <= 0.0:
-            a, b = v[0], v[np.argmax(np.hypot(*(v - v[0]).T))]
-            t = rng.uniform(0.0, 1.0, size=(count, 1))
-            return np.asarray(a + t * (b - a), dtype=np.float64)
-        # Fan triangulation from vertex 0, triangles picked by area.
+        # Fan triangulation from vertex 0, triangles picked by area. A sliver's triangles can
+        # round to a negative area: none is drawn; when none is left, the polygon is a segment.
         a = v[0]
         b = v[1:-1]
         c = v[2:]
-        weights = 0.5 * _convex.cross2(b - a, c - a)
+        weights = np.maximum(0.5 * _convex.cross2(b - a, c - a), 0.0)
+        if self.area <= 0.0 or not weights.sum() > 0.0:
+            a, b = v[0], v[np.argmax(np.hypot(*(v - v[0]).T))]
+            t = rng.uniform(0.0, 1.0, size=(count, 1))
+            return np.asarray(a + t * (b - a), dtype=np.float64)
         pick = rng.choice(len(weights), size=count, p=weights / weights.sum())
         r1 = np.sqrt(rng.uniform(0.0, 1.0, size=count))
         r2 = rng.uniform(0.0, 1.0, size=count)

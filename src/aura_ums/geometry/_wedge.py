@@ -154,12 +154,7 @@ class HeadingWedge:
         Returns a Python ``bool`` for a scalar and a boolean array otherwise.
         """
         headings = float_array(heading, "heading")
-        if self.is_full_circle:
-            inside = np.ones(headings.shape, dtype=bool)
-        else:
-            offset = np.mod(headings - (self.center - self.cw), TWO_PI)
-            # Offsets just below 2*pi are headings a hair clockwise of lo.
-            inside = (offset <= self.width + ANGLE_TOLERANCE) | (offset >= TWO_PI - ANGLE_TOLERANCE)
+        inside = wedges_contain(np.array([self.center, self.cw, self.ccw]), headings)
         if inside.ndim == 0:
             return bool(inside)
         return inside
@@ -171,6 +166,38 @@ class HeadingWedge:
     def rotated(self, angle: float) -> HeadingWedge:
         """Return the wedge turned by ``angle`` radians (counter-clockwise positive)."""
         return _normalized(self.center + angle, self.cw, self.ccw)
+
+
+def wedges_contain(wedges: NDArray[np.float64], headings: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Tell whether headings lie in wedges, element-wise: :meth:`HeadingWedge.contains` for many wedges.
+
+    Parameters
+    ----------
+    wedges : ndarray, shape (..., 3)
+        Each wedge's centre, clockwise and counter-clockwise extents, radians (as
+        :class:`HeadingWedge` holds them: finite, extents >= 0); trusted, not checked.
+    headings : ndarray
+        Radians, any winding; broadcast against ``wedges[..., 0]``.
+
+    Returns
+    -------
+    ndarray of bool
+        True where the heading is in its wedge (within ``ANGLE_TOLERANCE``).
+
+    Examples
+    --------
+    >>> import math
+    >>> wedges = np.array([[0.0, 0.1, 0.1], [math.pi, 0.1, 0.2], [1.0, 4.0, 3.0]])
+    >>> wedges_contain(wedges, np.array([0.2, -math.pi + 0.15, -2.0])).tolist()   # the last: full circle
+    [False, True, True]
+    """
+    center, cw, ccw = wedges[..., 0], wedges[..., 1], wedges[..., 2]
+    extent = cw + ccw
+    offset = np.mod(headings - (center - cw), TWO_PI)
+    # Offsets just below 2*pi are headings a hair clockwise of lo.
+    inside = (offset <= np.minimum(extent, TWO_PI) + ANGLE_TOLERANCE) | (offset >= TWO_PI - ANGLE_TOLERANCE)
+    full: NDArray[np.bool_] = inside | (extent >= TWO_PI)
+    return full
 
 
 # Setters of the slots (frozen: the dataclass's own __setattr__ refuses).

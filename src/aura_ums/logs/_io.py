@@ -30,7 +30,7 @@ from aura_ums._files import (
     key_path,
     load_toml,
     parse_csv,
-    parse_csv_floats,
+    read_csv_floats,
     read_text,
     scratch_path,
 )
@@ -189,9 +189,10 @@ class Units:
 class _CsvFile:
     """One CSV file: its path for messages, its columns and their line numbers.
 
-    A file of numbers only is parsed column-wise (:func:`parse_csv_floats`: no Python
-    object per cell, a 10^6-row odometry file in about a second); any other file, or one
-    that the fast path cannot read exactly, cell by cell (:func:`load_csv`).
+    A file of numbers only is read block by block and parsed column-wise
+    (:func:`read_csv_floats`: no Python object per cell, never the whole text in memory);
+    any other file, or one that the fast path cannot read exactly, cell by cell
+    (:func:`read_text`, :func:`parse_csv`).
     """
 
     def __init__(self, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> None:
@@ -201,16 +202,16 @@ class _CsvFile:
         self.values: dict[str, NDArray[np.float64]] | None = None
         self.fast: CsvFloats | None = None
         numeric = all(unit != "text" for unit in columns.values())
-        text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
         if numeric:
-            self.fast = parse_csv_floats(
-                text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
+            self.fast = read_csv_floats(
+                path, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
             )
         if self.fast is not None:
             self.lines: NDArray[np.int64] | tuple[int, ...] = self.fast.lines
             self.header = self.fast.header
             self.values = {name: self.fast.values[:, index] for index, name in enumerate(self.fast.header)}
         else:
+            text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
             table = parse_csv(
                 text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
             )
@@ -244,7 +245,8 @@ class _CsvFile:
                 row = int(np.argmax(bad))
                 cell = describe(self.cell(column, row))
                 self.fail_at(row, f"expected a finite number in column {column!r}, got {cell}")
-            result: NDArray[np.float64] = values * factor
+            # No copy in SI already (x * 1.0 is x): a long log's columns are large.
+            result: NDArray[np.float64] = values if factor == 1.0 else values * factor
         else:
             cells = self.cells[column]
             try:

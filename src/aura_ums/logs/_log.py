@@ -296,16 +296,9 @@ class LogObservation:
         Only the bearing is wrapped, as :meth:`__post_init__` wraps it.
         """
         observation = object.__new__(cls)
-        for name, value in (
-            ("time", time),
-            ("landmark_id", landmark_id),
-            ("bearing", _wrapped(bearing)),
-            ("range", range),
-            ("bearing_error", bearing_error),
-            ("range_error", range_error),
-            ("line", line),
-        ):
-            object.__setattr__(observation, name, value)
+        values = (time, landmark_id, _wrapped(bearing), range, bearing_error, range_error, line)
+        for setter, value in zip(_OBSERVATION_SETTERS, values, strict=True):
+            setter(observation, value)
         return observation
 
     @property
@@ -353,6 +346,13 @@ def _same_length(name: str, **columns: NDArray[np.float64]) -> None:
     if len(set(lengths.values())) > 1:
         shown = ", ".join(f"{key} {length}" for key, length in lengths.items())
         raise InputError(f"{name}: expected columns of equal length, got {shown}")
+
+
+# The slots' own setters in field order (frozen: the dataclass's __setattr__ refuses), for _checked.
+_OBSERVATION_SETTERS = tuple(
+    LogObservation.__dict__[name].__set__
+    for name in ("time", "landmark_id", "bearing", "range", "bearing_error", "range_error", "line")
+)
 
 
 @dataclass(frozen=True, slots=True, eq=False, init=False)

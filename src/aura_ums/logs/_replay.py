@@ -21,7 +21,7 @@ from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._log import LogObservation, RobotLog
 from aura_ums.logs._odometry import ReverseMotion
@@ -547,6 +547,31 @@ def observation_for(
     )
 
 
+def _observations(
+    rows: Sequence[LogObservation], bearing_only: bool, bounds: SensorBounds, offset: tuple[float, float]
+) -> list[Observation]:
+    """:func:`observation_for` of each row (``factor`` 1), without checking again what the log checked."""
+    found: list[Observation] = []
+    for row in rows:
+        bearing_error = bounds.bearing_error if row.bearing_error is None else row.bearing_error
+        measured = row.range
+        if bearing_only or measured is None:
+            found.append(
+                BearingObservation._trusted(row.landmark_id, row.time, row.bearing, bearing_error, offset)
+            )
+            continue
+        if row.range_error is not None:
+            low, high = max(0.0, measured - row.range_error), measured + row.range_error
+        else:
+            low, high = bounds.range_interval(measured)
+        found.append(
+            RangeBearingObservation._trusted(
+                row.landmark_id, row.time, row.bearing, bearing_error, low, high, offset
+            )
+        )
+    return found
+
+
 def meta_bounds(log: RobotLog) -> SensorBounds:
     """Return the sensor bounds a log's ``meta.toml`` states (its range fraction both ways)."""
     meta = log.meta
@@ -710,17 +735,12 @@ def replay_log(
     maps: list[SpatialUncertaintyMap] = []
     judge = _Judge(trace)
     offset = log.meta.sensor_offset
+    bearing_only = opts.landmark_class is LandmarkClass.VERTICAL_LINE
     with _StepsCsv(steps_csv) as writer:
         for index, frame_time in enumerate(frame_times[first:last].tolist()):
             rows = frames[frame_time]
-            working = [
-                observation_for(r, opts.landmark_class, working_bounds, sensor_offset=offset) for r in rows
-            ]
-            envelope = (
-                [observation_for(r, opts.landmark_class, envelope_bounds, sensor_offset=offset) for r in rows]
-                if robust
-                else None
-            )
+            working = _observations(rows, bearing_only, working_bounds, offset)
+            envelope = _observations(rows, bearing_only, envelope_bounds, offset) if robust else None
             due = []
             while next_report < report_times.size and report_times[next_report] <= frame_time:
                 due.append(
@@ -880,11 +900,11 @@ def _contains(maps: Sequence[SpatialUncertaintyMap], poses: NDArray[np.float64])
     relative_y = np.repeat(pose[:, 1], counts) - vertices[:, 1]
     signed = (edge[:, 0] * relative_y - edge[:, 1] * relative_x) / length
     in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
-    in_wedge = np.array(
-        [m.wedge.contains(heading) for m, heading in zip(chosen, pose[:, 2].tolist(), strict=True)],
-        dtype=bool,
-    )
-    result[batched] = in_polygon & in_wedge
+    wedges = np.empty((len(chosen), 3))
+    wedges[:, 0] = [m.wedge.center for m in chosen]
+    wedges[:, 1] = [m.wedge.cw for m in chosen]
+    wedges[:, 2] = [m.wedge.ccw for m in chosen]
+    result[batched] = in_polygon & wedges_contain(wedges, pose[:, 2])
     return result
 
 

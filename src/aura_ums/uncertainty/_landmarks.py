@@ -279,6 +279,23 @@ class BearingObservation:
         object.__setattr__(self, "bearing", finite_float(self.bearing, "bearing"))
         object.__setattr__(self, "bearing_error", nonnegative_float(self.bearing_error, "bearing_error"))
 
+    @classmethod
+    def _trusted(
+        cls,
+        landmark_id: str,
+        time: float,
+        bearing: float,
+        bearing_error: float,
+        sensor_offset: tuple[float, float],
+    ) -> BearingObservation:
+        """Build from values the library checked already (a log's rows): a long replay builds two per row."""
+        observation = object.__new__(cls)
+        for setter, value in zip(
+            _BEARING_SETTERS, (landmark_id, time, bearing, bearing_error, sensor_offset), strict=True
+        ):
+            setter(observation, value)
+        return observation
+
     @property
     def landmark_class(self) -> LandmarkClass:
         """Always :attr:`LandmarkClass.VERTICAL_LINE`."""
@@ -312,10 +329,37 @@ class RangeBearingObservation:
         if self.range_max < self.range_min:
             raise InputError(f"range_max: expected >= range_min ({self.range_min}), got {self.range_max}")
 
+    @classmethod
+    def _trusted(
+        cls,
+        landmark_id: str,
+        time: float,
+        bearing: float,
+        bearing_error: float,
+        range_min: float,
+        range_max: float,
+        sensor_offset: tuple[float, float],
+    ) -> RangeBearingObservation:
+        """Build from values the library checked already (a log's rows): a long replay builds two per row."""
+        observation = object.__new__(cls)
+        values = (landmark_id, time, bearing, bearing_error, sensor_offset, range_min, range_max)
+        for setter, value in zip(_RANGE_BEARING_SETTERS, values, strict=True):
+            setter(observation, value)
+        return observation
+
     @property
     def landmark_class(self) -> LandmarkClass:
         """Always :attr:`LandmarkClass.POINT`."""
         return LandmarkClass.POINT
+
+
+# The slots' own setters (frozen: the dataclass's __setattr__ refuses), for the _trusted builders.
+_OBSERVATION_FIELDS = ("landmark_id", "time", "bearing", "bearing_error", "sensor_offset")
+_BEARING_SETTERS = tuple(BearingObservation.__dict__[name].__set__ for name in _OBSERVATION_FIELDS)
+_RANGE_BEARING_SETTERS = tuple(
+    RangeBearingObservation.__dict__[name].__set__
+    for name in (*_OBSERVATION_FIELDS, "range_min", "range_max")
+)
 
 
 @dataclass(frozen=True, slots=True)
