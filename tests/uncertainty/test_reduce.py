@@ -345,6 +345,29 @@ def test_cos_range_bounds_the_arc(lo: float, width: float, where: float) -> None
 # --- 4. edge cases ------------------------------------------------------------------
 
 
+def test_centre_moved_onto_a_noisy_boundary_stays_in_the_map() -> None:
+    # Found by hypothesis (seed 268435457 of random_prior): the reduced polygon keeps a
+    # 5.6e-8 m edge turned by -8e-9 rad, whose line passes 1e-8 m outside the centre the
+    # kernel moved onto the boundary a metre away; the map did not hold its own centre.
+    vertices = [
+        [2.5702884802889185, 4.364821588788148],
+        [3.246525013368236, 3.0627425546861877],
+        [6.0786962448374755, 2.4421785037655854],
+        [6.507412228951517, 3.3572765040553305],
+        [6.325212519481392, 5.30844328240303],
+        [2.7018177713003166, 5.263123264161785],
+    ]
+    wedge = HeadingWedge(-0.7844263618966081, 1.5256962779505814, 1.6140354563554697)
+    prior = SpatialUncertaintyMap(ConvexPolygon(vertices), [4.6759311995566675, 4.05353532759001], wedge)
+    pole = VerticalLineLandmark("a", 0.0, 0.0, 0.0, 3.0, "", 0.25)
+    reduction = prior.reduce(BearingObservation("a", 0.0, 0.0, 0.0, (0.0, -0.0234375)), pole)
+    assert reduction.consistent
+    pose = reduction.map.most_probable_pose()
+    assert reduction.map.contains(pose)
+    # Moved inside by rounding's margin only: still the point nearest the prior centre.
+    assert math.hypot(pose.x - 4.343060338036021, pose.y - 4.35706526462637) < 1e-6
+
+
 def test_empty_intersection_returns_prior_unchanged() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
     cases: list[Case] = [

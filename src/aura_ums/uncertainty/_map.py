@@ -382,7 +382,13 @@ class SpatialUncertaintyMap:
         return self.wedge.center
 
     def most_probable_pose(self) -> Pose:
-        """Return the map's centre and most probable heading as a Pose."""
+        """Return the map's centre and most probable heading as a Pose, a pose the map contains.
+
+        The centre lies in the polygon (in the home slice's for a sliced map) within
+        ``POSITION_TOLERANCE``: a reduction that cuts it away moves it to the nearest point
+        the reduced polygon holds. The heading is the wedge's centre, the end of a one-sided
+        wedge; a point polygon's centre is the point.
+        """
         pose = self._pose
         if pose is None:
             pose = Pose(float(self.center[0]), float(self.center[1]), self.wedge.center)

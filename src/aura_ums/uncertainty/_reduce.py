@@ -14,11 +14,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
 from aura_ums.errors import InputError
-from aura_ums.geometry import HeadingWedge
+from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -174,6 +175,8 @@ def reduce_checked(
     # Bytes are immutable, so the array is read-only as map values must be.
     reduced_vertices = np.frombuffer(raw, _FLOAT64).reshape(-1, 2)
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
+    if x != center_x or y != center_y:
+        x, y = held_centre(reduced_vertices, x, y)
     reduced = type(prior)._trusted(
         type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
     )
@@ -292,11 +295,59 @@ def _reduce_sliced(
         kept, centers = [kept[k] for k in order], [centers[k] for k in order]
     home = home_slice(kept, heading)
     x, y = centers[home]
+    if x != center_x or y != center_y:
+        x, y = held_centre(kept[home].vertices, x, y)
     reduced = type(prior)._sliced(
         tuple(kept), np.array([x, y]), clamp_into(heading, kept[home].lo, kept[home].hi), prior._cells,
         prior._max_slices,
     )  # fmt: skip
     return reduced, prior.area, reduced.area
+
+
+def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[float, float]:
+    """Return a kernel's moved centre, or the nearest point to it that the polygon holds (metres).
+
+    A centre the prior's polygon no longer holds is moved by the kernel to the reduced
+    polygon's nearest point, on its boundary. A reduced polygon may keep an edge shorter
+    than rounding whose direction is noise (a turn of -1e-8 rad is within the convexity
+    tolerance); its line, extended, can pass more than ``POSITION_TOLERANCE`` outside a
+    boundary point a metre away, so the map would not hold its own centre. Such a point is
+    moved towards the mean of the vertices, by steps growing fourfold from
+    ``POSITION_TOLERANCE``, until :func:`~aura_ums.geometry.points_in_convex` holds it with
+    that tolerance, the test ``SpatialUncertaintyMap.contains`` applies; the mean itself is
+    the last resort. A point or a segment holds every point of itself, so a degenerate
+    polygon keeps the kernel's point.
+
+    Parameters
+    ----------
+    vertices : ndarray, shape (n, 2)
+        The reduced polygon, counter-clockwise, metres, n >= 1.
+    x, y : float
+        The kernel's centre, on or near the polygon, metres.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> held_centre(square, 1.0, 0.5)                 # on the boundary: held as it is
+    (1.0, 0.5)
+    >>> notch = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [1.0 - 1e-8, 1.0 - 1e-16], [0.0, 1.0]])
+    >>> x, y = held_centre(notch, 0.5, 1.0)           # a noisy 1e-8 m edge cuts the top edge
+    >>> abs(x - 0.5) < 1e-6 and 1.0 - 1e-6 < y < 1.0
+    True
+    """
+    point = np.array([[x, y]])
+    if points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
+        return x, y
+    inner = vertices.mean(axis=0)
+    gap = inner - point[0]
+    length = math.hypot(gap[0], gap[1])
+    step = POSITION_TOLERANCE
+    while step < length:
+        candidate = point[0] + (step / length) * gap
+        if points_in_convex(vertices, candidate[None, :], POSITION_TOLERANCE)[0]:
+            return float(candidate[0]), float(candidate[1])
+        step *= 4.0
+    return float(inner[0]), float(inner[1])
 
 
 _TWO_PI = 2.0 * math.pi
