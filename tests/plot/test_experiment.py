@@ -236,6 +236,37 @@ def test_the_truth_is_lost_only_after_a_wrong_identification(
     assert lost < len(results) // 4
 
 
+def at_most_q_of_any_n(wrong: list[bool], q: int, n: int) -> bool:
+    """Whether at most ``q`` of any ``n`` consecutive items are True."""
+    return all(sum(wrong[i : i + n]) <= q for i in range(max(1, len(wrong) - n + 1)))
+
+
+def test_the_truth_stays_inside_while_at_most_q_of_n_identifications_are_wrong(
+    paper_runs: tuple[Scenario, list[RunResult]],
+) -> None:
+    # From position 4 the building's far vertical edge lies in the corner's window and the
+    # line finder sometimes takes it: a wrong identification every reduction agrees with.
+    # The relaxed intersection's guarantee: the truth stays inside whenever at most q of any
+    # N consecutive identifications are wrong (with the gate alone, 0.9675 of 400 frames).
+    paper, results = paper_runs
+    settings = paper.settings
+    tolerated = 0
+    for result in results:
+        records = result.records
+        wrong = [ident in misidentified(paper, record) for record in records for ident in record.posted]
+        if at_most_q_of_any_n(wrong, settings.relaxed_q, settings.relaxed_window):
+            assert all(record.inside for record in result.records), [r.posted for r in result.records]
+            tolerated += any(wrong)
+    # Runs with a wrong identification the guarantee covers: not a vacuous check.
+    assert tolerated >= 1
+
+
+def test_at_most_q_of_any_n() -> None:
+    assert at_most_q_of_any_n([], 1, 10)
+    assert at_most_q_of_any_n([True, False, False, True], 1, 3)
+    assert not at_most_q_of_any_n([True, False, True, False], 1, 3)
+
+
 def test_with_three_confirming_frames_the_first_two_positions_cannot_prune() -> None:
     # What Figure 12 did before: identifications confirmed over three frames prune at the
     # third image at the earliest, where the paper prunes at every one.

@@ -277,7 +277,13 @@ def encode_relaxed(state: RelaxedState) -> dict[str, object]:
     """Return the relaxed intersection's branches and window as a JSON object, every float exact."""
     return {
         "branches": [
-            {"excluded": sorted(branch.excluded), "map": encode_map(branch.map)} for branch in state.branches
+            {
+                "excluded": sorted(branch.excluded),
+                "map": encode_map(branch.map),
+                # Only when some: documents without carried sightings read as they always did.
+                **({"carried": sorted(branch.carried)} if branch.carried else {}),
+            }
+            for branch in state.branches
         ],
         "window": [
             {"serial": sighting.serial, "observation": encode_observation(sighting.observation)}
@@ -315,11 +321,14 @@ def decode_relaxed(reader: Reader, value: object, where: str, q: int, window: in
     branches: list[Branch] = []
     for k, item in enumerate(reader.array(data["branches"], f"{where}.branches")):
         place = f"{where}.branches[{k}]"
-        entry = reader.mapping(item, place, ("excluded", "map"))
+        entry = reader.mapping(item, place, ("excluded", "map"), optional=("carried",))
         excluded = serial_set(entry["excluded"], f"{place}.excluded", q)
-        if any(branch.excluded == excluded for branch in branches):
+        carried = serial_set(entry.get("carried", []), f"{place}.carried", len(serials))
+        if both := sorted(carried & excluded):
+            reader.fail(f"{place}.carried", f"expected no serial of excluded, got {both}")
+        if any((branch.excluded, branch.carried) == (excluded, carried) for branch in branches):
             reader.fail(f"{place}.excluded", f"expected a set no other branch has, got {sorted(excluded)}")
-        branches.append(Branch(excluded, reader.uncertainty_map(entry["map"], f"{place}.map")))
+        branches.append(Branch(excluded, reader.uncertainty_map(entry["map"], f"{place}.map"), carried))
     if not branches:
         reader.fail(f"{where}.branches", "expected at least one branch, got none")
     reported = serial_set(data["reported"], f"{where}.reported", len(serials))

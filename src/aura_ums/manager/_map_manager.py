@@ -203,13 +203,16 @@ class UncertaintyMapManager:
     ``relaxed_window = N`` sightings (observations that passed the checks above):
     branches, each a map and the sightings of the window it excludes, at most q. Each
     sighting reduces every branch (one it empties dies) and spawns from each branch with
-    fewer than q exclusions a copy that excludes it; when an excluded sighting leaves the
+    fewer than q exclusions a copy that excludes it (a branch that excluded a sighting of a
+    landmark ignores that landmark's next sightings while it is in the window: a misread
+    landmark tends to be misread again); when an excluded sighting leaves the
     window, its branch merges into the one with the same exclusions minus it (hull of the
     polygons, union of the wedges: :func:`~aura_ums.uncertainty.union_of_maps`). The map
     reported is the outer bound of every branch, with the centre and most probable heading
-    of the branch with the fewest exclusions. Guarantee: the truth stays inside whenever at
-    most q of any N consecutive sightings are wrong (and the growth and the right
-    sightings' bounds hold). A sighting every surviving branch excludes is *excluded*
+    of the branch with the fewest exclusions. Guarantee: the truth stays inside whenever the
+    wrong sightings among any N consecutive ones name at most q landmarks -- in particular
+    whenever at most q of them are wrong (and the growth and the right sightings' bounds
+    hold). A sighting every surviving branch excludes is *excluded*
     (:attr:`ManagerStep.excluded`; :attr:`RejectReason.EXCLUDED` when so on arrival, not an
     inconsistency). Only when every branch dies does the consistency gate apply, and
     with it re-localization. The cost: up to ``sum(C(N, k), k <= q)`` branches, each
@@ -688,7 +691,7 @@ class UncertaintyMapManager:
             if relaxed is not None:
                 state = relaxed
                 after = state.primary
-                everywhere = frozenset.intersection(*(branch.excluded for branch in state.branches))
+                everywhere = frozenset.intersection(*(branch.ignored for branch in state.branches))
                 for (position, observation, _), serial in zip(chunk, serials, strict=True):
                     dropped = serial in everywhere
                     verdicts[position] = ObservationOutcome(
@@ -711,7 +714,7 @@ class UncertaintyMapManager:
                     reduced = branch.map
                     for observation, landmark in pairs:
                         reduced = self._reduce(reduced, observation, landmark, record)
-                gated.append(Branch(branch.excluded, reduced))
+                gated.append(Branch(branch.excluded, reduced, branch.carried))
                 if record is not None:
                     for (position, _, _), outcome in zip(chunk, record, strict=True):
                         verdicts[position] = outcome

@@ -2,27 +2,36 @@
 
 A *sighting* is an observation that passed the manager's checks and met the map; each gets
 a serial number. The window holds the latest ``N`` sightings. A *branch* is a map and the
-set of sightings of the window it excludes (at most ``q``): its map holds the poses
-consistent with every sighting but those (and, after merges, an outer bound of that).
+set of sightings of the window it excludes (at most ``q``, its *choices*), plus the
+sightings it *carries*: later sightings of a landmark whose sighting it chose to exclude,
+while that one is in the window. Its map holds the poses consistent with every sighting
+but those (and, after merges, an outer bound of that).
 
-- A new sighting reduces every branch (a branch it empties dies) and, from each branch
-  with fewer than ``q`` exclusions, spawns a copy that excludes it (unless the reduction
-  left the branch as it was: the copy would add nothing).
-- When an excluded sighting leaves the window, its branch merges into the branch with the
-  same set minus it (an outer bound: hull of polygons, union of headings), or takes its
-  place.
+- A new sighting reduces every branch (a branch it empties dies), unless the branch has
+  chosen to exclude a sighting of the same landmark still in the window: then the branch
+  carries it (one wrong identity is not trusted again while its wrong sighting is in view
+  of the window; a misread barcode tends to repeat). From each branch with fewer than ``q``
+  choices it spawns a copy that excludes it (the sightings of one landmark in one instant
+  go together: one choice, the rest carried), unless the reduction left the branch as it
+  was (the copy would add nothing).
+- When a sighting leaves the window, each branch forgets it (its choices and carried
+  sightings without it); branches left with the same sets merge (an outer bound: hull of
+  polygons, union of headings).
 - Growth applies to every branch; the reported map is the outer bound of all branches.
 
-Guarantee: the truth stays inside whenever at most ``q`` of any ``N`` consecutive
-sightings are wrong (and the growth and the correct sightings' bounds hold). Invariant,
-by induction over sightings: some branch whose excluded set is a subset of the window's
-wrong sightings holds the truth. Growth keeps it; a departing sighting only merges (an
-outer bound) into a branch whose set is still such a subset; a correct arrival reduces it
-soundly; a wrong arrival finds it with fewer than ``q`` exclusions (the window before the
-arrival held at most ``q - 1`` wrong ones), so its copy excluding the arrival exists, or
-the reduction left it unchanged. Any two branches may also merge into the intersection of
-their sets (the same argument); nothing here needs it, since ``q`` and ``N`` bound the
-branch count by the sum of ``C(N, k)`` for ``k <= q``.
+Guarantee: the truth stays inside whenever the wrong sightings among any ``N`` consecutive
+ones name at most ``q`` landmarks; in particular whenever at most ``q`` of any ``N``
+consecutive sightings are wrong (and the growth and the correct sightings' bounds hold).
+Invariant, by induction over sightings: some branch holds the truth whose choices are
+sightings of the window of distinct landmarks, each with a wrong sighting of its landmark
+in its instant. Growth keeps it; a departing sighting only
+merges it (an outer bound) into a branch with the same property; a correct arrival reduces
+it soundly or is carried (ignoring a sighting only loosens); a wrong arrival of a landmark
+it chose in the window is carried; a wrong arrival of another landmark finds it with fewer
+than ``q`` choices (they and the arrival are wrong sightings of distinct landmarks in ``N``
+consecutive ones), so its copy excluding the arrival exists, or the reduction left it
+unchanged. Nothing here needs more: ``q`` and ``N`` bound the branch count by the sum of
+``C(N, k)`` for ``k <= q``.
 """
 
 from __future__ import annotations
@@ -40,10 +49,20 @@ Reducer = Callable[[SpatialUncertaintyMap, Sequence[int]], SpatialUncertaintyMap
 
 @dataclass(frozen=True, slots=True)
 class Branch:
-    """One hypothesis of the relaxed intersection: the sightings it excludes, and its map."""
+    """One hypothesis of the relaxed intersection: the sightings it excludes, and its map.
+
+    ``excluded`` are its choices (at most ``q``); ``carried`` the sightings it ignores
+    because it chose to exclude a sighting of their landmark (see the module notes).
+    """
 
     excluded: frozenset[int]
     map: SpatialUncertaintyMap
+    carried: frozenset[int] = frozenset()
+
+    @property
+    def ignored(self) -> frozenset[int]:
+        """Every sighting of the window whose bounds its map need not respect: chosen or carried."""
+        return self.excluded | self.carried
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,7 +129,7 @@ def admit(
     while kept and len(kept) + len(observations) > window:
         leaving = kept.pop(0).serial
         reported = reported - {leaving}
-        if any(leaving in branch.excluded for branch in branches):
+        if any(leaving in branch.ignored for branch in branches):
             branches = _merged(branches, leaving, max_vertices)
     serials = tuple(range(state.next_serial, state.next_serial + len(observations)))
     kept += [Sighting(serial, observation) for serial, observation in zip(serials, observations, strict=True)]
@@ -121,44 +140,54 @@ def admit(
 
 
 def _merged(branches: Sequence[Branch], leaving: int, max_vertices: int) -> list[Branch]:
-    """Merge each branch excluding ``leaving`` into the one with the same set minus it."""
-    by_set: dict[frozenset[int], SpatialUncertaintyMap] = {
-        branch.excluded: branch.map for branch in branches if leaving not in branch.excluded
+    """Forget ``leaving`` in every branch; merge the branches then left with the same sets."""
+    by_set: dict[tuple[frozenset[int], frozenset[int]], SpatialUncertaintyMap] = {
+        (branch.excluded, branch.carried): branch.map for branch in branches if leaving not in branch.ignored
     }
     for branch in branches:
-        if leaving in branch.excluded:
-            target = branch.excluded - {leaving}
+        if leaving in branch.ignored:
+            target = (branch.excluded - {leaving}, branch.carried - {leaving})
             there = by_set.get(target)
             by_set[target] = (
                 branch.map if there is None else union_of_maps([there, branch.map], max_vertices=max_vertices)
             )
-    return [Branch(excluded, uncertainty_map) for excluded, uncertainty_map in by_set.items()]
+    return [Branch(excluded, found, carried) for (excluded, carried), found in by_set.items()]
 
 
 def relax(state: RelaxedState, serials: Sequence[int], q: int, reduce: Reducer) -> RelaxedState | None:
     """Return the state after an instant's sightings (``serials``, already admitted); None if all die.
 
-    Each branch with ``k`` exclusions has a child for each subset of the new sightings of
-    at most ``q - k`` items: the branch reduced by the others, excluding the subset. A
-    child whose reduction is empty dies; a child whose map is that of a child with a
-    smaller set (the reduction changed nothing) adds nothing and is dropped.
+    A branch carries the new sightings of the landmarks it chose to exclude in the window.
+    For the others, grouped by landmark, each branch with ``k`` choices has a child for each
+    set of at most ``q - k`` groups: the branch reduced by the other sightings, excluding
+    the set's (one choice per group, the rest carried). A child whose reduction is empty
+    dies; a child whose map is that of a child with fewer choices (the reduction changed
+    nothing) adds nothing and is dropped.
     """
-    count = len(serials)
+    landmark_of = {sighting.serial: sighting.observation.landmark_id for sighting in state.window}
     children: list[Branch] = []
     for branch in state.branches:
+        chosen = {landmark_of[serial] for serial in branch.excluded}
+        carry = [index for index, serial in enumerate(serials) if landmark_of[serial] in chosen]
+        groups: dict[str, list[int]] = {}
+        for index, serial in enumerate(serials):
+            if index not in carry:
+                groups.setdefault(landmark_of[serial], []).append(index)
         room = q - len(branch.excluded)
         made: list[tuple[frozenset[int], SpatialUncertaintyMap]] = []
-        for size in range(min(room, count) + 1):
-            for dropped in itertools.combinations(range(count), size):
-                keep = [index for index in range(count) if index not in dropped]
+        for size in range(min(room, len(groups)) + 1):
+            for dropped in itertools.combinations(groups.values(), size):
+                ignored = set(carry).union(*dropped)
+                keep = [index for index in range(len(serials)) if index not in ignored]
                 reduced = reduce(branch.map, keep) if keep else branch.map
                 if reduced is None:
                     continue
-                excluded = branch.excluded | {serials[index] for index in dropped}
+                excluded = branch.excluded | {serials[group[0]] for group in dropped}
                 if any(other is reduced and smaller <= excluded for smaller, other in made):
                     continue
                 made.append((excluded, reduced))
-                children.append(Branch(excluded, reduced))
+                carried = branch.carried | {serials[index] for index in ignored} - excluded
+                children.append(Branch(excluded, reduced, frozenset(carried)))
     if not children:
         return None
     return dataclasses.replace(state, branches=_sorted(children))
@@ -167,12 +196,12 @@ def relax(state: RelaxedState, serials: Sequence[int], q: int, reduce: Reducer) 
 def newly_excluded(state: RelaxedState) -> tuple[RelaxedState, tuple[Observation, ...]]:
     """Return the sightings that every branch now excludes and were not reported yet.
 
-    A sighting of the window is *excluded* when every surviving branch counts it among
-    its exclusions: no pose the manager still keeps had to agree with it. Until it
-    leaves the window no branch including it can come back (children only add
-    exclusions), so each is reported once.
+    A sighting of the window is *excluded* when every surviving branch ignores it (chose
+    to exclude it, or carries it): no pose the manager still keeps had to agree with it.
+    Until it leaves the window no branch respecting it can come back (children only add
+    to what they ignore), so each is reported once.
     """
-    common = frozenset.intersection(*(branch.excluded for branch in state.branches))
+    common = frozenset.intersection(*(branch.ignored for branch in state.branches))
     fresh = common - state.reported
     if not fresh:
         return state, ()

@@ -309,8 +309,9 @@ relocalize_after (2), got 1
     relaxed_q: int = _setting(
         0,
         SettingInfo(
-            "Wrong observations tolerated among any relaxed_window consecutive ones: the map keeps "
-            "the poses consistent with all but at most this many of the latest (0: every one trusted)",
+            "Wrong observations tolerated among any relaxed_window consecutive ones (repeats of one "
+            "landmark count once): the map keeps the poses consistent with all but at most this many "
+            "of the latest (0: every one trusted)",
             "",
             int,
             low=0,
