@@ -46,8 +46,8 @@ def random_slices(rng: np.random.Generator) -> tuple[Array, Counts, Array, Array
     else:
         width = float(rng.choice([0.01, 0.07, 0.5]))
         cells = np.sort(rng.choice(int(TWO_PI / width), size=count, replace=False))
-        lo = cells * width
-        hi = lo + width * rng.uniform(0.0, 1.0, len(lo))
+        lo = np.asarray(cells * width, dtype=np.float64)
+        hi = np.asarray(lo + width * rng.uniform(0.0, 1.0, len(lo)), dtype=np.float64)
     heading = float(rng.choice([rng.uniform(-math.pi, math.pi), lo[0], hi[-1] + 0.1]))
     points = np.ascontiguousarray(np.concatenate(polygons))
     return points, np.array([len(p) for p in polygons], dtype=np.int64), lo, hi, heading
@@ -81,16 +81,17 @@ def test_compiled_growth_of_every_slice_is_the_loop_over_slices(seed: int, cap: 
     for end, size in zip(ends.tolist(), ours.counts.tolist(), strict=True):
         polygon = ours.points[end - size : end]
         assert convexity_defect(polygon) is None
-        assert polygon_area(polygon) == pytest.approx(
-            polygon_area(reference.points[end - size : end]), rel=1e-6, abs=1e-9 * scale**2
-        ) or len(polygon) == cap
+        assert (
+            polygon_area(polygon)
+            == pytest.approx(polygon_area(reference.points[end - size : end]), rel=1e-6, abs=1e-9 * scale**2)
+            or len(polygon) == cap
+        )
 
 
 def random_pieces(rng: np.random.Generator) -> tuple[Array, Counts, Array, Array, Counts, int]:
     """Grown-like pieces: unwrapped intervals of any width, some sharing a source."""
     count = int(rng.integers(1, 7))
-    polygons = [random_polygon(rng) * 0.0 + random_polygon(rng)[:1] if rng.uniform() < 0.2 else random_polygon(rng)
-                for _ in range(count)]  # fmt: skip
+    polygons = [random_polygon(rng)[:1] if rng.uniform() < 0.2 else random_polygon(rng) for _ in range(count)]
     starts = rng.uniform(-7.0, 7.0, count)
     stops = starts + np.where(rng.uniform(0.0, 1.0, count) < 0.1, 7.0, rng.uniform(0.0, 2.0, count))
     sources = np.arange(count, dtype=np.int64)
@@ -107,14 +108,17 @@ def random_pieces(rng: np.random.Generator) -> tuple[Array, Counts, Array, Array
 def test_compiled_redistribution_is_the_reference(seed: int, cap: int, max_slices: int) -> None:
     rng = np.random.default_rng(seed)
     points, counts, starts, stops, sources, cells = random_pieces(rng)
-    if len(points) * (1 + int(cells >= 90)) > 200:  # the reference's hull prefilters larger groups with shapely
+    if (
+        len(points) * (1 + int(cells >= 90)) > 200
+    ):  # the reference's hull prefilters larger groups with shapely
         return
     heading = float(rng.uniform(-math.pi, math.pi))
     arguments = (points, counts, starts, stops, sources, cells, cap, max_slices, heading)
     ours = native_slices.distribute_slices_compiled(*arguments)
     assert same(ours, native_slices.distribute_slices_reference(*arguments))
     assert len(ours.lo) <= max_slices
-    assert np.all(np.diff(ours.lo) >= 0.0) and np.all(ours.hi >= ours.lo)
+    assert np.all(np.diff(ours.lo) >= 0.0)
+    assert np.all(ours.hi >= ours.lo)
 
 
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 8, 64]))
@@ -133,7 +137,9 @@ def test_every_piece_lands_in_a_slice_that_holds_it(seed: int, cap: int) -> None
         found = False
         for slot in np.flatnonzero(holding).tolist():
             polygon = grid.points[int(ends[slot]) - int(grid.counts[slot]) : int(ends[slot])]
-            found |= bool(ConvexPolygon._trusted(polygon.copy()).contains(piece, tolerance=1e-9 * scale).all())
+            found |= bool(
+                ConvexPolygon._trusted(polygon.copy()).contains(piece, tolerance=1e-9 * scale).all()
+            )
         assert found
 
 
@@ -166,7 +172,9 @@ def test_the_batched_kernels_refuse_bad_input() -> None:
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     one, zero = np.array([4], dtype=np.int64), np.zeros(1, dtype=np.int64)
     with pytest.raises(ValueError, match="counts: expected slice sizes adding up to the 4 rows"):
-        module.distribute_slices(square, np.array([3], dtype=np.int64), np.zeros(1), np.ones(1), zero, 9, 8, 4, 0.0)
+        module.distribute_slices(
+            square, np.array([3], dtype=np.int64), np.zeros(1), np.ones(1), zero, 9, 8, 4, 0.0
+        )
     with pytest.raises(ValueError, match="lo: expected a 1-D float64 buffer of 1 items"):
         module.distribute_slices(square, one, np.zeros(2), np.ones(1), zero, 9, 8, 4, 0.0)
     with pytest.raises(ValueError, match="counts: expected a 1-D int64 buffer"):
@@ -183,4 +191,6 @@ def test_the_batched_kernels_refuse_bad_input() -> None:
     with pytest.raises(TypeError, match="reduce_strip_slices: expected 19 arguments, got 2"):
         module.reduce_strip_slices(square, one)
     with pytest.raises(ValueError, match="counts: expected slice sizes adding up to the 4 rows"):
-        native_slices.distribute_slices_reference(square, np.array([3]), np.zeros(1), np.ones(1), zero, 9, 8, 4, 0.0)
+        native_slices.distribute_slices_reference(
+            square, np.array([3]), np.zeros(1), np.ones(1), zero, 9, 8, 4, 0.0
+        )

@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from aura_ums._native import narrowed, summary_wedge
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.geometry._angles import TWO_PI
@@ -26,7 +27,6 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
     reduce_jointly,
 )
-from aura_ums._native import narrowed, summary_wedge
 from aura_ums.uncertainty._slices import SliceSet, distributed, split_product
 from tests.uncertainty.test_reduce import (
     MakeCase,
@@ -130,14 +130,27 @@ def test_summary_wedge_leaves_out_the_widest_gap() -> None:
 
 
 def pieces_of(
-    polygons: list[np.ndarray], starts: list[float], stops: list[float], cells: int, max_vertices: int, cap: int
+    polygons: list[np.ndarray],
+    starts: list[float],
+    stops: list[float],
+    cells: int,
+    max_vertices: int,
+    cap: int,
 ) -> tuple[SliceSet, HeadingWedge]:
     """Distribute pieces, each its own source, with the summary centred on the first piece's start."""
     points = np.concatenate(polygons)
     counts = np.array([len(p) for p in polygons], dtype=np.int64)
     sources = np.arange(len(polygons), dtype=np.int64)
     return distributed(
-        points, counts, np.array(starts), np.array(stops), sources, cells, max_vertices, cap, starts[0] % TWO_PI
+        points,
+        counts,
+        np.array(starts),
+        np.array(stops),
+        sources,
+        cells,
+        max_vertices,
+        cap,
+        starts[0] % TWO_PI,
     )
 
 

@@ -17,16 +17,6 @@ from aura_ums._native import _distance, _expecter, _growth, _reduce, _slices
 from aura_ums._native._expecter import ExpectedPoints
 from aura_ums._native._extension import BUILT
 from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bounds
-from aura_ums._native._slices import (
-    ANGLE_SLACK,
-    Distributed,
-    GrownSlices,
-    ReducedSlices,
-    clamp_into,
-    home_slice,
-    narrowed,
-    summary_wedge,
-)
 from aura_ums._native._reduce import (
     CONE_PIECE,
     SECTOR_PIECE,
@@ -36,6 +26,16 @@ from aura_ums._native._reduce import (
     RawReduction,
     StripKernel,
     cap_inside,
+)
+from aura_ums._native._slices import (
+    ANGLE_SLACK,
+    Distributed,
+    GrownSlices,
+    ReducedSlices,
+    clamp_into,
+    home_slice,
+    narrowed,
+    summary_wedge,
 )
 
 #: Whether the kernels run compiled: the extension was built, and ``AURA_UMS_NATIVE=0`` was
@@ -51,7 +51,9 @@ merge_groups = _slices.merge_groups_compiled if NATIVE else _slices.merge_groups
 distribute_slices = _slices.distribute_slices_compiled if NATIVE else _slices.distribute_slices_reference
 grow_slices = _slices.grow_slices_compiled if NATIVE else _slices.grow_slices_reference
 reduce_cone_slices = _slices.reduce_cone_slices_compiled if NATIVE else _slices.reduce_cone_slices_reference
-reduce_strip_slices = _slices.reduce_strip_slices_compiled if NATIVE else _slices.reduce_strip_slices_reference
+reduce_strip_slices = (
+    _slices.reduce_strip_slices_compiled if NATIVE else _slices.reduce_strip_slices_reference
+)
 
 __all__ = [
     "ANGLE_SLACK",

@@ -6,6 +6,8 @@ from typing_extensions import Buffer
 
 # Vertices: a C-contiguous (n, 2) float64 buffer, usually an array.
 Vertices = NDArray[np.float64] | Buffer
+# Items: a C-contiguous 1-D float64 (headings) or int64 (counts, sources) buffer.
+Items = NDArray[np.float64] | NDArray[np.int64] | Buffer
 
 ARC_STEP: float
 TINY_ANGLE: float
@@ -123,10 +125,10 @@ def polygon_distance(vertices: Vertices, ax: float, ay: float, bx: float, by: fl
 def merge_groups(points: Vertices, counts: Sequence[int], max_vertices: int, /) -> tuple[bytes, ...]: ...
 def distribute_slices(
     points: Vertices,
-    counts: Buffer,
-    starts: Buffer,
-    stops: Buffer,
-    sources: Buffer,
+    counts: Items,
+    starts: Items,
+    stops: Items,
+    sources: Items,
     cells: int,
     max_vertices: int,
     max_slices: int,
@@ -135,9 +137,9 @@ def distribute_slices(
 ) -> tuple[bytes, bytes, bytes, bytes, bytes, float, float, float]: ...
 def grow_slices(
     points: Vertices,
-    counts: Buffer,
-    lo: Buffer,
-    hi: Buffer,
+    counts: Items,
+    lo: Items,
+    hi: Items,
     center_x: float,
     center_y: float,
     heading: float,
@@ -156,9 +158,9 @@ def grow_slices(
 ) -> tuple[bytes, bytes, bytes, bytes, float, float, float]: ...
 def reduce_cone_slices(
     points: Vertices,
-    counts: Buffer,
-    lo: Buffer,
-    hi: Buffer,
+    counts: Items,
+    lo: Items,
+    hi: Items,
     center_x: float,
     center_y: float,
     heading: float,
@@ -177,9 +179,9 @@ def reduce_cone_slices(
 ) -> tuple[bytes, bytes, bytes, bytes, float, float, float, float, float] | int: ...
 def reduce_strip_slices(
     points: Vertices,
-    counts: Buffer,
-    lo: Buffer,
-    hi: Buffer,
+    counts: Items,
+    lo: Items,
+    hi: Items,
     center_x: float,
     center_y: float,
     heading: float,

@@ -241,7 +241,9 @@ class SpatialUncertaintyMap:
         wedge = self.wedge
         polygon = self.polygon
         vertices = polygon.vertices
-        slices, summary = split_product(vertices, wedge.center - wedge.cw, wedge.width, cells, cap, wedge.center)
+        slices, summary = split_product(
+            vertices, wedge.center - wedge.cw, wedge.width, cells, cap, wedge.center
+        )
         return SpatialUncertaintyMap._sliced(slices, self.center, summary, cells, cap, polygon)
 
     @classmethod
@@ -306,7 +308,9 @@ class SpatialUncertaintyMap:
                     f"slices[{index}]: expected lo in [0, 2 pi) and width in [0, 2 pi], got {lo!r}, {span!r}"
                 )
             if los and lo < los[-1]:
-                raise InputError(f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {los[-1]!r}")
+                raise InputError(
+                    f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {los[-1]!r}"
+                )
             if not (wedge.contains(lo) and wedge.contains(lo + span)):
                 raise InputError(
                     f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}"
@@ -582,7 +586,10 @@ class SpatialUncertaintyMap:
             polygons = slices.polygons()
             los, his = slices.lo.tolist(), slices.hi.tolist()
             weights = np.array(
-                [(polygon_area(p) + 1e-12) * (h - lo + 1e-12) for p, lo, h in zip(polygons, los, his, strict=True)]
+                [
+                    (polygon_area(p) + 1e-12) * (h - lo + 1e-12)
+                    for p, lo, h in zip(polygons, los, his, strict=True)
+                ]
             )
             chosen = rng.choice(len(polygons), size=count, p=weights / weights.sum())
             rows = np.empty((count, 3))
@@ -610,9 +617,9 @@ class SpatialUncertaintyMap:
 _set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon | None], None] = SpatialUncertaintyMap.__dict__[
     "_polygon"
 ].__set__
-_set_slices: Callable[[SpatialUncertaintyMap, SliceSet | None], None] = (
-    SpatialUncertaintyMap.__dict__["_slices"].__set__
-)
+_set_slices: Callable[[SpatialUncertaintyMap, SliceSet | None], None] = SpatialUncertaintyMap.__dict__[
+    "_slices"
+].__set__
 _set_cells: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__["_cells"].__set__
 _set_max_slices: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__[
     "_max_slices"
@@ -644,13 +651,24 @@ def _grow_sliced(
     heading, as a product map's does. Two kernel calls, whatever the slice count.
     """
     x, y = current.center.tolist()
+    heading = current.wedge.center
     grown = _native.grow_slices(
-        slices.points, slices.counts, slices.lo, slices.hi, x, y, current.wedge.center, terrain, sigmas, values,
+        slices.points,
+        slices.counts,
+        slices.lo,
+        slices.hi,
+        x,
+        y,
+        heading,
+        terrain,
+        sigmas,
+        values,
         max_vertices,
-    )  # fmt: skip
+    )
     cells, cap = current._cells, current._max_slices
+    each_own = np.arange(len(grown.counts), dtype=np.int64)
     grid, wedge = distributed(
-        grown.points, grown.counts, grown.starts, grown.stops, np.arange(len(grown.counts), dtype=np.int64),
+        grown.points, grown.counts, grown.starts, grown.stops, each_own,
         cells, max_vertices, cap, grown.heading,
     )  # fmt: skip
     return SpatialUncertaintyMap._sliced(grid, np.array([grown.x, grown.y]), wedge, cells, cap)

@@ -238,10 +238,8 @@ def _reduce_sliced(
     points = found.points
     points.setflags(write=False)
     kept = SliceSet(points, found.counts, found.lo, found.hi, np.arange(len(found.counts), dtype=np.int64))
-    reduced = type(prior)._sliced(
-        kept, np.array([found.x, found.y]), HeadingWedge._trusted(found.center, found.cw, found.ccw), prior._cells,
-        prior._max_slices,
-    )  # fmt: skip
+    wedge = HeadingWedge._trusted(found.center, found.cw, found.ccw)
+    reduced = type(prior)._sliced(kept, np.array([found.x, found.y]), wedge, prior._cells, prior._max_slices)
     return reduced, prior.area, reduced.area
 
 

@@ -70,7 +70,9 @@ class SliceSet(NamedTuple):
     def polygons(self) -> list[Array]:
         """Return each slice's polygon (views of :attr:`points`)."""
         ends = np.cumsum(self.counts).tolist()
-        return [self.points[end - int(size) : end] for size, end in zip(self.counts.tolist(), ends, strict=True)]
+        return [
+            self.points[end - int(size) : end] for size, end in zip(self.counts.tolist(), ends, strict=True)
+        ]
 
 
 class HeadingSlice(NamedTuple):
@@ -143,7 +145,7 @@ def split_product(
     --------
     >>> point = np.zeros((1, 2))
     >>> slices, wedge = split_product(point, -0.1, 0.3, 36, 48, 0.0)
-    >>> [round(v, 3) for v in slices.lo], [round(v, 3) for v in slices.hi]
+    >>> [round(v, 3) for v in slices.lo.tolist()], [round(v, 3) for v in slices.hi.tolist()]
     ([0.0, 0.175, 6.183], [0.175, 0.2, 6.283])
     >>> len(split_product(point, 0.0, 7.0, 36, 48, 0.0)[0].lo)    # every heading: every cell
     36
@@ -166,7 +168,7 @@ def distributed(
     max_slices: int,
     heading: float,
 ) -> tuple[SliceSet, HeadingWedge]:
-    """Put pieces (packed polygons with unwrapped heading intervals) on the grid; see ``_native.distribute_slices``.
+    """Put pieces (packed polygons, unwrapped heading intervals) on the grid: ``_native.distribute_slices``.
 
     Returns the slices and their summary wedge, centred on ``heading`` clamped into it.
     """
@@ -231,7 +233,11 @@ def contains(slices: SliceSet, points: Array, headings: Array, tolerance: float)
     width = hi - lo
     # near[i, j]: heading i lies in slice j's interval (within the slack).
     offset = np.mod(headings[:, None] - lo[None, :], _TWO_PI)
-    near = (offset <= width + _native.ANGLE_SLACK) | (offset >= _TWO_PI - _native.ANGLE_SLACK) | (width >= _TWO_PI)
+    near = (
+        (offset <= width + _native.ANGLE_SLACK)
+        | (offset >= _TWO_PI - _native.ANGLE_SLACK)
+        | (width >= _TWO_PI)
+    )
     inside = np.zeros(len(points), dtype=bool)
     candidates = np.flatnonzero(near.any(axis=0)).tolist()
     if not candidates:
