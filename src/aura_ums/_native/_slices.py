@@ -547,7 +547,7 @@ def _grow_slices(
         begins.append(grown.heading - grown.cw)
         ends.append(grown.heading + grown.ccw)
         if index == home:
-            x_out, y_out, heading_out = grown.x, grown.y, grown.heading
+            x_out, y_out, heading_out = float(grown.x), float(grown.y), float(grown.heading)
     out_points, out_counts = _packed(grown_polygons)
     return GrownSlices(out_points, out_counts, np.array(begins), np.array(ends), x_out, y_out, heading_out)
 
