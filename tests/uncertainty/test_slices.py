@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from aura_ums._native import narrowed, summary_wedge
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.geometry._angles import TWO_PI
@@ -26,8 +27,7 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
     reduce_jointly,
 )
-from aura_ums.uncertainty._reduce import narrowed
-from aura_ums.uncertainty._slices import Slice, capped, distribute, split_product, summary_wedge
+from aura_ums.uncertainty._slices import SliceSet, distributed, split_product
 from tests.uncertainty.test_reduce import (
     MakeCase,
     class_one_cases,
@@ -118,44 +118,68 @@ def test_with_slices_keeps_a_map_already_on_that_grid() -> None:
 
 
 def test_summary_wedge_leaves_out_the_widest_gap() -> None:
-    point = np.zeros((1, 2))
-    slices = (Slice(0.1, 0.2, point), Slice(3.5, 3.6, point), Slice(5.0, 5.1, point))
-    wedge = summary_wedge(slices, 0.15)
+    wedge = HeadingWedge._trusted(*summary_wedge([0.1, 3.5, 5.0], [0.2, 3.6, 5.1], 0.15))
     # Widest gap: 0.2 .. 3.5 (the wrap 5.1 .. 0.1 is narrower); the wedge runs from 3.5 round to 0.2.
     assert wedge.width == pytest.approx(TWO_PI - 3.3)
     assert wedge.contains(0.15)
     assert wedge.contains(3.55)
     assert wedge.contains(6.0)
     assert not wedge.contains(1.5)
-    every = tuple(Slice(k * 0.5, (k + 1) * 0.5, point) for k in range(13))
-    assert summary_wedge(every, 1.0).is_full_circle
+    every = [k * 0.5 for k in range(13)]
+    assert HeadingWedge._trusted(*summary_wedge(every, [k + 0.5 for k in every], 1.0)).is_full_circle
+
+
+def pieces_of(
+    polygons: list[np.ndarray],
+    starts: list[float],
+    stops: list[float],
+    cells: int,
+    max_vertices: int,
+    cap: int,
+) -> tuple[SliceSet, HeadingWedge]:
+    """Distribute pieces, each its own source, with the summary centred on the first piece's start."""
+    points = np.concatenate(polygons)
+    counts = np.array([len(p) for p in polygons], dtype=np.int64)
+    sources = np.arange(len(polygons), dtype=np.int64)
+    return distributed(
+        points,
+        counts,
+        np.array(starts),
+        np.array(stops),
+        sources,
+        cells,
+        max_vertices,
+        cap,
+        starts[0] % TWO_PI,
+    )
 
 
 def test_distribute_gives_a_piece_to_every_cell_it_meets() -> None:
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     other = square + 5.0
     cells = 4  # quarter turns
-    found = distribute([(-0.1, 0.2, square), (0.1, 1.7, other)], cells, 16)
-    assert [round(s.lo, 3) for s in found] == [0.0, 1.571, 6.183]
+    found, _ = pieces_of([square, other], [-0.1, 0.1], [0.2, 1.7], cells, 16, 48)
+    assert [round(lo, 3) for lo in found.lo.tolist()] == [0.0, 1.571, 6.183]
     # Cell 0 holds both pieces: their hull; cell 1 only the second; cell 3 only the first.
-    assert ConvexPolygon(found[0].vertices).area == pytest.approx(11.0)
-    assert np.array_equal(found[1].vertices, other)
-    assert np.array_equal(found[2].vertices, square)
-    assert found[2].hi == pytest.approx(TWO_PI)
-    assert len(distribute([(0.0, 7.0, square)], cells, 16)) == cells
+    polygons = found.polygons()
+    assert ConvexPolygon(polygons[0]).area == pytest.approx(11.0)
+    assert np.array_equal(polygons[1], other)
+    assert np.array_equal(polygons[2], square)
+    assert found.hi[2] == pytest.approx(TWO_PI)
+    assert len(pieces_of([square], [0.0], [7.0], cells, 16, 48)[0].lo) == cells
 
 
 def test_capped_merges_neighbours_into_an_outer_bound(rng: np.random.Generator) -> None:
-    pieces = tuple(
-        Slice(k * 0.1, k * 0.1 + 0.05, rng.normal(size=(1, 2)) + np.array([[k, 0.0]])) for k in range(20)
-    )
-    few = capped(pieces, 6, 8)
-    assert len(few) <= 6
-    for piece in pieces:
-        holder = [s for s in few if s.lo <= piece.lo and piece.hi <= s.hi]
+    polygons = [rng.normal(size=(1, 2)) + np.array([[k, 0.0]]) for k in range(20)]
+    starts = [k * 0.1 for k in range(20)]
+    few, _ = pieces_of(polygons, starts, [start + 0.05 for start in starts], 63, 8, 6)
+    assert len(few.lo) <= 6
+    held = few.polygons()
+    for polygon, start in zip(polygons, starts, strict=True):
+        holder = [k for k in range(len(few.lo)) if few.lo[k] <= start and start + 0.05 <= few.hi[k]]
         assert len(holder) == 1
-        assert ConvexPolygon(holder[0].vertices).contains(piece.vertices).all()
-        assert len(holder[0].vertices) <= 8
+        assert ConvexPolygon(held[holder[0]]).contains(polygon).all()
+        assert len(held[holder[0]]) <= 8
 
 
 @given(st.floats(-20.0, 20.0), st.floats(0.0, 0.5), st.floats(0.0, 6.0), st.floats(0.001, 3.0))
@@ -303,10 +327,11 @@ def test_joint_reduction_of_a_sliced_map_is_slice_by_slice() -> None:
 
 
 def test_split_product_of_a_full_circle_covers_every_cell() -> None:
-    slices = split_product(np.zeros((1, 2)), 1.0, TWO_PI, 12)
-    assert len(slices) == 12
-    assert slices[0].lo == 0.0
-    assert slices[-1].hi == pytest.approx(TWO_PI)
+    slices, wedge = split_product(np.zeros((1, 2)), 1.0, TWO_PI, 12, 48, 1.0)
+    assert len(slices.lo) == 12
+    assert slices.lo[0] == 0.0
+    assert slices.hi[-1] == pytest.approx(TWO_PI)
+    assert wedge.is_full_circle
 
 
 def test_sliced_map_repr_and_product_slices() -> None:

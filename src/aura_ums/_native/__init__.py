@@ -7,7 +7,7 @@ when aura-ums is imported: the C one when the extension was built, unless the en
 sets ``AURA_UMS_NATIVE=0``; the numpy reference otherwise (:data:`NATIVE`).
 
 Only the layer that owns a kernel calls it, as ``_native.<kernel>``: ``uncertainty`` the
-growth, the reductions and the slices' merging, ``expecter`` its points, ``schemas`` the
+growth, the reductions and the slices' kernels, ``expecter`` its points, ``schemas`` the
 polygon distance. This package imports nothing of aura-ums but ``geometry``.
 """
 
@@ -27,6 +27,16 @@ from aura_ums._native._reduce import (
     StripKernel,
     cap_inside,
 )
+from aura_ums._native._slices import (
+    ANGLE_SLACK,
+    Distributed,
+    GrownSlices,
+    ReducedSlices,
+    clamp_into,
+    home_slice,
+    narrowed,
+    summary_wedge,
+)
 
 #: Whether the kernels run compiled: the extension was built, and ``AURA_UMS_NATIVE=0`` was
 #: not set when aura-ums was imported.
@@ -38,25 +48,43 @@ reduce_strip: StripKernel = _reduce.reduce_strip_compiled if NATIVE else _reduce
 expecter_points = _expecter.expecter_points_compiled if NATIVE else _expecter.expecter_points_reference
 polygon_distance = _distance.polygon_distance_compiled if NATIVE else _distance.polygon_distance_reference
 merge_groups = _slices.merge_groups_compiled if NATIVE else _slices.merge_groups_reference
+distribute_slices = _slices.distribute_slices_compiled if NATIVE else _slices.distribute_slices_reference
+grow_slices = _slices.grow_slices_compiled if NATIVE else _slices.grow_slices_reference
+reduce_cone_slices = _slices.reduce_cone_slices_compiled if NATIVE else _slices.reduce_cone_slices_reference
+reduce_strip_slices = (
+    _slices.reduce_strip_slices_compiled if NATIVE else _slices.reduce_strip_slices_reference
+)
 
 __all__ = [
+    "ANGLE_SLACK",
     "BUILT",
     "CONE_PIECE",
     "NATIVE",
     "SECTOR_PIECE",
     "TOLERANCE",
+    "Distributed",
     "EmptyReason",
     "ExpectedPoints",
     "Grown",
+    "GrownSlices",
     "MotionBounds",
     "MotionModel",
     "RawReduction",
+    "ReducedSlices",
     "cap_inside",
+    "clamp_into",
+    "distribute_slices",
     "expecter_points",
     "grow_commands",
+    "grow_slices",
+    "home_slice",
     "merge_groups",
     "motion_bounds",
+    "narrowed",
     "polygon_distance",
     "reduce_cone",
+    "reduce_cone_slices",
     "reduce_strip",
+    "reduce_strip_slices",
+    "summary_wedge",
 ]

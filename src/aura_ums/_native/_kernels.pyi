@@ -6,6 +6,8 @@ from typing_extensions import Buffer
 
 # Vertices: a C-contiguous (n, 2) float64 buffer, usually an array.
 Vertices = NDArray[np.float64] | Buffer
+# Items: a C-contiguous 1-D float64 (headings) or int64 (counts, sources) buffer.
+Items = NDArray[np.float64] | NDArray[np.int64] | Buffer
 
 ARC_STEP: float
 TINY_ANGLE: float
@@ -121,3 +123,79 @@ def expecter_points(
 ) -> tuple[bytes, float, float, float, float] | None: ...
 def polygon_distance(vertices: Vertices, ax: float, ay: float, bx: float, by: float, /) -> float: ...
 def merge_groups(points: Vertices, counts: Sequence[int], max_vertices: int, /) -> tuple[bytes, ...]: ...
+def distribute_slices(
+    points: Vertices,
+    counts: Items,
+    starts: Items,
+    stops: Items,
+    sources: Items,
+    cells: int,
+    max_vertices: int,
+    max_slices: int,
+    heading: float,
+    /,
+) -> tuple[bytes, bytes, bytes, bytes, bytes, float, float, float]: ...
+def grow_slices(
+    points: Vertices,
+    counts: Items,
+    lo: Items,
+    hi: Items,
+    center_x: float,
+    center_y: float,
+    heading: float,
+    rotation_loss: float,
+    rotation_sd: float,
+    translation_loss: float,
+    translation_sd: float,
+    translation_inertial_loss: float,
+    drift: float,
+    skitter: float,
+    skitter_sd: float,
+    sigmas: float,
+    commands: Sequence[float],
+    max_vertices: int,
+    /,
+) -> tuple[bytes, bytes, bytes, bytes, float, float, float]: ...
+def reduce_cone_slices(
+    points: Vertices,
+    counts: Items,
+    lo: Items,
+    hi: Items,
+    center_x: float,
+    center_y: float,
+    heading: float,
+    forward: float,
+    left: float,
+    landmark_x: float,
+    landmark_y: float,
+    widen: float,
+    bearing: float,
+    bearing_error: float,
+    range_min: float,
+    range_max: float,
+    piece: float,
+    max_vertices: int,
+    /,
+) -> tuple[bytes, bytes, bytes, bytes, float, float, float, float, float] | int: ...
+def reduce_strip_slices(
+    points: Vertices,
+    counts: Items,
+    lo: Items,
+    hi: Items,
+    center_x: float,
+    center_y: float,
+    heading: float,
+    forward: float,
+    left: float,
+    start_x: float,
+    start_y: float,
+    end_x: float,
+    end_y: float,
+    position_uncertainty: float,
+    offset: float,
+    offset_error: float,
+    angle: float,
+    angle_error: float,
+    max_vertices: int,
+    /,
+) -> tuple[bytes, bytes, bytes, bytes, float, float, float, float, float] | int: ...

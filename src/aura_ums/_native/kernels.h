@@ -171,6 +171,45 @@ int parse_count(PyObject *arg, const char *name, Py_ssize_t low, Py_ssize_t high
 /* A C-contiguous float64 buffer of n >= 1 finite (x, y) rows; released on failure. */
 int get_vertices(PyObject *object, Py_buffer *view, Py_ssize_t *n);
 
+/* --- heading slices (slices.c) ---------------------------------------------------------- */
+
+/* A sliced map's slices as a kernel reads them: every slice's vertices one after the other
+   ((n, 2) float64), each slice's vertex count (k int64, each >= 1, adding up to n) and each
+   interval's ends (k float64 each). The views are held until packed_release. */
+typedef struct {
+    Py_buffer views[4];
+    int held;
+    const double *v, *lo, *hi;
+    const long long *counts;
+    Py_ssize_t n, k;
+} Packed;
+
+/* Read args[0..3] (points, counts, lo, hi) into p; -1 with an exception set (nothing held). */
+int get_packed(PyObject *const *args, Packed *p);
+void packed_release(Packed *p);
+
+/* Slices being built: the same layout, with each slice's source (equal sources: the same
+   polygon, which merging keeps as it is). All fields start zeroed; slices_free frees them. */
+typedef struct {
+    Poly points;
+    long long *counts, *sources;
+    double *lo, *hi;
+    Py_ssize_t k, cap;
+} SliceList;
+
+int slices_append(SliceList *s, const double *v, Py_ssize_t n, double lo, double hi, long long source);
+void slices_free(SliceList *s);
+/* New references to the bytes of the points, counts, lo and hi (and sources when `with_sources`)
+   stored into out[0..]; -1 with an exception set (none stored). */
+int slices_bytes(const SliceList *s, int with_sources, PyObject **out);
+/* See uncertainty._slices: clamp_into, home_slice and summary_wedge (the wedge as unwrapped
+   centre, cw, ccw). */
+double clamp_into(double heading, double lo, double hi);
+Py_ssize_t home_slice(const double *lo, const double *hi, Py_ssize_t k, double heading);
+void summary_wedge(const double *lo, const double *hi, Py_ssize_t k, double heading, double *wedge);
+/* Slack of a heading's test against a slice, rad (uncertainty._slices._ANGLE_SLACK). */
+#define ANGLE_SLACK 1e-9
+
 /* --- the kernels, one per concept file ------------------------------------------------- */
 
 PyObject *grow_commands(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
@@ -179,5 +218,9 @@ PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *distribute_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *grow_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *reduce_cone_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *reduce_strip_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 
 #endif

@@ -29,6 +29,23 @@ static PyMethodDef methods[] = {
     {"merge_groups", (PyCFunction)(void (*)(void))merge_groups, METH_FASTCALL,
      "merge_groups(points, counts, max_vertices) -> tuple of vertex bytes: for each group of counts[i] "
      "consecutive rows of the (n, 2) float64 points, their convex hull with the outer vertex cap"},
+    {"distribute_slices", (PyCFunction)(void (*)(void))distribute_slices, METH_FASTCALL,
+     "distribute_slices(points, counts, starts, stops, sources, cells, max_vertices, max_slices, heading) -> "
+     "(points, counts, lo, hi, sources bytes, wedge_center, wedge_cw, wedge_ccw): the pieces on the heading grid, "
+     "each cell the capped hull of what meets it, then neighbours merged under max_slices"},
+    {"grow_slices", (PyCFunction)(void (*)(void))grow_slices, METH_FASTCALL,
+     "grow_slices(points, counts, lo, hi, center_x, center_y, heading, rotation_loss, rotation_sd, "
+     "translation_loss, translation_sd, translation_inertial_loss, drift, skitter, skitter_sd, sigmas, commands, "
+     "max_vertices) -> (points, counts, starts, stops bytes, center_x, center_y, heading unwrapped): every slice "
+     "grown by the commands"},
+    {"reduce_cone_slices", (PyCFunction)(void (*)(void))reduce_cone_slices, METH_FASTCALL,
+     "reduce_cone_slices(points, counts, lo, hi, center_x, center_y, heading, forward, left, landmark_x, "
+     "landmark_y, widen, bearing, bearing_error, range_min, range_max, piece, max_vertices) -> (points, counts, "
+     "lo, hi bytes, center_x, center_y, wedge_center, wedge_cw, wedge_ccw), or an int reason code"},
+    {"reduce_strip_slices", (PyCFunction)(void (*)(void))reduce_strip_slices, METH_FASTCALL,
+     "reduce_strip_slices(points, counts, lo, hi, center_x, center_y, heading, forward, left, start_x, start_y, "
+     "end_x, end_y, position_uncertainty, offset, offset_error, angle, angle_error, max_vertices) -> (points, "
+     "counts, lo, hi bytes, center_x, center_y, wedge_center, wedge_cw, wedge_ccw), or an int reason code"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -384,3 +384,196 @@ done:
     return result;
 }
 
+
+/* --- every slice of a sliced map at once ---------------------------------------------------- */
+
+/* See uncertainty._reduce.narrowed: a slice's interval [lo, hi] narrowed to a kernel's arc. */
+static void narrowed(double arc_lo, double arc_width, double *lo, double *hi) {
+    double span = *hi - *lo;
+    if (arc_width >= span) return;
+    if (span >= TWO_PI) {
+        double start = floor_mod(arc_lo, TWO_PI);
+        *lo = start;
+        *hi = start + arc_width;
+        return;
+    }
+    if (span > M_PI) return;
+    double offset = floor_mod(arc_lo - *lo, TWO_PI);
+    if (offset > 0.5 * (span + TWO_PI)) offset -= TWO_PI; /* the arc starts clockwise of lo */
+    double new_lo = greater(*lo + offset, *lo);
+    double new_hi = lesser(*lo + offset + arc_width, *hi);
+    if (new_hi < new_lo) new_hi = new_lo = lesser(greater(new_lo, *lo), *hi); /* rounding at an end */
+    *lo = new_lo;
+    *hi = new_hi;
+}
+
+/* The arguments of one slice-by-slice reduction after the packed slices, the centre and the
+   heading: the cone's or the strip's numbers and the vertex cap. */
+typedef struct {
+    int strip;
+    double a[13];
+    Py_ssize_t max_vertices;
+} SliceReduction;
+
+/* Reduce the slices one by one (_native._slices.reduce_slices_reference); the kept slices,
+   narrowed and in heading order, then (x, y, wedge centre, cw, ccw), or the first slice's
+   reason when none is kept. */
+static PyObject *reduce_slices(const Packed *p, double center_x, double center_y, double heading,
+                               const SliceReduction *r) {
+    Work w;
+    memset(&w, 0, sizeof(w));
+    SliceList kept = {0}, ordered = {0};
+    double *centers = PyMem_Malloc(sizeof(double) * 2 * (size_t)p->k);
+    Py_ssize_t *order = PyMem_Malloc(sizeof(Py_ssize_t) * (size_t)p->k), *starts = NULL;
+    PyObject *result = NULL, *items[4];
+    int first_reason = -1;
+    if (!centers || !order) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t start = 0;
+    for (Py_ssize_t i = 0; i < p->k; i++) {
+        const double *prior = p->v + 2 * start;
+        Py_ssize_t n = (Py_ssize_t)p->counts[i];
+        start += n;
+        double piece_lo = p->lo[i], piece_hi = p->hi[i];
+        double middle = clamp_into(heading, piece_lo, piece_hi);
+        double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+        wedge_arc(middle, middle - piece_lo, greater(0.0, piece_hi - middle), &heading_lo, &heading_width);
+        int reason = -1;
+        Poly *positions = NULL;
+        const double *a = r->a;
+        if (r->strip) {
+            if (strip_reduction(prior, n, heading_lo, heading_width, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
+                                a[8], a[9], a[10], &w.positions, &w, &reason, &arc_lo, &arc_width) < 0)
+                goto done;
+            positions = &w.positions;
+        } else {
+            double margin = a[6] + TOLERANCE;
+            Cone cone = {a[2], a[3], a[4], heading_lo + a[5] + M_PI - margin, heading_width + 2.0 * margin,
+                         a[7], a[8], a[9]};
+            if (cone_reduction(prior, n, heading_lo, heading_width, a[0], a[1], a[5], a[6], &cone, &w, &reason,
+                               &positions, &arc_lo, &arc_width) < 0)
+                goto done;
+        }
+        if (reason >= 0) {
+            if (first_reason < 0) first_reason = reason;
+            continue;
+        }
+        /* finish: the vertex cap, then the centre kept or moved to the nearest position. */
+        if (positions->n > r->max_vertices) {
+            if (cap_inside(positions, prior, n, r->max_vertices) < 0) goto done;
+            if (positions->n > r->max_vertices && positions->n > n && copy_into(positions, prior, n) < 0) goto done;
+        }
+        double distance;
+        nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, &centers[2 * kept.k],
+                           &centers[2 * kept.k + 1]);
+        if (arc_width < piece_hi - piece_lo) narrowed(arc_lo, arc_width, &piece_lo, &piece_hi);
+        if (slices_append(&kept, positions->v, positions->n, piece_lo, piece_hi, kept.k) < 0) goto done;
+    }
+    if (kept.k == 0) {
+        result = PyLong_FromLong(first_reason);
+        goto done;
+    }
+    /* A full-circle slice's arc may start anywhere: keep the slices in heading order (a
+       stable insertion sort, as Python's sorted). */
+    for (Py_ssize_t i = 0; i < kept.k; i++) {
+        Py_ssize_t j = i, item = i;
+        while (j > 0 && kept.lo[item] < kept.lo[order[j - 1]]) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = item;
+    }
+    SliceList *final = &kept;
+    double *x_y = centers;
+    int sorted = 1;
+    for (Py_ssize_t i = 0; i < kept.k; i++) sorted &= order[i] == i;
+    if (!sorted) {
+        starts = PyMem_Malloc(sizeof(Py_ssize_t) * (size_t)kept.k);
+        double *moved = PyMem_Malloc(sizeof(double) * 2 * (size_t)kept.k);
+        if (!starts || !moved) {
+            PyMem_Free(moved);
+            PyErr_NoMemory();
+            goto done;
+        }
+        Py_ssize_t at = 0;
+        for (Py_ssize_t i = 0; i < kept.k; i++) {
+            starts[i] = at;
+            at += (Py_ssize_t)kept.counts[i];
+        }
+        for (Py_ssize_t i = 0; i < kept.k; i++) {
+            Py_ssize_t from = order[i];
+            moved[2 * i] = centers[2 * from];
+            moved[2 * i + 1] = centers[2 * from + 1];
+            if (slices_append(&ordered, kept.points.v + 2 * starts[from], (Py_ssize_t)kept.counts[from],
+                              kept.lo[from], kept.hi[from], i) < 0) {
+                PyMem_Free(moved);
+                goto done;
+            }
+        }
+        memcpy(centers, moved, sizeof(double) * 2 * (size_t)kept.k);
+        PyMem_Free(moved);
+        final = &ordered;
+    }
+    Py_ssize_t home = home_slice(final->lo, final->hi, final->k, heading);
+    double wedge[3];
+    summary_wedge(final->lo, final->hi, final->k, clamp_into(heading, final->lo[home], final->hi[home]), wedge);
+    if (slices_bytes(final, 0, items) == 0)
+        result = Py_BuildValue("(NNNNddddd)", items[0], items[1], items[2], items[3], x_y[2 * home],
+                               x_y[2 * home + 1], wedge[0], wedge[1], wedge[2]);
+done:
+    work_free(&w);
+    slices_free(&kept);
+    slices_free(&ordered);
+    PyMem_Free(centers);
+    PyMem_Free(order);
+    PyMem_Free(starts);
+    return result;
+}
+
+/* reduce_cone_slices(points, counts, lo, hi, center_x, center_y, heading, forward, left,
+   landmark_x, landmark_y, widen, bearing, bearing_error, range_min, range_max, piece,
+   max_vertices) and reduce_strip_slices(points, counts, lo, hi, center_x, center_y, heading,
+   forward, left, start_x, start_y, end_x, end_y, position_uncertainty, offset, offset_error,
+   angle, angle_error, max_vertices). */
+static PyObject *reduce_slices_call(PyObject *const *args, Py_ssize_t nargs, int strip) {
+    static const char *const cone_names[] = {"center_x", "center_y", "heading", "forward", "left", "landmark_x",
+                                             "landmark_y", "widen", "bearing", "bearing_error", "range_min",
+                                             "range_max", "piece"};
+    static const char *const strip_names[] = {"center_x", "center_y", "heading", "forward", "left", "start_x",
+                                              "start_y", "end_x", "end_y", "position_uncertainty", "offset",
+                                              "offset_error", "angle", "angle_error"};
+    Py_ssize_t doubles = strip ? 14 : 13;
+    if (nargs != doubles + 5) {
+        PyErr_Format(PyExc_TypeError, "%s: expected %zd arguments, got %zd",
+                     strip ? "reduce_strip_slices" : "reduce_cone_slices", doubles + 5, nargs);
+        return NULL;
+    }
+    double values[14];
+    SliceReduction r;
+    r.strip = strip;
+    if (parse_doubles(args + 4, doubles, strip ? strip_names : cone_names, values) < 0 ||
+        parse_cap(args[doubles + 4], &r.max_vertices) < 0)
+        return NULL;
+    memcpy(r.a, values + 3, sizeof(double) * (size_t)(doubles - 3));
+    if (!strip && (!(r.a[9] > 0.0) || TWO_PI / r.a[9] > 1e6)) {
+        PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R", args[16]);
+        return NULL;
+    }
+    Packed p;
+    if (get_packed(args, &p) < 0) return NULL;
+    PyObject *result = reduce_slices(&p, values[0], values[1], values[2], &r);
+    packed_release(&p);
+    return result;
+}
+
+PyObject *reduce_cone_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    return reduce_slices_call(args, nargs, 0);
+}
+
+PyObject *reduce_strip_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    return reduce_slices_call(args, nargs, 1);
+}

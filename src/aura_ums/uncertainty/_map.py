@@ -45,15 +45,13 @@ from aura_ums.uncertainty._slices import (
     DEFAULT_MAX_SLICES,
     DEFAULT_SLICE_WIDTH,
     HeadingSlice,
-    Slice,
-    capped,
+    SliceSet,
     cell_count,
-    clamp_into,
-    distribute,
-    home_slice,
+    distributed,
+    heading_slices,
+    packed,
     split_product,
     summary_polygon,
-    summary_wedge,
 )
 from aura_ums.uncertainty._slices import contains as slices_contain
 from aura_ums.uncertainty._terrain import TerrainStats
@@ -100,7 +98,7 @@ class SpatialUncertaintyMap:
     _pose: Pose | None = field(init=False, repr=False, compare=False)
     # The slices of a sliced map (None: a product map), the grid's cell count and the cap
     # on the slice count.
-    _slices: tuple[Slice, ...] | None = field(init=False, repr=False, compare=False)
+    _slices: SliceSet | None = field(init=False, repr=False, compare=False)
     _cells: int = field(init=False, repr=False, compare=False)
     _max_slices: int = field(init=False, repr=False, compare=False)
 
@@ -141,19 +139,19 @@ class SpatialUncertaintyMap:
     @classmethod
     def _sliced(
         cls,
-        slices: tuple[Slice, ...],
+        slices: SliceSet,
         center: NDArray[np.float64],
-        heading: float,
+        wedge: HeadingWedge,
         cells: int,
         max_slices: int,
         polygon: ConvexPolygon | None = None,
     ) -> SpatialUncertaintyMap:
-        """Build a sliced map; ``heading`` (radians, any winding) is clamped into the slices' wedge."""
+        """Build a sliced map from its slices and their summary wedge (as the slice kernels give it)."""
         result = object.__new__(cls)
         center.setflags(write=False)
         _set_polygon(result, polygon)
         _set_center(result, center)
-        _set_wedge(result, summary_wedge(slices, heading))
+        _set_wedge(result, wedge)
         _set_pose(result, None)
         _set_slices(result, slices)
         _set_cells(result, cells)
@@ -204,10 +202,7 @@ class SpatialUncertaintyMap:
             wedge = self.wedge
             lo = (wedge.center - wedge.cw) % (2.0 * math.pi)
             return (HeadingSlice(self.polygon, lo, wedge.width),)
-        return tuple(
-            HeadingSlice(ConvexPolygon._trusted(piece.vertices), piece.lo, piece.hi - piece.lo)
-            for piece in slices
-        )
+        return heading_slices(slices)
 
     def with_slices(
         self, slice_width: float = DEFAULT_SLICE_WIDTH, max_slices: int = DEFAULT_MAX_SLICES
@@ -246,10 +241,10 @@ class SpatialUncertaintyMap:
         wedge = self.wedge
         polygon = self.polygon
         vertices = polygon.vertices
-        slices = split_product(vertices, wedge.center - wedge.cw, wedge.width, cells)
-        if len(slices) > cap:
-            slices = capped(slices, cap, max(len(vertices), 3))
-        return SpatialUncertaintyMap._sliced(slices, self.center, wedge.center, cells, cap, polygon)
+        slices, summary = split_product(
+            vertices, wedge.center - wedge.cw, wedge.width, cells, cap, wedge.center
+        )
+        return SpatialUncertaintyMap._sliced(slices, self.center, summary, cells, cap, polygon)
 
     @classmethod
     def from_slices(
@@ -300,7 +295,9 @@ class SpatialUncertaintyMap:
             raise InputError(f"wedge: expected a HeadingWedge, got {type(wedge).__name__}")
         if not 1 <= len(slices) <= cap:
             raise InputError(f"slices: expected 1 to {cap} heading slices, got {len(slices)}")
-        pieces: list[Slice] = []
+        polygons: list[NDArray[np.float64]] = []
+        los: list[float] = []
+        his: list[float] = []
         for index, piece in enumerate(slices):
             if not isinstance(piece, HeadingSlice) or not isinstance(piece.polygon, ConvexPolygon):
                 raise InputError(f"slices[{index}]: expected a HeadingSlice, got {type(piece).__name__}")
@@ -310,26 +307,30 @@ class SpatialUncertaintyMap:
                 raise InputError(
                     f"slices[{index}]: expected lo in [0, 2 pi) and width in [0, 2 pi], got {lo!r}, {span!r}"
                 )
-            if pieces and lo < pieces[-1].lo:
+            if los and lo < los[-1]:
                 raise InputError(
-                    f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {pieces[-1].lo!r}"
+                    f"slices[{index}].lo: expected slices ordered by lo, got {lo!r} after {los[-1]!r}"
                 )
             if not (wedge.contains(lo) and wedge.contains(lo + span)):
                 raise InputError(
                     f"slices[{index}]: expected an interval inside the wedge, got {lo!r} + {span!r}"
                 )
-            pieces.append(Slice(lo, lo + span, piece.polygon.vertices))
+            polygons.append(piece.polygon.vertices)
+            los.append(lo)
+            his.append(lo + span)
         point = points_array(center, "center", min_rows=1)
         if point.shape != (1, 2):
             raise InputError(f"center: expected one (x, y) point, got shape {point.shape}")
-        if not any(points_in_convex(p.vertices, point, 1e-6)[0] for p in pieces):
+        if not any(points_in_convex(p, point, 1e-6)[0] for p in polygons):
             raise InputError(f"center: expected a point inside a slice's polygon, got {point[0].tolist()}")
         result = object.__new__(cls)
         _set_polygon(result, None)
         _set_center(result, read_only(point[0].copy()))
         _set_wedge(result, wedge)
         _set_pose(result, None)
-        _set_slices(result, tuple(pieces))
+        points, counts, lo_array, hi_array, sources = packed(polygons, los, his)
+        points.setflags(write=False)
+        _set_slices(result, SliceSet(points, counts, lo_array, hi_array, sources))
         _set_cells(result, cell_count(width))
         _set_max_slices(result, cap)
         return result
@@ -588,16 +589,21 @@ class SpatialUncertaintyMap:
         """
         slices = self._slices
         if slices is not None:
-            weights = np.array([(polygon_area(s.vertices) + 1e-12) * (s.hi - s.lo + 1e-12) for s in slices])
-            chosen = rng.choice(len(slices), size=count, p=weights / weights.sum())
+            polygons = slices.polygons()
+            los, his = slices.lo.tolist(), slices.hi.tolist()
+            weights = np.array(
+                [
+                    (polygon_area(p) + 1e-12) * (h - lo + 1e-12)
+                    for p, lo, h in zip(polygons, los, his, strict=True)
+                ]
+            )
+            chosen = rng.choice(len(polygons), size=count, p=weights / weights.sum())
             rows = np.empty((count, 3))
-            for index in np.unique(chosen):
+            for index in np.unique(chosen).tolist():
                 picked = chosen == index
-                piece = slices[int(index)]
-                rows[picked, :2] = ConvexPolygon._trusted(piece.vertices).sample(int(picked.sum()), rng)
-                rows[picked, 2] = wrap_angle(
-                    piece.lo + rng.uniform(0.0, 1.0, int(picked.sum())) * (piece.hi - piece.lo)
-                )
+                lo, hi = los[index], his[index]
+                rows[picked, :2] = ConvexPolygon._trusted(polygons[index]).sample(int(picked.sum()), rng)
+                rows[picked, 2] = wrap_angle(lo + rng.uniform(0.0, 1.0, int(picked.sum())) * (hi - lo))
             return rows
         positions = self.polygon.sample(count, rng)
         wedge = self.wedge
@@ -605,7 +611,7 @@ class SpatialUncertaintyMap:
         return np.column_stack([positions, headings])
 
     def __repr__(self) -> str:
-        sliced = "" if self._slices is None else f", slices={len(self._slices)}"
+        sliced = "" if self._slices is None else f", slices={len(self._slices.lo)}"
         return (
             f"SpatialUncertaintyMap(center=({self.center[0]:.4g}, {self.center[1]:.4g}), "
             f"area={self.area:.4g} m^2, vertices={self.polygon.vertex_count}, "
@@ -617,9 +623,9 @@ class SpatialUncertaintyMap:
 _set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon | None], None] = SpatialUncertaintyMap.__dict__[
     "_polygon"
 ].__set__
-_set_slices: Callable[[SpatialUncertaintyMap, tuple[Slice, ...] | None], None] = (
-    SpatialUncertaintyMap.__dict__["_slices"].__set__
-)
+_set_slices: Callable[[SpatialUncertaintyMap, SliceSet | None], None] = SpatialUncertaintyMap.__dict__[
+    "_slices"
+].__set__
 _set_cells: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__["_cells"].__set__
 _set_max_slices: Callable[[SpatialUncertaintyMap, int], None] = SpatialUncertaintyMap.__dict__[
     "_max_slices"
@@ -637,7 +643,7 @@ _set_pose: Callable[[SpatialUncertaintyMap, Pose | None], None] = SpatialUncerta
 
 def _grow_sliced(
     current: SpatialUncertaintyMap,
-    slices: tuple[Slice, ...],
+    slices: SliceSet,
     values: list[float],
     terrain: TerrainStats,
     sigmas: float,
@@ -648,33 +654,27 @@ def _grow_sliced(
     Each slice is a product map of its polygon and interval, grown as such (sound for its
     poses); its grown interval is cut at the grid's cells, and each cell takes the hull of
     the polygons that reach it. The most probable pose grows in the slice that holds its
-    heading, as a product map's does.
+    heading, as a product map's does. Two kernel calls, whatever the slice count.
     """
     x, y = current.center.tolist()
     heading = current.wedge.center
-    home = home_slice(slices, heading)
-    pieces: list[tuple[float, float, NDArray[np.float64]]] = []
-    center = current.center
-    new_heading = heading
-    for index, piece in enumerate(slices):
-        middle = clamp_into(heading, piece.lo, piece.hi) if index == home else 0.5 * (piece.lo + piece.hi)
-        grown = _native.grow_commands(
-            piece.vertices,
-            x,
-            y,
-            middle,
-            middle - piece.lo,
-            max(0.0, piece.hi - middle),
-            terrain,
-            sigmas,
-            values,
-            max_vertices,
-        )
-        pieces.append((grown.heading - grown.cw, grown.heading + grown.ccw, grown.vertices))
-        if index == home:
-            center, new_heading = np.array([grown.x, grown.y]), grown.heading
+    grown = _native.grow_slices(
+        slices.points,
+        slices.counts,
+        slices.lo,
+        slices.hi,
+        x,
+        y,
+        heading,
+        terrain,
+        sigmas,
+        values,
+        max_vertices,
+    )
     cells, cap = current._cells, current._max_slices
-    grid = distribute(pieces, cells, max_vertices)
-    if len(grid) > cap:
-        grid = capped(grid, cap, max_vertices)
-    return SpatialUncertaintyMap._sliced(grid, center, new_heading, cells, cap)
+    each_own = np.arange(len(grown.counts), dtype=np.int64)
+    grid, wedge = distributed(
+        grown.points, grown.counts, grown.starts, grown.stops, each_own,
+        cells, max_vertices, cap, grown.heading,
+    )  # fmt: skip
+    return SpatialUncertaintyMap._sliced(grid, np.array([grown.x, grown.y]), wedge, cells, cap)

@@ -30,7 +30,7 @@ from aura_ums.uncertainty._landmarks import (
     RangeBearingObservation,
     VerticalLineLandmark,
 )
-from aura_ums.uncertainty._slices import Slice, clamp_into, home_slice
+from aura_ums.uncertainty._slices import SliceSet
 
 if TYPE_CHECKING:
     from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -167,7 +167,7 @@ def reduce_checked(
         return _reduce_sliced(prior, slices, observation, landmark, max_vertices)
     wedge = prior.wedge
     center_x, center_y = prior.center.tolist()
-    kernel, arguments = _kernel_call(observation, landmark, max_vertices)
+    kernel, _, arguments = _kernel_call(observation, landmark, max_vertices)
     found = kernel(prior.polygon.vertices, center_x, center_y, wedge.center, wedge.cw, wedge.ccw, *arguments)
     if isinstance(found, int):
         return _REASONS[found]
@@ -184,12 +184,15 @@ def reduce_checked(
 
 
 #: A reduction kernel with its observation's arguments: called on (vertices, centre x, centre
-#: y, wedge centre, cw, ccw) of one polygon and wedge.
-_Call = tuple[Callable[..., "RawReduction | int"], tuple[float | int, ...]]
+#: y, wedge centre, cw, ccw) of one polygon and wedge; and its kernel over every slice of a
+#: sliced map, called on (points, counts, lo, hi, centre x, centre y, heading).
+_Call = tuple[
+    Callable[..., "RawReduction | int"], Callable[..., "_native.ReducedSlices | int"], tuple[float | int, ...]
+]
 
 
 def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int) -> _Call:
-    """Return the reduction kernel of the observation's class and its arguments after the wedge."""
+    """Return the reduction kernels of the observation's class and their arguments after the wedge."""
     forward, left = observation.sensor_offset
     if isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
         landmark, (VerticalLineLandmark, PointLandmark)
@@ -198,13 +201,13 @@ def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int
             r_min, r_max, piece = observation.range_min, observation.range_max, SECTOR_PIECE
         else:
             r_min, r_max, piece = 0.0, math.inf, CONE_PIECE
-        return _native.reduce_cone, (
+        return _native.reduce_cone, _native.reduce_cone_slices, (
             forward, left, landmark.x, landmark.y, landmark.position_uncertainty, observation.bearing,
             observation.bearing_error, r_min, r_max, piece, max_vertices,
         )  # fmt: skip
     if isinstance(observation, GroundLineObservation) and isinstance(landmark, GroundLineLandmark):
         (start_x, start_y), (end_x, end_y) = landmark.start.tolist(), landmark.end.tolist()
-        return _native.reduce_strip, (
+        return _native.reduce_strip, _native.reduce_strip_slices, (
             forward, left, start_x, start_y, end_x, end_y, landmark.position_uncertainty, observation.offset,
             observation.offset_error, observation.angle, observation.angle_error, max_vertices,
         )  # fmt: skip
@@ -214,46 +217,14 @@ def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int
     )  # pragma: no cover
 
 
-def narrowed(arc_lo: float, arc_width: float, lo: float, hi: float) -> tuple[float, float]:
-    """Return a slice's interval [lo, hi] narrowed to a kernel's heading arc ``(arc_lo, arc_width)``.
-
-    The kernel's arc holds every heading of the slice that agrees with the observation,
-    so their intersection does; where that intersection is not one interval (a slice wider
-    than pi) or the arc is no narrower, the slice's interval is kept (an outer bound).
-
-    Examples
-    --------
-    >>> [round(h, 9) for h in narrowed(0.15 - 2 * math.pi, 0.02, 0.1, 0.2)]   # any winding
-    [0.15, 0.17]
-    >>> [round(h, 9) for h in narrowed(0.05, 0.08, 0.1, 0.2)]                 # cut to the slice
-    [0.1, 0.13]
-    """
-    span = hi - lo
-    if arc_width >= span:
-        return lo, hi
-    if span >= _TWO_PI:
-        start = arc_lo % _TWO_PI
-        return start, start + arc_width
-    if span > math.pi:
-        return lo, hi
-    offset = (arc_lo - lo) % _TWO_PI
-    if offset > 0.5 * (span + _TWO_PI):
-        offset -= _TWO_PI  # the arc starts clockwise of lo
-    new_lo = max(lo + offset, lo)
-    new_hi = min(lo + offset + arc_width, hi)
-    if new_hi < new_lo:  # rounding at an end: keep the end's heading
-        new_hi = new_lo = min(max(new_lo, lo), hi)
-    return new_lo, new_hi
-
-
 def _reduce_sliced(
     prior: SpatialUncertaintyMap,
-    slices: tuple[Slice, ...],
+    slices: SliceSet,
     observation: Observation,
     landmark: Landmark,
     max_vertices: int,
 ) -> Reduced:
-    """Reduce a sliced map slice by slice; empty slices drop out, all empty is inconsistent.
+    """Reduce a sliced map slice by slice (one kernel call); empty slices drop out, all empty is inconsistent.
 
     Each slice is a product map of its polygon and its (narrow) interval, so its reduction
     is the single kernel's, sound as it is; the union of the reduced slices holds every
@@ -261,46 +232,22 @@ def _reduce_sliced(
     the kernel kept (or moved) in the slice nearest to the prior heading.
     """
     center_x, center_y = prior.center.tolist()
-    heading = prior.wedge.center
-    kept: list[Slice] = []
-    centers: list[tuple[float, float]] = []
-    first_reason = -1
-    kernel, arguments = _kernel_call(observation, landmark, max_vertices)
-    for piece in slices:
-        piece_lo, piece_hi = piece.lo, piece.hi
-        middle = clamp_into(heading, piece_lo, piece_hi)
-        found = kernel(
-            piece.vertices,
-            center_x,
-            center_y,
-            middle,
-            middle - piece_lo,
-            max(0.0, piece_hi - middle),
-            *arguments,
-        )
-        if isinstance(found, int):
-            if first_reason < 0:
-                first_reason = found
-            continue
-        raw, lo, width, x, y, _, _ = found
-        if width < piece_hi - piece_lo:
-            piece_lo, piece_hi = narrowed(lo, width, piece_lo, piece_hi)
-        kept.append(Slice(piece_lo, piece_hi, np.frombuffer(raw, _FLOAT64).reshape(-1, 2)))
-        centers.append((x, y))
-    if not kept:
-        return _REASONS[first_reason]
-    if any(kept[k + 1].lo < kept[k].lo for k in range(len(kept) - 1)):
-        # A full-circle slice's arc may start anywhere: keep the slices in heading order.
-        order = sorted(range(len(kept)), key=lambda k: kept[k].lo)
-        kept, centers = [kept[k] for k in order], [centers[k] for k in order]
-    home = home_slice(kept, heading)
-    x, y = centers[home]
+    _, kernel, arguments = _kernel_call(observation, landmark, max_vertices)
+    found = kernel(
+        slices.points, slices.counts, slices.lo, slices.hi, center_x, center_y, prior.wedge.center, *arguments
+    )
+    if isinstance(found, int):
+        return _REASONS[found]
+    points = found.points
+    points.setflags(write=False)
+    kept = SliceSet(points, found.counts, found.lo, found.hi, np.arange(len(found.counts), dtype=np.int64))
+    wedge = HeadingWedge._trusted(found.center, found.cw, found.ccw)
+    x, y = found.x, found.y
     if x != center_x or y != center_y:
-        x, y = held_centre(kept[home].vertices, x, y)
-    reduced = type(prior)._sliced(
-        tuple(kept), np.array([x, y]), clamp_into(heading, kept[home].lo, kept[home].hi), prior._cells,
-        prior._max_slices,
-    )  # fmt: skip
+        home = _native.home_slice(found.lo.tolist(), found.hi.tolist(), prior.wedge.center)
+        start = int(found.counts[:home].sum())
+        x, y = held_centre(points[start : start + int(found.counts[home])], x, y)
+    reduced = type(prior)._sliced(kept, np.array([x, y]), wedge, prior._cells, prior._max_slices)
     return reduced, prior.area, reduced.area
 
 
@@ -350,5 +297,4 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
     return float(inner[0]), float(inner[1])
 
 
-_TWO_PI = 2.0 * math.pi
 _FLOAT64 = np.dtype(np.float64)

@@ -13,7 +13,7 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._slices import capped, distribute, split_product
+from aura_ums.uncertainty._slices import distributed, split_product
 
 _TWO_PI = 2.0 * math.pi
 
@@ -96,17 +96,33 @@ def _sliced_union(
     bound, as tight as the grid allows; the slice cap merges neighbours, as growth does.
     """
     cells, cap = primary._cells, primary._max_slices
-    pieces: list[tuple[float, float, NDArray[np.float64]]] = []
+    parts = []
+    # Slices of one map that hold one polygon keep their common source; no two maps share one.
+    offset = 0
+    seen: dict[int, int] = {}
     for item in items:
         slices = item._slices
         if slices is None or item._cells != cells:
             wedge = item.wedge
-            slices = split_product(item.polygon.vertices, wedge.center - wedge.cw, wedge.width, cells)
-        pieces += [(piece.lo, piece.hi, piece.vertices) for piece in slices]
-    grid = distribute(pieces, cells, max_vertices)
-    if len(grid) > cap:
-        grid = capped(grid, cap, max_vertices)
-    return SpatialUncertaintyMap._sliced(grid, primary.center.copy(), primary.wedge.center, cells, cap)
+            slices, _ = split_product(
+                item.polygon.vertices, wedge.center - wedge.cw, wedge.width, cells, cells + 1, wedge.center
+            )
+        base = seen.setdefault(id(item), offset)
+        if base == offset:
+            offset += int(slices.sources.max()) + 1
+        parts.append((slices, base))
+    grid, wedge = distributed(
+        np.concatenate([p.points for p, _ in parts]),
+        np.concatenate([p.counts for p, _ in parts]),
+        np.concatenate([p.lo for p, _ in parts]),
+        np.concatenate([p.hi for p, _ in parts]),
+        np.concatenate([p.sources + base for p, base in parts]),
+        cells,
+        max_vertices,
+        cap,
+        primary.wedge.center,
+    )
+    return SpatialUncertaintyMap._sliced(grid, primary.center.copy(), wedge, cells, cap)
 
 
 def union_of_wedges(wedges: Sequence[HeadingWedge], center: float) -> HeadingWedge:
