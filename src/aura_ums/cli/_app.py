@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from aura_ums.cli._campaign import DEFAULTS, Retries, RunTimeout, Scheduler, Workers, campaign_settings
 from aura_ums.cli._common import (
     NO_OPTIONS,
     PlainCommand,
@@ -104,20 +105,25 @@ def simulate(
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
     mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     settings: SettingOptions = NO_OPTIONS,
 ) -> None:
     """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics.
 
-    The map manager's options override the scenario's [manager] table.
+    The map manager's options override the scenario's [manager] table. With --workers N
+    or --scheduler the runs go to Dask workers; the metrics are those of one process.
     """
-    import numpy as np
-
     from aura_ums import Metrics
+    from aura_ums.campaign import simulate_campaign
     from aura_ums.errors import AuraUmsError
-    from aura_ums.sim import Scenario, run_scenario, summarize_runs
+    from aura_ums.sim import Scenario, summarize_runs
 
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if runs < 1:
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
     if seed < 0:
@@ -136,14 +142,11 @@ def simulate(
         loaded.check_runs(runs)  # before spawning a generator per run
     except AuraUmsError as exc:
         raise fail(f"--{exc}") from None
-    generators = np.random.default_rng(seed).spawn(runs)
-    results = []
     try:
         with progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
-            for done, rng in enumerate(generators, start=1):
-                results.append(run_scenario(loaded, rng, prune=prune))
-                if advance is not None:
-                    advance(done, runs)
+            campaign = simulate_campaign(
+                loaded, runs, seed, prune=prune, settings=campaign_options, progress=advance
+            )
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = Metrics(
@@ -154,7 +157,8 @@ def simulate(
             "prune": prune,
             "relaxed_q": loaded.settings.relaxed_q,
             "relaxed_window": loaded.settings.relaxed_window,
-            **summarize_runs(results),
+            **summarize_runs(campaign.values),
+            "runs_retried": campaign.retried,
         }
     )
     for line in metrics.lines():
