@@ -9,6 +9,15 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.table import Table
 
+from aura_ums.cli._campaign import (
+    DEFAULTS,
+    Retries,
+    RunTimeout,
+    Scheduler,
+    Workers,
+    campaign_settings,
+    replay_logs,
+)
 from aura_ums.cli._common import (
     NO_OPTIONS,
     Quiet,
@@ -159,12 +168,20 @@ def calibrate(
         ),
     ] = None,
     max_truth_gap: _MaxTruthGap = None,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
-    """Estimate terrain statistics and sensor bounds from logs with ground truth."""
+    """Estimate terrain statistics and sensor bounds from logs with ground truth.
+
+    With --workers N or --scheduler the logs are read on Dask workers; the fit pools them.
+    """
+    from aura_ums.campaign import LoadLog, run_campaign
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import calibrate_logs, load_log
+    from aura_ums.logs import calibrate_logs
 
     out_target = Target("--out", out)
     sensors_target = Target(
@@ -176,13 +193,11 @@ def calibrate(
         [Source("LOG_DIRS", folder, folder=True) for folder in log_dirs],
         overwrite=overwrite,
     )
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     try:
-        logs = []
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
-            for folder in log_dirs:
-                logs.append(_with_truth_gap(load_log(folder), max_truth_gap))
-                if advance is not None:
-                    advance(len(logs), len(log_dirs))
+            loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
+        logs = list(loaded.values)
         if horizons:
             calibration = calibrate_logs(logs, quantile=quantile, move=move, horizons=tuple(horizons))
         else:  # calibrate_logs' default horizons
@@ -203,13 +218,21 @@ def calibrate(
             f"+-{bounds.range_error:.3f} m "
             f"({calibration.observations} observations)"
         )
+    if campaign_options.distributed:
+        console.print(f"logs read on Dask workers: {len(logs)} ({loaded.retried} retried)", highlight=False)
     console.print("growth bound against the truth, by horizon without correction:", highlight=False)
     console.print(calibration.report(), highlight=False, markup=False)
 
 
 @manager_options()
 def replay(
-    log_dir: Annotated[Path, typer.Argument(help="Log folder (docs/log-format.md).")],
+    log_dirs: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers).",
+            metavar="LOG_DIR...",
+        ),
+    ],
     terrain: _Terrain,
     sensors: _Sensors = None,
     classes: _Classes = Classes.VERTICAL_LINE,
@@ -243,6 +266,10 @@ def replay(
         float | None,
         typer.Option("--until", help="Stop after the last frame at or before this log time, in s."),
     ] = None,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
@@ -254,6 +281,10 @@ def replay(
     With --resume the replay continues where a --save-state left it (its settings are the
     saved ones) and reports the frames after it; it ends with exactly the map of a
     replay run in one go.
+
+    With several LOG_DIRs, each is replayed on its own (on Dask workers with --workers N
+    or --scheduler) and the metrics list one entry per log (`replays`); the outputs of
+    one log's steps, maps and state need one LOG_DIR.
     """
     from aura_ums import Metrics
     from aura_ums.camera import load_camera
@@ -265,6 +296,29 @@ def replay(
         raise fail("--windows-csv: expected --camera too, got no camera")
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
+    if len(log_dirs) > 1:
+        one_log = {"--steps-csv": steps_csv, "--plot": plot, "--mcap": mcap, "--save-state": save_state,
+                   "--resume": resume, "--windows-csv": windows_csv}  # fmt: skip
+        given = [flag for flag, value in one_log.items() if value is not None]
+        if given:
+            raise fail(f"{given[0]}: expected one LOG_DIR, got {len(log_dirs)}")
+        json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
+        sources: list[Source | None] = [Source("LOG_DIR", folder, folder=True) for folder in log_dirs]
+        sources += [Source("--terrain", terrain), None if sensors is None else Source("--sensors", sensors),
+                    None if camera is None else Source("--camera", camera)]  # fmt: skip
+        check_outputs([json_target], sources, overwrite=overwrite)
+        try:
+            many = TerrainTable.from_toml(terrain)
+            options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
+            lens = None if camera is None else load_camera(camera)
+        except AuraUmsError as exc:
+            raise fail(str(exc)) from None
+        replay_logs(log_dirs, many, options, camera=lens, window_margin=window_margin,
+                    max_truth_gap=max_truth_gap, until=until, json_target=json_target,
+                    settings=campaign_options, quiet=quiet)  # fmt: skip
+        return
+    (log_dir,) = log_dirs
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
         Source("--terrain", terrain),
