@@ -229,8 +229,7 @@ def replay(
     log_dirs: Annotated[
         list[Path],
         typer.Argument(
-            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers).",
-            metavar="LOG_DIR...",
+            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers)."
         ),
     ],
     terrain: _Terrain,
