@@ -44,7 +44,8 @@ def scheduler() -> Iterator[str]:
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
-        scheduler_kwargs={"allowed_failures": 0},
+        # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
+        scheduler_kwargs={"allowed_failures": 0, "dashboard": False, "dashboard_address": "127.0.0.1:0"},
     )
     with cluster:
         yield cluster.scheduler_address

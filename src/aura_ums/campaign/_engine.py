@@ -163,7 +163,8 @@ def _client(settings: CampaignSettings) -> Iterator[Client]:
         host="127.0.0.1",
         dashboard_address=None,
         silence_logs=logging.ERROR,
-        scheduler_kwargs={"allowed_failures": 0},
+        # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
+        scheduler_kwargs={"allowed_failures": 0, "dashboard": False, "dashboard_address": "127.0.0.1:0"},
     )
     with cluster, Client(cluster, set_as_default=False) as client:
         yield client
