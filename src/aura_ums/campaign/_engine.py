@@ -73,7 +73,7 @@ def run_campaign(
     task : callable
         ``task(item) -> value``. On Dask it is pickled to the workers (with cloudpickle
         where plain pickle fails), and so are the items and values: a module-level
-        function, a :func:`functools.partial` of one or a frozen dataclass with
+        function, a ``functools.partial`` of one or a frozen dataclass with
         ``__call__``. It must depend on its item alone for a Dask campaign to equal a
         serial one.
     items : sequence

@@ -99,7 +99,7 @@ def simulate_campaign(
     ----------
     scenario : Scenario
     runs : int
-        In [1, 100000] (:meth:`Scenario.check_runs`).
+        In [1, 100000] (:meth:`Scenario.check_runs <aura_ums.sim.Scenario.check_runs>`).
     seed : int
         >= 0.
     prune : bool
@@ -182,7 +182,10 @@ class LogReplay:
     until: float | None = None
 
     def __call__(self, folder: str | os.PathLike[str]) -> Metrics:
-        """Replay the log in ``folder`` and return :meth:`ReplayResult.metrics` (with the windows')."""
+        """Replay the log in ``folder`` and return its metrics (with the windows', given a camera).
+
+        The metrics are :meth:`ReplayResult.metrics <aura_ums.logs.ReplayResult.metrics>`.
+        """
         log = self.load(folder)
         if self.camera is None:
             return replay_log(log, self.table, self.options, keep_maps=False, until=self.until).metrics()
