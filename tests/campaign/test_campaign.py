@@ -19,9 +19,8 @@ from aura_ums.campaign import (
     simulate_campaign,
 )
 from aura_ums.errors import InputError, MissingDependencyError, RunLostError
-from aura_ums.logs import ReplayOptions, synthetic_log, write_log
+from aura_ums.logs import ReplayOptions, calibrate_logs, synthetic_log, write_log
 from aura_ums.sim import Scenario, summarize_runs
-from aura_ums.uncertainty import TerrainTable
 from tests.campaign.campaign_helpers import FailOn, HangOnce, KillAlways, KillOnce, run_figures
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
@@ -155,12 +154,10 @@ def test_a_runs_own_error_is_raised_not_retried(scheduler: str) -> None:
 
 def test_a_local_cluster_replays_logs_as_the_serial_campaign(tmp_path: Path) -> None:
     pytest.importorskip("distributed", reason="the dask extra is not installed")
-    folders = []
-    for index in range(3):
-        folders.append(
-            write_log(synthetic_log(np.random.default_rng(index), duration=30.0), tmp_path / f"l{index}")
-        )
-    replay = LogReplay(TerrainTable.default(), ReplayOptions(), load=LoadLog(max_truth_gap=1.0))
+    logs = [synthetic_log(np.random.default_rng(index), duration=30.0) for index in range(3)]
+    folders = [write_log(log, tmp_path / f"l{index}") for index, log in enumerate(logs)]
+    table = calibrate_logs(logs).terrain_table()  # the synthetic logs' terrain
+    replay = LogReplay(table, ReplayOptions(), load=LoadLog(max_truth_gap=1.0))
     serial = run_campaign(replay, folders)
     parallel = run_campaign(replay, folders, CampaignSettings(workers=2))
     timing = {"median_update_us"}
