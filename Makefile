@@ -34,7 +34,7 @@ $(VENV)/.stamp-install: $(BUILD_INPUTS) | $(UV_STAMP)
 	@touch $@
 
 $(VENV)/.stamp-dev: $(BUILD_INPUTS) | $(UV_STAMP)
-	$(SYNC) --extra dev --extra opencv --extra foxglove --extra ros --extra codac
+	$(SYNC) --extra dev --extra opencv --extra foxglove --extra ros --extra codac --extra dask
 	@touch $@ $(VENV)/.stamp-install
 
 $(VENV)/.stamp-docs: $(BUILD_INPUTS) | $(UV_STAMP)

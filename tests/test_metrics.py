@@ -23,6 +23,7 @@ END = "<!-- end of the metrics table -->"
 WRITERS = {
     "simulate",
     "replay",
+    "replay (several logs)",
     "compare",
     "compare (per method)",
     "replay --steps-csv",

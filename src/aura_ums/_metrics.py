@@ -42,6 +42,7 @@ class _Kind(enum.Enum):
 # Who writes a key; also the column "written by" of docs/metrics.md.
 SIMULATE = "simulate"
 REPLAY = "replay"
+REPLAY_LOGS = "replay (several logs)"
 COMPARE = "compare"
 COMPARE_ROW = "compare (per method)"
 STEPS_CSV = "replay --steps-csv"
@@ -69,7 +70,8 @@ class MetricKey:
         The outputs that hold the key: ``"simulate"``, ``"replay"``, ``"compare"``,
         ``"compare (per method)"``, ``"replay --steps-csv"`` (a column of the per-step CSV),
         ``"replay --camera"``, ``"replay --camera (per baseline)"`` (an entry of
-        ``window_baselines``), ``"replay --windows-csv"`` (a column of the per-window CSV).
+        ``window_baselines``), ``"replay --windows-csv"`` (a column of the per-window CSV),
+        ``"replay (several logs)"`` (a replay of several LOG_DIRs at once).
     meaning : str
         One sentence, with what ``null`` means when the value can be undefined.
     """
@@ -92,6 +94,21 @@ _TABLE: tuple[MetricKey, ...] = (
     _key("runs", "count", _K.COUNT, (SIMULATE,), "Monte Carlo runs."),
     _key("seed", "", _K.INTEGER, (SIMULATE,), "Seed of the whole Monte Carlo."),
     _key("prune", "", _K.FLAG, (SIMULATE,), "Whether landmarks reduced the map (false: growth only)."),
+    _key(
+        "replays",
+        "",
+        _K.ROWS,
+        (REPLAY_LOGS,),
+        "One entry per log, in the order given, with the keys replay writes for one log.",
+    ),
+    _key(
+        "runs_retried",
+        "count",
+        _K.COUNT,
+        (SIMULATE, REPLAY_LOGS),
+        "Runs (or logs) submitted again because their Dask worker died or they timed out, each counted "
+        "once; always 0 in one process.",
+    ),
     _key("log", "", _K.TEXT, (REPLAY, COMPARE), "Name of the log (its meta.toml)."),
     _key(
         "landmark_class",

@@ -14,6 +14,7 @@ __all__ = [
     "InputError",
     "MissingDependencyError",
     "OutsideMapError",
+    "RunLostError",
     "UnknownLandmarkError",
     "UnknownTerrainError",
 ]
@@ -33,6 +34,10 @@ class OutsideMapError(InputError):
 
 class MissingDependencyError(AuraUmsError, ImportError):
     """An optional dependency (an extra such as ``opencv``) is needed but not installed."""
+
+
+class RunLostError(AuraUmsError):
+    """A run of a campaign was lost (its worker died or it timed out) more often than its retries allow."""
 
 
 class FileFormatError(InputError):

@@ -88,16 +88,17 @@ def test_an_off_flag_sets_none_and_bad_values_name_their_option() -> None:
 
 
 def test_simulate_options_override_the_scenarios_manager_table(monkeypatch: pytest.MonkeyPatch) -> None:
-    import aura_ums.sim
+    import aura_ums.campaign
 
     ran: list[Scenario] = []
-    real = aura_ums.sim.run_scenario
+    real = aura_ums.campaign.simulate_campaign
 
     def spy(scenario: Scenario, *args: Any, **kwargs: Any) -> Any:
         ran.append(scenario)
         return real(scenario, *args, **kwargs)
 
-    monkeypatch.setattr(aura_ums.sim, "run_scenario", spy)
+    # simulate runs its Monte Carlo as a campaign (aura_ums.campaign), serially by default.
+    monkeypatch.setattr(aura_ums.campaign, "simulate_campaign", spy)
     path = str(SCENARIOS / "paper_sidewalk.toml")
     result = runner.invoke(app, ["simulate", path, "--runs", "1", "--gate-only", "--missed-limit", "5"])
     assert result.exit_code == 0, result.output

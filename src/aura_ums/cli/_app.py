@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from aura_ums.cli._campaign import DEFAULTS, Retries, RunTimeout, Scheduler, Workers, campaign_settings
 from aura_ums.cli._common import (
     NO_OPTIONS,
     PlainCommand,
@@ -118,21 +119,29 @@ def simulate(
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,
     live_rate: LiveRate = LIVE_DEFAULTS.rate,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
     settings: SettingOptions = NO_OPTIONS,
 ) -> None:
     """Run SCENARIO through the closed loop RUNS times and print (and save) the metrics.
 
-    The map manager's options override the scenario's [manager] table. With --live, each
-    run is streamed to Foxglove as it computes, one after another.
+    The map manager's options override the scenario's [manager] table. With --workers N
+    or --scheduler the runs go to Dask workers; the metrics are those of one process. With
+    --live, each run is streamed to Foxglove as it computes, one after another, in this
+    process.
     """
     import numpy as np
 
     from aura_ums import Metrics
+    from aura_ums.campaign import run_seeds, simulate_campaign
     from aura_ums.errors import AuraUmsError
     from aura_ums.sim import Scenario, run_scenario, summarize_runs
 
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if runs < 1:
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
     if seed < 0:
@@ -151,16 +160,29 @@ def simulate(
         loaded.check_runs(runs)  # before spawning a generator per run
     except AuraUmsError as exc:
         raise fail(f"--{exc}") from None
-    generators = np.random.default_rng(seed).spawn(runs)
-    results = []
+    if live and (campaign_options.workers > 1 or campaign_options.scheduler is not None):
+        raise fail(
+            f"--live: expected the runs in this process (--workers 1, no --scheduler), got "
+            f"--workers {campaign_options.workers}"
+            + ("" if campaign_options.scheduler is None else f" --scheduler {campaign_options.scheduler}")
+        )
     watch = live_simulation(loaded, live=live, host=live_host, port=live_port, rate=live_rate)
     try:
         with watch as view, progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
-            after_frame = None if view is None else view.frame
-            for done, rng in enumerate(generators, start=1):
-                results.append(run_scenario(loaded, rng, prune=prune, after_frame=after_frame))
-                if advance is not None:
-                    advance(done, runs)
+            if view is None:
+                campaign = simulate_campaign(
+                    loaded, runs, seed, prune=prune, settings=campaign_options, progress=advance
+                )
+                values = list(campaign.values)
+                retried = campaign.retried
+            else:
+                values = []
+                retried = 0
+                for done, run_seed in enumerate(run_seeds(seed, runs), start=1):
+                    rng = np.random.default_rng(run_seed)
+                    values.append(run_scenario(loaded, rng, prune=prune, after_frame=view.frame))
+                    if advance is not None:
+                        advance(done, runs)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = Metrics(
@@ -171,7 +193,8 @@ def simulate(
             "prune": prune,
             "relaxed_q": loaded.settings.relaxed_q,
             "relaxed_window": loaded.settings.relaxed_window,
-            **summarize_runs(results),
+            **summarize_runs(values),
+            "runs_retried": retried,
         }
     )
     for line in metrics.lines():

@@ -9,6 +9,15 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.table import Table
 
+from aura_ums.cli._campaign import (
+    DEFAULTS,
+    Retries,
+    RunTimeout,
+    Scheduler,
+    Workers,
+    campaign_settings,
+    replay_logs,
+)
 from aura_ums.cli._common import (
     NO_OPTIONS,
     Quiet,
@@ -33,7 +42,7 @@ from aura_ums.cli._outputs import (
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayOptions, ReplayResult, RobotLog
+    from aura_ums.logs import ReplayOptions, ReplayResult
     from aura_ums.manager import ManagerSettings
 
 
@@ -115,14 +124,6 @@ def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
     return None
 
 
-def _with_truth_gap(log: RobotLog, max_truth_gap: float | None) -> RobotLog:
-    import dataclasses
-
-    if max_truth_gap is None or log.groundtruth is None:
-        return log
-    return dataclasses.replace(log, groundtruth=log.groundtruth.with_max_gap(max_truth_gap))
-
-
 def _options(
     classes: Classes, sensors: Path | None, settings: ManagerSettings, reverse: Reverse = Reverse.ERROR
 ) -> ReplayOptions:
@@ -169,12 +170,20 @@ def calibrate(
             "or move by move.",
         ),
     ] = False,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
-    """Estimate terrain statistics and sensor bounds from logs with ground truth."""
+    """Estimate terrain statistics and sensor bounds from logs with ground truth.
+
+    With --workers N or --scheduler the logs are read on Dask workers; the fit pools them.
+    """
+    from aura_ums.campaign import LoadLog, run_campaign
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import calibrate_logs, load_log
+    from aura_ums.logs import calibrate_logs
 
     out_target = Target("--out", out)
     sensors_target = Target(
@@ -186,13 +195,11 @@ def calibrate(
         [Source("LOG_DIRS", folder, folder=True) for folder in log_dirs],
         overwrite=overwrite,
     )
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     try:
-        logs = []
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
-            for folder in log_dirs:
-                logs.append(_with_truth_gap(load_log(folder), max_truth_gap))
-                if advance is not None:
-                    advance(len(logs), len(log_dirs))
+            loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
+        logs = list(loaded.values)
         if horizons:
             calibration = calibrate_logs(
                 logs, quantile=quantile, move=move, horizons=tuple(horizons), anchor=anchor
@@ -215,13 +222,20 @@ def calibrate(
             f"+-{bounds.range_error:.3f} m "
             f"({calibration.observations} observations)"
         )
+    if campaign_options.distributed:
+        console.print(f"logs read on Dask workers: {len(logs)} ({loaded.retried} retried)", highlight=False)
     console.print("growth bound against the truth, by horizon without correction:", highlight=False)
     console.print(calibration.report(), highlight=False, markup=False)
 
 
 @manager_options()
 def replay(
-    log_dir: Annotated[Path, typer.Argument(help="Log folder (docs/log-format.md).")],
+    log_dirs: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers)."
+        ),
+    ],
     terrain: _Terrain,
     sensors: _Sensors = None,
     classes: _Classes = Classes.VERTICAL_LINE,
@@ -259,6 +273,10 @@ def replay(
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,
     live_rate: LiveRate = LIVE_DEFAULTS.rate,
+    workers: Workers = DEFAULTS.workers,
+    scheduler: Scheduler = DEFAULTS.scheduler,
+    retries: Retries = DEFAULTS.retries,
+    run_timeout: RunTimeout = DEFAULTS.timeout_s,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
 ) -> None:
@@ -271,17 +289,46 @@ def replay(
     saved ones) and reports the frames after it; it ends with exactly the map of a
     replay run in one go. With --live, the replay is streamed to Foxglove as it computes
     (with --camera, its windows too, on a blank image: logs carry no images).
+
+    With several LOG_DIRs, each is replayed on its own (on Dask workers with --workers N
+    or --scheduler) and the metrics list one entry per log (`replays`); the outputs of
+    one log's steps, maps and state, and --live, need one LOG_DIR.
     """
     from aura_ums import Metrics
     from aura_ums.camera import load_camera
+    from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import ReplayState, load_log, replay_log, replay_windows
+    from aura_ums.logs import ReplayState, replay_log, replay_windows
     from aura_ums.uncertainty import TerrainTable
 
     if windows_csv is not None and camera is None:
         raise fail("--windows-csv: expected --camera too, got no camera")
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
+    if len(log_dirs) > 1:
+        one_log = {"--steps-csv": steps_csv, "--plot": plot, "--mcap": mcap, "--save-state": save_state,
+                   "--resume": resume, "--windows-csv": windows_csv}  # fmt: skip
+        given = [flag for flag, value in one_log.items() if value is not None]
+        given += ["--live"] if live else []
+        if given:
+            raise fail(f"{given[0]}: expected one LOG_DIR, got {len(log_dirs)}")
+        json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
+        sources: list[Source | None] = [Source("LOG_DIR", folder, folder=True) for folder in log_dirs]
+        sources += [Source("--terrain", terrain), None if sensors is None else Source("--sensors", sensors),
+                    None if camera is None else Source("--camera", camera)]  # fmt: skip
+        check_outputs([json_target], sources, overwrite=overwrite)
+        try:
+            many = TerrainTable.from_toml(terrain)
+            options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
+            lens = None if camera is None else load_camera(camera)
+        except AuraUmsError as exc:
+            raise fail(str(exc)) from None
+        replay_logs(log_dirs, many, options, camera=lens, window_margin=window_margin,
+                    max_truth_gap=max_truth_gap, until=until, json_target=json_target,
+                    settings=campaign_options, quiet=quiet)  # fmt: skip
+        return
+    (log_dir,) = log_dirs
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
         Source("--terrain", terrain),
@@ -300,7 +347,7 @@ def replay(
     json_target, csv_target, mcap_target, state_target, windows_target = targets
     windows = None
     try:
-        log = _with_truth_gap(load_log(log_dir), max_truth_gap)
+        log = LoadLog(max_truth_gap)(log_dir)
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
@@ -393,6 +440,7 @@ def compare(
 
     from aura_ums import Metrics
     from aura_ums.baselines import codac_available
+    from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
     from aura_ums.uncertainty import TerrainTable
@@ -408,7 +456,7 @@ def compare(
     ]
     check_outputs([json_target], sources, overwrite=overwrite)
     try:
-        log = _with_truth_gap(load_log(log_dir), max_truth_gap)
+        log = LoadLog(max_truth_gap)(log_dir)
         table = TerrainTable.from_toml(terrain)
         sensors_file = _sensors_file(sensors, terrain)
         options = _options(classes, sensors_file, settings.over(), reverse)

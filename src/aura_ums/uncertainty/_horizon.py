@@ -37,10 +37,11 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from aura_ums._native import clamp_into
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs, nearest_on_polygon
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import TurnAndRun
-from aura_ums.uncertainty._slices import capped, clamp_into, distribute
+from aura_ums.uncertainty._slices import distributed, packed
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _TWO_PI = 2.0 * math.pi
@@ -308,29 +309,33 @@ def _intersect_sliced(
     arcs: list[tuple[float, float]] = []
     left: list[NDArray[np.float64]] = []
     right: list[NDArray[np.float64]] = []
-    for piece in mine:
+    for piece_lo, piece_hi, vertices_mine in zip(
+        mine.lo.tolist(), mine.hi.tolist(), mine.polygons(), strict=True
+    ):
         for lo, width, vertices in theirs:
-            arc = intersect_arcs((piece.lo, piece.hi - piece.lo), (lo, width))
+            arc = intersect_arcs((piece_lo, piece_hi - piece_lo), (lo, width))
             if arc is not None:
                 arcs.append(arc)
-                left.append(piece.vertices)
+                left.append(vertices_mine)
                 right.append(vertices)
     if not arcs:
         return None
-    pieces = [
-        (lo, lo + width, common)
+    kept = [
+        (lo, width, common)
         for (lo, width), common in zip(arcs, _intersections(left, right), strict=True)
         if common is not None
     ]
-    if not pieces:
+    if not kept:
         return None
     cells, cap = first._cells, first._max_slices
-    grid = distribute(pieces, cells, max_vertices)
-    if len(grid) > cap:
-        grid = capped(grid, cap, max_vertices)
-    near = min(grid, key=lambda s: _distance(s.vertices, first.center))
-    center = _inside(near.vertices, first.center)
-    return SpatialUncertaintyMap._sliced(grid, center, first.wedge.center, cells, cap)
+    points, counts, starts, stops, sources = packed(
+        [common for _, _, common in kept], [lo for lo, _, _ in kept], [lo + width for lo, width, _ in kept]
+    )
+    heading = first.wedge.center
+    grid, wedge = distributed(points, counts, starts, stops, sources, cells, max_vertices, cap, heading)
+    near = min(grid.polygons(), key=lambda vertices: _distance(vertices, first.center))
+    center = _inside(near, first.center)
+    return SpatialUncertaintyMap._sliced(grid, center, wedge, cells, cap)
 
 
 def _distance(vertices: NDArray[np.float64], point: NDArray[np.float64]) -> float:

@@ -1,0 +1,201 @@
+"""The runs of aura-ums' campaigns: a seeded simulation, a log loaded, a log replayed.
+
+Each is a frozen value with ``__call__(item)``, so that Dask can pickle it to a worker
+with everything it needs, and its value depends on its item alone: the campaign on any
+number of workers equals the serial one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import numbers
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from aura_ums._metrics import Metrics
+from aura_ums.camera import Camera
+from aura_ums.campaign._engine import Campaign, run_campaign
+from aura_ums.campaign._settings import CampaignSettings
+from aura_ums.errors import InputError
+from aura_ums.logs import ReplayOptions, RobotLog, load_log, replay_log, replay_windows
+from aura_ums.sim import RunResult, Scenario, run_scenario
+from aura_ums.uncertainty import TerrainTable
+
+
+def run_seeds(seed: int, runs: int) -> tuple[np.random.SeedSequence, ...]:
+    """Return the seed of each run of a Monte Carlo: ``SeedSequence(seed).spawn(runs)``.
+
+    The same seeds as ``numpy.random.default_rng(seed).spawn(runs)`` (the generators'
+    seed sequences), so a run's draws depend on ``seed`` and its index only.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the whole Monte Carlo, >= 0.
+    runs : int
+        Number of runs, >= 0.
+
+    Examples
+    --------
+    >>> first, second = run_seeds(7, 2)
+    >>> first.spawn_key, second.spawn_key
+    ((0,), (1,))
+    >>> run_seeds(7, 0)
+    ()
+    """
+    for value, name in ((seed, "seed"), (runs, "runs")):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+            raise InputError(f"{name}: expected an integer >= 0, got {value!r}")
+    return tuple(np.random.SeedSequence(int(seed)).spawn(int(runs)))
+
+
+@dataclass(frozen=True, slots=True)
+class SimulationRun:
+    """One Monte Carlo run of a scenario: ``SimulationRun(scenario)(seed) -> RunResult``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario, settings included.
+    prune : bool
+        Reduce the map by landmarks (False: growth only).
+    """
+
+    scenario: Scenario
+    prune: bool = True
+
+    def __call__(self, seed: np.random.SeedSequence) -> RunResult:
+        """Run the scenario once with the generator of ``seed``.
+
+        A fresh copy of ``seed`` is used: a seed sequence counts the children it spawned,
+        and the run spawns from it, so a second call with the same seed would otherwise
+        draw differently.
+        """
+        if not isinstance(seed, np.random.SeedSequence):
+            raise InputError(f"seed: expected a numpy.random.SeedSequence, got {type(seed).__name__}")
+        fresh = np.random.SeedSequence(seed.entropy, spawn_key=seed.spawn_key, pool_size=seed.pool_size)
+        return run_scenario(self.scenario, np.random.default_rng(fresh), prune=self.prune)
+
+
+def simulate_campaign(
+    scenario: Scenario,
+    runs: int,
+    seed: int,
+    *,
+    prune: bool = True,
+    settings: CampaignSettings | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Campaign[RunResult]:
+    """Run a scenario's Monte Carlo: ``runs`` runs seeded by :func:`run_seeds` (``seed``, ``runs``).
+
+    The runs come back in their order, the same on any number of workers; summarize them
+    with :func:`aura_ums.sim.summarize_runs`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    runs : int
+        In [1, 100000] (:meth:`Scenario.check_runs <aura_ums.sim.Scenario.check_runs>`).
+    seed : int
+        >= 0.
+    prune : bool
+        Reduce the map by landmarks (False: growth only).
+    settings : CampaignSettings or None
+        Where to run (default: serially, in this process).
+    progress : callable or None
+        ``progress(done, total)`` after each finished run.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> from aura_ums.sim import summarize_runs
+    >>> scenario = Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml"))
+    >>> campaign = simulate_campaign(scenario, 2, seed=1)
+    >>> summarize_runs(campaign.values)["frames"], campaign.retried
+    (8, 0)
+    >>> simulate_campaign(scenario, 0, seed=1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: runs: expected an integer in [1, 100000], got 0
+    """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    count = scenario.check_runs(runs)  # before a seed is spawned per run
+    return run_campaign(SimulationRun(scenario, prune), run_seeds(seed, count), settings, progress=progress)
+
+
+@dataclass(frozen=True, slots=True)
+class LoadLog:
+    """Read a log folder: ``LoadLog()(folder) -> RobotLog`` (:func:`~aura_ums.logs.load_log`).
+
+    Parameters
+    ----------
+    max_truth_gap : float or None
+        Longest interval, s, between ground-truth rows interpolated across
+        (:meth:`GroundTruth.with_max_gap <aura_ums.logs.GroundTruth.with_max_gap>`);
+        None: the log's own.
+    """
+
+    max_truth_gap: float | None = None
+
+    def __call__(self, folder: str | os.PathLike[str]) -> RobotLog:
+        """Read ``folder`` (on the worker: the path must be readable there)."""
+        log = load_log(Path(folder))
+        if self.max_truth_gap is None or log.groundtruth is None:
+            return log
+        return dataclasses.replace(log, groundtruth=log.groundtruth.with_max_gap(self.max_truth_gap))
+
+
+@dataclass(frozen=True, slots=True)
+class LogReplay:
+    """Replay a log folder and return its metrics: ``LogReplay(table, options)(folder) -> Metrics``.
+
+    The replay of ``aura-ums replay`` (:func:`~aura_ums.logs.replay_log`, or with a camera
+    :func:`~aura_ums.logs.replay_windows`), without maps kept: a worker returns only the
+    figures.
+
+    Parameters
+    ----------
+    table : TerrainTable
+        Terrain statistics holding the logs' terrains.
+    options : ReplayOptions
+        The replay's settings and bounds.
+    camera : Camera or None
+        Judge each observation's image window through this camera too.
+    window_margin : float
+        Pixels added on every side of each window (with a camera), >= 0.
+    load : LoadLog
+        How the folder is read.
+    until : float or None
+        Stop after the last frame at or before this log time, s.
+    """
+
+    table: TerrainTable
+    options: ReplayOptions
+    camera: Camera | None = None
+    window_margin: float = 0.0
+    load: LoadLog = LoadLog()
+    until: float | None = None
+
+    def __call__(self, folder: str | os.PathLike[str]) -> Metrics:
+        """Replay the log in ``folder`` and return its metrics (with the windows', given a camera).
+
+        The metrics are :meth:`ReplayResult.metrics <aura_ums.logs.ReplayResult.metrics>`.
+        """
+        log = self.load(folder)
+        if self.camera is None:
+            return replay_log(log, self.table, self.options, keep_maps=False, until=self.until).metrics()
+        result, windows = replay_windows(
+            log,
+            self.table,
+            self.camera,
+            self.options,
+            margin=self.window_margin,
+            keep_maps=False,
+            until=self.until,
+        )
+        return Metrics({**result.metrics(), **windows.metrics()})

@@ -1,0 +1,167 @@
+"""``aura_ums.campaign``: serial and Dask campaigns agree; a lost run is retried, never dropped."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from aura_ums.campaign import (
+    CampaignSettings,
+    LoadLog,
+    LogReplay,
+    SimulationRun,
+    run_campaign,
+    run_seeds,
+    simulate_campaign,
+)
+from aura_ums.errors import InputError, MissingDependencyError, RunLostError
+from aura_ums.logs import ReplayOptions, calibrate_logs, synthetic_log, write_log
+from aura_ums.sim import Scenario, summarize_runs
+from tests.campaign.campaign_helpers import FailOn, HangOnce, KillAlways, KillOnce, run_figures
+
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+# The one timing key of simulate's metrics: measured, so never equal between two campaigns.
+TIMING = {"median_frame_ms"}
+
+
+@pytest.fixture(scope="module")
+def scenario() -> Scenario:
+    return Scenario.from_toml(SCENARIO)
+
+
+@pytest.fixture(scope="module")
+def scheduler() -> Iterator[str]:
+    """A two-worker cluster of processes, as the campaign starts its own, shared by the Dask tests."""
+    distributed = pytest.importorskip("distributed", reason="the dask extra is not installed")
+    cluster = distributed.LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
+        scheduler_kwargs={"allowed_failures": 0, "dashboard": False, "dashboard_address": "127.0.0.1:0"},
+    )
+    with cluster:
+        yield cluster.scheduler_address
+
+
+def test_a_serial_campaign_keeps_the_order_and_reports_progress() -> None:
+    seen: list[tuple[int, int]] = []
+    campaign = run_campaign(abs, [-3, 1, -2], progress=lambda done, total: seen.append((done, total)))
+    assert campaign.values == (3, 1, 2)
+    assert campaign.retried == 0
+    assert seen == [(1, 3), (2, 3), (3, 3)]
+
+
+def test_run_seeds_are_the_generators_simulate_always_spawned() -> None:
+    # simulate seeded its runs with default_rng(seed).spawn(runs): the same streams.
+    before = [g.integers(2**62, size=4) for g in np.random.default_rng(11).spawn(5)]
+    now = [np.random.default_rng(s).integers(2**62, size=4) for s in run_seeds(11, 5)]
+    for old, new in zip(before, now, strict=True):
+        assert np.array_equal(old, new)
+
+
+def test_a_run_called_twice_with_one_seed_draws_the_same(scenario: Scenario) -> None:
+    # run_scenario spawns from its generator's seed sequence, which counts its children.
+    (seed,) = run_seeds(3, 1)
+    run = SimulationRun(scenario)
+    assert run_figures(run(seed)) == run_figures(run(seed))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"workers": 0}, r"workers: expected an integer in \[1, 256\], got 0"),
+        ({"workers": 2.0}, r"workers: expected an integer in \[1, 256\], got 2\.0"),
+        ({"retries": -1}, r"retries: expected an integer in \[0, 100\], got -1"),
+        ({"timeout_s": 0.0}, r"timeout_s: expected a finite number of seconds > 0 or None, got 0\.0"),
+        ({"timeout_s": float("inf")}, r"timeout_s: expected a finite number of seconds > 0 or None"),
+        ({"scheduler": " "}, r"scheduler: expected a Dask scheduler address, got ' '"),
+        ({"scheduler": "tcp://127.0.0.1:8786", "workers": 3}, r"workers: expected 1 with a scheduler"),
+    ],
+)
+def test_bad_settings_are_refused_by_name(kwargs: dict[str, object], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        CampaignSettings(**kwargs)  # type: ignore[arg-type]
+
+
+def test_without_the_extra_a_dask_campaign_names_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(MissingDependencyError, match=r"install aura-ums\[dask\]"):
+        run_campaign(abs, [1], CampaignSettings(workers=2))
+    # Serially nothing more is needed.
+    assert run_campaign(abs, [-1], CampaignSettings()).values == (1,)
+
+
+def test_a_campaign_on_a_cluster_equals_the_serial_one(scenario: Scenario, scheduler: str) -> None:
+    serial = simulate_campaign(scenario, 6, seed=4)
+    seen: list[tuple[int, int]] = []
+    parallel = simulate_campaign(
+        scenario,
+        6,
+        seed=4,
+        settings=CampaignSettings(scheduler=scheduler),
+        progress=lambda *p: seen.append(p),
+    )
+    assert [run_figures(r) for r in parallel.values] == [run_figures(r) for r in serial.values]
+    summary, again = summarize_runs(serial.values), summarize_runs(parallel.values)
+    assert {k: v for k, v in summary.items() if k not in TIMING} == {
+        k: v for k, v in again.items() if k not in TIMING
+    }
+    assert parallel.retried == 0
+    assert seen == [(done, 6) for done in range(1, 7)]
+
+
+def test_a_killed_worker_is_retried_and_the_campaign_still_equals_the_serial_one(
+    scenario: Scenario, scheduler: str, tmp_path: Path
+) -> None:
+    seeds = run_seeds(9, 10)
+    serial = run_campaign(SimulationRun(scenario), seeds)
+    killer = KillOnce(SimulationRun(scenario), victim=6, marker=tmp_path / "killed", items=seeds)
+    parallel = run_campaign(killer, seeds, CampaignSettings(scheduler=scheduler, retries=2))
+    assert (tmp_path / "killed").exists(), "the victim's first attempt never ran"
+    assert parallel.retried == 1
+    assert [run_figures(r) for r in parallel.values] == [run_figures(r) for r in serial.values]
+
+
+def test_a_run_lost_more_often_than_its_retries_fails_the_campaign(scheduler: str) -> None:
+    with pytest.raises(
+        RunLostError, match=r"run 2: expected it to finish within 1 retries, got it lost 2 times"
+    ):
+        run_campaign(KillAlways(victim=2), [0, 1, 2, 3], CampaignSettings(scheduler=scheduler, retries=1))
+
+
+def test_a_stuck_run_times_out_and_is_retried(scheduler: str, tmp_path: Path) -> None:
+    stuck = HangOnce(victim=1, marker=tmp_path / "hung")
+    # The clock of a run starts when it is handed to a worker, a restarted worker's imports
+    # included: generous, for a loaded machine; the stuck run sleeps far longer.
+    settings = CampaignSettings(scheduler=scheduler, retries=2, timeout_s=10.0)
+    campaign = run_campaign(stuck, [0, 1, 2, 3], settings)
+    assert (tmp_path / "hung").exists(), "the stuck attempt never ran"
+    assert campaign.values == (0, 1, 4, 9)
+    assert campaign.retried >= 1
+
+
+def test_a_runs_own_error_is_raised_not_retried(scheduler: str) -> None:
+    with pytest.raises(InputError, match="item: expected anything but 3, got it"):
+        run_campaign(FailOn(victim=3), [1, 2, 3], CampaignSettings(scheduler=scheduler, retries=5))
+
+
+def test_a_local_cluster_replays_logs_as_the_serial_campaign(tmp_path: Path) -> None:
+    pytest.importorskip("distributed", reason="the dask extra is not installed")
+    logs = [synthetic_log(np.random.default_rng(index), duration=30.0) for index in range(3)]
+    folders = [write_log(log, tmp_path / f"l{index}") for index, log in enumerate(logs)]
+    table = calibrate_logs(logs).terrain_table()  # the synthetic logs' terrain
+    replay = LogReplay(table, ReplayOptions(), load=LoadLog(max_truth_gap=1.0))
+    serial = run_campaign(replay, folders)
+    parallel = run_campaign(replay, folders, CampaignSettings(workers=2))
+    timing = {"median_update_us"}
+    assert [{k: v for k, v in m.items() if k not in timing} for m in parallel.values] == [
+        {k: v for k, v in m.items() if k not in timing} for m in serial.values
+    ]
+    assert [m["log"] for m in parallel.values] == [m["log"] for m in serial.values]

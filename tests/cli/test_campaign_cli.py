@@ -1,0 +1,108 @@
+"""``--workers``, ``--scheduler``: simulate, replay and calibrate as campaigns equal the serial commands."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from aura_ums import Metrics
+from aura_ums.cli import app
+from aura_ums.logs import synthetic_log, write_log
+
+runner = CliRunner()
+SCENARIO = str(Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml")
+# Measured times: never equal between two runs.
+TIMING = {"median_frame_ms", "median_update_us"}
+
+
+def strict_json(text: str) -> Any:
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def untimed(figures: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in figures.items() if k not in TIMING}
+
+
+@pytest.fixture(scope="module")
+def log_folders(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    root = tmp_path_factory.mktemp("logs")
+    return [
+        write_log(synthetic_log(np.random.default_rng(seed), duration=20.0), root / f"r{seed}")
+        for seed in (4, 5)
+    ]
+
+
+def test_simulate_on_two_workers_writes_the_serial_metrics(tmp_path: Path) -> None:
+    pytest.importorskip("distributed", reason="the dask extra is not installed")
+    written = {}
+    for workers in ("1", "2"):
+        out = tmp_path / f"w{workers}.json"
+        args = ["simulate", SCENARIO, "--runs", "4", "--seed", "3", "--workers", workers]
+        result = runner.invoke(app, [*args, "--metrics-json", str(out)])
+        assert result.exit_code == 0, result.output
+        written[workers] = strict_json(out.read_text())
+    assert set(written["2"]) == {key.name for key in Metrics.table() if "simulate" in key.written_by}
+    assert written["2"]["runs_retried"] == 0
+    assert untimed(written["2"]) == untimed(written["1"])
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--workers", "0"], r"--workers: expected an integer in [1, 256], got 0"),
+        (["--retries", "-1"], r"--retries: expected an integer in [0, 100], got -1"),
+        (["--run-timeout", "0"], r"--run-timeout: expected a finite number of seconds > 0 or None, got 0.0"),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers: expected 1 with a scheduler"),
+    ],
+)
+def test_bad_campaign_options_are_clean_errors(options: list[str], message: str) -> None:
+    result = runner.invoke(app, ["simulate", SCENARIO, "--runs", "1", *options])
+    assert result.exit_code == 2
+    assert message in result.output
+    assert "Traceback" not in result.output
+
+
+def test_without_the_extra_workers_name_it_and_one_worker_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    result = runner.invoke(app, ["simulate", SCENARIO, "--runs", "1", "--workers", "2"])
+    assert result.exit_code == 2
+    assert "install aura-ums[dask]" in result.output
+    assert "Traceback" not in result.output
+    assert runner.invoke(app, ["simulate", SCENARIO, "--runs", "1"]).exit_code == 0
+
+
+def test_replay_of_several_logs_lists_each_as_its_own_replay(log_folders: list[Path], tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    calibrated = runner.invoke(app, ["calibrate", *map(str, log_folders), "--out", str(terrain)])
+    assert calibrated.exit_code == 0, calibrated.output
+    out = tmp_path / "all.json"
+    both = runner.invoke(
+        app, ["replay", *map(str, log_folders), "--terrain", str(terrain), "--metrics-json", str(out)]
+    )
+    assert both.exit_code == 0, both.output
+    together = strict_json(out.read_text())
+    assert set(together) == {key.name for key in Metrics.table() if "replay (several logs)" in key.written_by}
+    assert together["runs_retried"] == 0
+    for folder, entry in zip(log_folders, together["replays"], strict=True):
+        alone = tmp_path / f"{folder.name}.json"
+        result = runner.invoke(
+            app, ["replay", str(folder), "--terrain", str(terrain), "--metrics-json", str(alone)]
+        )
+        assert result.exit_code == 0, result.output
+        assert untimed(entry) == untimed(strict_json(alone.read_text()))
+
+
+def test_replay_of_several_logs_refuses_the_outputs_of_one(log_folders: list[Path], tmp_path: Path) -> None:
+    args = ["replay", *map(str, log_folders), "--terrain", str(tmp_path / "t.toml")]
+    result = runner.invoke(app, [*args, "--steps-csv", str(tmp_path / "s.csv")])
+    assert result.exit_code == 2
+    assert "--steps-csv: expected one LOG_DIR, got 2" in result.output
