@@ -30,6 +30,8 @@ def _first_attempt(marker: Path) -> bool:
 
 
 def _key(item: Any) -> Any:
+    if isinstance(item, tuple):  # a batch of seeds
+        return tuple(_key(part) for part in item)
     return getattr(item, "spawn_key", item)
 
 

@@ -13,7 +13,9 @@ from aura_ums.campaign import (
     CampaignSettings,
     LoadLog,
     LogReplay,
+    SimulationBatch,
     SimulationRun,
+    batches,
     run_campaign,
     run_seeds,
     simulate_campaign,
@@ -127,6 +129,46 @@ def test_a_killed_worker_is_retried_and_the_campaign_still_equals_the_serial_one
     assert (tmp_path / "killed").exists(), "the victim's first attempt never ran"
     assert parallel.retried == 1
     assert [run_figures(r) for r in parallel.values] == [run_figures(r) for r in serial.values]
+
+
+@pytest.mark.parametrize(("size", "count"), [(0, 3), (1, 3), (5, 2), (7, 3), (10, 64)])
+def test_batches_keep_every_item_in_order_and_differ_by_at_most_one(size: int, count: int) -> None:
+    items = tuple(range(size))
+    parts = batches(items, count)
+    assert tuple(i for part in parts for i in part) == items
+    assert len(parts) == max(1, min(count, size))
+    if size:
+        assert max(map(len, parts)) - min(map(len, parts)) <= 1
+
+
+def test_a_batched_campaign_with_a_killed_worker_equals_the_serial_one(
+    scenario: Scenario, scheduler: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import aura_ums.campaign._jobs as jobs
+
+    # Three batches of 3-4 runs on the test cluster, as a large campaign would have.
+    monkeypatch.setattr(jobs, "BATCHES_ON_A_SCHEDULER", 3)
+    seeds = run_seeds(5, 10)
+    serial = simulate_campaign(scenario, 10, seed=5)
+    seen: list[tuple[int, int]] = []
+    batched = simulate_campaign(
+        scenario,
+        10,
+        seed=5,
+        settings=CampaignSettings(scheduler=scheduler),
+        progress=lambda *p: seen.append(p),
+    )
+    assert [run_figures(r) for r in batched.values] == [run_figures(r) for r in serial.values]
+    assert seen == sorted(seen)
+    assert seen[-1] == (10, 10)
+    assert len(seen) == 3
+    parts = batches(seeds, 3)
+    batch = SimulationBatch(SimulationRun(scenario))
+    killer = KillOnce(batch, victim=1, marker=tmp_path / "killed", items=parts)
+    again = run_campaign(killer, parts, CampaignSettings(scheduler=scheduler, retries=2))
+    assert again.retried == 1
+    assert again.retried_items == (1,)
+    assert [run_figures(r) for part in again.values for r in part] == [run_figures(r) for r in serial.values]
 
 
 def test_a_run_lost_more_often_than_its_retries_fails_the_campaign(scheduler: str) -> None:

@@ -10,7 +10,15 @@ optional extra ``aura-ums[dask]``; a serial campaign needs nothing more.
 """
 
 from aura_ums.campaign._engine import Campaign, run_campaign
-from aura_ums.campaign._jobs import LoadLog, LogReplay, SimulationRun, run_seeds, simulate_campaign
+from aura_ums.campaign._jobs import (
+    LoadLog,
+    LogReplay,
+    SimulationBatch,
+    SimulationRun,
+    batches,
+    run_seeds,
+    simulate_campaign,
+)
 from aura_ums.campaign._settings import CampaignSettings
 
 __all__ = [
@@ -18,7 +26,9 @@ __all__ = [
     "CampaignSettings",
     "LoadLog",
     "LogReplay",
+    "SimulationBatch",
     "SimulationRun",
+    "batches",
     "run_campaign",
     "run_seeds",
     "simulate_campaign",

@@ -53,10 +53,13 @@ class Campaign(Generic[_R]):
     retried : int
         Items whose run was submitted again (its worker died or it timed out), each
         counted once however many retries it took; 0 for a serial campaign.
+    retried_items : tuple of int
+        Their indices, ascending.
     """
 
     values: tuple[_R, ...]
     retried: int
+    retried_items: tuple[int, ...] = ()
 
 
 def run_campaign(
@@ -246,7 +249,8 @@ def _run_on(
             runs.lost(index, f"{type(error).__name__}: {error}" if error is not None else str(future.status))
         if settings.timeout_s is not None:
             _time_out(client, runs, settings.timeout_s)
-    return Campaign(tuple(runs.values[i] for i in range(total)), len(runs.retried))
+    values = tuple(runs.values[i] for i in range(total))
+    return Campaign(values, len(runs.retried), tuple(sorted(runs.retried)))
 
 
 def _time_out(client: Client, runs: _Runs[_T, _R], timeout_s: float) -> None:

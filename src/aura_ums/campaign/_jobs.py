@@ -13,6 +13,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -24,6 +25,14 @@ from aura_ums.errors import InputError
 from aura_ums.logs import ReplayOptions, RobotLog, load_log, replay_log, replay_windows
 from aura_ums.sim import RunResult, Scenario, run_scenario
 from aura_ums.uncertainty import TerrainTable
+
+_Item = TypeVar("_Item")
+
+#: Tasks per worker of a local cluster when a Monte Carlo is batched, and tasks on an
+#: existing scheduler (whose size is not known here): enough to balance the load, few
+#: enough that Dask's cost per task (tens of ms, about one short run's) stays small.
+BATCHES_PER_WORKER = 4
+BATCHES_ON_A_SCHEDULER = 64
 
 
 def run_seeds(seed: int, runs: int) -> tuple[np.random.SeedSequence, ...]:
@@ -81,6 +90,40 @@ class SimulationRun:
         return run_scenario(self.scenario, np.random.default_rng(fresh), prune=self.prune)
 
 
+@dataclass(frozen=True, slots=True)
+class SimulationBatch:
+    """Consecutive Monte Carlo runs in one task: ``SimulationBatch(run)(seeds) -> tuple of RunResult``.
+
+    Each run is ``run(seed)`` as alone, so a batched campaign equals the per-run one.
+
+    Parameters
+    ----------
+    run : SimulationRun
+        One run of the scenario.
+    """
+
+    run: SimulationRun
+
+    def __call__(self, seeds: tuple[np.random.SeedSequence, ...]) -> tuple[RunResult, ...]:
+        """Run the scenario once per seed, in order."""
+        return tuple(self.run(seed) for seed in seeds)
+
+
+def batches(items: tuple[_Item, ...], count: int) -> list[tuple[_Item, ...]]:
+    """Split ``items`` into ``count`` consecutive batches whose sizes differ by at most one.
+
+    Examples
+    --------
+    >>> batches((1, 2, 3, 4, 5), 2)
+    [(1, 2), (3, 4, 5)]
+    >>> batches((1, 2), 5)          # never an empty batch
+    [(1,), (2,)]
+    """
+    parts = max(1, min(count, len(items)))
+    ends = [len(items) * k // parts for k in range(parts + 1)]
+    return [items[ends[k] : ends[k + 1]] for k in range(parts)]
+
+
 def simulate_campaign(
     scenario: Scenario,
     runs: int,
@@ -125,7 +168,28 @@ def simulate_campaign(
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
     count = scenario.check_runs(runs)  # before a seed is spawned per run
-    return run_campaign(SimulationRun(scenario, prune), run_seeds(seed, count), settings, progress=progress)
+    run, seeds = SimulationRun(scenario, prune), run_seeds(seed, count)
+    chosen = CampaignSettings() if settings is None else settings
+    if not isinstance(chosen, CampaignSettings):
+        raise InputError(f"settings: expected CampaignSettings or None, got {type(chosen).__name__}")
+    if not chosen.distributed:
+        return run_campaign(run, seeds, chosen, progress=progress)
+    # A run takes tens of ms, about Dask's own cost per task: runs go to workers in batches.
+    tasks = BATCHES_PER_WORKER * chosen.workers if chosen.scheduler is None else BATCHES_ON_A_SCHEDULER
+    parts = batches(seeds, tasks)
+    longest = max(len(part) for part in parts)
+    if chosen.timeout_s is not None:  # a run's limit, so a batch's is its longest's sum
+        chosen = dataclasses.replace(chosen, timeout_s=chosen.timeout_s * longest)
+
+    def advance(done: int, total: int) -> None:
+        if progress is not None:
+            progress(count * done // total, count)
+
+    batched = run_campaign(SimulationBatch(run), parts, chosen, progress=advance)
+    starts = np.cumsum([0] + [len(part) for part in parts]).tolist()
+    retried = tuple(i for b in batched.retried_items for i in range(starts[b], starts[b + 1]))
+    values = tuple(result for part in batched.values for result in part)
+    return Campaign(values, len(retried), retried)
 
 
 @dataclass(frozen=True, slots=True)
