@@ -20,6 +20,11 @@ from aura_ums.errors import InputError
 
 #: Seconds between two looks at the clock while waiting for a client (Ctrl-C lands between them).
 _POLL = 0.1
+#: A client's subscriptions reach the listener one channel at a time: streaming waits until
+#: none came for this many seconds (at most :data:`_SETTLE_MAX` after the first), or the
+#: first messages would reach only the channels subscribed so far.
+_SETTLE = 0.25
+_SETTLE_MAX = 2.0
 
 
 class _Subscriptions(ServerListener):
@@ -27,6 +32,7 @@ class _Subscriptions(ServerListener):
 
     def __init__(self) -> None:
         self.first = threading.Event()
+        self.last = 0.0  # time.monotonic() of the latest subscription
         self.topics: collections.deque[str] = collections.deque()
         self._lock = threading.Lock()
         self._active: set[tuple[int, int]] = set()
@@ -35,6 +41,7 @@ class _Subscriptions(ServerListener):
         with self._lock:
             self._active.add((client.id, channel.id))
         self.topics.append(channel.topic)
+        self.last = time.monotonic()
         self.first.set()
 
     def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
@@ -92,13 +99,16 @@ class LiveServer:
         return int(self._server.port)
 
     def wait_for_client(self, timeout: float | None) -> bool:
-        """Block until a client subscribes to a channel (True), or ``timeout`` seconds pass (False)."""
+        """Block until a client subscribes and its subscriptions settle (True), or ``timeout`` s (False)."""
         deadline = math.inf if timeout is None else time.monotonic() + timeout
         while not self._listener.first.is_set():
             left = deadline - time.monotonic()
             if left <= 0.0:
                 return False
             self._listener.first.wait(min(_POLL, left))
+        settled = time.monotonic() + _SETTLE_MAX
+        while time.monotonic() < min(settled, self._listener.last + _SETTLE):
+            time.sleep(_SETTLE / 5)
         return True
 
     def wait_while_watched(self, timeout: float | None) -> bool:
