@@ -67,6 +67,8 @@ from contextlib import contextmanager
 from typing import Any
 
 from aura_ums._validate import nonnegative_float, positive_float
+from aura_ums.baselines._ekf import check_observation
+from aura_ums.baselines._moments import check_motion
 from aura_ums.baselines._region import ConfidenceRegion, check_probability
 from aura_ums.errors import InputError, MissingDependencyError
 from aura_ums.geometry import ConvexPolygon
@@ -364,10 +366,7 @@ class CodacLocalizer:
         terrain : TerrainStats
             Statistics of the terrain it happens on.
         """
-        if not isinstance(command, TurnAndRun):
-            raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-        if not isinstance(terrain, TerrainStats):
-            raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+        check_motion(command, terrain)
         bounds = motion_bounds(terrain, command, self._sigmas)
         with codac_rounding():
             self._box = _move(self._codac, self._box, bounds)
@@ -385,11 +384,7 @@ class CodacLocalizer:
             True when the relaxed intersection over the window was not empty; False when
             the box had to be re-initialised (counted in :attr:`reinitialisations`).
         """
-        if not isinstance(observation, (BearingObservation, RangeBearingObservation)):
-            raise InputError(
-                "observation: expected a BearingObservation or RangeBearingObservation, "
-                f"got {type(observation).__name__}"
-            )
+        check_observation(observation)
         if len(landmark_xy) != 2 or not all(math.isfinite(v) for v in landmark_xy):
             raise InputError(
                 f"landmark_xy: expected (x, y), two finite numbers in metres, got {landmark_xy!r}"

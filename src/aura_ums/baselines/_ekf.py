@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, positive_float
-from aura_ums.baselines._moments import motion_moments
+from aura_ums.baselines._moments import check_motion, motion_moments
 from aura_ums.baselines._region import ConfidenceRegion, check_probability, chi2_quantile, gaussian_region
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import BearingObservation, Pose, RangeBearingObservation, TerrainStats, TurnAndRun
@@ -228,10 +228,7 @@ class ExtendedKalmanFilter:
         terrain : TerrainStats
             Statistics of the terrain it happens on.
         """
-        if not isinstance(command, TurnAndRun):
-            raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-        if not isinstance(terrain, TerrainStats):
-            raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+        check_motion(command, terrain)
         turn_mean, turn_var, m, run_var, drift_var, skitter_var = motion_moments(terrain, command)
         psi = self._h + turn_mean
         c, s = math.cos(psi), math.sin(psi)

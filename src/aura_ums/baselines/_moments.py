@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from aura_ums.errors import InputError
 from aura_ums.uncertainty import TerrainStats, TurnAndRun
 
 _SQRT_HALF = math.sqrt(0.5)
@@ -88,6 +89,15 @@ class MotionMoments(NamedTuple):
     run_var: float
     drift_var: float
     skitter_var: float
+
+
+def check_motion(command: object, terrain: object) -> tuple[TurnAndRun, TerrainStats]:
+    """Return ``(command, terrain)`` if they are a TurnAndRun and TerrainStats, else raise InputError."""
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+    if not isinstance(terrain, TerrainStats):
+        raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+    return command, terrain
 
 
 def motion_moments(terrain: TerrainStats, command: TurnAndRun) -> MotionMoments:

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.baselines._ekf import _gate_threshold, check_observation, landmark_position
+from aura_ums.baselines._moments import check_motion
 from aura_ums.baselines._region import (
     ConfidenceRegion,
     check_probability,
@@ -255,10 +256,7 @@ class ParticleFilter:
         terrain : TerrainStats
             Statistics of the terrain it happens on.
         """
-        if not isinstance(command, TurnAndRun):
-            raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-        if not isinstance(terrain, TerrainStats):
-            raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+        check_motion(command, terrain)
         if 1.0 / float(np.dot(self._weights, self._weights)) < self._resample_below:
             self._resample()
         self._particles = terrain.sample_motions(self._particles, command, self._rng)
