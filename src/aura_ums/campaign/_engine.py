@@ -62,6 +62,14 @@ class Campaign(Generic[_R]):
     retried_items: tuple[int, ...] = ()
 
 
+def settings_or_serial(settings: CampaignSettings | None) -> CampaignSettings:
+    """Return ``settings``, or the serial default for None; anything else is an InputError."""
+    chosen = CampaignSettings() if settings is None else settings
+    if not isinstance(chosen, CampaignSettings):
+        raise InputError(f"settings: expected CampaignSettings or None, got {type(chosen).__name__}")
+    return chosen
+
+
 def run_campaign(
     task: Callable[[_T], _R],
     items: Sequence[_T],
@@ -108,9 +116,7 @@ def run_campaign(
     >>> run_campaign(abs, []).values
     ()
     """
-    chosen = CampaignSettings() if settings is None else settings
-    if not isinstance(chosen, CampaignSettings):
-        raise InputError(f"settings: expected CampaignSettings or None, got {type(chosen).__name__}")
+    chosen = settings_or_serial(settings)
     work = list(items)
     if not chosen.distributed:
         values = []

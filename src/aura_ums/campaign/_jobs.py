@@ -19,7 +19,7 @@ import numpy as np
 
 from aura_ums._metrics import Metrics
 from aura_ums.camera import Camera
-from aura_ums.campaign._engine import Campaign, run_campaign
+from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
 from aura_ums.errors import InputError
 from aura_ums.logs import ReplayOptions, RobotLog, load_log, replay_log, replay_windows
@@ -169,9 +169,7 @@ def simulate_campaign(
         raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
     count = scenario.check_runs(runs)  # before a seed is spawned per run
     run, seeds = SimulationRun(scenario, prune), run_seeds(seed, count)
-    chosen = CampaignSettings() if settings is None else settings
-    if not isinstance(chosen, CampaignSettings):
-        raise InputError(f"settings: expected CampaignSettings or None, got {type(chosen).__name__}")
+    chosen = settings_or_serial(settings)
     if not chosen.distributed:
         return run_campaign(run, seeds, chosen, progress=progress)
     # A run takes tens of ms, about Dask's own cost per task: runs go to workers in batches.
