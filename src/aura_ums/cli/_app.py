@@ -137,9 +137,9 @@ def simulate(
     import numpy as np
 
     from aura_ums import Metrics
-    from aura_ums.campaign import run_seeds, simulate_campaign
+    from aura_ums.campaign import run_campaign, run_seeds, simulate_campaign
     from aura_ums.errors import AuraUmsError
-    from aura_ums.sim import Scenario, run_scenario, summarize_runs
+    from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
 
     campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if runs < 1:
@@ -175,14 +175,15 @@ def simulate(
                 )
                 values = list(campaign.values)
                 retried = campaign.retried
-            else:
-                values = []
-                retried = 0
-                for done, run_seed in enumerate(run_seeds(seed, runs), start=1):
+            else:  # streamed from this process: the serial campaign, each frame to the view
+                frame = view.frame
+
+                def watched(run_seed: np.random.SeedSequence) -> RunResult:
                     rng = np.random.default_rng(run_seed)
-                    values.append(run_scenario(loaded, rng, prune=prune, after_frame=view.frame))
-                    if advance is not None:
-                        advance(done, runs)
+                    return run_scenario(loaded, rng, prune=prune, after_frame=frame)
+
+                values = list(run_campaign(watched, run_seeds(seed, runs), progress=advance).values)
+                retried = 0
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
     metrics = Metrics(
