@@ -47,10 +47,12 @@ __all__ = [
     "MAX_BYTES",
     "MAX_ROWS",
     "SCRATCH_SUFFIX",
+    "CsvFallback",
     "CsvFloats",
     "CsvTable",
     "Fields",
     "atomic_path",
+    "csv_blocks",
     "decode",
     "describe",
     "key_path",
@@ -646,6 +648,171 @@ def _is_row(line: str) -> bool:
     return bool(stripped) and not stripped.startswith("#")
 
 
+class CsvFallback(Exception):
+    """Raised by :func:`csv_blocks` for a file it cannot read block by block exactly.
+
+    The caller then reads the whole file (:func:`read_text`, :func:`parse_csv`), whose
+    messages name what is wrong, or which reads what the blocks could not.
+    """
+
+
+# Line breaks str.splitlines knows besides "\n" (and "\r\n"): a block holding one would
+# number its lines otherwise than parse_csv does.
+_OTHER_BREAKS = re.compile("\r(?!\n)|[\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def csv_blocks(
+    path: str | os.PathLike[str],
+    *,
+    columns: Sequence[str],
+    required: Sequence[str] = (),
+    numeric: bool,
+    max_rows: int | None = None,
+    max_bytes: int | None = None,
+    block_bytes: int = CSV_BLOCK_BYTES,
+) -> Iterator[CsvFloats | CsvTable]:
+    r"""Read a CSV file ``block_bytes`` at a time and yield each block's rows as they are read.
+
+    Each block is cut after its last line break and parsed below the file's header, so
+    the rows, the header and the line numbers (of the file) are exactly those
+    :func:`parse_csv` gives for the whole text; the text of a large file is never in
+    memory whole, and the rows of one block are dropped once the caller moves on.
+    ``numeric`` files are parsed by :func:`parse_csv_floats` (every cell a float),
+    others by :func:`parse_csv` (stripped cells). Nothing is yielded for a file without
+    data rows (the header only).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    columns, required, max_rows, max_bytes
+        As for :func:`parse_csv`.
+    numeric : bool
+        Yield :class:`CsvFloats` (every cell a number) rather than :class:`CsvTable`.
+    block_bytes : int
+        Bytes read at a time, >= 1.
+
+    Yields
+    ------
+    CsvFloats or CsvTable
+        One block's rows; ``lines`` are lines of the file, ``text`` (of a
+        :class:`CsvFloats`) is None.
+
+    Raises
+    ------
+    CsvFallback
+        Whenever a block cannot be read exactly so (a missing, unreadable or too large
+        file, text that is not UTF-8 (ASCII when ``numeric``), a line break other than
+        ``"\n"``, a bad header, a cell ``parse_csv_floats`` refuses, too many rows), possibly
+        after blocks were yielded: the caller reads the whole file instead.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "o.csv"
+    >>> _ = path.write_bytes(b"# odometry\ntime,v\n0.5, 1.0\n\n1.5,2e-1\n2.5,3\n")
+    >>> [b.lines.tolist() for b in csv_blocks(path, columns=("time", "v"), numeric=True, block_bytes=8)]
+    [[], [3], [5], [6]]
+    >>> _ = path.write_bytes(b"time,v\n")
+    >>> [len(b) for b in csv_blocks(path, columns=("time", "v"), numeric=True)]   # the header alone
+    [0]
+    >>> _ = path.write_bytes(b"time,v\n0.5,\n")
+    >>> list(csv_blocks(path, columns=("time", "v"), numeric=True))   # an empty cell: parse_csv says more
+    Traceback (most recent call last):
+    ...
+    aura_ums._files.CsvFallback
+    """
+    source = str(path)
+    limit = _limit(max_bytes, MAX_BYTES)
+    most = _limit(max_rows, MAX_ROWS)
+    try:
+        handle = open(path, "rb")  # noqa: SIM115 - closed below, on every path
+    except (OSError, ValueError):
+        raise CsvFallback from None
+    with handle:
+        try:
+            if os.fstat(handle.fileno()).st_size > limit:
+                raise CsvFallback
+        except OSError:
+            raise CsvFallback from None
+        header_text: str | None = None
+        rows = 0
+        lines_before = 0  # lines of the file before the block
+        carry = b""
+        first = True
+        while True:
+            try:
+                chunk = handle.read(block_bytes)
+            except OSError:
+                raise CsvFallback from None
+            data = carry + chunk
+            if chunk:
+                cut = data.rfind(b"\n") + 1
+                if cut == 0:  # no line break yet: read on
+                    carry = data
+                    continue
+                block, carry = data[:cut], data[cut:]
+            else:
+                block, carry = data, b""
+            if first:
+                block = block.removeprefix(_BOM.encode("utf-8"))
+                first = False
+            if numeric and not block.isascii():
+                raise CsvFallback
+            try:
+                text = block.decode("utf-8")
+            except UnicodeDecodeError:
+                raise CsvFallback from None
+            if not numeric and _OTHER_BREAKS.search(text):
+                raise CsvFallback
+            found: CsvFloats | CsvTable | None
+            if header_text is None:
+                if chunk and not any(_is_row(line) for line in text.splitlines()):
+                    carry = block + carry  # comments and blank lines only: the header is further on
+                    continue
+                found = _parse_block(text, source, columns, required, numeric, most, limit)
+                if found is None:
+                    raise CsvFallback
+                header_text = text.splitlines()[found.header_line - 1]
+                lines = found.lines
+            else:
+                # The header again before the block: the block's rows read as they would below it.
+                found = _parse_block(
+                    f"{header_text}\n{text}", source, columns, required, numeric, most - rows, limit
+                )
+                if found is None or found.header_line != 1:
+                    raise CsvFallback
+                lines = np.asarray(found.lines, dtype=np.int64) - 1 + lines_before
+            rows += len(found)
+            lines_before += block.count(b"\n")
+            if len(found) or rows == len(found):
+                lines = np.asarray(lines, dtype=np.int64)
+                if isinstance(found, CsvFloats):
+                    yield CsvFloats(source, found.header, found.header_line, found.values, lines, None)
+                else:
+                    yield CsvTable(source, found.header, found.header_line, found.rows, tuple(lines.tolist()))
+            if not chunk:
+                return
+
+
+def _parse_block(
+    text: str,
+    source: str,
+    columns: Sequence[str],
+    required: Sequence[str],
+    numeric: bool,
+    most: int,
+    limit: int,
+) -> CsvFloats | CsvTable | None:
+    """One block of :func:`csv_blocks`: its rows, or None when it cannot be read exactly."""
+    if numeric:
+        return parse_csv_floats(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
+    try:
+        return parse_csv(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
+    except FileFormatError:
+        return None
+
+
 def read_csv_floats(
     path: str | os.PathLike[str],
     *,
@@ -655,17 +822,16 @@ def read_csv_floats(
     max_bytes: int | None = None,
     block_bytes: int = CSV_BLOCK_BYTES,
 ) -> CsvFloats | None:
-    r"""Read a CSV file of numbers only block by block (:func:`parse_csv_floats`); None when it cannot.
+    r"""Read a CSV file of numbers only block by block (:func:`csv_blocks`); None when it cannot.
 
     The file is read ``block_bytes`` at a time, each block cut after its last line break,
     so the text of a large file is never in memory whole: only the values and the line
-    numbers grow with it. Each block is read by :func:`parse_csv_floats` below the header,
-    so the result is exactly what :func:`parse_csv` and ``float()`` of every cell give; None
-    whenever a block's is None (at least whenever that of the whole text would be), and for
-    a file that is missing, unreadable, larger than ``max_bytes`` or not ASCII: the caller
-    then reads it with :func:`read_text` and :func:`parse_csv`, whose messages say what is
-    wrong. The result holds no text (:meth:`CsvFloats.cell` reads the file again, for a
-    message).
+    numbers grow with it. The result is exactly what :func:`parse_csv` and ``float()`` of
+    every cell give; None whenever :func:`csv_blocks` cannot read it (at least whenever
+    :func:`parse_csv_floats` of the whole text would give None), and for a file that is
+    missing, unreadable, larger than ``max_bytes`` or not ASCII: the caller then reads it
+    with :func:`read_text` and :func:`parse_csv`, whose messages say what is wrong. The
+    result holds no text (:meth:`CsvFloats.cell` reads the file again, for a message).
 
     Parameters
     ----------
@@ -693,92 +859,41 @@ def read_csv_floats(
     >>> read_csv_floats(path, columns=("time", "v")) is None   # an empty cell: parse_csv says more
     True
     """
-    source = str(path)
-    limit = _limit(max_bytes, MAX_BYTES)
-    most = _limit(max_rows, MAX_ROWS)
     try:
-        handle = open(path, "rb")  # noqa: SIM115 - closed below, on every path
-    except (OSError, ValueError):
-        return None
-    with handle:
-        try:
-            if os.fstat(handle.fileno()).st_size > limit:
-                return None
-        except OSError:
-            return None
-        try:
+        with open(path, "rb") as handle:
             # Rows are at most the line breaks plus one: the values are written in place, never
             # held twice (as blocks and as their concatenation).
             capacity = 1 + sum(piece.count(b"\n") for piece in iter(lambda: handle.read(block_bytes), b""))
-            handle.seek(0)
-        except OSError:
-            return None
-        header: CsvFloats | None = None
-        header_text = ""
-        values = np.empty((0, 0))
-        lines = np.empty(0, dtype=np.int64)
-        rows = 0
-        lines_before = 0  # lines of the file before the block
-        carry = b""
-        first = True
-        while True:
-            try:
-                chunk = handle.read(block_bytes)
-            except OSError:
-                return None
-            data = carry + chunk
-            if chunk:
-                cut = data.rfind(b"\n") + 1
-                if cut == 0:  # no line break yet: read on
-                    carry = data
-                    continue
-                block, carry = data[:cut], data[cut:]
-            else:
-                block, carry = data, b""
-            if first:
-                block = block.removeprefix(_BOM.encode("utf-8"))
-                first = False
-            if not block.isascii():
-                return None
-            text = block.decode("ascii")
+    except (OSError, ValueError):
+        return None
+    values: NDArray[np.float64] | None = None
+    lines = np.empty(capacity, dtype=np.int64)
+    header: CsvFloats | None = None
+    rows = 0
+    try:
+        for block in csv_blocks(
+            path,
+            columns=columns,
+            required=required,
+            numeric=True,
+            max_rows=max_rows,
+            max_bytes=max_bytes,
+            block_bytes=block_bytes,
+        ):
+            assert isinstance(block, CsvFloats)
             if header is None:
-                if chunk and not any(_is_row(line) for line in text.splitlines()):
-                    carry = block + carry  # comments and blank lines only: the header is further on
-                    continue
-                header = parse_csv_floats(
-                    text, source, columns=columns, required=required, max_rows=most, max_bytes=limit
-                )
-                if header is None:
-                    return None
-                header_text = text.splitlines()[header.header_line - 1]
-                values = np.empty((capacity, len(header.header)))
-                lines = np.empty(capacity, dtype=np.int64)
-                found = header.lines
-                parsed = header.values
-            else:
-                # The header again before the block: the block's rows read as they would below it.
-                table = parse_csv_floats(
-                    f"{header_text}\n{text}",
-                    source,
-                    columns=columns,
-                    required=required,
-                    max_rows=most - rows,
-                    max_bytes=limit,
-                )
-                if table is None or table.header_line != 1:
-                    return None
-                found = table.lines - 1
-                parsed = table.values
-            if rows + len(found) > capacity:  # the file grew since its line breaks were counted
+                header = block
+                values = np.empty((capacity, len(block.header)))
+            assert values is not None
+            if rows + len(block) > capacity:  # the file grew since its line breaks were counted
                 return None
-            values[rows : rows + len(found)] = parsed
-            lines[rows : rows + len(found)] = found + lines_before
-            rows += len(found)
-            lines_before += block.count(b"\n")
-            if not chunk:
-                break
-    assert header is not None  # the first block parsed, or None was returned
-    return CsvFloats(source, header.header, header.header_line, values[:rows], lines[:rows], None)
+            values[rows : rows + len(block)] = block.values
+            lines[rows : rows + len(block)] = block.lines
+            rows += len(block)
+    except CsvFallback:
+        return None
+    assert header is not None and values is not None  # the header's block comes first, or CsvFallback
+    return CsvFloats(str(path), header.header, header.header_line, values[:rows], lines[:rows], None)
 
 
 # --- typed values --------------------------------------------------------------------------
