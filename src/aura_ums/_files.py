@@ -775,6 +775,7 @@ def csv_blocks(
                     raise CsvFallback
                 header_text = text.splitlines()[found.header_line - 1]
                 lines = found.lines
+                head = True
             else:
                 # The header again before the block: the block's rows read as they would below it.
                 found = _parse_block(
@@ -783,9 +784,10 @@ def csv_blocks(
                 if found is None or found.header_line != 1:
                     raise CsvFallback
                 lines = np.asarray(found.lines, dtype=np.int64) - 1 + lines_before
+                head = False
             rows += len(found)
             lines_before += block.count(b"\n")
-            if len(found) or rows == len(found):
+            if len(found) or head:
                 lines = np.asarray(lines, dtype=np.int64)
                 if isinstance(found, CsvFloats):
                     yield CsvFloats(source, found.header, found.header_line, found.values, lines, None)
