@@ -8,6 +8,7 @@ written log reads back equal.
 from __future__ import annotations
 
 import contextlib
+import copy
 import csv
 import io
 import json
@@ -23,9 +24,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import (
+    CsvFallback,
     CsvFloats,
+    CsvTable,
     Fields,
     atomic_path,
+    csv_blocks,
     describe,
     key_path,
     load_toml,
@@ -195,14 +199,21 @@ class _CsvFile:
     (:func:`read_text`, :func:`parse_csv`).
     """
 
-    def __init__(self, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> None:
+    def __init__(
+        self,
+        path: Path,
+        columns: Mapping[str, str],
+        required: Sequence[str],
+        block: CsvFloats | CsvTable | None = None,
+    ) -> None:
         self.source = str(path)
         self.units = columns
         self.cells: dict[str, list[str]] = {}
         self.values: dict[str, NDArray[np.float64]] | None = None
         self.fast: CsvFloats | None = None
-        numeric = all(unit != "text" for unit in columns.values())
-        if numeric:
+        if isinstance(block, CsvFloats):
+            self.fast = block
+        elif block is None and all(unit != "text" for unit in columns.values()):
             self.fast = read_csv_floats(
                 path, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
             )
@@ -211,13 +222,46 @@ class _CsvFile:
             self.header = self.fast.header
             self.values = {name: self.fast.values[:, index] for index, name in enumerate(self.fast.header)}
         else:
-            text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
-            table = parse_csv(
-                text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
-            )
-            self.lines = table.lines
-            self.header = table.header
-            self.cells = table.columns()
+            if block is None:
+                text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
+                block = parse_csv(
+                    text, self.source, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
+                )
+            assert isinstance(block, CsvTable)
+            self.lines = block.lines
+            self.header = block.header
+            self.cells = block.columns()
+
+    @classmethod
+    def blocks(cls, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> Iterator[_CsvFile]:
+        """Yield the file's rows block by block (:func:`csv_blocks`), each block a table of its own.
+
+        A file the blocks cannot read exactly is read whole (its message, when it is
+        malformed, is that of the whole file), and only its rows after those already
+        yielded are yielded.
+        """
+        numeric = all(unit != "text" for unit in columns.values())
+        done = 0  # the last line yielded
+        try:
+            for block in csv_blocks(
+                path, columns=tuple(columns), required=required, numeric=numeric, max_bytes=LOG_CSV_MAX_BYTES
+            ):
+                table = cls(path, columns, required, block)
+                if len(table):
+                    done = int(table.lines[-1])
+                yield table
+        except CsvFallback:
+            whole = cls(path, columns, required, _text_table(path, columns, required))
+            yield whole.after(done)
+
+    def after(self, line: int) -> _CsvFile:
+        """Return this table's rows after line ``line`` (all of them for 0)."""
+        first = int(np.searchsorted(np.asarray(self.lines, dtype=np.int64), line, side="right"))
+        table = copy.copy(self)
+        table.lines = self.lines[first:]
+        assert self.fast is None  # the whole file read cell by cell
+        table.cells = {name: cells[first:] for name, cells in self.cells.items()}
+        return table
 
     def __len__(self) -> int:
         return len(self.lines)
@@ -331,6 +375,12 @@ class _CsvFile:
     def need_rows(self) -> None:
         if not len(self.lines):
             self.fail("", "expected at least one data row, got none")
+
+
+def _text_table(path: Path, columns: Mapping[str, str], required: Sequence[str]) -> CsvTable:
+    """Read a CSV file of a log whole and cell by cell (the reader whose messages name the line)."""
+    text = read_text(path, kind="CSV", max_bytes=LOG_CSV_MAX_BYTES)
+    return parse_csv(text, str(path), columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES)
 
 
 def _within(values: NDArray[np.float64], bounds: Range) -> NDArray[np.bool_]:
@@ -494,8 +544,16 @@ def _read_landmarks(path: Path, units: Units) -> tuple[LogLandmark, ...]:
     return tuple(result)
 
 
-def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogObservation, ...]:
-    table = _CsvFile(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"))
+#: The columns of a block of ``observations.csv``: time (s), landmark id, bearing (rad),
+#: range (m; NaN when not given), bearing_error (rad; NaN), range_error (m; NaN), file line.
+ObservationColumns = tuple[
+    NDArray[np.float64], list[str], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+    NDArray[np.float64], NDArray[np.int64],
+]  # fmt: skip
+
+
+def _observation_columns(table: _CsvFile, units: Units, known: set[str]) -> ObservationColumns:
+    """Check and convert the rows of one table (a whole file or a block) of ``observations.csv``."""
     times = table.times(units, strict=False)
     ids = table.texts("landmark_id")
     for row, ident in enumerate(ids):
@@ -508,6 +566,13 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
     table.at_least("range", measured)
     table.at_least("bearing_error", bearing_error, positive=True)
     table.at_least("range_error", range_error)
+    lines = np.asarray(table.lines, dtype=np.int64)
+    return times, ids, bearing, measured, bearing_error, range_error, lines
+
+
+def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogObservation, ...]:
+    table = _CsvFile(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"))
+    times, ids, bearing, measured, bearing_error, range_error, lines = _observation_columns(table, units, known)
     # Every column was checked above, as LogObservation checks each value.
     return tuple(
         LogObservation._checked(*values)
@@ -518,18 +583,87 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
             _given(measured),
             _given(bearing_error),
             _given(range_error),
-            table.lines,
+            lines.tolist(),
             strict=True,
         )
     )
 
 
+def observation_blocks(path: Path, units: Units, known: set[str]) -> Iterator[ObservationColumns]:
+    """Yield the checked columns of ``observations.csv`` block by block (:meth:`_CsvFile.blocks`).
+
+    Each block is checked as :func:`load_log` checks the whole file, and its times
+    against the previous block's; when a check fails, the whole file is read again, so
+    the message is exactly :func:`load_log`'s (naming the fault it finds first).
+    """
+
+    def whole() -> None:
+        _read_observations(path, units, known)
+
+    previous = -math.inf
+    for table in _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing")):
+        with _as_whole(whole):
+            columns = _observation_columns(table, units, known)
+        times = columns[0]
+        if times.size:
+            if times[0] < previous:
+                _whole_fails(whole)
+            previous = float(times[-1])
+            yield columns
+
+
+@contextlib.contextmanager
+def _as_whole(whole: Callable[[], object]) -> Iterator[None]:
+    """Fail as the whole file's reader fails when a block's check fails."""
+    try:
+        yield
+    except FileFormatError:
+        _whole_fails(whole)
+
+
+def _whole_fails(whole: Callable[[], object]) -> NoReturn:
+    whole()  # raises the whole file's message
+    raise AssertionError("a block failed a check the whole file passes")  # pragma: no cover
+
+
 def _read_odometry(path: Path, units: Units) -> Odometry:
     table = _CsvFile(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"))
     table.need_rows()
+    return Odometry(*_odometry_columns(table, units))
+
+
+OdometryColumns = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+
+def _odometry_columns(table: _CsvFile, units: Units) -> OdometryColumns:
     time = table.times(units, strict=True)
     table.no_clock_jump(time)
-    return Odometry(time, table.numbers("v", units), table.numbers("omega", units))
+    return time, table.numbers("v", units), table.numbers("omega", units)
+
+
+def odometry_blocks(path: Path, units: Units) -> Iterator[OdometryColumns]:
+    """Yield the checked time (s), v (m/s) and omega (rad/s) of ``odometry.csv`` block by block.
+
+    Checked as :func:`load_log` checks the whole file (times strictly increasing and
+    without clock jumps across blocks too); a failing check fails with the whole file's
+    message. At least one block is yielded.
+    """
+
+    def whole() -> None:
+        _read_odometry(path, units)
+
+    previous = math.nan
+    for table in _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega")):
+        with _as_whole(whole):
+            columns = _odometry_columns(table, units)
+        time = columns[0]
+        if time.size:
+            if not math.isnan(previous) and (not time[0] > previous or time[0] - previous > ROW_GAP.high):
+                _whole_fails(whole)
+            previous = float(time[-1])
+            yield columns
+    if math.isnan(previous):
+        _whole_fails(whole)  # no rows
 
 
 def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
@@ -546,10 +680,40 @@ def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
 def _read_groundtruth(path: Path, units: Units) -> GroundTruth:
     table = _CsvFile(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"))
     table.need_rows()
+    return GroundTruth(*_groundtruth_columns(table, units))
+
+
+TruthColumns = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+
+def _groundtruth_columns(table: _CsvFile, units: Units) -> TruthColumns:
     time = table.times(units, strict=True)
-    return GroundTruth(
-        time, table.numbers("x", units), table.numbers("y", units), table.numbers("heading", units)
-    )
+    return time, table.numbers("x", units), table.numbers("y", units), table.numbers("heading", units)
+
+
+def groundtruth_blocks(path: Path, units: Units) -> Iterator[TruthColumns]:
+    """Yield the checked time (s), x, y (m) and heading (rad, as in the file) of ``groundtruth.csv`` block by block.
+
+    Checked as :func:`load_log` checks the whole file (times strictly increasing across
+    blocks too); a failing check fails with the whole file's message. At least one block
+    is yielded.
+    """
+
+    def whole() -> None:
+        _read_groundtruth(path, units)
+
+    previous = math.nan
+    for table in _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading")):
+        with _as_whole(whole):
+            columns = _groundtruth_columns(table, units)
+        time = columns[0]
+        if time.size:
+            if not math.isnan(previous) and not time[0] > previous:
+                _whole_fails(whole)
+            previous = float(time[-1])
+            yield columns
+    if math.isnan(previous):
+        _whole_fails(whole)  # no rows
 
 
 # --- writing -----------------------------------------------------------------------------------
