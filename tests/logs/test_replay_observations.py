@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from aura_ums.logs import LogObservation, SensorBounds, observation_for, synthetic_log
-from aura_ums.logs._replay import _observations
+from aura_ums.logs._replay import _observations, _row_of
 from aura_ums.uncertainty import LandmarkClass
 
 BOUNDS = (SensorBounds(0.02), SensorBounds(0.05, 0.1, 0.02, 0.03))
@@ -27,6 +27,6 @@ def test_the_replays_observations_are_observation_for_of_each_row(
     ]
     offset = (0.25, -0.125)
     expected = [observation_for(row, landmark_class, bounds, sensor_offset=offset) for row in rows]
-    found = _observations(rows, landmark_class is LandmarkClass.VERTICAL_LINE, bounds, offset)
+    found = _observations([_row_of(row) for row in rows], landmark_class is LandmarkClass.VERTICAL_LINE, bounds, offset)
     assert found == expected
     assert [type(o) for o in found] == [type(o) for o in expected]

@@ -9,7 +9,7 @@ import os
 import secrets
 import time as _time
 import types
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
@@ -23,7 +23,9 @@ from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
-from aura_ums.logs._log import LogObservation, RobotLog
+from aura_ums.logs._io import _given
+from aura_ums.logs._log import LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
+from aura_ums.logs._stream import LogStream, OdometryReports, TruthWindow
 from aura_ums.logs._odometry import ReverseMotion
 from aura_ums.logs._state import ReplayState
 from aura_ums.manager import (
@@ -252,6 +254,26 @@ class ReplayTrace:
             np.zeros(count, dtype=np.int8),
             np.zeros(count, dtype=bool),
             np.zeros(count, dtype=np.int64),
+        )
+
+    @classmethod
+    def concatenate(cls, traces: Sequence[ReplayTrace]) -> ReplayTrace:
+        """Return the steps of ``traces`` one after the other.
+
+        Examples
+        --------
+        >>> len(ReplayTrace.concatenate([ReplayTrace.empty(2), ReplayTrace.empty(1)]))
+        3
+        >>> len(ReplayTrace.concatenate([]))
+        0
+        """
+        if not traces:
+            return cls.empty(0)
+        return cls(
+            *(
+                np.concatenate([getattr(trace, name) for trace in traces])
+                for name in cls.__dataclass_fields__
+            )
         )
 
     @classmethod
@@ -490,19 +512,33 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
     (Class I, heights from the row or the meta) or :class:`~aura_ums.uncertainty.PointLandmark`
     (Class II, at the row's mid height).
     """
-    points = [(lm.x, lm.y) for lm in log.landmarks]
-    if log.meta.start is not None:
-        points.append((log.meta.start.x, log.meta.start.y))
-    if log.groundtruth is not None:
-        truth = log.groundtruth
-        points += [(float(truth.x.min()), float(truth.y.min())), (float(truth.x.max()), float(truth.y.max()))]
+    truth = log.groundtruth
+    box = None
+    if truth is not None:
+        box = (float(truth.x.min()), float(truth.y.min()), float(truth.x.max()), float(truth.y.max()))
+    return _meadow_map(log.meta, log.landmarks, box, landmark_class, margin)
+
+
+def _meadow_map(
+    meta: LogMeta,
+    landmarks: Sequence[LogLandmark],
+    truth_box: tuple[float, float, float, float] | None,
+    landmark_class: LandmarkClass,
+    margin: float,
+) -> MeadowMap:
+    """:func:`log_meadow_map` from the log's parts (the ground truth's extent, not its rows)."""
+    points = [(lm.x, lm.y) for lm in landmarks]
+    if meta.start is not None:
+        points.append((meta.start.x, meta.start.y))
+    if truth_box is not None:
+        points += [(truth_box[0], truth_box[1]), (truth_box[2], truth_box[3])]
     xy = np.array(points, dtype=np.float64).reshape(-1, 2)
     if not xy.size:
         xy = np.zeros((1, 2))
     (x0, y0), (x1, y1) = xy.min(axis=0) - margin - 1.0, xy.max(axis=0) + margin + 1.0
     records = []
-    for lm in log.landmarks:
-        bottom, top = lm.heights(log.meta)
+    for lm in landmarks:
+        bottom, top = lm.heights(meta)
         landmark: VerticalLineLandmark | PointLandmark
         if landmark_class is LandmarkClass.VERTICAL_LINE:
             landmark = VerticalLineLandmark(
@@ -514,7 +550,7 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
             )
         records.append(LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, 1.0e6, 0.0))
     arena = ConvexPolygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
-    meadow = Meadow("arena", arena, log.meta.terrain, tuple(lm.id for lm in log.landmarks))
+    meadow = Meadow("arena", arena, meta.terrain, tuple(lm.id for lm in landmarks))
     return MeadowMap([meadow], records)
 
 
@@ -548,26 +584,21 @@ def observation_for(
 
 
 def _observations(
-    rows: Sequence[LogObservation], bearing_only: bool, bounds: SensorBounds, offset: tuple[float, float]
+    rows: Sequence[_Row], bearing_only: bool, bounds: SensorBounds, offset: tuple[float, float]
 ) -> list[Observation]:
     """:func:`observation_for` of each row (``factor`` 1), without checking again what the log checked."""
     found: list[Observation] = []
-    for row in rows:
-        bearing_error = bounds.bearing_error if row.bearing_error is None else row.bearing_error
-        measured = row.range
+    for time, landmark_id, bearing, measured, row_bearing_error, row_range_error in rows:
+        bearing_error = bounds.bearing_error if row_bearing_error is None else row_bearing_error
         if bearing_only or measured is None:
-            found.append(
-                BearingObservation._trusted(row.landmark_id, row.time, row.bearing, bearing_error, offset)
-            )
+            found.append(BearingObservation._trusted(landmark_id, time, bearing, bearing_error, offset))
             continue
-        if row.range_error is not None:
-            low, high = max(0.0, measured - row.range_error), measured + row.range_error
+        if row_range_error is not None:
+            low, high = max(0.0, measured - row_range_error), measured + row_range_error
         else:
             low, high = bounds.range_interval(measured)
         found.append(
-            RangeBearingObservation._trusted(
-                row.landmark_id, row.time, row.bearing, bearing_error, low, high, offset
-            )
+            RangeBearingObservation._trusted(landmark_id, time, bearing, bearing_error, low, high, offset)
         )
     return found
 
@@ -681,8 +712,8 @@ def replay_log(
     ...
     aura_ums.errors.InputError: table: expected a terrain 'floor' (the log's), got none of that name
     """
-    if not isinstance(log, RobotLog):
-        raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
+    if not isinstance(log, (RobotLog, LogStream)):
+        raise InputError(f"log: expected a RobotLog or a LogStream, got {type(log).__name__}")
     if not isinstance(table, TerrainTable):
         raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
     opts = ReplayOptions() if options is None else options
@@ -701,103 +732,362 @@ def replay_log(
     stop = math.inf if until is None else finite_float(until, "until")
     if resume is not None and not isinstance(resume, ReplayState):
         raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")
+    if isinstance(log, LogStream) and (resume is not None or save_state):
+        raise InputError(
+            "log: expected a RobotLog (load_log) to resume or save a replay's state "
+            "(its digest covers the whole log), got a LogStream"
+        )
     log = with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
     envelope_bounds = (
         opts.envelope if opts.envelope is not None else working_bounds.widened(opts.settings.envelope_factor)
     )
-
-    start_time, start_pose = replay_start(log)
+    source = (
+        _stream_source(log, opts, stop, keep_rows=before_frame is not None)
+        if isinstance(log, LogStream)
+        else _whole_source(log, opts, stop, resume)
+    )
     initial = SpatialUncertaintyMap.from_pose(
-        start_pose, log.meta.start_radius, log.meta.start_heading_halfwidth
+        source.start_pose, log.meta.start_radius, log.meta.start_heading_halfwidth
     )
-    meadow_map = log_meadow_map(log, opts.landmark_class, margin=opts.arena_margin)
-    manager = UncertaintyMapManager(initial, meadow_map, table, opts.settings)
+    manager = UncertaintyMapManager(initial, source.meadow_map, table, opts.settings)
     board = Blackboard()
-    frames = frames_after(log, start_time)
-    frame_times = np.array(sorted(frames), dtype=np.float64)
-    end = float(frame_times[-1]) if frame_times.size else start_time
-    report_times, report_turns, report_runs = log.position_report_arrays(
-        frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
-    )
-    first, next_report = 0, 0
     if resume is not None:
-        first, next_report = _resumed_at(resume, log, frames, frame_times, int(report_times.size))
-        manager = UncertaintyMapManager.from_json(resume.manager_json, meadow_map, table, source="resume")
+        manager = UncertaintyMapManager.from_json(resume.manager_json, source.meadow_map, table, source="resume")
         board = Blackboard.from_json(resume.blackboard_json, source="resume")
-    # The frames this replay makes: those after a resumed state's, up to ``until``.
-    last = int(np.searchsorted(frame_times, stop, side="right")) if until is not None else frame_times.size
-    last = max(last, first)
-    trace = ReplayTrace.empty(last - first)
-    if log.groundtruth is not None:
-        trace.truth[:] = log.groundtruth.at(frame_times[first:last])
+    trace = _TraceBuilder()
     maps: list[SpatialUncertaintyMap] = []
-    judge = _Judge(trace)
     offset = log.meta.sensor_offset
     bearing_only = opts.landmark_class is LandmarkClass.VERTICAL_LINE
+    reports = source.reports
+    done = source.first
     with _StepsCsv(steps_csv) as writer:
-        for index, frame_time in enumerate(frame_times[first:last].tolist()):
-            rows = frames[frame_time]
-            working = _observations(rows, bearing_only, working_bounds, offset)
-            envelope = _observations(rows, bearing_only, envelope_bounds, offset) if robust else None
-            due = []
-            while next_report < report_times.size and report_times[next_report] <= frame_time:
-                due.append(
-                    PositionReport(
-                        float(report_times[next_report]),
-                        TurnAndRun(float(report_turns[next_report]), float(report_runs[next_report])),
+        for chunk in source.chunks:
+            report_times, report_turns, report_runs = reports.until(chunk.times)
+            next_report = 0
+            part = trace.start(len(chunk.times))
+            part.time[:] = chunk.times
+            part.truth[:] = source.truth(chunk.times)
+            judge = _Judge(part)
+            rows = chunk.rows
+            for index, frame_time in enumerate(chunk.times.tolist()):
+                frame = rows[chunk.offsets[index] : chunk.offsets[index + 1]]
+                working = _observations(frame, bearing_only, working_bounds, offset)
+                envelope = _observations(frame, bearing_only, envelope_bounds, offset) if robust else None
+                due = []
+                while next_report < report_times.size and report_times[next_report] <= frame_time:
+                    due.append(
+                        PositionReport(
+                            float(report_times[next_report]),
+                            TurnAndRun(float(report_turns[next_report]), float(report_runs[next_report])),
+                        )
                     )
-                )
-                next_report += 1
-            began = _time.perf_counter()
-            for report in due:
-                board.post_report(report)
-            if before_frame is not None:
-                grown = manager.update(board, now=frame_time).map
-                paused = _time.perf_counter()
-                before_frame(frame_time, grown, rows)
-                began += _time.perf_counter() - paused
-            for observation in working:
-                board.identified.post(observation)
-            step = manager.update(board, now=frame_time, envelope=envelope)
-            trace.update_us[index] = (_time.perf_counter() - began) * 1e6
-            trace.time[index] = frame_time
-            trace.accepted[index] = len(step.accepted)
-            trace.rejected[index] = len(step.rejected)
-            trace.state[index] = _STATES.index(step.state)
-            trace.relocalized[index] = step.relocalized
-            trace.excluded[index] = len(step.excluded)
-            judge.add(index, step.map, step.envelope_map)
-            if keep_maps:
-                maps.append(step.map)
-            if judge.full():
-                writer.write(trace, *judge.flush())
-            if after_step is not None:
-                after_step(_step_now(trace, index, step.map, step.envelope_map))
-            if progress is not None:
-                progress(first + index + 1, int(frame_times.size))
-        writer.write(trace, *judge.flush())
+                    next_report += 1
+                began = _time.perf_counter()
+                for report in due:
+                    board.post_report(report)
+                if before_frame is not None:
+                    grown = manager.update(board, now=frame_time).map
+                    paused = _time.perf_counter()
+                    assert chunk.logged is not None
+                    before_frame(frame_time, grown, chunk.logged[chunk.offsets[index] : chunk.offsets[index + 1]])
+                    began += _time.perf_counter() - paused
+                for observation in working:
+                    board.identified.post(observation)
+                step = manager.update(board, now=frame_time, envelope=envelope)
+                part.update_us[index] = (_time.perf_counter() - began) * 1e6
+                part.accepted[index] = len(step.accepted)
+                part.rejected[index] = len(step.rejected)
+                part.state[index] = _STATES.index(step.state)
+                part.relocalized[index] = step.relocalized
+                part.excluded[index] = len(step.excluded)
+                judge.add(index, step.map, step.envelope_map)
+                if keep_maps:
+                    maps.append(step.map)
+                if after_step is not None:
+                    after_step(_step_now(part, index, step.map, step.envelope_map))
+                done += 1
+                if progress is not None:
+                    progress(done, max(source.total, done))
+            judge.flush()
+            writer.write(part, 0, len(part))
+            reports.posted += next_report
+        source.finish()
+    result_trace = trace.build()
     state = None
     if save_state:
+        assert isinstance(log, RobotLog) and source.frames is not None
+        frame_times = source.frame_times
+        last = done
         state = ReplayState(
             log.meta.name,
             last,
-            next_report,
+            reports.posted,
             float(frame_times[last - 1]) if last else math.nan,
-            _digest(frames, frame_times[:last]),
+            _digest(source.frames, frame_times[:last]),
             manager.to_json(),
             board.to_json(),
         )
     return ReplayResult(
         log,
         opts,
-        trace,
+        result_trace,
         types.MappingProxyType(dict(manager.rejected_counts)),
         manager.relocalizations,
         tuple(maps) if keep_maps else None,
         state,
     )
+
+
+# One row of observations.csv as the replay reads it: time (s), landmark id, bearing (rad),
+# range (m), bearing_error (rad) and range_error (m), None where not given.
+_Row = tuple[float, str, float, "float | None", "float | None", "float | None"]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _FrameChunk:
+    """A few frames in time order: their times, and their rows one after the other."""
+
+    times: NDArray[np.float64]
+    offsets: list[int]  # frame i's rows are rows[offsets[i] : offsets[i + 1]]
+    rows: list[_Row]
+    logged: list[LogObservation] | None  # the rows as log rows, for before_frame
+
+
+class _WholeReports:
+    """The position reports of a whole log, made at once (:meth:`RobotLog.position_report_arrays`)."""
+
+    def __init__(self, times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64], posted: int):
+        self.times, self.turns, self.runs = times, turns, runs
+        self.posted = posted
+
+    def until(self, frames: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        """The reports not posted yet up to the last of ``frames``."""
+        stop = int(np.searchsorted(self.times, frames[-1], side="right"))
+        begin = self.posted
+        return self.times[begin:stop], self.turns[begin:stop], self.runs[begin:stop]
+
+    def finish(self) -> None:
+        """Nothing left to read."""
+
+
+class _StreamReports:
+    """:class:`OdometryReports` counting the reports posted."""
+
+    def __init__(self, reports: OdometryReports) -> None:
+        self.reports = reports
+        self.posted = 0
+
+    def until(self, frames: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        return self.reports.until(frames)
+
+    def finish(self) -> None:
+        self.reports.finish()
+
+
+@dataclass(slots=True, eq=False)
+class _Source:
+    """What a replay reads of a log: its start, arena, frames, reports and truth."""
+
+    start_time: float
+    start_pose: Pose
+    meadow_map: MeadowMap
+    chunks: Iterator[_FrameChunk]
+    reports: _WholeReports | _StreamReports
+    truth: Callable[[NDArray[np.float64]], NDArray[np.float64]]
+    total: int  # frames of the log after its start (0 when not known before the end)
+    first: int = 0  # frames done before (a resumed replay)
+    frames: Mapping[float, list[LogObservation]] | None = None
+    frame_times: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
+
+    def finish(self) -> None:
+        self.reports.finish()
+
+
+def _row_of(row: LogObservation) -> _Row:
+    return (row.time, row.landmark_id, row.bearing, row.range, row.bearing_error, row.range_error)
+
+
+def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: ReplayState | None) -> _Source:
+    """A whole log in memory: its frames, reports and truth as :func:`replay_log` always made them."""
+    start_time, start_pose = replay_start(log)
+    meadow_map = log_meadow_map(log, opts.landmark_class, margin=opts.arena_margin)
+    frames = frames_after(log, start_time)
+    frame_times = np.array(sorted(frames), dtype=np.float64)
+    end = float(frame_times[-1]) if frame_times.size else start_time
+    report_arrays = log.position_report_arrays(
+        frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
+    )
+    first, posted = 0, 0
+    if resume is not None:
+        first, posted = _resumed_at(resume, log, frames, frame_times, int(report_arrays[0].size))
+    # The frames this replay makes: those after a resumed state's, up to ``until``.
+    last = int(np.searchsorted(frame_times, stop, side="right")) if math.isfinite(stop) else frame_times.size
+    last = max(last, first)
+
+    def chunks() -> Iterator[_FrameChunk]:
+        for begin in range(first, last, _CHUNK):
+            times = frame_times[begin : min(begin + _CHUNK, last)]
+            logged = [row for frame_time in times.tolist() for row in frames[frame_time]]
+            offsets = [0]
+            for frame_time in times.tolist():
+                offsets.append(offsets[-1] + len(frames[frame_time]))
+            yield _FrameChunk(times, offsets, [_row_of(row) for row in logged], logged)
+
+    truth = log.groundtruth
+
+    def truth_at(times: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.full((len(times), 3), np.nan) if truth is None else truth.at(times)
+
+    return _Source(
+        start_time,
+        start_pose,
+        meadow_map,
+        chunks(),
+        _WholeReports(*report_arrays, posted),
+        truth_at,
+        int(frame_times.size),
+        first,
+        frames,
+        frame_times,
+    )
+
+
+def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_rows: bool) -> _Source:
+    """A log read block by block (:class:`LogStream`): the same frames, reports and truth, in bounded memory."""
+    truth = None
+    if stream.truth_box is not None:
+        truth = TruthWindow(stream.groundtruth_blocks(), stream.max_gap)
+    odometry = None
+    meta = stream.meta
+    if stream.commands is None:
+        odometry = OdometryReports(stream.odometry_blocks(), meta, 0.0, opts.max_interval, opts.reverse)
+        first_motion = odometry.first_time
+    else:
+        commands = stream.commands
+        first_motion = (commands[0].time if commands else math.nan) + meta.delay_s
+        if commands:
+            period = commands[1].time - commands[0].time if len(commands) > 1 else 1e-6
+            first_motion -= period
+    if meta.start is not None:
+        start_time, start_pose = first_motion, meta.start
+    elif truth is None:
+        raise InputError(
+            f"log {meta.name!r}: expected a [start] pose in meta.toml or a groundtruth.csv, got neither"
+        )
+    else:
+        start_time = max(first_motion, truth.first)
+        x, y, heading = truth.at(np.array([start_time]))[0]
+        start_pose = Pose(float(x), float(y), float(heading))
+    meadow_map = _meadow_map(meta, stream.landmarks, stream.truth_box, opts.landmark_class, opts.arena_margin)
+    reports: _WholeReports | _StreamReports
+    if odometry is not None:
+        odometry.low = start_time
+        reports = _StreamReports(odometry)
+    else:
+        whole = RobotLog(meta, stream.landmarks, (), commands=stream.commands)
+        reports = _WholeReports(*whole.position_report_arrays(start=start_time), 0)
+
+    def truth_at(times: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.full((len(times), 3), np.nan) if truth is None else truth.at(times)
+
+    return _Source(
+        start_time,
+        start_pose,
+        meadow_map,
+        _stream_chunks(stream, start_time, stop, keep_rows),
+        reports,
+        truth_at,
+        0,
+    )
+
+
+def _stream_chunks(stream: LogStream, start: float, stop: float, keep_rows: bool) -> Iterator[_FrameChunk]:
+    """The frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time."""
+    pending: list[_Row] = []
+    lines: list[int] = []
+    for times, ids, bearing, measured, bearing_error, range_error, line in stream.observation_blocks():
+        beyond = bool(times.size) and float(times[-1]) > stop
+        wanted = (times > start) & (times <= stop)
+        if not np.all(wanted):
+            keep = np.flatnonzero(wanted)
+            times, bearing, measured = times[keep], bearing[keep], measured[keep]
+            bearing_error, range_error, line = bearing_error[keep], range_error[keep], line[keep]
+            ids = [ids[index] for index in keep.tolist()]
+        pending.extend(
+            zip(
+                times.tolist(),
+                ids,
+                [_wrapped(value) for value in bearing.tolist()],
+                _given(measured),
+                _given(bearing_error),
+                _given(range_error),
+                strict=True,
+            )
+        )
+        if keep_rows:
+            lines.extend(line.tolist())
+        # Whole frames only: the last time of the block may go on in the next one.
+        while pending:
+            chunk, pending, lines = _take_frames(pending, lines, keep_rows, ended=False)
+            if chunk is None:
+                break
+            yield chunk
+        if beyond:
+            break
+    while pending:
+        chunk, pending, lines = _take_frames(pending, lines, keep_rows, ended=True)
+        assert chunk is not None
+        yield chunk
+
+
+def _take_frames(
+    rows: list[_Row], lines: list[int], keep_rows: bool, *, ended: bool
+) -> tuple[_FrameChunk | None, list[_Row], list[int]]:
+    """Split up to :data:`_CHUNK` whole frames off ``rows``; the last one only when ``ended``."""
+    times: list[float] = []
+    offsets: list[int] = []  # where each frame's rows start
+    for index, row in enumerate(rows):
+        if not times or row[0] != times[-1]:
+            if len(times) == _CHUNK:
+                offsets.append(index)
+                return _chunk(times, offsets, rows[:index], lines[:index], keep_rows), rows[index:], lines[index:]
+            offsets.append(index)
+            times.append(row[0])
+    if ended:
+        offsets.append(len(rows))
+        return _chunk(times, offsets, rows, lines, keep_rows), [], []
+    if len(times) <= 1:  # the last frame may go on in the next block
+        return None, rows, lines
+    times.pop()
+    cut = offsets[-1]
+    return _chunk(times, offsets, rows[:cut], lines[:cut], keep_rows), rows[cut:], lines[cut:]
+
+
+def _chunk(times: list[float], offsets: list[int], rows: list[_Row], lines: list[int], keep_rows: bool) -> _FrameChunk:
+    logged = None
+    if keep_rows:
+        logged = [LogObservation._checked(*row, line) for row, line in zip(rows, lines, strict=True)]
+    return _FrameChunk(np.array(times, dtype=np.float64), offsets, rows, logged)
+
+
+
+class _TraceBuilder:
+    """The trace, a chunk of steps at a time."""
+
+    def __init__(self) -> None:
+        self.parts: list[ReplayTrace] = []
+
+    def start(self, count: int) -> ReplayTrace:
+        part = ReplayTrace.empty(count)
+        self.parts.append(part)
+        return part
+
+    def build(self) -> ReplayTrace:
+        if len(self.parts) == 1:
+            return self.parts[0]
+        return ReplayTrace.concatenate(self.parts)
 
 
 def _step_now(

@@ -1,0 +1,382 @@
+"""A log folder read as the replay goes: its large files block by block, in bounded memory.
+
+:func:`open_log` reads what is small (``meta.toml``, ``landmarks.csv``, ``commands.csv``)
+and passes once over ``groundtruth.csv`` (checking it, and the bounding box the replay's
+arena needs); :func:`~aura_ums.logs.replay_log` then reads ``observations.csv``,
+``odometry.csv`` and ``groundtruth.csv`` block by block (:func:`aura_ums._files.csv_blocks`)
+as its frames reach them. The windows below hold only the rows the next frames need, and
+give exactly what the whole-log arrays give (the same arithmetic on the same rows, the
+running sums carried across blocks in the same order).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from aura_ums.errors import FileFormatError, InputError
+from aura_ums.logs._io import (
+    COMMANDS,
+    GROUNDTRUTH,
+    LANDMARKS,
+    META,
+    OBSERVATIONS,
+    ODOMETRY,
+    ObservationColumns,
+    OdometryColumns,
+    TruthColumns,
+    Units,
+    _MetaReader,
+    _read_commands,
+    _read_landmarks,
+    groundtruth_blocks,
+    load_log,
+    observation_blocks,
+    odometry_blocks,
+)
+from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
+from aura_ums.logs._odometry import ReverseMotion, report_times
+from aura_ums.manager import PositionReport
+from aura_ums.geometry import wrap_angle
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LogStream:
+    """A log folder opened to be replayed block by block (:func:`open_log`): memory bounded whatever its length.
+
+    Attributes
+    ----------
+    meta : LogMeta
+        Name, terrain, bounds and start (``meta.toml``).
+    landmarks : tuple of LogLandmark
+        ``landmarks.csv``.
+    path : Path
+        The folder.
+    units : Units
+        The files' units (``meta.toml``'s ``[units]``).
+    commands : tuple of PositionReport or None
+        ``commands.csv`` when the log has one (read whole: recorded commands are few),
+        None for an ``odometry.csv`` (read block by block).
+    truth_box : tuple of float or None
+        ``(x_min, y_min, x_max, y_max)`` of the ground truth, metres; None without
+        ``groundtruth.csv``.
+    max_gap : float
+        Seconds: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
+    """
+
+    meta: LogMeta
+    landmarks: tuple[LogLandmark, ...]
+    path: Path
+    units: Units
+    commands: tuple[PositionReport, ...] | None
+    truth_box: tuple[float, float, float, float] | None
+    max_gap: float = DEFAULT_MAX_TRUTH_GAP
+
+    def observation_blocks(self) -> Iterator[ObservationColumns]:
+        """Yield ``observations.csv``'s checked columns block by block (time, id, bearing, ...)."""
+        known = {landmark.id for landmark in self.landmarks}
+        return observation_blocks(self.path / OBSERVATIONS, self.units, known)
+
+    def odometry_blocks(self) -> Iterator[OdometryColumns]:
+        """Yield ``odometry.csv``'s checked time, v, omega block by block (at least one block)."""
+        return odometry_blocks(self.path / ODOMETRY, self.units)
+
+    def groundtruth_blocks(self) -> Iterator[TruthColumns]:
+        """Yield ``groundtruth.csv``'s checked time, x, y, heading block by block (heading wrapped to (-pi, pi])."""
+        for time, x, y, heading in groundtruth_blocks(self.path / GROUNDTRUTH, self.units):
+            outside = (heading <= -math.pi) | (heading > math.pi)
+            if np.any(outside):
+                heading = heading.copy()
+                heading[outside] = wrap_angle(heading[outside])
+            yield time, x, y, heading
+
+    def load(self) -> RobotLog:
+        """Read the whole log (:func:`~aura_ums.logs.load_log`), for what needs it all at once."""
+        log = load_log(self.path)
+        if log.groundtruth is not None and self.max_gap != log.groundtruth.max_gap:
+            log = dataclasses.replace(log, groundtruth=log.groundtruth.with_max_gap(self.max_gap))
+        return dataclasses.replace(log, meta=self.meta)
+
+
+def open_log(folder: str | os.PathLike[str], *, max_gap: float = DEFAULT_MAX_TRUTH_GAP) -> LogStream:
+    r"""Open a log folder to replay it block by block: what :func:`~aura_ums.logs.load_log` reads, in bounded memory.
+
+    ``meta.toml`` and ``landmarks.csv`` are read and checked now, as is the whole
+    ``groundtruth.csv`` (in blocks; the replay's arena needs its extent before the first
+    frame). ``observations.csv`` and ``odometry.csv`` are checked as the replay reads
+    them, with :func:`~aura_ums.logs.load_log`'s messages (file and line), so a fault in
+    them fails the replay when it gets there (the per-step CSV is then not written).
+
+    Parameters
+    ----------
+    folder : str or path-like
+        A log folder (``docs/log-format.md``).
+    max_gap : float
+        Seconds, > 0: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
+
+    Returns
+    -------
+    LogStream
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`~aura_ums.logs.load_log` for the files read now.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "meta.toml").write_text('name = "demo"\n')
+    >>> _ = (folder / "landmarks.csv").write_text("id,x,y\npole,3.0,0.0\n")
+    >>> _ = (folder / "observations.csv").write_text("time,landmark_id,bearing\n0.5,pole,0.1\n")
+    >>> _ = (folder / "odometry.csv").write_text("time,v,omega\n0.0,0.5,0.0\n1.0,0.5,0.0\n")
+    >>> stream = open_log(folder)
+    >>> stream.meta.name, [block[0].tolist() for block in stream.odometry_blocks()]
+    ('demo', [[0.0, 1.0]])
+    >>> open_log(folder / "missing")      # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: .../missing: expected a log folder, got no such folder
+    """
+    base = Path(folder)
+    if not base.is_dir():
+        raise FileFormatError(str(base), "", "expected a log folder, got no such folder")
+    gap = _max_gap(max_gap, "max_gap")
+    meta, units = _MetaReader(base / META).read(base.name)
+    landmarks = _read_landmarks(base / LANDMARKS, units)
+    has_odometry, has_commands = (base / ODOMETRY).exists(), (base / COMMANDS).exists()
+    if has_odometry == has_commands:
+        got = "both" if has_odometry else "neither"
+        raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
+    commands = None if has_odometry else _read_commands(base / COMMANDS, units)
+    box = None
+    if (base / GROUNDTRUTH).exists():
+        low, high = np.full(2, np.inf), np.full(2, -np.inf)
+        for _, x, y, _ in groundtruth_blocks(base / GROUNDTRUTH, units):
+            low = np.minimum(low, (x.min(), y.min()))
+            high = np.maximum(high, (x.max(), y.max()))
+        box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
+    return LogStream(meta, landmarks, base, units, commands, box, gap)
+
+
+class TruthWindow:
+    """The ground truth at increasing times, from its rows read block by block.
+
+    Gives exactly :meth:`GroundTruth.at` of the whole record: the same interpolation
+    between the same two rows, and the heading unwrapped with the running sum of its
+    corrections carried from block to block (as :func:`numpy.unwrap` sums them).
+    """
+
+    def __init__(self, blocks: Iterator[TruthColumns], max_gap: float) -> None:
+        self.blocks = blocks
+        self.max_gap = max_gap
+        empty = np.empty(0)
+        self.time, self.x, self.y, self.heading, self.unwrapped = empty, empty, empty, empty, empty
+        self.correction: float | None = None  # the running sum of the unwrapping corrections
+        self.ended = False
+        self._read()
+        self.first = float(self.time[0])
+
+    def _read(self) -> None:
+        try:
+            time, x, y, heading = next(self.blocks)
+        except StopIteration:
+            self.ended = True
+            return
+        # numpy.unwrap's arithmetic (period 2 pi), its cumulative sum carried from block to block.
+        joined = np.concatenate((self.heading[-1:], heading))
+        dd = np.diff(joined)
+        ddmod = np.mod(dd - (-np.pi), 2 * np.pi) + (-np.pi)
+        np.copyto(ddmod, np.pi, where=(ddmod == -np.pi) & (dd > 0))
+        ph_correct = ddmod - dd
+        np.copyto(ph_correct, 0, where=abs(dd) < np.pi)
+        if self.correction is None:
+            sums = ph_correct.cumsum()
+        else:
+            sums = np.concatenate(([self.correction], ph_correct)).cumsum()[1:]
+        if self.heading.size:
+            unwrapped = heading + sums
+        else:  # the record's first row is its own unwrapped heading
+            unwrapped = np.array(heading, copy=True)
+            unwrapped[1:] = heading[1:] + sums
+        if sums.size:
+            self.correction = float(sums[-1])
+        self.time = np.concatenate((self.time, time))
+        self.x = np.concatenate((self.x, x))
+        self.y = np.concatenate((self.y, y))
+        self.heading = np.concatenate((self.heading, heading))
+        self.unwrapped = np.concatenate((self.unwrapped, unwrapped))
+
+    def at(self, times: Array) -> Array:
+        """Return the poses at ``times`` (increasing, and not before the times asked before): rows of x, y, heading."""
+        query = np.asarray(times, dtype=np.float64).reshape(-1)
+        if not query.size:
+            return np.empty((0, 3))
+        latest = float(query.max())
+        while not self.ended and self.time[-1] <= latest:
+            self._read()
+        time = self.time
+        out = np.empty((len(query), 3))
+        out[:, 0] = np.interp(query, time, self.x)
+        out[:, 1] = np.interp(query, time, self.y)
+        out[:, 2] = wrap_angle(np.interp(query, time, self.unwrapped))
+        out[(query < self.first) | ((query > time[-1]) if self.ended else False)] = np.nan
+        after = np.searchsorted(time, query, side="right")
+        inner = (after > 0) & (after < len(time))
+        gap = np.zeros(len(query), dtype=bool)
+        before = after[inner] - 1
+        gap[inner] = (time[before + 1] - time[before] > self.max_gap) & (query[inner] > time[before])
+        out[gap] = np.nan
+        # Later times are at or after ``latest``: only its row and those after it are needed.
+        keep = max(int(np.searchsorted(time, latest, side="right")) - 1, 0)
+        if keep:
+            self.time, self.x, self.y = time[keep:], self.x[keep:], self.y[keep:]
+            self.heading, self.unwrapped = self.heading[keep:], self.unwrapped[keep:]
+        return out
+
+
+class OdometryReports:
+    """The position reports of an odometry record read block by block, cut at the frames as they come.
+
+    Gives exactly :meth:`RobotLog.position_report_arrays` of the whole record over the
+    same frames (:func:`~aura_ums.logs.odometry_report_arrays`): each call covers the
+    frames from the previous call's last to its own, and the integrals of the rows
+    dropped before are carried as the whole record's cumulative sums hold them.
+    """
+
+    def __init__(
+        self,
+        blocks: Iterator[OdometryColumns],
+        meta: LogMeta,
+        start: float,
+        max_interval: float,
+        reverse: ReverseMotion,
+    ) -> None:
+        self.blocks = blocks
+        self.meta = meta
+        self.low = start
+        self.max_interval = max_interval
+        self.reverse = reverse
+        empty = np.empty(0)
+        self.time, self.v, self.omega = empty, empty, empty
+        self.row = 0  # index in the whole record of the window's first row
+        self.read = 0  # rows read so far
+        # The integrals (turn, forward, backward) from the record's first row to the window's.
+        self.carry: tuple[float, float, float] | None = None
+        self.ended = False
+        self._read()
+
+    @property
+    def first_time(self) -> float:
+        """The (delayed) time of the record's first row, s."""
+        return float(self.time[0]) if self.row == 0 else math.nan
+
+    def _read(self) -> None:
+        try:
+            time, v, omega = next(self.blocks)
+        except StopIteration:
+            self.ended = True
+            return
+        reversing = v < 0.0
+        if self.reverse is ReverseMotion.ERROR and np.any(reversing):
+            row = int(np.argmax(reversing))
+            raise InputError(
+                f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
+                f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), "
+                f"got {float(v[row])!r} at row {self.read + row}"
+            )
+        self.read += len(time)
+        self.time = np.concatenate((self.time, time + self.meta.delay_s))
+        self.v = np.concatenate((self.v, v))
+        self.omega = np.concatenate((self.omega, omega))
+
+    def until(self, frames: Array) -> tuple[Array, Array, Array]:
+        """Return the reports (times, turns, runs) after the previous call's last frame up to ``frames[-1]``.
+
+        ``frames``: the next frame times, increasing, after the previous call's.
+        """
+        high = float(frames[-1])
+        while not self.ended and self.time[-1] <= high:
+            self._read()
+        t, forward, angular = self.time, self.v, self.omega
+        reversing = forward < 0.0
+        boundaries = frames
+        if np.any(reversing):
+            changes = np.flatnonzero(np.diff(reversing.astype(np.int8)) != 0) + 1
+            boundaries = np.concatenate((frames, t[changes]))
+        times = report_times(boundaries, self.low, high, self.max_interval)
+        edges = np.concatenate(([self.low], times))
+        carry = self.carry
+        meta = self.meta
+        turn = np.diff(self._integral(angular, edges, None if carry is None else carry[0])) * meta.turn_scale
+        ahead_sum = self._integral(np.maximum(forward, 0.0), edges, None if carry is None else carry[1])
+        back_sum = self._integral(np.maximum(-forward, 0.0), edges, None if carry is None else carry[2])
+        ahead = np.maximum(np.diff(ahead_sum) * meta.run_scale, 0.0)
+        back = np.maximum(np.diff(back_sum) * meta.run_scale, 0.0)
+        self._drop_before(high)
+        self.low = high
+        if len(times) == 0:
+            return times, times, times
+        flipped = back > 0.0
+        if not np.any(flipped):
+            return times, turn, ahead
+        count = np.where(flipped, 2, 1)
+        first = np.cumsum(count) - count
+        out_times = np.repeat(times, count)
+        out_turns = np.repeat(turn, count)
+        out_runs = np.repeat(ahead, count)
+        out_turns[first[flipped]] = turn[flipped] + math.pi
+        out_runs[first[flipped]] = back[flipped]
+        out_turns[first[flipped] + 1] = -math.pi
+        out_runs[first[flipped] + 1] = 0.0
+        return out_times, out_turns, out_runs
+
+    def finish(self) -> None:
+        """Read (and check) the rows after the last frame: a replay checks the whole record, as load_log does."""
+        while not self.ended:
+            self.time, self.v, self.omega = self.time[-1:], self.v[-1:], self.omega[-1:]
+            self._read()
+
+    def _sums(self, values: Array, carry: float | None) -> Array:
+        """The integral from the record's first row to each row of the window (cumulative_integral's)."""
+        steps = values[:-1] * np.diff(self.time)
+        if carry is None:
+            return np.concatenate(([0.0], np.cumsum(steps)))
+        return np.cumsum(np.concatenate(([carry], steps)))
+
+    def _integral(self, values: Array, query: Array, carry: float | None) -> Array:
+        # cumulative_integral's arithmetic, on the window's rows from the carried sums.
+        at_rows = self._sums(values, carry)
+        t = self.time
+        # Not ended: every query is before the window's last row, which is then not the record's.
+        clipped = np.clip(query, t[0], t[-1])
+        row = np.clip(np.searchsorted(t, clipped, side="right") - 1, 0, len(t) - 1)
+        partial = np.where(row < len(t) - 1, values[row] * (clipped - t[row]), 0.0)
+        result: Array = at_rows[row] + partial
+        return result
+
+    def _drop_before(self, high: float) -> None:
+        """Drop the rows before the one holding ``high``, carrying their integrals."""
+        keep = max(int(np.searchsorted(self.time, high, side="right")) - 1, 0)
+        if not keep:
+            return
+        carry = self.carry
+        sums = [
+            float(self._sums(values, None if carry is None else carry[index])[keep])
+            for index, values in enumerate(
+                (self.omega, np.maximum(self.v, 0.0), np.maximum(-self.v, 0.0))
+            )
+        ]
+        self.carry = (sums[0], sums[1], sums[2])
+        self.time, self.v, self.omega = self.time[keep:], self.v[keep:], self.omega[keep:]
+        self.row += keep
