@@ -808,7 +808,9 @@ def _parse_block(
 ) -> CsvFloats | CsvTable | None:
     """One block of :func:`csv_blocks`: its rows, or None when it cannot be read exactly."""
     if numeric:
-        return parse_csv_floats(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
+        return parse_csv_floats(
+            text, source, columns=columns, required=required, max_rows=most, max_bytes=limit
+        )
     try:
         return parse_csv(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
     except FileFormatError:

@@ -27,6 +27,8 @@ def test_the_replays_observations_are_observation_for_of_each_row(
     ]
     offset = (0.25, -0.125)
     expected = [observation_for(row, landmark_class, bounds, sensor_offset=offset) for row in rows]
-    found = _observations([_row_of(row) for row in rows], landmark_class is LandmarkClass.VERTICAL_LINE, bounds, offset)
+    found = _observations(
+        [_row_of(row) for row in rows], landmark_class is LandmarkClass.VERTICAL_LINE, bounds, offset
+    )
     assert found == expected
     assert [type(o) for o in found] == [type(o) for o in expected]

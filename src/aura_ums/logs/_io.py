@@ -160,6 +160,10 @@ _FIELD_PLACES["start"] = "[start]"
 #: written with ``repr`` floats (as :func:`write_log` writes) takes up to ~80 bytes.
 LOG_CSV_MAX_BYTES = 256 * 1024 * 1024
 
+#: Bytes a streamed replay reads of a log's CSV file at a time (:func:`aura_ums.logs.open_log`):
+#: its rows, parsed, cost a few times that while they are in use, whatever the log's length.
+STREAM_BLOCK_BYTES = 512 * 1024
+
 #: Line of the first data row in the CSV files :func:`write_log` writes (a comment, then the header).
 FIRST_ROW_LINE = 3
 
@@ -233,7 +237,9 @@ class _CsvFile:
             self.cells = block.columns()
 
     @classmethod
-    def blocks(cls, path: Path, columns: Mapping[str, str], required: Sequence[str]) -> Iterator[_CsvFile]:
+    def blocks(
+        cls, path: Path, columns: Mapping[str, str], required: Sequence[str], block_bytes: int
+    ) -> Iterator[_CsvFile]:
         """Yield the file's rows block by block (:func:`csv_blocks`), each block a table of its own.
 
         A file the blocks cannot read exactly is read whole (its message, when it is
@@ -244,7 +250,12 @@ class _CsvFile:
         done = 0  # the last line yielded
         try:
             for block in csv_blocks(
-                path, columns=tuple(columns), required=required, numeric=numeric, max_bytes=LOG_CSV_MAX_BYTES
+                path,
+                columns=tuple(columns),
+                required=required,
+                numeric=numeric,
+                max_bytes=LOG_CSV_MAX_BYTES,
+                block_bytes=block_bytes,
             ):
                 table = cls(path, columns, required, block)
                 if len(table):
@@ -572,7 +583,9 @@ def _observation_columns(table: _CsvFile, units: Units, known: set[str]) -> Obse
 
 def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogObservation, ...]:
     table = _CsvFile(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"))
-    times, ids, bearing, measured, bearing_error, range_error, lines = _observation_columns(table, units, known)
+    times, ids, bearing, measured, bearing_error, range_error, lines = _observation_columns(
+        table, units, known
+    )
     # Every column was checked above, as LogObservation checks each value.
     return tuple(
         LogObservation._checked(*values)
@@ -589,7 +602,9 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
     )
 
 
-def observation_blocks(path: Path, units: Units, known: set[str]) -> Iterator[ObservationColumns]:
+def observation_blocks(
+    path: Path, units: Units, known: set[str], block_bytes: int = STREAM_BLOCK_BYTES
+) -> Iterator[ObservationColumns]:
     """Yield the checked columns of ``observations.csv`` block by block (:meth:`_CsvFile.blocks`).
 
     Each block is checked as :func:`load_log` checks the whole file, and its times
@@ -601,7 +616,7 @@ def observation_blocks(path: Path, units: Units, known: set[str]) -> Iterator[Ob
         _read_observations(path, units, known)
 
     previous = -math.inf
-    for table in _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing")):
+    for table in _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"), block_bytes):
         with _as_whole(whole):
             columns = _observation_columns(table, units, known)
         times = columns[0]
@@ -641,7 +656,9 @@ def _odometry_columns(table: _CsvFile, units: Units) -> OdometryColumns:
     return time, table.numbers("v", units), table.numbers("omega", units)
 
 
-def odometry_blocks(path: Path, units: Units) -> Iterator[OdometryColumns]:
+def odometry_blocks(
+    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES
+) -> Iterator[OdometryColumns]:
     """Yield the checked time (s), v (m/s) and omega (rad/s) of ``odometry.csv`` block by block.
 
     Checked as :func:`load_log` checks the whole file (times strictly increasing and
@@ -653,7 +670,7 @@ def odometry_blocks(path: Path, units: Units) -> Iterator[OdometryColumns]:
         _read_odometry(path, units)
 
     previous = math.nan
-    for table in _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega")):
+    for table in _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"), block_bytes):
         with _as_whole(whole):
             columns = _odometry_columns(table, units)
         time = columns[0]
@@ -691,7 +708,9 @@ def _groundtruth_columns(table: _CsvFile, units: Units) -> TruthColumns:
     return time, table.numbers("x", units), table.numbers("y", units), table.numbers("heading", units)
 
 
-def groundtruth_blocks(path: Path, units: Units) -> Iterator[TruthColumns]:
+def groundtruth_blocks(
+    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES
+) -> Iterator[TruthColumns]:
     """Yield the checked time (s), x, y (m) and heading (rad, as in the file) of ``groundtruth.csv`` block by block.
 
     Checked as :func:`load_log` checks the whole file (times strictly increasing across
@@ -703,7 +722,7 @@ def groundtruth_blocks(path: Path, units: Units) -> Iterator[TruthColumns]:
         _read_groundtruth(path, units)
 
     previous = math.nan
-    for table in _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading")):
+    for table in _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"), block_bytes):
         with _as_whole(whole):
             columns = _groundtruth_columns(table, units)
         time = columns[0]

@@ -270,10 +270,7 @@ class ReplayTrace:
         if not traces:
             return cls.empty(0)
         return cls(
-            *(
-                np.concatenate([getattr(trace, name) for trace in traces])
-                for name in cls.__dataclass_fields__
-            )
+            *(np.concatenate([getattr(trace, name) for trace in traces]) for name in cls.__dataclass_fields__)
         )
 
     @classmethod
@@ -754,7 +751,9 @@ def replay_log(
     manager = UncertaintyMapManager(initial, source.meadow_map, table, opts.settings)
     board = Blackboard()
     if resume is not None:
-        manager = UncertaintyMapManager.from_json(resume.manager_json, source.meadow_map, table, source="resume")
+        manager = UncertaintyMapManager.from_json(
+            resume.manager_json, source.meadow_map, table, source="resume"
+        )
         board = Blackboard.from_json(resume.blackboard_json, source="resume")
     trace = _TraceBuilder()
     maps: list[SpatialUncertaintyMap] = []
@@ -791,7 +790,9 @@ def replay_log(
                     grown = manager.update(board, now=frame_time).map
                     paused = _time.perf_counter()
                     assert chunk.logged is not None
-                    before_frame(frame_time, grown, chunk.logged[chunk.offsets[index] : chunk.offsets[index + 1]])
+                    before_frame(
+                        frame_time, grown, chunk.logged[chunk.offsets[index] : chunk.offsets[index + 1]]
+                    )
                     began += _time.perf_counter() - paused
                 for observation in working:
                     board.identified.post(observation)
@@ -858,7 +859,9 @@ class _FrameChunk:
 class _WholeReports:
     """The position reports of a whole log, made at once (:meth:`RobotLog.position_report_arrays`)."""
 
-    def __init__(self, times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64], posted: int):
+    def __init__(
+        self, times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64], posted: int
+    ):
         self.times, self.turns, self.runs = times, turns, runs
         self.posted = posted
 
@@ -1052,7 +1055,11 @@ def _take_frames(
         if not times or row[0] != times[-1]:
             if len(times) == _CHUNK:
                 offsets.append(index)
-                return _chunk(times, offsets, rows[:index], lines[:index], keep_rows), rows[index:], lines[index:]
+                return (
+                    _chunk(times, offsets, rows[:index], lines[:index], keep_rows),
+                    rows[index:],
+                    lines[index:],
+                )
             offsets.append(index)
             times.append(row[0])
     if ended:
@@ -1065,12 +1072,13 @@ def _take_frames(
     return _chunk(times, offsets, rows[:cut], lines[:cut], keep_rows), rows[cut:], lines[cut:]
 
 
-def _chunk(times: list[float], offsets: list[int], rows: list[_Row], lines: list[int], keep_rows: bool) -> _FrameChunk:
+def _chunk(
+    times: list[float], offsets: list[int], rows: list[_Row], lines: list[int], keep_rows: bool
+) -> _FrameChunk:
     logged = None
     if keep_rows:
         logged = [LogObservation._checked(*row, line) for row, line in zip(rows, lines, strict=True)]
     return _FrameChunk(np.array(times, dtype=np.float64), offsets, rows, logged)
-
 
 
 class _TraceBuilder:

@@ -373,9 +373,7 @@ class OdometryReports:
         carry = self.carry
         sums = [
             float(self._sums(values, None if carry is None else carry[index])[keep])
-            for index, values in enumerate(
-                (self.omega, np.maximum(self.v, 0.0), np.maximum(-self.v, 0.0))
-            )
+            for index, values in enumerate((self.omega, np.maximum(self.v, 0.0), np.maximum(-self.v, 0.0)))
         ]
         self.carry = (sums[0], sums[1], sums[2])
         self.time, self.v, self.omega = self.time[keep:], self.v[keep:], self.omega[keep:]
