@@ -66,6 +66,8 @@ _CHUNK = 1024
 # up to 4096 point-edge pairs: below that, the batched arithmetic is the same, bit for bit).
 _BATCHED_VERTICES = 1024
 _STATES = tuple(ManagerState)
+# HeadingWedge.width caps a wedge at the full circle.
+_FULL_CIRCLE = 2.0 * math.pi
 
 
 @dataclass(frozen=True, slots=True)
@@ -812,7 +814,7 @@ def replay_log(
                 if progress is not None:
                     progress(done, max(source.total, done))
             judge.flush()
-            writer.write(part, 0, len(part))
+            writer.write(part)
             reports.posted += next_report
         source.finish()
     result_trace = trace.build()
@@ -1122,87 +1124,121 @@ def _step_now(
 
 
 class _Judge:
-    """Collects the maps of a few steps, then judges the truth against them all at once.
+    """Collects the maps of a chunk of steps, then measures and judges them all at once.
 
-    Gives exactly :meth:`SpatialUncertaintyMap.contains`: the same arithmetic, element by
-    element, over the vertices of many polygons together instead of a call per map
-    (which costs more than the map's update on a long log).
+    Gives exactly :attr:`SpatialUncertaintyMap.area`, ``wedge.width`` and
+    :meth:`SpatialUncertaintyMap.contains`: the same arithmetic, element by element (and
+    the area's two dot products polygon by polygon), over the vertices of many polygons
+    together instead of a few calls per map (which cost more than the map's update on a
+    long log).
     """
 
     def __init__(self, trace: ReplayTrace) -> None:
         self.trace = trace
-        self.first = 0
-        self.indices: list[int] = []
         self.working: list[SpatialUncertaintyMap] = []
         self.envelope: list[tuple[int, SpatialUncertaintyMap]] = []
 
     def add(self, index: int, working: SpatialUncertaintyMap, envelope: SpatialUncertaintyMap | None) -> None:
-        trace = self.trace
-        trace.area_m2[index] = working.area
-        trace.wedge_width_rad[index] = working.wedge.width
-        self.indices.append(index)
+        """Keep step ``index``'s maps (steps are added in order from 0)."""
         self.working.append(working)
         if envelope is not None:
             self.envelope.append((index, envelope))
 
-    def full(self) -> bool:
-        return len(self.indices) >= _CHUNK
-
-    def flush(self) -> tuple[int, int]:
-        """Judge the collected steps; return the range of step indices done."""
+    def flush(self) -> None:
+        """Measure the collected steps' working maps and judge the truth against both maps."""
         trace = self.trace
-        if self.indices:
-            steps = np.array(self.indices)
-            known = ~np.isnan(trace.truth[steps, 0])
-            judged = steps[known]
-            trace.inside[judged] = _contains(
-                [m for m, k in zip(self.working, known, strict=True) if k], trace.truth[judged]
+        count = len(self.working)
+        if count:
+            polygons = [step_map.polygon for step_map in self.working]
+            vertices = [polygon.vertices for polygon in polygons]
+            wedges = _wedges(self.working)
+            trace.area_m2[:count] = _areas(vertices)
+            trace.wedge_width_rad[:count] = np.minimum(wedges[:, 1] + wedges[:, 2], _FULL_CIRCLE)
+            known = np.flatnonzero(~np.isnan(trace.truth[:count, 0]))
+            if known.size:
+                chosen = known.tolist()
+                trace.inside[known] = _contains(
+                    [self.working[i] for i in chosen],
+                    trace.truth[known],
+                    [vertices[i] for i in chosen],
+                    trace.area_m2[known],
+                    wedges[known],
+                )
+        with_envelope = [(i, m) for i, m in self.envelope if not math.isnan(trace.truth[i, 0])]
+        if with_envelope:
+            at = np.array([i for i, _ in with_envelope])
+            maps = [m for _, m in with_envelope]
+            vertices = [m.polygon.vertices for m in maps]
+            trace.envelope_inside[at] = _contains(
+                maps, trace.truth[at], vertices, _areas(vertices), _wedges(maps)
             )
-            with_envelope = [(i, m) for i, m in self.envelope if not math.isnan(trace.truth[i, 0])]
-            if with_envelope:
-                at = np.array([i for i, _ in with_envelope])
-                trace.envelope_inside[at] = _contains([m for _, m in with_envelope], trace.truth[at])
-        done = (self.first, self.first + len(self.indices))
-        self.first = done[1]
-        self.indices, self.working, self.envelope = [], [], []
-        return done
+        self.working, self.envelope = [], []
 
 
-def _contains(maps: Sequence[SpatialUncertaintyMap], poses: NDArray[np.float64]) -> NDArray[np.int8]:
-    """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``)."""
-    result = np.zeros(len(maps), dtype=np.int8)
-    batched: list[int] = []
-    for index, step_map in enumerate(maps):
-        # A sliced map is judged by its slices (its polygon and wedge are only their summary).
-        if (
-            not step_map.is_sliced
-            and 3 <= len(step_map.polygon.vertices) <= _BATCHED_VERTICES
-            and (step_map.polygon.area > 0.0)
-        ):
-            batched.append(index)
-        else:  # a sliced map, a point, a segment, or a huge polygon: its own test
-            x, y, heading = poses[index].tolist()
-            result[index] = step_map.contains(x, y, heading)
-    if not batched:
-        return result
-    chosen = [maps[index] for index in batched]
-    counts = np.array([len(m.polygon.vertices) for m in chosen])
+def _wedges(maps: Sequence[SpatialUncertaintyMap]) -> NDArray[np.float64]:
+    """Each map's wedge: rows of centre, clockwise and counter-clockwise extents (rad)."""
+    wedges = [step_map.wedge for step_map in maps]
+    return np.array([(w.center, w.cw, w.ccw) for w in wedges], dtype=np.float64).reshape(-1, 3)
+
+
+def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
+    """Each polygon's area, m^2: exactly :func:`aura_ums.geometry.polygon_area` of each."""
+    areas = np.zeros(len(vertices))
+    counts = np.array([len(v) for v in vertices], dtype=np.int64)
+    if not np.any(counts >= 3):
+        return areas
+    every = np.concatenate(vertices)
     first = np.cumsum(counts) - counts
-    vertices = np.concatenate([m.polygon.vertices for m in chosen])
-    following = np.arange(1, len(vertices) + 1)
+    following = np.arange(1, len(every) + 1)
     following[first + counts - 1] = first
-    edge = vertices[following] - vertices
+    # Relative to each polygon's first vertex, as polygon_area does; its two dot products per polygon.
+    x = every[:, 0] - np.repeat(every[first, 0], counts)
+    y = every[:, 1] - np.repeat(every[first, 1], counts)
+    x_next, y_next = x[following], y[following]
+    for index, (begin, size) in enumerate(zip(first.tolist(), counts.tolist(), strict=True)):
+        if size >= 3:
+            end = begin + size
+            areas[index] = float(
+                0.5 * (np.dot(x[begin:end], y_next[begin:end]) - np.dot(y[begin:end], x_next[begin:end]))
+            )
+    return areas
+
+
+def _contains(
+    maps: Sequence[SpatialUncertaintyMap],
+    poses: NDArray[np.float64],
+    vertices: Sequence[NDArray[np.float64]],
+    areas: NDArray[np.float64],
+    wedges: NDArray[np.float64],
+) -> NDArray[np.int8]:
+    """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``).
+
+    ``vertices``, ``areas`` and ``wedges`` are those of each map's polygon and wedge.
+    """
+    result = np.zeros(len(maps), dtype=np.int8)
+    counts = np.array([len(v) for v in vertices], dtype=np.int64)
+    sliced = np.array([step_map.is_sliced for step_map in maps], dtype=bool)
+    # A sliced map is judged by its slices (its polygon and wedge are only their summary).
+    batch = ~sliced & (counts >= 3) & (counts <= _BATCHED_VERTICES) & (areas > 0.0)
+    for index in np.flatnonzero(~batch).tolist():  # a sliced map, a point, a segment, or a huge polygon
+        x, y, heading = poses[index].tolist()
+        result[index] = maps[index].contains(x, y, heading)
+    batched = np.flatnonzero(batch)
+    if not batched.size:
+        return result
+    chosen = counts[batched]
+    every = np.concatenate([vertices[index] for index in batched.tolist()])
+    first = np.cumsum(chosen) - chosen
+    following = np.arange(1, len(every) + 1)
+    following[first + chosen - 1] = first
+    edge = every[following] - every
     length = np.hypot(edge[:, 0], edge[:, 1])
     pose = poses[batched]
-    relative_x = np.repeat(pose[:, 0], counts) - vertices[:, 0]
-    relative_y = np.repeat(pose[:, 1], counts) - vertices[:, 1]
+    relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]
+    relative_y = np.repeat(pose[:, 1], chosen) - every[:, 1]
     signed = (edge[:, 0] * relative_y - edge[:, 1] * relative_x) / length
     in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
-    wedges = np.empty((len(chosen), 3))
-    wedges[:, 0] = [m.wedge.center for m in chosen]
-    wedges[:, 1] = [m.wedge.cw for m in chosen]
-    wedges[:, 2] = [m.wedge.ccw for m in chosen]
-    result[batched] = in_polygon & wedges_contain(wedges, pose[:, 2])
+    result[batched] = in_polygon & wedges_contain(wedges[batched], pose[:, 2])
     return result
 
 
@@ -1229,9 +1265,9 @@ class _StepsCsv:
                 ) from None
         return self
 
-    def write(self, trace: ReplayTrace, start: int, stop: int) -> None:
-        if self.stream is not None and stop > start:
-            self.stream.write("".join(line + "\n" for line in trace.csv_lines(start, stop)))
+    def write(self, trace: ReplayTrace) -> None:
+        if self.stream is not None and len(trace):
+            self.stream.write("".join(line + "\n" for line in trace.csv_lines()))
 
     def __exit__(self, kind: object, error: object, traceback: object) -> None:
         if self.stream is None or self.scratch is None or self.target is None:
