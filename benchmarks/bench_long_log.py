@@ -56,11 +56,13 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
     """Replay one log in this process and print its figures as JSON."""
     import inspect
 
+    import aura_ums.logs
     from aura_ums.logs import ReplayOptions, load_log, load_sensors, replay_log
     from aura_ums.uncertainty import LandmarkClass, TerrainTable
 
     began = time.perf_counter()
-    log = load_log(folder)
+    # A tree that streams the log opens it (its large files read as the replay goes); older ones load it whole.
+    log = aura_ums.logs.open_log(folder) if hasattr(aura_ums.logs, "open_log") else load_log(folder)
     loaded = time.perf_counter()
     load_peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     table = TerrainTable.from_toml(terrain)

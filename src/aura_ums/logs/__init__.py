@@ -3,7 +3,8 @@
 A log is a folder of a ``meta.toml`` and CSV files (``docs/log-format.md``):
 
 - :func:`load_log` reads and validates one into a :class:`RobotLog` (SI units), and
-  :func:`write_log` writes one back exactly;
+  :func:`write_log` writes one back exactly; :func:`open_log` opens one as a
+  :class:`LogStream`, which :func:`replay_log` reads block by block in bounded memory;
 - :class:`RobotLog` holds :class:`LogMeta`, :class:`LogLandmark` s, :class:`LogObservation` s,
   the motion as :class:`Odometry` (velocities) or recorded position reports, and an optional
   :class:`GroundTruth`; :meth:`RobotLog.position_reports` turns the motion into the
@@ -48,6 +49,7 @@ from aura_ums.logs._log import (
     RobotLog,
 )
 from aura_ums.logs._mrclam import import_mrclam, read_mrclam
+from aura_ums.logs._stream import LogStream, open_log
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, odometry_to_commands
 from aura_ums.logs._replay import (
     ReplayOptions,
@@ -70,6 +72,7 @@ __all__ = [
     "HorizonCheck",
     "LogLandmark",
     "LogMeta",
+    "LogStream",
     "LogObservation",
     "MethodSummary",
     "MotionCalibration",
@@ -93,6 +96,7 @@ __all__ = [
     "import_mrclam",
     "import_rosbag",
     "load_log",
+    "open_log",
     "load_noise",
     "load_sensors",
     "log_files_in",

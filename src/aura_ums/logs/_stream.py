@@ -29,6 +29,7 @@ from aura_ums.logs._io import (
     META,
     OBSERVATIONS,
     ODOMETRY,
+    STREAM_BLOCK_BYTES,
     ObservationColumns,
     OdometryColumns,
     TruthColumns,
@@ -71,6 +72,8 @@ class LogStream:
         ``groundtruth.csv``.
     max_gap : float
         Seconds: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
+    block_bytes : int
+        Bytes read of a CSV file at a time.
     """
 
     meta: LogMeta
@@ -80,19 +83,20 @@ class LogStream:
     commands: tuple[PositionReport, ...] | None
     truth_box: tuple[float, float, float, float] | None
     max_gap: float = DEFAULT_MAX_TRUTH_GAP
+    block_bytes: int = STREAM_BLOCK_BYTES
 
     def observation_blocks(self) -> Iterator[ObservationColumns]:
         """Yield ``observations.csv``'s checked columns block by block (time, id, bearing, ...)."""
         known = {landmark.id for landmark in self.landmarks}
-        return observation_blocks(self.path / OBSERVATIONS, self.units, known)
+        return observation_blocks(self.path / OBSERVATIONS, self.units, known, self.block_bytes)
 
     def odometry_blocks(self) -> Iterator[OdometryColumns]:
         """Yield ``odometry.csv``'s checked time, v, omega block by block (at least one block)."""
-        return odometry_blocks(self.path / ODOMETRY, self.units)
+        return odometry_blocks(self.path / ODOMETRY, self.units, self.block_bytes)
 
     def groundtruth_blocks(self) -> Iterator[TruthColumns]:
         """Yield ``groundtruth.csv``'s checked time, x, y, heading block by block (heading wrapped to (-pi, pi])."""
-        for time, x, y, heading in groundtruth_blocks(self.path / GROUNDTRUTH, self.units):
+        for time, x, y, heading in groundtruth_blocks(self.path / GROUNDTRUTH, self.units, self.block_bytes):
             outside = (heading <= -math.pi) | (heading > math.pi)
             if np.any(outside):
                 heading = heading.copy()
@@ -107,7 +111,12 @@ class LogStream:
         return dataclasses.replace(log, meta=self.meta)
 
 
-def open_log(folder: str | os.PathLike[str], *, max_gap: float = DEFAULT_MAX_TRUTH_GAP) -> LogStream:
+def open_log(
+    folder: str | os.PathLike[str],
+    *,
+    max_gap: float = DEFAULT_MAX_TRUTH_GAP,
+    block_bytes: int = STREAM_BLOCK_BYTES,
+) -> LogStream:
     r"""Open a log folder to replay it block by block: what :func:`~aura_ums.logs.load_log` reads, in bounded memory.
 
     ``meta.toml`` and ``landmarks.csv`` are read and checked now, as is the whole
@@ -122,6 +131,9 @@ def open_log(folder: str | os.PathLike[str], *, max_gap: float = DEFAULT_MAX_TRU
         A log folder (``docs/log-format.md``).
     max_gap : float
         Seconds, > 0: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
+    block_bytes : int
+        Bytes read of a CSV file at a time, >= 1 (default 512 KiB): what the replay's
+        memory holds of each file beyond the rows it needs.
 
     Returns
     -------
@@ -152,6 +164,8 @@ def open_log(folder: str | os.PathLike[str], *, max_gap: float = DEFAULT_MAX_TRU
     if not base.is_dir():
         raise FileFormatError(str(base), "", "expected a log folder, got no such folder")
     gap = _max_gap(max_gap, "max_gap")
+    if isinstance(block_bytes, bool) or not isinstance(block_bytes, int) or block_bytes < 1:
+        raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
     meta, units = _MetaReader(base / META).read(base.name)
     landmarks = _read_landmarks(base / LANDMARKS, units)
     has_odometry, has_commands = (base / ODOMETRY).exists(), (base / COMMANDS).exists()
@@ -162,11 +176,11 @@ def open_log(folder: str | os.PathLike[str], *, max_gap: float = DEFAULT_MAX_TRU
     box = None
     if (base / GROUNDTRUTH).exists():
         low, high = np.full(2, np.inf), np.full(2, -np.inf)
-        for _, x, y, _ in groundtruth_blocks(base / GROUNDTRUTH, units):
+        for _, x, y, _ in groundtruth_blocks(base / GROUNDTRUTH, units, block_bytes):
             low = np.minimum(low, (x.min(), y.min()))
             high = np.maximum(high, (x.max(), y.max()))
         box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
-    return LogStream(meta, landmarks, base, units, commands, box, gap)
+    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes)
 
 
 class TruthWindow:
