@@ -52,6 +52,22 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 
+def _peak_mb() -> float:
+    """This process's peak resident memory, MB: the memory map's high-water mark.
+
+    Not ``getrusage``: its ``ru_maxrss`` keeps, across ``exec``, the peak of the forked
+    copy of the parent (which holds the generated log), and would report that instead.
+    """
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return float(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
     """Replay one log in this process and print its figures as JSON."""
     import inspect
@@ -61,10 +77,10 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
     from aura_ums.uncertainty import LandmarkClass, TerrainTable
 
     began = time.perf_counter()
-    # A tree that streams the log opens it (its large files read as the replay goes); older ones load it whole.
+    # A tree that streams the log opens it (its files read as the replay goes); older ones load it.
     log = aura_ums.logs.open_log(folder) if hasattr(aura_ums.logs, "open_log") else load_log(folder)
     loaded = time.perf_counter()
-    load_peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    load_peak_mb = _peak_mb()
     table = TerrainTable.from_toml(terrain)
     motion, working, envelope = load_sensors(sensors)
     options = ReplayOptions(
@@ -87,7 +103,7 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
         update_us = sum(s.update_us for s in result.steps)
     metrics = result.metrics()
     done = time.perf_counter()
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    peak_mb = _peak_mb()
     figures = {
         "load_s": loaded - began,
         "total_s": done - began,
@@ -151,14 +167,18 @@ def main() -> None:
             read_by = sensors if args.src is None else _older_inputs(folder, sensors)
             out = work / f"out-{rows}"
             out.mkdir()
-            figures = _replay(args.src, folder, terrain, read_by, out)
-            print(
-                f"{rows:>9} {figures['steps']:>7} {figures['load_s']:>7.2f} {figures['update_s']:>9.2f} "
-                f"{figures['total_s']:>8.2f} {1e6 * figures['total_s'] / rows:>13.2f} "
-                f"{figures['load_peak_mb']:>13.0f} {figures['peak_mb']:>8.0f} "
-                f"{figures['containment_rate']:>11.4f}",
-                flush=True,
-            )
+            try:
+                figures = _replay(args.src, folder, terrain, read_by, out)
+                print(
+                    f"{rows:>9} {figures['steps']:>7} {figures['load_s']:>7.2f} {figures['update_s']:>9.2f} "
+                    f"{figures['total_s']:>8.2f} {1e6 * figures['total_s'] / rows:>13.2f} "
+                    f"{figures['load_peak_mb']:>13.0f} {figures['peak_mb']:>8.0f} "
+                    f"{figures['containment_rate']:>11.4f}",
+                    flush=True,
+                )
+            except subprocess.CalledProcessError as failed:  # e.g. an older tree refusing > 2e6 rows
+                reason = failed.stderr.strip().splitlines()[-1] if failed.stderr.strip() else "failed"
+                print(f"{rows:>9} failed: {reason}", flush=True)
             for path in (*folder.iterdir(), *out.iterdir()):
                 path.unlink()
             if read_by != sensors:

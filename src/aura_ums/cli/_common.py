@@ -66,7 +66,8 @@ def progress_bar(
         task = bar.add_task(escape(label), total=total)
 
         def advance(done: int, total: int) -> None:
-            bar.update(task, completed=done, total=total)
+            # 0: not known yet (a streamed log's frames); the bar then pulses.
+            bar.update(task, completed=done, total=total or None)
 
         yield advance
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -42,7 +43,7 @@ from aura_ums.cli._outputs import (
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import ReplayOptions, ReplayResult
+    from aura_ums.logs import LogStream, ReplayOptions, ReplayResult
     from aura_ums.manager import ManagerSettings
 
 
@@ -298,7 +299,7 @@ def replay(
     from aura_ums.camera import load_camera
     from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
-    from aura_ums.logs import ReplayState, replay_log, replay_windows
+    from aura_ums.logs import ReplayState, RobotLog, replay_log, replay_windows
     from aura_ums.uncertainty import TerrainTable
 
     if windows_csv is not None and camera is None:
@@ -347,7 +348,10 @@ def replay(
     json_target, csv_target, mcap_target, state_target, windows_target = targets
     windows = None
     try:
-        log = LoadLog(max_truth_gap)(log_dir)
+        # Streamed (bounded memory) unless an output needs the whole log: maps drawn or
+        # exported, the live view, a camera's windows, a saved state's digest.
+        whole = any(item is not None for item in (plot, mcap, resume, save_state, camera)) or live
+        log = LoadLog(max_truth_gap)(log_dir) if whole else _open(log_dir, max_truth_gap)
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
@@ -359,7 +363,11 @@ def replay(
         # The per-step CSV is streamed, through a scratch file renamed onto it whole.
         steps_path = None if csv_target is None else resolved(csv_target.path)
         lens = None if camera is None else load_camera(camera)
-        watch = live_replay(log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate)
+        watch = (
+            live_replay(log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate)
+            if isinstance(log, RobotLog)
+            else contextlib.nullcontext(None)
+        )
         with watch as view, progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
             if lens is None:
                 result = replay_log(
@@ -368,6 +376,7 @@ def replay(
                     after_step=None if view is None else view.step,
                 )  # fmt: skip
             else:
+                assert isinstance(log, RobotLog)
                 result, windows = replay_windows(
                     log, table, lens, options, margin=window_margin, keep_maps=keep_maps,
                     steps_csv=steps_path, progress=advance, until=until, resume=saved,
@@ -392,6 +401,13 @@ def replay(
         from aura_ums.cli._interop import write_replay_mcap_option
 
         write_replay_mcap_option(mcap_target, result, quiet=quiet, windows=windows)
+
+
+def _open(folder: Path, max_truth_gap: float | None) -> LogStream:
+    """Open a log folder to replay it block by block (:func:`~aura_ums.logs.open_log`)."""
+    from aura_ums.logs import open_log
+
+    return open_log(folder) if max_truth_gap is None else open_log(folder, max_gap=max_truth_gap)
 
 
 def _draw(result: ReplayResult, target: Target) -> None:

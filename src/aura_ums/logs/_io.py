@@ -164,6 +164,11 @@ LOG_CSV_MAX_BYTES = 256 * 1024 * 1024
 #: its rows, parsed, cost a few times that while they are in use, whatever the log's length.
 STREAM_BLOCK_BYTES = 512 * 1024
 
+#: Most data rows of a log's CSV file read block by block (:func:`aura_ums.logs.open_log`):
+#: above :data:`aura_ums._files.MAX_ROWS`, which bounds what a whole file costs in memory.
+#: (A file the blocks cannot read is read whole, under that bound.)
+STREAM_MAX_ROWS = 100_000_000
+
 #: Line of the first data row in the CSV files :func:`write_log` writes (a comment, then the header).
 FIRST_ROW_LINE = 3
 
@@ -254,6 +259,7 @@ class _CsvFile:
                 columns=tuple(columns),
                 required=required,
                 numeric=numeric,
+                max_rows=STREAM_MAX_ROWS,
                 max_bytes=LOG_CSV_MAX_BYTES,
                 block_bytes=block_bytes,
             ):

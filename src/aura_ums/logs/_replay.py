@@ -12,7 +12,7 @@ import types
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import TextIO, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,6 +49,8 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
+
+LogT = TypeVar("LogT", RobotLog, LogStream)
 
 _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
 
@@ -343,8 +345,8 @@ class ReplayResult:
 
     Attributes
     ----------
-    log : RobotLog
-        The log replayed.
+    log : RobotLog or LogStream
+        The log replayed (as given: loaded whole, or opened block by block).
     options : ReplayOptions
         How.
     trace : ReplayTrace
@@ -361,7 +363,7 @@ class ReplayResult:
         save and resume from; None when not recorded.
     """
 
-    log: RobotLog
+    log: RobotLog | LogStream
     options: ReplayOptions
     trace: ReplayTrace
     rejected_counts: Mapping[RejectReason, int]
@@ -602,7 +604,7 @@ def _observations(
     return found
 
 
-def meta_bounds(log: RobotLog) -> SensorBounds:
+def meta_bounds(log: RobotLog | LogStream) -> SensorBounds:
     """Return the sensor bounds a log's ``meta.toml`` states (its range fraction both ways)."""
     meta = log.meta
     return SensorBounds(
@@ -611,7 +613,7 @@ def meta_bounds(log: RobotLog) -> SensorBounds:
 
 
 def replay_log(
-    log: RobotLog,
+    log: RobotLog | LogStream,
     table: TerrainTable,
     options: ReplayOptions | None = None,
     *,
@@ -643,11 +645,17 @@ def replay_log(
 
     Memory: the position reports are made one at a time from arrays, and each step
     keeps a few numbers (:class:`ReplayTrace`); only ``keep_maps`` keeps a map per step.
+    A :class:`LogStream` (:func:`~aura_ums.logs.open_log`) is read block by block as the
+    frames reach its rows, a chunk of frames at a time: its observations, odometry and
+    ground truth are never in memory whole, and the replay gives exactly the figures
+    (and maps) of the whole log's. It cannot ``resume`` or ``save_state`` (their digest
+    covers the whole log: :meth:`LogStream.load` it).
 
     Parameters
     ----------
-    log : RobotLog
-        The log.
+    log : RobotLog or LogStream
+        The log, loaded whole (:func:`~aura_ums.logs.load_log`) or opened to be read block
+        by block (:func:`~aura_ums.logs.open_log`).
     table : TerrainTable
         Must hold the log's terrain (``meta.terrain``).
     options : ReplayOptions or None
@@ -668,7 +676,8 @@ def replay_log(
         missing.
     progress : callable or None
         Called as ``progress(done, total)`` after each frame (``total`` frames of the log
-        after its start); nothing is printed here.
+        after its start; 0 for a :class:`LogStream`, whose frames are counted only as they
+        are read); nothing is printed here.
     until : float or None
         Stop after the last frame at or before this time, s (None: replay to the end);
         the result's ``state`` then resumes from there.
@@ -736,7 +745,7 @@ def replay_log(
             "log: expected a RobotLog (load_log) to resume or save a replay's state "
             "(its digest covers the whole log), got a LogStream"
         )
-    log = with_motion(log, opts.motion)
+    log = with_motion(log, opts.motion) if isinstance(log, RobotLog) else with_motion(log, opts.motion)
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
     envelope_bounds = (
@@ -812,7 +821,7 @@ def replay_log(
                     after_step(_step_now(part, index, step.map, step.envelope_map))
                 done += 1
                 if progress is not None:
-                    progress(done, max(source.total, done))
+                    progress(done, source.total)
             judge.flush()
             writer.write(part)
             reports.posted += next_report
@@ -1322,7 +1331,7 @@ def _resumed_at(
     return state.frames_done, state.reports_posted
 
 
-def with_motion(log: RobotLog, motion: MotionCalibration | None) -> RobotLog:
+def with_motion(log: LogT, motion: MotionCalibration | None) -> LogT:
     """Return ``log`` with its meta's delay and scales replaced by ``motion`` (unchanged for None)."""
     if motion is None:
         return log
