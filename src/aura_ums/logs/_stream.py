@@ -14,6 +14,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import tempfile
+import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +52,16 @@ from aura_ums.geometry import wrap_angle
 Array = NDArray[np.float64]
 
 
+class ScratchFile:
+    """A scratch file removed when the last object holding it is (copies of a stream share it)."""
+
+    __slots__ = ("__weakref__", "path")
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        weakref.finalize(self, _remove, path)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class LogStream:
     """A log folder opened to be replayed block by block (:func:`open_log`): memory bounded whatever its length.
@@ -70,6 +82,10 @@ class LogStream:
     truth_box : tuple of float or None
         ``(x_min, y_min, x_max, y_max)`` of the ground truth, metres; None without
         ``groundtruth.csv``.
+    truth_scratch : ScratchFile or None
+        The ground truth as :func:`open_log` read and checked it (time, x, y, wrapped
+        heading: four float64 a row), in a scratch file removed with the stream, so the
+        replay does not parse ``groundtruth.csv`` twice; None: parse it again.
     max_gap : float
         Seconds: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
     block_bytes : int
@@ -84,6 +100,7 @@ class LogStream:
     truth_box: tuple[float, float, float, float] | None
     max_gap: float = DEFAULT_MAX_TRUTH_GAP
     block_bytes: int = STREAM_BLOCK_BYTES
+    truth_scratch: ScratchFile | None = None
 
     def observation_blocks(self) -> Iterator[ObservationColumns]:
         """Yield ``observations.csv``'s checked columns block by block (time, id, bearing, ...)."""
@@ -95,13 +112,16 @@ class LogStream:
         return odometry_blocks(self.path / ODOMETRY, self.units, self.block_bytes)
 
     def groundtruth_blocks(self) -> Iterator[TruthColumns]:
-        """Yield ``groundtruth.csv``'s checked time, x, y, heading block by block (heading wrapped to (-pi, pi])."""
-        for time, x, y, heading in groundtruth_blocks(self.path / GROUNDTRUTH, self.units, self.block_bytes):
-            outside = (heading <= -math.pi) | (heading > math.pi)
-            if np.any(outside):
-                heading = heading.copy()
-                heading[outside] = wrap_angle(heading[outside])
-            yield time, x, y, heading
+        """Yield the ground truth's checked time, x, y, heading block by block (heading wrapped to (-pi, pi])."""
+        if self.truth_scratch is not None:
+            rows = max(self.block_bytes // 32, 1)
+            with self.truth_scratch.path.open("rb") as handle:
+                while True:
+                    block = np.fromfile(handle, dtype=np.float64, count=4 * rows).reshape(-1, 4)
+                    if not len(block):
+                        return
+                    yield block[:, 0].copy(), block[:, 1].copy(), block[:, 2].copy(), block[:, 3].copy()
+        yield from _wrapped_truth(groundtruth_blocks(self.path / GROUNDTRUTH, self.units, self.block_bytes))
 
     def load(self) -> RobotLog:
         """Read the whole log (:func:`~aura_ums.logs.load_log`), for what needs it all at once."""
@@ -173,14 +193,60 @@ def open_log(
         got = "both" if has_odometry else "neither"
         raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
     commands = None if has_odometry else _read_commands(base / COMMANDS, units)
-    box = None
+    box, scratch = None, None
     if (base / GROUNDTRUTH).exists():
-        low, high = np.full(2, np.inf), np.full(2, -np.inf)
-        for _, x, y, _ in groundtruth_blocks(base / GROUNDTRUTH, units, block_bytes):
+        box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
+    held = None if scratch is None else ScratchFile(scratch)
+    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, held)
+
+
+def _read_truth(
+    path: Path, units: Units, block_bytes: int
+) -> tuple[tuple[float, float, float, float], Path | None]:
+    """Check the whole ground truth block by block: its extent, and the scratch copy of its rows."""
+    low, high = np.full(2, np.inf), np.full(2, -np.inf)
+    handle = None
+    try:
+        handle = tempfile.NamedTemporaryFile(prefix="aura-ums-truth-", suffix=".f8", delete=False)  # noqa: SIM115
+    except OSError:
+        pass
+    try:
+        for block in _wrapped_truth(groundtruth_blocks(path, units, block_bytes)):
+            _, x, y, _ = block
             low = np.minimum(low, (x.min(), y.min()))
             high = np.maximum(high, (x.max(), y.max()))
-        box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
-    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes)
+            if handle is not None:
+                try:
+                    handle.write(np.column_stack(block).tobytes())
+                except OSError:  # no room: the replay parses the file again
+                    handle.close()
+                    _remove(Path(handle.name))
+                    handle = None
+    except BaseException:
+        if handle is not None:
+            handle.close()
+            _remove(Path(handle.name))
+        raise
+    box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
+    if handle is None:
+        return box, None
+    handle.close()
+    return box, Path(handle.name)
+
+
+def _remove(path: Path) -> None:
+    path.unlink(missing_ok=True)
+
+
+
+def _wrapped_truth(blocks: Iterator[TruthColumns]) -> Iterator[TruthColumns]:
+    """The blocks with their headings wrapped to (-pi, pi], as :class:`~aura_ums.logs.GroundTruth` stores them."""
+    for time, x, y, heading in blocks:
+        outside = (heading <= -math.pi) | (heading > math.pi)
+        if np.any(outside):
+            heading = heading.copy()
+            heading[outside] = wrap_angle(heading[outside])
+        yield time, x, y, heading
 
 
 class TruthWindow:
