@@ -47,7 +47,7 @@ __all__ = [
     "MAX_BYTES",
     "MAX_ROWS",
     "SCRATCH_SUFFIX",
-    "CsvFallback",
+    "CsvFallbackError",
     "CsvFloats",
     "CsvTable",
     "Fields",
@@ -648,7 +648,7 @@ def _is_row(line: str) -> bool:
     return bool(stripped) and not stripped.startswith("#")
 
 
-class CsvFallback(Exception):
+class CsvFallbackError(Exception):
     """Raised by :func:`csv_blocks` for a file it cannot read block by block exactly.
 
     The caller then reads the whole file (:func:`read_text`, :func:`parse_csv`), whose
@@ -700,7 +700,7 @@ def csv_blocks(
 
     Raises
     ------
-    CsvFallback
+    CsvFallbackError
         Whenever a block cannot be read exactly so (a missing, unreadable or too large
         file, text that is not UTF-8 (ASCII when ``numeric``), a line break other than
         ``"\n"``, a bad header, a cell ``parse_csv_floats`` refuses, too many rows), possibly
@@ -720,7 +720,7 @@ def csv_blocks(
     >>> list(csv_blocks(path, columns=("time", "v"), numeric=True))   # an empty cell: parse_csv says more
     Traceback (most recent call last):
     ...
-    aura_ums._files.CsvFallback
+    aura_ums._files.CsvFallbackError
     """
     source = str(path)
     limit = _limit(max_bytes, MAX_BYTES)
@@ -728,13 +728,13 @@ def csv_blocks(
     try:
         handle = open(path, "rb")  # noqa: SIM115 - closed below, on every path
     except (OSError, ValueError):
-        raise CsvFallback from None
+        raise CsvFallbackError from None
     with handle:
         try:
             if os.fstat(handle.fileno()).st_size > limit:
-                raise CsvFallback
+                raise CsvFallbackError
         except OSError:
-            raise CsvFallback from None
+            raise CsvFallbackError from None
         header_text: str | None = None
         rows = 0
         lines_before = 0  # lines of the file before the block
@@ -744,7 +744,7 @@ def csv_blocks(
             try:
                 chunk = handle.read(block_bytes)
             except OSError:
-                raise CsvFallback from None
+                raise CsvFallbackError from None
             data = carry + chunk
             if chunk:
                 cut = data.rfind(b"\n") + 1
@@ -758,13 +758,13 @@ def csv_blocks(
                 block = block.removeprefix(_BOM.encode("utf-8"))
                 first = False
             if numeric and not block.isascii():
-                raise CsvFallback
+                raise CsvFallbackError
             try:
                 text = block.decode("utf-8")
             except UnicodeDecodeError:
-                raise CsvFallback from None
+                raise CsvFallbackError from None
             if not numeric and _OTHER_BREAKS.search(text):
-                raise CsvFallback
+                raise CsvFallbackError
             found: CsvFloats | CsvTable | None
             if header_text is None:
                 if chunk and not any(_is_row(line) for line in text.splitlines()):
@@ -772,7 +772,7 @@ def csv_blocks(
                     continue
                 found = _parse_block(text, source, columns, required, numeric, most, limit)
                 if found is None:
-                    raise CsvFallback
+                    raise CsvFallbackError
                 header_text = text.splitlines()[found.header_line - 1]
                 lines = found.lines
                 head = True
@@ -782,7 +782,7 @@ def csv_blocks(
                     f"{header_text}\n{text}", source, columns, required, numeric, most - rows, limit
                 )
                 if found is None or found.header_line != 1:
-                    raise CsvFallback
+                    raise CsvFallbackError
                 lines = np.asarray(found.lines, dtype=np.int64) - 1 + lines_before
                 head = False
             rows += len(found)
@@ -894,9 +894,11 @@ def read_csv_floats(
             values[rows : rows + len(block)] = block.values
             lines[rows : rows + len(block)] = block.lines
             rows += len(block)
-    except CsvFallback:
+    except CsvFallbackError:
         return None
-    assert header is not None and values is not None  # the header's block comes first, or CsvFallback
+    # The header's block comes first, or CsvFallbackError.
+    assert header is not None
+    assert values is not None
     return CsvFloats(str(path), header.header, header.header_line, values[:rows], lines[:rows], None)
 
 

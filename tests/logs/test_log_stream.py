@@ -86,7 +86,8 @@ def test_motion_calibration_class_one_and_until_stream_as_the_whole_log(folder: 
     whole = replay_log(load_log(folder), FLOOR, options, until=50.0)
     stream = replay_log(open_log(folder, block_bytes=300), FLOOR, options, until=50.0)
     _same(stream, whole)
-    assert stream.maps is not None and whole.maps is not None
+    assert stream.maps is not None
+    assert whole.maps is not None
     assert [m.polygon.vertices.tolist() for m in stream.maps] == [
         m.polygon.vertices.tolist() for m in whole.maps
     ]
@@ -94,7 +95,8 @@ def test_motion_calibration_class_one_and_until_stream_as_the_whole_log(folder: 
 
 def test_reversing_odometry_a_truth_gap_and_the_frame_hook_stream_as_the_whole_log(tmp_path: Path) -> None:
     log = long_odometry_log(2500, rate=50.0, frame_every=5)
-    assert log.odometry is not None and log.groundtruth is not None
+    assert log.odometry is not None
+    assert log.groundtruth is not None
     odometry = log.odometry
     v = np.where((odometry.time > 10.0) & (odometry.time < 12.0), -odometry.v, odometry.v)
     truth = log.groundtruth

@@ -49,7 +49,6 @@ from aura_ums.logs._log import (
     RobotLog,
 )
 from aura_ums.logs._mrclam import import_mrclam, read_mrclam
-from aura_ums.logs._stream import LogStream, open_log
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, odometry_to_commands
 from aura_ums.logs._replay import (
     ReplayOptions,
@@ -62,6 +61,7 @@ from aura_ums.logs._replay import (
 )
 from aura_ums.logs._rosbag import import_rosbag, read_rosbag
 from aura_ums.logs._state import ReplayState
+from aura_ums.logs._stream import LogStream, open_log
 from aura_ums.logs._synthetic import synthetic_log
 from aura_ums.logs._windows import WindowReport, WindowRow, ekf_noise, replay_windows
 
@@ -72,8 +72,8 @@ __all__ = [
     "HorizonCheck",
     "LogLandmark",
     "LogMeta",
-    "LogStream",
     "LogObservation",
+    "LogStream",
     "MethodSummary",
     "MotionCalibration",
     "ObservationKind",
@@ -96,7 +96,6 @@ __all__ = [
     "import_mrclam",
     "import_rosbag",
     "load_log",
-    "open_log",
     "load_noise",
     "load_sensors",
     "log_files_in",
@@ -105,6 +104,7 @@ __all__ = [
     "observation_for",
     "odometry_report_arrays",
     "odometry_to_commands",
+    "open_log",
     "read_mrclam",
     "read_rosbag",
     "replay_log",

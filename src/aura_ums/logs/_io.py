@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import (
-    CsvFallback,
+    CsvFallbackError,
     CsvFloats,
     CsvTable,
     Fields,
@@ -267,7 +267,7 @@ class _CsvFile:
                 if len(table):
                     done = int(table.lines[-1])
                 yield table
-        except CsvFallback:
+        except CsvFallbackError:
             whole = cls(path, columns, required, _text_table(path, columns, required))
             yield whole.after(done)
 
@@ -717,7 +717,7 @@ def _groundtruth_columns(table: _CsvFile, units: Units) -> TruthColumns:
 def groundtruth_blocks(
     path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES
 ) -> Iterator[TruthColumns]:
-    """Yield the checked time (s), x, y (m) and heading (rad, as in the file) of ``groundtruth.csv`` block by block.
+    """Yield the checked time (s), x, y (m) and heading (rad) of ``groundtruth.csv`` block by block.
 
     Checked as :func:`load_log` checks the whole file (times strictly increasing across
     blocks too); a failing check fails with the whole file's message. At least one block

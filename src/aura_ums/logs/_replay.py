@@ -25,9 +25,9 @@ from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._io import _given
 from aura_ums.logs._log import LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
-from aura_ums.logs._stream import LogStream, OdometryReports, TruthWindow
 from aura_ums.logs._odometry import ReverseMotion
 from aura_ums.logs._state import ReplayState
+from aura_ums.logs._stream import LogStream, OdometryReports, TruthWindow
 from aura_ums.manager import (
     Blackboard,
     ManagerSettings,
@@ -745,7 +745,7 @@ def replay_log(
             "log: expected a RobotLog (load_log) to resume or save a replay's state "
             "(its digest covers the whole log), got a LogStream"
         )
-    log = with_motion(log, opts.motion) if isinstance(log, RobotLog) else with_motion(log, opts.motion)
+    log = dataclasses.replace(log, meta=_motion_meta(log.meta, opts.motion))
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
     robust = opts.settings.robust
     envelope_bounds = (
@@ -829,7 +829,8 @@ def replay_log(
     result_trace = trace.build()
     state = None
     if save_state:
-        assert isinstance(log, RobotLog) and source.frames is not None
+        assert isinstance(log, RobotLog)
+        assert source.frames is not None
         frame_times = source.frame_times
         last = done
         state = ReplayState(
@@ -877,7 +878,7 @@ class _WholeReports:
         self.posted = posted
 
     def until(self, frames: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-        """The reports not posted yet up to the last of ``frames``."""
+        """Return the reports not posted yet up to the last of ``frames``."""
         stop = int(np.searchsorted(self.times, frames[-1], side="right"))
         begin = self.posted
         return self.times[begin:stop], self.turns[begin:stop], self.runs[begin:stop]
@@ -924,7 +925,7 @@ def _row_of(row: LogObservation) -> _Row:
 
 
 def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: ReplayState | None) -> _Source:
-    """A whole log in memory: its frames, reports and truth as :func:`replay_log` always made them."""
+    """Read a whole log in memory: its frames, reports and truth as :func:`replay_log` always made them."""
     start_time, start_pose = replay_start(log)
     meadow_map = log_meadow_map(log, opts.landmark_class, margin=opts.arena_margin)
     frames = frames_after(log, start_time)
@@ -969,7 +970,7 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
 
 
 def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_rows: bool) -> _Source:
-    """A log read block by block (:class:`LogStream`): the same frames, reports and truth, in bounded memory."""
+    """Read a :class:`LogStream` block by block: the same frames, reports and truth, in bounded memory."""
     truth = None
     if stream.truth_box is not None:
         truth = TruthWindow(stream.groundtruth_blocks(), stream.max_gap)
@@ -1018,7 +1019,7 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
 
 
 def _stream_chunks(stream: LogStream, start: float, stop: float, keep_rows: bool) -> Iterator[_FrameChunk]:
-    """The frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time."""
+    """Yield the frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time."""
     pending: list[_Row] = []
     lines: list[int] = []
     for times, ids, bearing, measured, bearing_error, range_error, line in stream.observation_blocks():
@@ -1333,12 +1334,16 @@ def _resumed_at(
 
 def with_motion(log: LogT, motion: MotionCalibration | None) -> LogT:
     """Return ``log`` with its meta's delay and scales replaced by ``motion`` (unchanged for None)."""
+    return log if motion is None else dataclasses.replace(log, meta=_motion_meta(log.meta, motion))
+
+
+def _motion_meta(meta: LogMeta, motion: MotionCalibration | None) -> LogMeta:
+    """Return ``meta`` with its delay and scales replaced by ``motion`` (unchanged for None)."""
     if motion is None:
-        return log
-    meta = dataclasses.replace(
-        log.meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
+        return meta
+    return dataclasses.replace(
+        meta, delay_s=motion.delay_s, run_scale=motion.run_scale, turn_scale=motion.turn_scale
     )
-    return dataclasses.replace(log, meta=meta)
 
 
 def frames_after(log: RobotLog, start: float) -> dict[float, list[LogObservation]]:

@@ -11,6 +11,7 @@ running sums carried across blocks in the same order).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums.errors import FileFormatError, InputError
+from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
     COMMANDS,
     GROUNDTRUTH,
@@ -47,7 +49,6 @@ from aura_ums.logs._io import (
 from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
 from aura_ums.logs._odometry import ReverseMotion, report_times
 from aura_ums.manager import PositionReport
-from aura_ums.geometry import wrap_angle
 
 Array = NDArray[np.float64]
 
@@ -64,7 +65,7 @@ class ScratchFile:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class LogStream:
-    """A log folder opened to be replayed block by block (:func:`open_log`): memory bounded whatever its length.
+    """A log folder opened to be replayed block by block (:func:`open_log`), in bounded memory.
 
     Attributes
     ----------
@@ -112,7 +113,7 @@ class LogStream:
         return odometry_blocks(self.path / ODOMETRY, self.units, self.block_bytes)
 
     def groundtruth_blocks(self) -> Iterator[TruthColumns]:
-        """Yield the ground truth's checked time, x, y, heading block by block (heading wrapped to (-pi, pi])."""
+        """Yield the ground truth's checked time, x, y, heading (wrapped to (-pi, pi]) block by block."""
         if self.truth_scratch is not None:
             rows = max(self.block_bytes // 32, 1)
             with self.truth_scratch.path.open("rb") as handle:
@@ -137,7 +138,7 @@ def open_log(
     max_gap: float = DEFAULT_MAX_TRUTH_GAP,
     block_bytes: int = STREAM_BLOCK_BYTES,
 ) -> LogStream:
-    r"""Open a log folder to replay it block by block: what :func:`~aura_ums.logs.load_log` reads, in bounded memory.
+    r"""Open a log folder to replay it block by block: :func:`~aura_ums.logs.load_log` in bounded memory.
 
     ``meta.toml`` and ``landmarks.csv`` are read and checked now, as is the whole
     ``groundtruth.csv`` (in blocks; the replay's arena needs its extent before the first
@@ -206,10 +207,8 @@ def _read_truth(
     """Check the whole ground truth block by block: its extent, and the scratch copy of its rows."""
     low, high = np.full(2, np.inf), np.full(2, -np.inf)
     handle = None
-    try:
+    with contextlib.suppress(OSError):  # no scratch file: the replay parses the file again
         handle = tempfile.NamedTemporaryFile(prefix="aura-ums-truth-", suffix=".f8", delete=False)  # noqa: SIM115
-    except OSError:
-        pass
     try:
         for block in _wrapped_truth(groundtruth_blocks(path, units, block_bytes)):
             _, x, y, _ = block
@@ -238,9 +237,8 @@ def _remove(path: Path) -> None:
     path.unlink(missing_ok=True)
 
 
-
 def _wrapped_truth(blocks: Iterator[TruthColumns]) -> Iterator[TruthColumns]:
-    """The blocks with their headings wrapped to (-pi, pi], as :class:`~aura_ums.logs.GroundTruth` stores them."""
+    """Yield the blocks with their headings wrapped to (-pi, pi] (as GroundTruth stores them)."""
     for time, x, y, heading in blocks:
         outside = (heading <= -math.pi) | (heading > math.pi)
         if np.any(outside):
@@ -298,7 +296,7 @@ class TruthWindow:
         self.unwrapped = np.concatenate((self.unwrapped, unwrapped))
 
     def at(self, times: Array) -> Array:
-        """Return the poses at ``times`` (increasing, and not before the times asked before): rows of x, y, heading."""
+        """Return the poses (rows of x, y, heading) at ``times``: increasing, none before earlier ones."""
         query = np.asarray(times, dtype=np.float64).reshape(-1)
         if not query.size:
             return np.empty((0, 3))
@@ -422,13 +420,13 @@ class OdometryReports:
         return out_times, out_turns, out_runs
 
     def finish(self) -> None:
-        """Read (and check) the rows after the last frame: a replay checks the whole record, as load_log does."""
+        """Read and check the rows after the last frame: the whole record is checked, as load_log does."""
         while not self.ended:
             self.time, self.v, self.omega = self.time[-1:], self.v[-1:], self.omega[-1:]
             self._read()
 
     def _sums(self, values: Array, carry: float | None) -> Array:
-        """The integral from the record's first row to each row of the window (cumulative_integral's)."""
+        """Return the integral from the record's first row to each row of the window."""
         steps = values[:-1] * np.diff(self.time)
         if carry is None:
             return np.concatenate(([0.0], np.cumsum(steps)))
