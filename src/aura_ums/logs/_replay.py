@@ -68,6 +68,7 @@ _CHUNK = 1024
 # up to 4096 point-edge pairs: below that, the batched arithmetic is the same, bit for bit).
 _BATCHED_VERTICES = 1024
 _STATES = tuple(ManagerState)
+_STATE_INDEX = {state: index for index, state in enumerate(_STATES)}
 # HeadingWedge.width caps a wedge at the full circle.
 _FULL_CIRCLE = 2.0 * math.pi
 
@@ -774,23 +775,30 @@ def replay_log(
     done = source.first
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
-            report_times, report_turns, report_runs = reports.until(chunk.times)
+            report_times, report_turns, report_runs = (
+                values.tolist() for values in reports.until(chunk.times)
+            )
+            due_count = len(report_times)
             next_report = 0
-            part = trace.start(len(chunk.times))
+            count = len(chunk.times)
+            part = trace.start(count)
             part.time[:] = chunk.times
             part.truth[:] = source.truth(chunk.times)
             judge = _Judge(part)
-            rows = chunk.rows
+            rows, offsets = chunk.rows, chunk.offsets
+            # Each step's figures, into the trace's arrays once the chunk is done (or at
+            # once for after_step, which reads them).
+            update_us, accepted, rejected, states, relocalized, excluded = [], [], [], [], [], []
             for index, frame_time in enumerate(chunk.times.tolist()):
-                frame = rows[chunk.offsets[index] : chunk.offsets[index + 1]]
+                frame = rows[offsets[index] : offsets[index + 1]]
                 working = _observations(frame, bearing_only, working_bounds, offset)
                 envelope = _observations(frame, bearing_only, envelope_bounds, offset) if robust else None
                 due = []
-                while next_report < report_times.size and report_times[next_report] <= frame_time:
+                while next_report < due_count and report_times[next_report] <= frame_time:
                     due.append(
                         PositionReport(
-                            float(report_times[next_report]),
-                            TurnAndRun(float(report_turns[next_report]), float(report_runs[next_report])),
+                            report_times[next_report],
+                            TurnAndRun(report_turns[next_report], report_runs[next_report]),
                         )
                     )
                     next_report += 1
@@ -801,27 +809,27 @@ def replay_log(
                     grown = manager.update(board, now=frame_time).map
                     paused = _time.perf_counter()
                     assert chunk.logged is not None
-                    before_frame(
-                        frame_time, grown, chunk.logged[chunk.offsets[index] : chunk.offsets[index + 1]]
-                    )
+                    before_frame(frame_time, grown, chunk.logged[offsets[index] : offsets[index + 1]])
                     began += _time.perf_counter() - paused
                 for observation in working:
                     board.identified.post(observation)
                 step = manager.update(board, now=frame_time, envelope=envelope)
-                part.update_us[index] = (_time.perf_counter() - began) * 1e6
-                part.accepted[index] = len(step.accepted)
-                part.rejected[index] = len(step.rejected)
-                part.state[index] = _STATES.index(step.state)
-                part.relocalized[index] = step.relocalized
-                part.excluded[index] = len(step.excluded)
+                update_us.append((_time.perf_counter() - began) * 1e6)
+                accepted.append(len(step.accepted))
+                rejected.append(len(step.rejected))
+                states.append(_STATE_INDEX[step.state])
+                relocalized.append(step.relocalized)
+                excluded.append(len(step.excluded))
                 judge.add(index, step.map, step.envelope_map)
                 if keep_maps:
                     maps.append(step.map)
                 if after_step is not None:
+                    _fill(part, index, update_us, accepted, rejected, states, relocalized, excluded)
                     after_step(_step_now(part, index, step.map, step.envelope_map))
                 done += 1
                 if progress is not None:
                     progress(done, source.total)
+            _fill(part, slice(0, count), update_us, accepted, rejected, states, relocalized, excluded)
             judge.flush()
             writer.write(part)
             reports.posted += next_report
@@ -851,6 +859,38 @@ def replay_log(
         tuple(maps) if keep_maps else None,
         state,
     )
+
+
+def _fill(
+    part: ReplayTrace,
+    at: int | slice,
+    update_us: list[float],
+    accepted: list[int],
+    rejected: list[int],
+    states: list[int],
+    relocalized: list[bool],
+    excluded: list[int],
+) -> None:
+    """Write the figures of the chunk's steps so far (``at`` an index: the last step's) into its trace."""
+    if isinstance(at, int):
+        last = len(update_us) - 1
+        part.update_us[at], part.accepted[at], part.rejected[at] = (
+            update_us[last],
+            accepted[last],
+            rejected[last],
+        )
+        part.state[at], part.relocalized[at], part.excluded[at] = (
+            states[last],
+            relocalized[last],
+            excluded[last],
+        )
+        return
+    part.update_us[at] = update_us
+    part.accepted[at] = accepted
+    part.rejected[at] = rejected
+    part.state[at] = states
+    part.relocalized[at] = relocalized
+    part.excluded[at] = excluded
 
 
 # One row of observations.csv as the replay reads it: time (s), landmark id, bearing (rad),
