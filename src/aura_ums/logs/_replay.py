@@ -1257,14 +1257,21 @@ def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
 def _contains(
     maps: Sequence[SpatialUncertaintyMap],
     poses: NDArray[np.float64],
-    vertices: Sequence[NDArray[np.float64]],
-    areas: NDArray[np.float64],
-    wedges: NDArray[np.float64],
+    vertices: Sequence[NDArray[np.float64]] | None = None,
+    areas: NDArray[np.float64] | None = None,
+    wedges: NDArray[np.float64] | None = None,
 ) -> NDArray[np.int8]:
     """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``).
 
-    ``vertices``, ``areas`` and ``wedges`` are those of each map's polygon and wedge.
+    ``vertices``, ``areas`` and ``wedges`` are those of each map's polygon and wedge, when
+    the caller has them already.
     """
+    if vertices is None:
+        vertices = [step_map.polygon.vertices for step_map in maps]
+    if areas is None:
+        areas = _areas(vertices)
+    if wedges is None:
+        wedges = _wedges(maps)
     result = np.zeros(len(maps), dtype=np.int8)
     counts = np.array([len(v) for v in vertices], dtype=np.int64)
     sliced = np.array([step_map.is_sliced for step_map in maps], dtype=bool)
