@@ -39,7 +39,6 @@ def test_compiled_merge_is_the_reference(seed: int, cap: int) -> None:
         assert not mine.flags.writeable
 
 
-
 @built
 @given(st.integers(0, 2**32 - 1), st.sampled_from(["shuffled", "ascending", "descending", "polygons"]))
 def test_compiled_hull_sorts_any_order_as_the_reference(seed: int, order: str) -> None:
@@ -61,6 +60,7 @@ def test_compiled_hull_sorts_any_order_as_the_reference(seed: int, order: str) -
     (ours,) = merge_groups_compiled(points, [len(points)], cap)
     (reference,) = merge_groups_reference(points, [len(points)], cap)
     assert ours.tobytes() == reference.tobytes()
+
 
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 8, 64]))
 def test_each_merge_holds_its_group_within_the_cap(seed: int, cap: int) -> None:
