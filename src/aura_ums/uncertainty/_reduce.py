@@ -137,6 +137,9 @@ _REASONS: dict[int, str] = {
 #: A reduction without its record: (reduced map, area before, area after), or why it is empty.
 Reduced = tuple["SpatialUncertaintyMap", float, float] | str
 
+#: A reduction that says only whether it kept the same set: (reduced map, same), or why it is empty.
+Kept = tuple["SpatialUncertaintyMap", bool] | str
+
 
 def reduce_map(
     prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
@@ -223,8 +226,13 @@ def _reduce_sliced(
     observation: Observation,
     landmark: Landmark,
     max_vertices: int,
+    *,
+    measured: bool = True,
 ) -> Reduced:
     """Reduce a sliced map slice by slice (one kernel call); empty slices drop out, all empty is inconsistent.
+
+    Without ``measured``, both areas are returned as NaN (the caller takes them if it needs
+    them: each is a hull of every slice).
 
     Each slice is a product map of its polygon and its (narrow) interval, so its reduction
     is the single kernel's, sound as it is; the union of the reduced slices holds every
@@ -248,7 +256,33 @@ def _reduce_sliced(
         start = int(found.counts[:home].sum())
         x, y = held_centre(points[start : start + int(found.counts[home])], x, y)
     reduced = type(prior)._sliced(kept, np.array([x, y]), wedge, prior._cells, prior._max_slices)
+    if not measured:
+        return reduced, math.nan, math.nan
     return reduced, prior.area, reduced.area
+
+
+def reduce_kept(
+    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+) -> Kept:
+    """:func:`reduce_checked`, telling only whether the reduced map is the same set as the prior.
+
+    *Same* is what the map manager tests: the areas before and after are equal and
+    positive, and the wedge kept its width. A sliced map's areas are its hulls' (a hull of
+    every slice each, the costly part of a reduction); they are taken only when the widths
+    agree, since a narrower wedge settles it. The answer is the test's, bit for bit.
+    """
+    slices = prior._slices
+    if slices is None:
+        found = reduce_checked(prior, observation, landmark, max_vertices)
+        if isinstance(found, str):
+            return found
+        reduced, before, after = found
+        return reduced, 0.0 < before == after and reduced.wedge.width == prior.wedge.width
+    sliced = _reduce_sliced(prior, slices, observation, landmark, max_vertices, measured=False)
+    if isinstance(sliced, str):
+        return sliced
+    reduced = sliced[0]
+    return reduced, reduced.wedge.width == prior.wedge.width and 0.0 < prior.area == reduced.area
 
 
 def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[float, float]:
