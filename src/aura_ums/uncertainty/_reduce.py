@@ -19,7 +19,8 @@ from numpy.typing import NDArray
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
 from aura_ums.errors import InputError
-from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex
+from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex, polygon_area
+from aura_ums.geometry._convex import _DENSE_LIMIT
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -317,7 +318,12 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
     True
     """
     point = np.array([[x, y]])
-    if points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
+    # Where points_in_convex would test the point edge by edge (a solid polygon), the
+    # compiled test does the same operations: the centre is tested so many times a frame.
+    solid = 3 <= len(vertices) <= _DENSE_LIMIT and polygon_area(vertices) > 0.0
+    if solid and _native.point_in_solid_convex(vertices, x, y, POSITION_TOLERANCE):
+        return x, y
+    if not solid and points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
         return x, y
     inner = vertices.mean(axis=0)
     gap = inner - point[0]
