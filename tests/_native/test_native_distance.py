@@ -9,7 +9,13 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from aura_ums._native._distance import polygon_distance_compiled, polygon_distance_reference
+from aura_ums._native._distance import (
+    point_in_solid_convex_compiled,
+    point_in_solid_convex_reference,
+    polygon_distance_compiled,
+    polygon_distance_reference,
+)
+from aura_ums.geometry import polygon_area
 from tests._native.native_helpers import built, random_polygon, scale_of
 
 
@@ -52,3 +58,36 @@ def test_the_kernel_refuses_bad_input() -> None:
         polygon_distance(None, 0.0, 0.0, 1.0, 1.0)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="polygon_distance: expected 5 arguments, got 1"):
         polygon_distance(square)  # type: ignore[call-arg]
+
+
+@built
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 1e-9, 1e-3]))
+def test_compiled_point_test_is_the_reference(seed: int, tolerance: float) -> None:
+    # Bit for bit: points on, just inside and just outside an edge decide alike.
+    rng = np.random.default_rng(seed)
+    vertices = random_polygon(rng, many=bool(rng.uniform() < 0.3))
+    if len(vertices) < 3 or polygon_area(vertices) <= 0.0:
+        return
+    edge = int(rng.integers(len(vertices)))
+    start, stop = vertices[edge], vertices[(edge + 1) % len(vertices)]
+    on_edge = start + rng.uniform() * (stop - start)
+    inner = vertices.mean(axis=0)
+    for point in (on_edge, on_edge + (on_edge - inner) * 1e-12, on_edge + (on_edge - inner) * 1e-9, inner,
+                  inner + rng.normal(size=2) * 5.0):  # fmt: skip
+        x, y = point.tolist()
+        ours = point_in_solid_convex_compiled(vertices, x, y, tolerance)
+        assert ours is point_in_solid_convex_reference(vertices, x, y, tolerance)
+
+
+@built
+def test_the_point_test_refuses_what_is_not_solid() -> None:
+    from aura_ums._native._kernels import point_in_solid_convex
+
+    segment = np.array([[0.0, 0.0], [1.0, 0.0]])
+    with pytest.raises(ValueError, match="vertices: expected a solid polygon of at least 3 vertices, got 2"):
+        point_in_solid_convex(segment, 0.5, 0.0, 0.0)
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    with pytest.raises(ValueError, match="tolerance: expected a finite number"):
+        point_in_solid_convex(square, 0.5, 0.5, math.inf)
+    with pytest.raises(TypeError, match="point_in_solid_convex: expected 4 arguments, got 3"):
+        point_in_solid_convex(square, 0.5, 0.5)

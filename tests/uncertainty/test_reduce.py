@@ -411,6 +411,29 @@ def test_the_managers_unchecked_reduction_gives_what_reduce_does() -> None:
         assert reduced.area < prior.area or reduced.wedge.width < prior.wedge.width
 
 
+@given(priors(), observations(), st.sampled_from([None, 0.0698, 0.5]))
+def test_the_managers_same_set_test_is_that_of_the_areas(
+    prior: SpatialUncertaintyMap, case: Case, slice_width: float | None
+) -> None:
+    # _reduce_kept takes a sliced map's areas only when the widths agree: the answer and the
+    # map must be those of the test on _reduce_checked's areas, bit for bit.
+    observation, landmark = case
+    if slice_width is not None:
+        prior = prior.with_slices(slice_width)
+    checked = prior._reduce_checked(observation, landmark)
+    kept = prior._reduce_kept(observation, landmark)
+    if isinstance(checked, str):
+        assert kept == checked
+        return
+    assert not isinstance(kept, str)
+    reduced, area_before, area_after = checked
+    same = 0.0 < area_before == area_after and reduced.wedge.width == prior.wedge.width
+    assert kept[1] == same
+    assert kept[0].polygon.vertices.tobytes() == reduced.polygon.vertices.tobytes()
+    assert kept[0].slices == reduced.slices
+    assert kept[0].wedge == reduced.wedge
+
+
 def test_landmark_inside_polygon(rng: np.random.Generator) -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 2.0, 0.3)
     poses = prior.sample_poses(300, rng)

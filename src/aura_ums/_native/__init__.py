@@ -47,6 +47,9 @@ reduce_cone: ConeKernel = _reduce.reduce_cone_compiled if NATIVE else _reduce.re
 reduce_strip: StripKernel = _reduce.reduce_strip_compiled if NATIVE else _reduce.reduce_strip_reference
 expecter_points = _expecter.expecter_points_compiled if NATIVE else _expecter.expecter_points_reference
 polygon_distance = _distance.polygon_distance_compiled if NATIVE else _distance.polygon_distance_reference
+point_in_solid_convex = (
+    _distance.point_in_solid_convex_compiled if NATIVE else _distance.point_in_solid_convex_reference
+)
 merge_groups = _slices.merge_groups_compiled if NATIVE else _slices.merge_groups_reference
 distribute_slices = _slices.distribute_slices_compiled if NATIVE else _slices.distribute_slices_reference
 grow_slices = _slices.grow_slices_compiled if NATIVE else _slices.grow_slices_reference
@@ -81,6 +84,7 @@ __all__ = [
     "merge_groups",
     "motion_bounds",
     "narrowed",
+    "point_in_solid_convex",
     "polygon_distance",
     "reduce_cone",
     "reduce_cone_slices",

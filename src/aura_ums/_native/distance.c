@@ -2,7 +2,9 @@
  * Compiled kernel of the find-landmark schemas' activation test: the distance between a
  * convex polygon (a point or a segment when degenerate) and a segment (a point when both
  * ends agree). Its reference is shapely's distance (_distance.polygon_distance_reference
- * beside this file).
+ * beside this file). And whether one point lies in a solid convex polygon, the dense test of
+ * geometry's points_in_convex (_distance.point_in_solid_convex_reference), operation for
+ * operation: a reduced map's centre is tested so, often many times a frame.
  */
 #include "kernels.h"
 
@@ -64,4 +66,34 @@ PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nar
     }
     PyBuffer_Release(&view);
     return PyFloat_FromDouble(best);
+}
+
+PyObject *point_in_solid_convex(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    static const char *const names[] = {"x", "y", "tolerance"};
+    double a[3];
+    Py_ssize_t n;
+    if (nargs != 4) {
+        PyErr_Format(PyExc_TypeError, "point_in_solid_convex: expected 4 arguments, got %zd", nargs);
+        return NULL;
+    }
+    if (parse_doubles(args + 1, 3, names, a) < 0) return NULL;
+    Py_buffer view;
+    if (get_vertices(args[0], &view, &n) < 0) return NULL;
+    if (n < 3) {
+        PyBuffer_Release(&view);
+        PyErr_Format(PyExc_ValueError, "vertices: expected a solid polygon of at least 3 vertices, got %zd", n);
+        return NULL;
+    }
+    const double *v = (const double *)view.buf;
+    /* The reference's np.hypot of each edge, then its signed distances: the same operations. */
+    int inside = 1;
+    for (Py_ssize_t i = 0; i < n && inside; i++) {
+        Py_ssize_t j = i + 1 < n ? i + 1 : 0;
+        double ex = v[2 * j] - v[2 * i], ey = v[2 * j + 1] - v[2 * i + 1];
+        double signed_distance = (ex * (a[1] - v[2 * i + 1]) - ey * (a[0] - v[2 * i])) / hypot(ex, ey);
+        inside = signed_distance >= -a[2];
+    }
+    PyBuffer_Release(&view);
+    return PyBool_FromLong(inside);
 }

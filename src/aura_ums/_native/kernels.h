@@ -217,6 +217,7 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *point_in_solid_convex(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *distribute_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *grow_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);

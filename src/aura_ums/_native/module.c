@@ -26,6 +26,9 @@ static PyMethodDef methods[] = {
      "x_min, y_min, x_max, y_max)"},
     {"polygon_distance", (PyCFunction)(void (*)(void))polygon_distance, METH_FASTCALL,
      "polygon_distance(vertices, ax, ay, bx, by) -> distance from the convex polygon to the segment [a, b]"},
+    {"point_in_solid_convex", (PyCFunction)(void (*)(void))point_in_solid_convex, METH_FASTCALL,
+     "point_in_solid_convex(vertices, x, y, tolerance) -> whether (x, y) lies within tolerance of the convex "
+     "counter-clockwise polygon of positive area (at least 3 vertices)"},
     {"merge_groups", (PyCFunction)(void (*)(void))merge_groups, METH_FASTCALL,
      "merge_groups(points, counts, max_vertices) -> tuple of vertex bytes: for each group of counts[i] "
      "consecutive rows of the (n, 2) float64 points, their convex hull with the outer vertex cap"},

@@ -678,21 +678,76 @@ typedef struct {
     double x, y;
 } Point;
 
-static int compare_points(const void *a, const void *b) {
-    const Point *p = a, *q = b;
+/* Whether p sorts strictly before q: by x, then y (total_order, NaN last). */
+static inline int point_before(const Point *p, const Point *q) {
     int by_x = total_order(p->x, q->x);
-    return by_x ? by_x : total_order(p->y, q->y);
+    return by_x ? by_x < 0 : total_order(p->y, q->y) < 0;
+}
+
+/* Stable sort of p[0..m) by point_before, with tmp: room for m points, then m run bounds.
+   Any stable sort orders the points alike (qsort's merge sort, before, included), so the
+   hull keeps its bits. This one merges the runs the input already has: the points are
+   mostly convex polygons one after the other, each at most three monotone runs in x. */
+static void sort_points(Point *p, Py_ssize_t m, Point *tmp) {
+    Py_ssize_t *bounds = (Py_ssize_t *)(tmp + m), runs = 0;
+    for (Py_ssize_t i = 0; i < m;) {
+        Py_ssize_t j = i + 1;
+        if (j < m && point_before(&p[j], &p[i])) {
+            /* Strictly descending: reversed, it stays stable (no two of it are equal). */
+            while (j + 1 < m && point_before(&p[j + 1], &p[j])) j++;
+            j++;
+            for (Py_ssize_t a = i, b = j - 1; a < b; a++, b--) {
+                Point swap = p[a];
+                p[a] = p[b];
+                p[b] = swap;
+            }
+        } else {
+            while (j < m && !point_before(&p[j], &p[j - 1])) j++;
+        }
+        bounds[runs++] = j;
+        i = j;
+    }
+    Point *from = p, *to = tmp;
+    while (runs > 1) {
+        Py_ssize_t out = 0, begin = 0;
+        for (Py_ssize_t r = 0; r < runs; r += 2) {
+            if (r + 1 == runs) {
+                memcpy(to + begin, from + begin, sizeof(Point) * (size_t)(bounds[r] - begin));
+                bounds[out++] = bounds[r];
+                break;
+            }
+            Py_ssize_t a = begin, mid = bounds[r], b = mid, end = bounds[r + 1], k = begin;
+            /* Ties take the left run's first: stable. */
+            while (a < mid && b < end) to[k++] = point_before(&from[b], &from[a]) ? from[b++] : from[a++];
+            while (a < mid) to[k++] = from[a++];
+            while (b < end) to[k++] = from[b++];
+            bounds[out++] = end;
+            begin = end;
+        }
+        runs = out;
+        Point *swap = from;
+        from = to;
+        to = swap;
+    }
+    if (from != p) memcpy(p, from, sizeof(Point) * (size_t)m);
 }
 
 /* See _convex.convex_hull (Andrew's monotone chain); `pts` must not be in `out`'s buffer. */
 int convex_hull(const double *pts, Py_ssize_t m, Poly *out, Work *w) {
-    Point *p = scratch(&w->points, m, sizeof(Point));
+    /* The points, room for as many to sort with, and the sort's run bounds. */
+    Py_ssize_t twice = checked_multiply(m, 2);
+    Py_ssize_t room = twice < 0 ? -1 : checked_add(twice, m / 2 + 1);
+    if (room < 0) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    Point *p = scratch(&w->points, room, sizeof(Point));
     if (!p) return -1;
     for (Py_ssize_t i = 0; i < m; i++) {
         p[i].x = pts[2 * i];
         p[i].y = pts[2 * i + 1];
     }
-    qsort(p, (size_t)m, sizeof(Point), compare_points);
+    sort_points(p, m, p + m);
     Py_ssize_t u = 0;
     for (Py_ssize_t i = 0; i < m; i++)
         if (u == 0 || p[i].x != p[u - 1].x || p[i].y != p[u - 1].y) p[u++] = p[i];

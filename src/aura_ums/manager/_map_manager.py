@@ -752,12 +752,12 @@ class UncertaintyMapManager:
             if together.consistent:
                 return together.map
         for observation, landmark in pairs:
-            found = current._reduce_checked(observation, landmark, self._max_vertices)
+            # Inside the prior with its area (> 0) and its wedge's width: the same set.
+            found = current._reduce_kept(observation, landmark, self._max_vertices)
             if isinstance(found, str):
                 return None
-            reduced, area_before, area_after = found
-            # Inside the prior with its area (> 0) and its wedge's width: the same set.
-            if not (0.0 < area_before == area_after and reduced.wedge.width == current.wedge.width):
+            reduced, same = found
+            if not same:
                 current = reduced
         return current
 

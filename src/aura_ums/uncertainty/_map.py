@@ -40,7 +40,7 @@ from aura_ums.geometry import (
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._motion import TurnAndRun
-from aura_ums.uncertainty._reduce import Reduced, Reduction, reduce_checked, reduce_map
+from aura_ums.uncertainty._reduce import Kept, Reduced, Reduction, reduce_checked, reduce_kept, reduce_map
 from aura_ums.uncertainty._slices import (
     DEFAULT_MAX_SLICES,
     DEFAULT_SLICE_WIDTH,
@@ -543,6 +543,12 @@ class SpatialUncertaintyMap:
         manager reads nothing else, so no :class:`Reduction` is built.
         """
         return reduce_checked(self, observation, landmark, max_vertices)
+
+    def _reduce_kept(
+        self, observation: Observation, landmark: Landmark, max_vertices: int = DEFAULT_MAX_VERTICES
+    ) -> Kept:
+        """:meth:`_reduce_checked`, telling only whether the result is the same set (see ``reduce_kept``)."""
+        return reduce_kept(self, observation, landmark, max_vertices)
 
     @overload
     def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...

@@ -19,7 +19,8 @@ from numpy.typing import NDArray
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
 from aura_ums.errors import InputError
-from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex
+from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex, polygon_area
+from aura_ums.geometry._convex import _DENSE_LIMIT
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -137,6 +138,9 @@ _REASONS: dict[int, str] = {
 #: A reduction without its record: (reduced map, area before, area after), or why it is empty.
 Reduced = tuple["SpatialUncertaintyMap", float, float] | str
 
+#: A reduction that says only whether it kept the same set: (reduced map, same), or why it is empty.
+Kept = tuple["SpatialUncertaintyMap", bool] | str
+
 
 def reduce_map(
     prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
@@ -223,8 +227,13 @@ def _reduce_sliced(
     observation: Observation,
     landmark: Landmark,
     max_vertices: int,
+    *,
+    measured: bool = True,
 ) -> Reduced:
     """Reduce a sliced map slice by slice (one kernel call); empty slices drop out, all empty is inconsistent.
+
+    Without ``measured``, both areas are returned as NaN (the caller takes them if it needs
+    them: each is a hull of every slice).
 
     Each slice is a product map of its polygon and its (narrow) interval, so its reduction
     is the single kernel's, sound as it is; the union of the reduced slices holds every
@@ -248,7 +257,33 @@ def _reduce_sliced(
         start = int(found.counts[:home].sum())
         x, y = held_centre(points[start : start + int(found.counts[home])], x, y)
     reduced = type(prior)._sliced(kept, np.array([x, y]), wedge, prior._cells, prior._max_slices)
+    if not measured:
+        return reduced, math.nan, math.nan
     return reduced, prior.area, reduced.area
+
+
+def reduce_kept(
+    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+) -> Kept:
+    """:func:`reduce_checked`, telling only whether the reduced map is the same set as the prior.
+
+    *Same* is what the map manager tests: the areas before and after are equal and
+    positive, and the wedge kept its width. A sliced map's areas are its hulls' (a hull of
+    every slice each, the costly part of a reduction); they are taken only when the widths
+    agree, since a narrower wedge settles it. The answer is the test's, bit for bit.
+    """
+    slices = prior._slices
+    if slices is None:
+        found = reduce_checked(prior, observation, landmark, max_vertices)
+        if isinstance(found, str):
+            return found
+        reduced, before, after = found
+        return reduced, 0.0 < before == after and reduced.wedge.width == prior.wedge.width
+    sliced = _reduce_sliced(prior, slices, observation, landmark, max_vertices, measured=False)
+    if isinstance(sliced, str):
+        return sliced
+    reduced = sliced[0]
+    return reduced, reduced.wedge.width == prior.wedge.width and 0.0 < prior.area == reduced.area
 
 
 def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[float, float]:
@@ -283,7 +318,12 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
     True
     """
     point = np.array([[x, y]])
-    if points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
+    # Where points_in_convex would test the point edge by edge (a solid polygon), the
+    # compiled test does the same operations: the centre is tested so many times a frame.
+    solid = 3 <= len(vertices) <= _DENSE_LIMIT and polygon_area(vertices) > 0.0
+    if solid and _native.point_in_solid_convex(vertices, x, y, POSITION_TOLERANCE):
+        return x, y
+    if not solid and points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
         return x, y
     inner = vertices.mean(axis=0)
     gap = inner - point[0]
