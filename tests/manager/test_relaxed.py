@@ -20,6 +20,8 @@ from aura_ums.manager import (
     RejectReason,
     UncertaintyMapManager,
 )
+from aura_ums.manager._relaxed import Branch, RelaxedState
+from aura_ums.manager._relaxed import grow as relaxed_grow
 from aura_ums.uncertainty import (
     BearingObservation,
     Observation,
@@ -301,3 +303,18 @@ def test_a_saved_branch_cannot_carry_a_sighting_it_chose() -> None:
     branch["carried"] = branch["carried"] + branch["excluded"]
     with pytest.raises(FileFormatError, match=r"carried: expected no serial of excluded, got \[\d+\]"):
         UncertaintyMapManager.from_json(json.dumps(document), WORLD, FLOOR)
+
+
+def test_growth_ends_what_branches_carry_and_keeps_their_choices() -> None:
+    start = SpatialUncertaintyMap.from_pose(Pose(10.0, 1.0, 0.0), 0.1, 0.02)
+    state = RelaxedState(
+        (Branch(frozenset(), start), Branch(frozenset({4}), start, frozenset({6, 7}))), (), frozenset(), 8
+    )
+
+    grown = relaxed_grow(state, lambda m: m.grow(TurnAndRun(0.0, 1.0), FLOOR["floor"]))
+
+    assert [(b.excluded, b.carried) for b in grown.branches] == [
+        (frozenset(), frozenset()),
+        (frozenset({4}), frozenset()),
+    ]
+    assert all(b.map.area > start.area for b in grown.branches)

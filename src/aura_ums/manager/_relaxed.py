@@ -17,7 +17,8 @@ but those (and, after merges, an outer bound of that).
 - When a sighting leaves the window, each branch forgets it (its choices and carried
   sightings without it); branches left with the same sets merge (an outer bound: hull of
   polygons, union of headings).
-- Growth applies to every branch; the reported map is the outer bound of all branches.
+- Growth applies to every branch and ends what each carries (see :func:`grow`); the
+  reported map is the outer bound of all branches.
 
 Guarantee: the truth stays inside whenever the wrong sightings among any ``N`` consecutive
 ones name at most ``q`` landmarks; in particular whenever at most ``q`` of any ``N``
@@ -109,7 +110,14 @@ def _sorted(branches: Sequence[Branch]) -> tuple[Branch, ...]:
 def grow(
     state: RelaxedState, grow_map: Callable[[SpatialUncertaintyMap], SpatialUncertaintyMap]
 ) -> RelaxedState:
-    """Return the state with every branch's map grown by ``grow_map``."""
+    """Return the state with every branch's map grown by ``grow_map``; the branches carry nothing after.
+
+    Dropping what a branch carries is what keeps the branch count within the sum of
+    ``C(N, k)``: after merges, branches with the same choices could otherwise differ only in
+    what they carry, and none would ever merge. It is sound: a carried sighting was never
+    applied to the branch's map, so forgetting it only spares the merge its leaving would
+    have made (the map stays an outer bound of what it claims).
+    """
     return dataclasses.replace(
         state, branches=tuple(Branch(branch.excluded, grow_map(branch.map)) for branch in state.branches)
     )
