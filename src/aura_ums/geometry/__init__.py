@@ -16,6 +16,7 @@ from aura_ums.geometry._convex import (
     points_in_convex,
     polygon_area,
     simplify_outer,
+    checks_every_edge,
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
 from aura_ums.geometry._pose import Pose
@@ -45,6 +46,7 @@ __all__ = [
     "regular_polygon",
     "simplify_outer",
     "subtended_arc",
+    "checks_every_edge",
     "wedges_contain",
     "wrap_angle",
 ]

@@ -550,6 +550,27 @@ def _support_polygon(vertices: Array, count: int) -> Array:
     return np.array(kept)
 
 
+def checks_every_edge(points: int, vertices: int) -> bool:
+    """Tell whether :func:`points_in_convex` checks these many points against every edge at once.
+
+    A compiled one-point test that must give the same answers takes the same path up to
+    this size (the edge-by-edge test, not the binary search on angles).
+
+    Parameters
+    ----------
+    points, vertices : int
+        How many points are tested, against a polygon of how many vertices (>= 0).
+
+    Examples
+    --------
+    >>> checks_every_edge(1, 64), checks_every_edge(1000, 1000)
+    (True, False)
+    >>> checks_every_edge(0, 0)   # nothing to test: trivially the dense path
+    True
+    """
+    return points * vertices <= _DENSE_LIMIT
+
+
 def points_in_convex(vertices: Array, points: Array, tolerance: float) -> NDArray[np.bool_]:
     """Tell which points lie in a convex polygon, counting ``tolerance`` metres around it.
 

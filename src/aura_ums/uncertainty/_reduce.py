@@ -19,8 +19,13 @@ from numpy.typing import NDArray
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
 from aura_ums.errors import InputError
-from aura_ums.geometry import POSITION_TOLERANCE, HeadingWedge, points_in_convex, polygon_area
-from aura_ums.geometry._convex import _DENSE_LIMIT
+from aura_ums.geometry import (
+    POSITION_TOLERANCE,
+    HeadingWedge,
+    points_in_convex,
+    polygon_area,
+    checks_every_edge,
+)
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
     GroundLineLandmark,
@@ -320,7 +325,7 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
     point = np.array([[x, y]])
     # Where points_in_convex would test the point edge by edge (a solid polygon), the
     # compiled test does the same operations: the centre is tested so many times a frame.
-    solid = 3 <= len(vertices) <= _DENSE_LIMIT and polygon_area(vertices) > 0.0
+    solid = len(vertices) >= 3 and checks_every_edge(1, len(vertices)) and polygon_area(vertices) > 0.0
     if solid and _native.point_in_solid_convex(vertices, x, y, POSITION_TOLERANCE):
         return x, y
     if not solid and points_in_convex(vertices, point, POSITION_TOLERANCE)[0]:
