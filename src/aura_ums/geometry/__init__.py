@@ -6,6 +6,7 @@ This package imports nothing else of aura-ums but its validation and errors.
 from aura_ums.geometry._angles import angle_difference, wrap_angle
 from aura_ums.geometry._arcs import Arc, intersect_arcs, nearest_on_polygon, subtended_arc
 from aura_ums.geometry._convex import (
+    checks_every_edge,
     clip_halfplane,
     convex_hull,
     cross2,
@@ -16,7 +17,6 @@ from aura_ums.geometry._convex import (
     points_in_convex,
     polygon_area,
     simplify_outer,
-    checks_every_edge,
 )
 from aura_ums.geometry._polygon import POSITION_TOLERANCE, ConvexPolygon, regular_polygon
 from aura_ums.geometry._pose import Pose
@@ -32,6 +32,7 @@ __all__ = [
     "ImageWindow",
     "Pose",
     "angle_difference",
+    "checks_every_edge",
     "clip_halfplane",
     "convex_hull",
     "cross2",
@@ -46,7 +47,6 @@ __all__ = [
     "regular_polygon",
     "simplify_outer",
     "subtended_arc",
-    "checks_every_edge",
     "wedges_contain",
     "wrap_angle",
 ]

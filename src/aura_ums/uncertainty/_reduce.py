@@ -22,9 +22,9 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import (
     POSITION_TOLERANCE,
     HeadingWedge,
+    checks_every_edge,
     points_in_convex,
     polygon_area,
-    checks_every_edge,
 )
 from aura_ums.uncertainty._landmarks import (
     BearingObservation,
