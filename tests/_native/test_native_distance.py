@@ -90,4 +90,4 @@ def test_the_point_test_refuses_what_is_not_solid() -> None:
     with pytest.raises(ValueError, match="tolerance: expected a finite number"):
         point_in_solid_convex(square, 0.5, 0.5, math.inf)
     with pytest.raises(TypeError, match="point_in_solid_convex: expected 4 arguments, got 3"):
-        point_in_solid_convex(square, 0.5, 0.5)
+        point_in_solid_convex(square, 0.5, 0.5)  # type: ignore[call-arg]  # the wrong count is the test
