@@ -226,11 +226,24 @@ def odometry_report_arrays(
     turn = np.diff(cumulative_integral(t, angular, edges)) * turn_scale
     ahead = np.maximum(np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale, 0.0)
     back = np.maximum(np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale, 0.0)
+    return turned_round(times, turn, ahead, back)
+
+
+def turned_round(
+    times: NDArray[np.float64],
+    turn: NDArray[np.float64],
+    ahead: NDArray[np.float64],
+    back: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Return report times, turns and runs with every piece that backs up made two commands.
+
+    ``times``, ``turn`` (rad), ``ahead`` and ``back`` (m, >= 0) are per piece; the log is
+    cut at every sign change, so a piece never runs both ways. A piece backing up becomes
+    a turn round and a run of ``back``, then, at the same time, a turn back and no run.
+    """
     flipped = back > 0.0
     if not np.any(flipped):
         return times, turn, ahead
-    # Cut at every sign change, so a piece backing up runs no distance forward: it
-    # becomes a turn round and a run, then, at the same time, a turn back.
     count = np.where(flipped, 2, 1)
     first = np.cumsum(count) - count
     out_times = np.repeat(times, count)

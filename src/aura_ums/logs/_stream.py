@@ -47,7 +47,7 @@ from aura_ums.logs._io import (
     odometry_blocks,
 )
 from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
-from aura_ums.logs._odometry import ReverseMotion, report_times
+from aura_ums.logs._odometry import ReverseMotion, report_times, turned_round
 from aura_ums.manager import PositionReport
 
 Array = NDArray[np.float64]
@@ -405,19 +405,7 @@ class OdometryReports:
         self.low = high
         if len(times) == 0:
             return times, times, times
-        flipped = back > 0.0
-        if not np.any(flipped):
-            return times, turn, ahead
-        count = np.where(flipped, 2, 1)
-        first = np.cumsum(count) - count
-        out_times = np.repeat(times, count)
-        out_turns = np.repeat(turn, count)
-        out_runs = np.repeat(ahead, count)
-        out_turns[first[flipped]] = turn[flipped] + math.pi
-        out_runs[first[flipped]] = back[flipped]
-        out_turns[first[flipped] + 1] = -math.pi
-        out_runs[first[flipped] + 1] = 0.0
-        return out_times, out_turns, out_runs
+        return turned_round(times, turn, ahead, back)
 
     def finish(self) -> None:
         """Read and check the rows after the last frame: the whole record is checked, as load_log does."""
