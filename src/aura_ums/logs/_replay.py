@@ -24,7 +24,7 @@ from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._io import _given
-from aura_ums.logs._log import LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
+from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
 from aura_ums.logs._odometry import ReverseMotion
 from aura_ums.logs._state import ReplayState
 from aura_ums.logs._stream import LogStream, OdometryReports, TruthWindow
@@ -964,6 +964,15 @@ def _row_of(row: LogObservation) -> _Row:
     return (row.time, row.landmark_id, row.bearing, row.range, row.bearing_error, row.range_error)
 
 
+def _truth_at(
+    truth: GroundTruth | TruthWindow | None,
+) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+    """Return the lookup of the true poses at given times: rows of NaN where the log has no truth."""
+    if truth is None:
+        return lambda times: np.full((len(times), 3), np.nan)
+    return truth.at
+
+
 def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: ReplayState | None) -> _Source:
     """Read a whole log in memory: its frames, reports and truth as :func:`replay_log` always made them."""
     start_time, start_pose = replay_start(log)
@@ -992,16 +1001,13 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
 
     truth = log.groundtruth
 
-    def truth_at(times: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.full((len(times), 3), np.nan) if truth is None else truth.at(times)
-
     return _Source(
         start_time,
         start_pose,
         meadow_map,
         chunks(),
         _WholeReports(*report_arrays, posted),
-        truth_at,
+        _truth_at(truth),
         int(frame_times.size),
         first,
         frames,
@@ -1044,16 +1050,13 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
         whole = RobotLog(meta, stream.landmarks, (), commands=stream.commands)
         reports = _WholeReports(*whole.position_report_arrays(start=start_time), 0)
 
-    def truth_at(times: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.full((len(times), 3), np.nan) if truth is None else truth.at(times)
-
     return _Source(
         start_time,
         start_pose,
         meadow_map,
         _stream_chunks(stream, start_time, stop, keep_rows),
         reports,
-        truth_at,
+        _truth_at(truth),
         0,
     )
 
