@@ -21,7 +21,7 @@ from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, wedges_contain
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, polygon_area, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._io import _given
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
@@ -1235,26 +1235,8 @@ def _wedges(maps: Sequence[SpatialUncertaintyMap]) -> NDArray[np.float64]:
 
 
 def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
-    """Each polygon's area, m^2: exactly :func:`aura_ums.geometry.polygon_area` of each."""
-    areas = np.zeros(len(vertices))
-    counts = np.array([len(v) for v in vertices], dtype=np.int64)
-    if not np.any(counts >= 3):
-        return areas
-    every = np.concatenate(vertices)
-    first = np.cumsum(counts) - counts
-    following = np.arange(1, len(every) + 1)
-    following[first + counts - 1] = first
-    # Relative to each polygon's first vertex, as polygon_area does; its two dot products per polygon.
-    x = every[:, 0] - np.repeat(every[first, 0], counts)
-    y = every[:, 1] - np.repeat(every[first, 1], counts)
-    x_next, y_next = x[following], y[following]
-    for index, (begin, size) in enumerate(zip(first.tolist(), counts.tolist(), strict=True)):
-        if size >= 3:
-            end = begin + size
-            areas[index] = float(
-                0.5 * (np.dot(x[begin:end], y_next[begin:end]) - np.dot(y[begin:end], x_next[begin:end]))
-            )
-    return areas
+    """Each polygon's area, m^2 (:func:`aura_ums.geometry.polygon_area` of each)."""
+    return np.array([polygon_area(v) for v in vertices], dtype=np.float64)
 
 
 def _contains(
