@@ -34,7 +34,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 
 from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.errors import InputError
@@ -213,6 +212,8 @@ class FastLineFinder:
 
     def _gradient(self, pixels: NDArray[np.float32]) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
         """Sobel gradient / 8 of the crop; zero on its one-pixel border (no full neighbourhood)."""
+        from scipy import ndimage  # deferred: scipy takes ~0.5 s to import
+
         if self.smoothing > 0.0:
             pixels = np.asarray(
                 ndimage.gaussian_filter(pixels, self.smoothing, mode="nearest"), dtype=np.float32
@@ -235,6 +236,8 @@ class FastLineFinder:
 
     def _label(self, masks: list[NDArray[np.bool_]]) -> tuple[NDArray[np.int32], int]:
         """Label the 8-connected components of each mask, numbering on across masks."""
+        from scipy import ndimage
+
         total = np.zeros(masks[0].shape, dtype=np.int32)
         count = 0
         cv2: Any = import_cv2("FastLineFinder") if self.backend is LineBackend.OPENCV else None
@@ -255,6 +258,8 @@ class FastLineFinder:
 
     def _label_one(self, mask: NDArray[np.bool_]) -> tuple[NDArray[np.int32], int]:
         """Label the 8-connected components of one mask: ``_label([mask])`` in fewer steps."""
+        from scipy import ndimage
+
         if self.backend is LineBackend.OPENCV:
             return self._label([mask])
         labels = np.empty(mask.shape, dtype=np.int32)

@@ -6,7 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 
 from aura_ums._validate import nonnegative_float
 from aura_ums.errors import InputError
@@ -77,6 +76,8 @@ class MoravecOperator:
         return self._response(crop.pixels.astype(np.float64))
 
     def _response(self, pixels: NDArray[np.float64]) -> NDArray[np.float64]:
+        from scipy import ndimage  # deferred: scipy takes ~0.5 s to import
+
         h, w = pixels.shape
         half = self.size // 2
         result = np.zeros((h, w))
@@ -124,6 +125,8 @@ class MoravecOperator:
         InputError
             When the image is not a 2-D array of finite numbers, or the window misses it.
         """
+        from scipy import ndimage
+
         crop = prepare(image, window, context=self.size // 2 + 1 + self.suppression)
         response = self._response(crop.pixels.astype(np.float64))
         local_max = ndimage.maximum_filter(response, size=2 * self.suppression + 1, mode="constant")

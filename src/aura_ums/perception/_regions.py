@@ -6,7 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import ndimage
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError
@@ -134,6 +133,8 @@ class RegionSegmenter:
         InputError
             When the image is not a 2-D array of finite numbers, or the window misses it.
         """
+        from scipy import ndimage  # deferred: scipy takes ~0.5 s to import
+
         crop = prepare(image, window, context=0)
         pixels = np.asarray(crop.pixels, dtype=np.float64)
         if pixels.size == 0:

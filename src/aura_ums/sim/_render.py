@@ -22,7 +22,6 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.special import ndtri
 
 from aura_ums._validate import integer_at_least, nonnegative_float
 from aura_ums.camera import Camera, undistort_points
@@ -180,6 +179,8 @@ class SyntheticCamera:
         self._camera = camera
         self._scene = scene
         self._rng = rng
+        from scipy.special import ndtri  # deferred: scipy takes ~0.5 s to import
+
         quantiles = (np.arange(65536, dtype=np.float64) + 0.5) / 65536.0
         self._noise_table = (self._noise * ndtri(quantiles)).astype(np.float32)
         self._prepare_background()

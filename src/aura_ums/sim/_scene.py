@@ -21,7 +21,6 @@ from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 
 from aura_ums._validate import (
     finite_float,
@@ -289,6 +288,8 @@ def ground_texture(
     >>> tile.shape, round(float(tile.std()), 3), tile.flags.writeable
     ((64, 64), 1.0, False)
     """
+    from scipy import ndimage  # deferred: scipy takes ~0.5 s to import
+
     if isinstance(size, bool) or not isinstance(size, int) or size < 4 or size & (size - 1):
         raise InputError(f"size: expected a power of two >= 4, got {size!r}")
     noise = rng.standard_normal((size, size))

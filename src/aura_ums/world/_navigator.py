@@ -14,7 +14,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import pairwise
 
-import networkx as nx
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
@@ -177,6 +176,9 @@ def plan_route(meadow_map: MeadowMap, start: ArrayLike, goal: ArrayLike) -> Rout
     points = {node: positions[node] for node in range(len(positions))}
     points[_START] = source
     points[_GOAL] = target
+
+    # Imported here: networkx takes about a second to import, and only path planning needs it.
+    import networkx as nx
 
     graph = nx.Graph()
     graph.add_nodes_from(points)
