@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -35,9 +36,9 @@ def scenario() -> Scenario:
     return Scenario.from_toml(SCENARIO)
 
 
-@pytest.fixture(scope="module")
-def scheduler() -> Iterator[str]:
-    """A two-worker cluster of processes, as the campaign starts its own, shared by the Dask tests."""
+@contextlib.contextmanager
+def two_worker_cluster() -> Iterator[str]:
+    """A two-worker cluster of processes, as the campaign starts its own: its scheduler's address."""
     distributed = pytest.importorskip("distributed", reason="the dask extra is not installed")
     cluster = distributed.LocalCluster(
         n_workers=2,
@@ -50,6 +51,24 @@ def scheduler() -> Iterator[str]:
     )
     with cluster:
         yield cluster.scheduler_address
+
+
+@pytest.fixture(scope="module")
+def scheduler() -> Iterator[str]:
+    """One cluster shared by the Dask tests (its workers may be killed: their nannies restart them)."""
+    with two_worker_cluster() as address:
+        yield address
+
+
+@pytest.fixture
+def fresh_scheduler() -> Iterator[str]:
+    """A cluster of its own, for a test that restarts workers.
+
+    A nanny whose worker process was killed once (the shared cluster's) may not bring its
+    worker back after a restart the scheduler asks for (distributed 2026.8).
+    """
+    with two_worker_cluster() as address:
+        yield address
 
 
 def test_a_serial_campaign_keeps_the_order_and_reports_progress() -> None:
@@ -178,11 +197,11 @@ def test_a_run_lost_more_often_than_its_retries_fails_the_campaign(scheduler: st
         run_campaign(KillAlways(victim=2), [0, 1, 2, 3], CampaignSettings(scheduler=scheduler, retries=1))
 
 
-def test_a_stuck_run_times_out_and_is_retried(scheduler: str, tmp_path: Path) -> None:
+def test_a_stuck_run_times_out_and_is_retried(fresh_scheduler: str, tmp_path: Path) -> None:
     stuck = HangOnce(victim=1, marker=tmp_path / "hung")
     # The clock of a run starts when it is handed to a worker, a restarted worker's imports
     # included: generous, for a loaded machine; the stuck run sleeps far longer.
-    settings = CampaignSettings(scheduler=scheduler, retries=2, timeout_s=10.0)
+    settings = CampaignSettings(scheduler=fresh_scheduler, retries=2, timeout_s=10.0)
     campaign = run_campaign(stuck, [0, 1, 2, 3], settings)
     assert (tmp_path / "hung").exists(), "the stuck attempt never ran"
     assert campaign.values == (0, 1, 4, 9)

@@ -38,7 +38,8 @@ _R = TypeVar("_R")
 
 #: Seconds to connect to a scheduler, and to wait for its first worker.
 _CONNECT_S = 30.0
-#: Seconds a worker restart (after a timed-out run) may take before the campaign goes on without it.
+#: Seconds a stuck worker may take to shut down, and the cluster to have a worker again,
+#: after a timed-out run.
 _RESTART_S = 60.0
 
 
@@ -280,8 +281,30 @@ def _time_out(client: Client, runs: _Runs[_T, _R], timeout_s: float) -> None:
         future.cancel()
         runs.lost(index, f"no result within {timeout_s:g} s")
     if stuck:
-        # A thread cannot be stopped: the worker's process is, by its nanny.
-        client.restart_workers(stuck, timeout=_RESTART_S, raise_for_error=False)
+        # A thread cannot be stopped: the worker's process is, by its nanny. Not waiting for
+        # the restarted workers to return: a nanny whose worker was lost before may never
+        # bring it back, and the campaign would stall for _RESTART_S on the others' behalf.
+        scheduler = client.scheduler
+        if scheduler is None:  # the client has closed: nothing can run any more
+            raise RunLostError(
+                f"scheduler: expected a connected client, got one closed "
+                f"(restarting {len(stuck)} stuck worker(s))"
+            )
+        client.sync(
+            scheduler.restart_workers,
+            workers=stuck,
+            timeout=_RESTART_S,
+            wait_for_workers=False,
+            on_error="return",
+            stimulus_id=f"aura-ums-timeout-{time.time()}",
+        )
+        try:
+            client.wait_for_workers(1, timeout=_RESTART_S)
+        except TimeoutError as error:  # distributed's WorkerStartTimeoutError is one
+            raise RunLostError(
+                f"scheduler: expected a worker within {_RESTART_S:g} s of restarting {len(stuck)} "
+                f"stuck worker(s), got none"
+            ) from error
         # The runs in flight waited for the restart (some were queued on that worker): their
         # time starts again now, or one stuck run would time out the runs behind it.
         restarted = time.monotonic()
