@@ -2,7 +2,7 @@
 
 MRCLAM Dataset 6 robot 1, Class II, calibrated on itself (the acceptance setup), replayed
 by the ``aura-ums`` command twice: with the kernels as installed and with
-``AURA_UMS_NATIVE=0``. ``make test`` runs this file in both of its passes.
+``AURA_UMS_NATIVE=0``. It sets the switch itself, so ``make test`` runs it in its first pass only.
 
 The two paths round differently (the C Minkowski sum orders edges by a pseudo-angle and
 adds them in another order), so where the vertex cap is at work its greedy merge may break
