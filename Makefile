@@ -60,14 +60,22 @@ lint: $(VENV)/.stamp-dev
 typecheck: $(VENV)/.stamp-dev
 	$(BIN)/mypy
 
-# The numeric core once more on the numpy reference (AURA_UMS_NATIVE=0: an install without a
-# C compiler), with tests/_native's real-log replay against the compiled kernels.
-NUMERIC_CORE := tests/geometry tests/uncertainty tests/expecter tests/manager tests/_native \
+# Every core runs tests (pytest-xdist; CI has two). PYTEST_WORKERS=0 runs them in one process.
+PYTEST_WORKERS ?= auto
+PYTEST := MPLBACKEND=Agg $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist worksteal
+
+# The second pass runs the library on the numpy reference (AURA_UMS_NATIVE=0: an install
+# without a C compiler): the switch, the doctests of the kernel-facing packages and the
+# soundness checks of growth, the map, the manager and the Expecter. The first pass already
+# holds every kernel to its reference (tests/_native, hypothesis) and replays a real log on
+# both paths (tests/_native/test_native_replay.py).
+REFERENCE_PASS := tests/_native/test_native_switch.py tests/geometry tests/uncertainty/test_map.py \
+	tests/uncertainty/test_growth.py tests/expecter/test_expecter_soundness.py tests/manager/test_map_manager.py \
 	src/aura_ums/_native src/aura_ums/geometry src/aura_ums/uncertainty src/aura_ums/expecter src/aura_ums/manager
 
 pytest: $(VENV)/.stamp-dev
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
-	AURA_UMS_NATIVE=0 MPLBACKEND=Agg $(BIN)/python -m pytest -q $(NUMERIC_CORE)
+	$(PYTEST)
+	AURA_UMS_NATIVE=0 $(PYTEST) $(REFERENCE_PASS)
 
 test: lint typecheck pytest
 
