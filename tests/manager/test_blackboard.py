@@ -217,3 +217,56 @@ def test_source_names_the_file_and_non_text_is_refused() -> None:
         Blackboard.from_json(b"{}", source="board.json")  # type: ignore[arg-type]
     with pytest.raises(InputError, match=r"board\.json: version: expected 1, got nothing"):
         Blackboard.from_json('{"format": "aura-ums/blackboard"}', source="board.json")
+
+
+# --- forgetting consumed reports -----------------------------------------------------------
+
+
+def test_forgotten_reports_keep_the_indices_of_the_rest() -> None:
+    board = Blackboard()
+    board.post_reports(report(float(t)) for t in range(6))
+    board.forget_reports_before(4)
+    assert (board.report_count, board.released_reports) == (6, 4)
+    assert [r.time for r in board.position_reports] == [4.0, 5.0]
+    assert board.report(4).time == 4.0
+    assert [r.time for r in board.reports_until(10.0, start=5)] == [5.0]
+    board.forget_reports_before(4)  # again: nothing more
+    board.post_report(report(6.0))
+    assert board.report(6).time == 6.0
+    assert board.report_count == 7
+    with pytest.raises(
+        InputError, match=r"index: expected an integer in \[4, 7\) \(older ones forgotten\), got 3"
+    ):
+        board.report(3)
+    with pytest.raises(
+        InputError, match=r"start: expected an integer >= 4 \(older reports were forgotten\), got 2"
+    ):
+        board.reports_until(10.0, start=2)
+    with pytest.raises(InputError, match=r"report\.time: expected a time >= 6\.0"):
+        board.post_report(report(5.5))  # the time order holds across what was forgotten
+
+
+@pytest.mark.parametrize("index", [3, 7, -1, 1.0, True])
+def test_forgetting_the_newest_report_or_a_forgotten_one_is_refused(index: object) -> None:
+    board = Blackboard()
+    board.post_reports(report(float(t)) for t in range(7))
+    board.forget_reports_before(4)
+    with pytest.raises(
+        InputError, match=r"index: expected an integer in \[4, 6\] \(the newest report is kept\)"
+    ):
+        board.forget_reports_before(index)  # type: ignore[arg-type]
+
+
+def test_a_board_that_forgot_round_trips_and_one_that_did_not_reads_as_before() -> None:
+    board = Blackboard()
+    board.post_reports(report(float(t), 0.1 * t) for t in range(5))
+    untouched = json.loads(board.to_json())
+    assert "released_reports" not in untouched
+    board.forget_reports_before(3)
+    again = Blackboard.from_json(board.to_json())
+    assert (again.report_count, again.released_reports) == (5, 3)
+    assert again.position_reports == board.position_reports
+    assert again.to_json() == board.to_json()
+    assert "older forgotten" in repr(again)
+    with pytest.raises(FileFormatError, match=r"released_reports"):
+        Blackboard.from_json(board.to_json().replace('"released_reports": 3', '"released_reports": -1'))

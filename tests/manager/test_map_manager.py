@@ -843,3 +843,27 @@ def test_the_vertex_cap_is_saved_and_an_older_document_restores_the_default() ->
     document["settings"]["max_vertices"] = 2
     with pytest.raises(FileFormatError, match=r"settings\.max_vertices: expected an integer >= 3, got 2"):
         UncertaintyMapManager.from_json(json.dumps(document), WORLD, TABLE)
+
+
+def test_a_manager_reading_a_board_that_forgot_what_it_consumed_grows_the_same_map() -> None:
+    commands = [TurnAndRun(0.05 * (k % 3), 0.4) for k in range(12)]
+    maps: list[tuple[list[list[float]], HeadingWedge]] = []
+    for forgetting in (False, True):
+        manager, board = manager_for(), Blackboard()
+        for k, command in enumerate(commands):
+            board.post_report(PositionReport(float(k + 1), command))
+            if k % 2:
+                grown = manager.update(board, now=float(k + 1)).map
+                maps.append((grown.polygon.vertices.tolist(), grown.wedge))
+                if forgetting:  # all but the last consumed report, which the manager checks
+                    board.forget_reports_before(manager.consumed_reports - 1)
+    assert maps[: len(maps) // 2] == maps[len(maps) // 2 :]
+    board = Blackboard()
+    board.post_reports(PositionReport(float(t), TurnAndRun(0.0, 0.1)) for t in (1.0, 2.0, 3.0))
+    manager = manager_for()
+    manager.update(board, now=2.0)
+    board.forget_reports_before(2)  # the last consumed report (index 1) is gone
+    with pytest.raises(
+        InputError, match=r"keeping its last consumed report 1, got one that forgot the reports before 2"
+    ):
+        manager.update(board, now=3.0)

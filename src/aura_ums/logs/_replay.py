@@ -833,6 +833,9 @@ def replay_log(
             judge.flush()
             writer.write(part)
             reports.posted += next_report
+            # The reports the manager consumed are not read again (but for the last, which it
+            # checks): a long log's replay keeps its memory, not every report since the start.
+            board.forget_reports_before(max(board.released_reports, manager.consumed_reports - 1))
         source.finish()
     result_trace = trace.build()
     state = None

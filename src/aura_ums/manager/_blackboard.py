@@ -68,7 +68,9 @@ class Blackboard:
     - :attr:`position_reports`: time-stamped :class:`PositionReport` s from the shaft
       encoders, appended in time order by the vehicle interface (or simulator) and read by
       the :class:`UncertaintyMapManager`, which remembers how many it has consumed. They
-      are kept, not removed, so that logs and plots can replay them.
+      are kept, so that logs and plots can replay them, until :meth:`forget_reports_before`
+      lets the oldest go (a long replay's memory); their indices stay those they were
+      posted with.
     - :attr:`identified`: the :class:`IdentifiedLandmarkBuffer` into which find-landmark
       schemas post observations and from which the manager drains them.
     - the command buffer: a first-in first-out queue of :class:`TurnAndRun` commands the
@@ -103,7 +105,7 @@ class Blackboard:
     aura_ums.errors.InputError: report.time: expected a time >= 2.0 (the last report's), got 1.5
     """
 
-    __slots__ = ("_commands", "_identified", "_reports")
+    __slots__ = ("_commands", "_identified", "_released", "_reports")
 
     def __init__(self, identified: IdentifiedLandmarkBuffer | None = None) -> None:
         if identified is None:
@@ -114,6 +116,8 @@ class Blackboard:
             )
         self._identified = identified
         self._reports: list[PositionReport] = []
+        #: How many of the oldest reports were forgotten: the index of ``_reports[0]``.
+        self._released = 0
         self._commands: deque[TurnAndRun] = deque()
 
     # --- position reports --------------------------------------------------------------
@@ -144,13 +148,60 @@ class Blackboard:
 
     @property
     def position_reports(self) -> tuple[PositionReport, ...]:
-        """Every position report posted, oldest first."""
+        """Every position report kept (posted and not forgotten), oldest first."""
         return tuple(self._reports)
 
     @property
     def report_count(self) -> int:
-        """Number of position reports posted."""
-        return len(self._reports)
+        """Number of position reports posted, forgotten ones included (the next one's index)."""
+        return self._released + len(self._reports)
+
+    @property
+    def released_reports(self) -> int:
+        """Number of the oldest position reports forgotten (the index of the oldest kept)."""
+        return self._released
+
+    def forget_reports_before(self, index: int) -> None:
+        """Forget the position reports older than ``index``; the others keep their indices.
+
+        A consumer that will not read them again lets them go, so that a long replay's
+        memory does not grow with its log: the replay keeps the last report its manager
+        consumed (which :meth:`UncertaintyMapManager.update` checks) and those after it.
+        :meth:`to_json` records how many were forgotten.
+
+        Parameters
+        ----------
+        index : int
+            The oldest report to keep: from :attr:`released_reports` (nothing forgotten)
+            to ``report_count - 1`` (the newest report is always kept).
+
+        Raises
+        ------
+        InputError
+            For an index outside that range.
+
+        Examples
+        --------
+        >>> board = Blackboard()
+        >>> board.post_reports(PositionReport(t, TurnAndRun(0.0, 0.1)) for t in (1.0, 2.0, 3.0))
+        >>> board.forget_reports_before(2)
+        >>> board.report_count, board.released_reports, board.report(2).time
+        (3, 2, 3.0)
+        >>> board.report(1)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: index: expected an integer in [2, 3) (older ones forgotten), got 1
+        >>> Blackboard().forget_reports_before(0)          # nothing posted: nothing to forget
+        """
+        count = self.report_count
+        newest = max(self._released, count - 1)
+        if isinstance(index, bool) or not isinstance(index, int) or not self._released <= index <= newest:
+            raise InputError(
+                f"index: expected an integer in [{self._released}, {newest}] (the newest report "
+                f"is kept), got {index!r}"
+            )
+        del self._reports[: index - self._released]
+        self._released = index
 
     @property
     def last_report_time(self) -> float | None:
@@ -176,10 +227,11 @@ class Blackboard:
         ...
         aura_ums.errors.InputError: index: expected an integer in [0, 1), got 1
         """
-        count = len(self._reports)
-        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < count:
-            raise InputError(f"index: expected an integer in [0, {count}), got {index!r}")
-        return self._reports[index]
+        count, first = self.report_count, self._released
+        if isinstance(index, bool) or not isinstance(index, int) or not first <= index < count:
+            forgotten = " (older ones forgotten)" if first else ""
+            raise InputError(f"index: expected an integer in [{first}, {count}){forgotten}, got {index!r}")
+        return self._reports[index - first]
 
     def reports_until(self, until: float, *, start: int = 0) -> tuple[PositionReport, ...]:
         """Return the reports from index ``start`` on whose time is ``<= until``, oldest first.
@@ -192,14 +244,20 @@ class Blackboard:
         until : float
             Latest time to take, seconds (inclusive).
         start : int
-            Index of the first report to consider (the number already consumed), >= 0.
+            Index of the first report to consider (the number already consumed), at least
+            :attr:`released_reports`.
         """
         limit = finite_float(until, "until")
-        if isinstance(start, bool) or not isinstance(start, int) or start < 0:
-            raise InputError(f"start: expected a non-negative integer, got {start!r}")
-        reports = self._reports
-        stop = bisect.bisect_right(reports, limit, lo=min(start, len(reports)), key=_report_time)
-        return tuple(reports[start:stop])
+        if isinstance(start, bool) or not isinstance(start, int) or start < self._released:
+            at_least = (
+                f"an integer >= {self._released} (older reports were forgotten)"
+                if self._released
+                else ("a non-negative integer")
+            )
+            raise InputError(f"start: expected {at_least}, got {start!r}")
+        reports, first = self._reports, start - self._released
+        stop = bisect.bisect_right(reports, limit, lo=min(first, len(reports)), key=_report_time)
+        return tuple(reports[first:stop])
 
     # --- command buffer ----------------------------------------------------------------
 
@@ -244,16 +302,16 @@ class Blackboard:
         (True, (BearingObservation(landmark_id='pole', time=0.5, bearing=0.25, bearing_error=0.01, \
 sensor_offset=(0.0, 0.0)),))
         """
-        return dump_document(
-            _KIND,
-            {
-                "position_reports": [
-                    {"time": r.time, "command": encode_command(r.command)} for r in self._reports
-                ],
-                "identified": [encode_observation(o) for o in self._identified.peek()],
-                "commands": [encode_command(c) for c in self._commands],
-            },
-        )
+        body: dict[str, object] = {
+            "position_reports": [
+                {"time": r.time, "command": encode_command(r.command)} for r in self._reports
+            ],
+            "identified": [encode_observation(o) for o in self._identified.peek()],
+            "commands": [encode_command(c) for c in self._commands],
+        }
+        if self._released:  # only then: a board that forgot nothing reads as before
+            body["released_reports"] = self._released
+        return dump_document(_KIND, body)
 
     @classmethod
     def from_json(cls, text: str, *, source: str = "<blackboard JSON>") -> Blackboard:
@@ -283,8 +341,11 @@ sensor_offset=(0.0, 0.0)),))
             reader.document(text, _KIND),
             "",
             ("format", "version", "position_reports", "identified", "commands"),
+            optional=("released_reports",),
         )
         board = cls()
+        if "released_reports" in data:
+            board._released = reader.integer(data["released_reports"], "released_reports")
         last: float | None = None
         for k, item in enumerate(reader.array(data["position_reports"], "position_reports")):
             where = f"position_reports[{k}]"
@@ -304,6 +365,8 @@ sensor_offset=(0.0, 0.0)),))
 
     def __repr__(self) -> str:
         return (
-            f"Blackboard({len(self._reports)} position reports, {len(self._identified)} identified "
+            f"Blackboard({len(self._reports)} position reports"
+            + (f" ({self._released} older forgotten)" if self._released else "")
+            + f", {len(self._identified)} identified "
             f"observations, {len(self._commands)} queued commands)"
         )
