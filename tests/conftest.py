@@ -11,6 +11,7 @@ import pytest
 from hypothesis import HealthCheck, settings
 
 import aura_ums as ums
+from aura_ums.logs import Calibration, RobotLog, calibrate_logs, read_mrclam
 
 # CI is reproducible (a failure shows every time, not by chance); developers' runs and the
 # "thorough" profile (AURA_HYPOTHESIS_PROFILE=thorough) keep exploring new examples.
@@ -28,6 +29,21 @@ settings.load_profile(os.environ.get("AURA_HYPOTHESIS_PROFILE") or ("ci" if os.e
 
 #: Where the published datasets live (never copied into the repository).
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+MRCLAM6 = SHARED_DATA / "mrclam6"
+
+
+@pytest.fixture(scope="session")
+def mrclam6_robot1() -> RobotLog:
+    """MRCLAM Dataset 6 robot 1, read once per test process (a log is an immutable value)."""
+    if not (MRCLAM6 / "Robot1_Measurement.dat").is_file():
+        pytest.skip(f"MRCLAM Dataset 6 not found at {MRCLAM6} (shared data is not part of the repository)")
+    return read_mrclam(MRCLAM6, 1)
+
+
+@pytest.fixture(scope="session")
+def mrclam6_robot1_calibration(mrclam6_robot1: RobotLog) -> Calibration:
+    """The calibration on MRCLAM Dataset 6 robot 1 with the defaults: the acceptance setup."""
+    return calibrate_logs([mrclam6_robot1])
 
 
 @pytest.fixture

@@ -10,12 +10,13 @@ import pytest
 
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
+    Calibration,
+    RobotLog,
     SensorBounds,
     calibrate_logs,
     load_noise,
     load_sensors,
     observation_errors,
-    read_mrclam,
     synthetic_log,
 )
 from aura_ums.uncertainty import TerrainTable
@@ -124,8 +125,10 @@ def test_sensor_bounds_range_interval_is_sound_for_relative_errors() -> None:
 
 
 @pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
-def test_mrclam_calibration_finds_the_command_delay_and_heavy_tails() -> None:
-    calibration = calibrate_logs([read_mrclam(MRCLAM, 1)])
+def test_mrclam_calibration_finds_the_command_delay_and_heavy_tails(
+    mrclam6_robot1_calibration: Calibration,
+) -> None:
+    calibration = mrclam6_robot1_calibration
     assert 0.1 <= calibration.motion.delay_s <= 0.3  # commanded velocities lead the robot
     assert calibration.motion.run_scale > 1.0  # the robot sometimes outruns its command
     assert calibration.envelope.bearing_error > 1.5 * calibration.working.bearing_error
@@ -168,8 +171,10 @@ def test_range_bounds_are_absolute_plus_relative() -> None:
 
 
 @pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
-def test_mrclam_growth_bound_holds_over_the_horizons_it_is_used() -> None:
-    calibration = calibrate_logs([read_mrclam(MRCLAM, 1)])
+def test_mrclam_growth_bound_holds_over_the_horizons_it_is_used(
+    mrclam6_robot1_calibration: Calibration,
+) -> None:
+    calibration = mrclam6_robot1_calibration
     checks = {check.horizon: check for check in calibration.checks}
     assert sorted(checks) == [1.0, 2.0, 5.0, 10.0, 30.0]
     for horizon in (5.0, 10.0, 30.0):
@@ -203,10 +208,11 @@ def test_anchor_calibration_scales_by_the_mean_and_says_what_it_is_for() -> None
 
 
 @pytest.mark.skipif(not MRCLAM.is_dir(), reason=f"MRCLAM data not found at {MRCLAM}")
-def test_mrclam_anchor_bound_holds_at_every_horizon_and_grows_sublinearly() -> None:
-    log = read_mrclam(MRCLAM, 1)
-    anchored = {c.horizon: c for c in calibrate_logs([log], anchor=True).checks}
-    per_move = {c.horizon: c for c in calibrate_logs([log]).checks}
+def test_mrclam_anchor_bound_holds_at_every_horizon_and_grows_sublinearly(
+    mrclam6_robot1: RobotLog, mrclam6_robot1_calibration: Calibration
+) -> None:
+    anchored = {c.horizon: c for c in calibrate_logs([mrclam6_robot1], anchor=True).checks}
+    per_move = {c.horizon: c for c in mrclam6_robot1_calibration.checks}
     for check in anchored.values():
         # A point start: the truth's own millimetres count; the fit covers 0.99 of the windows.
         assert check.containment >= 0.98

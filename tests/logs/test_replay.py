@@ -15,7 +15,6 @@ from aura_ums.logs import (
     ReplayOptions,
     RobotLog,
     SensorBounds,
-    calibrate_logs,
     observation_for,
     read_mrclam,
     replay_log,
@@ -114,12 +113,11 @@ def test_zero_length_log_gives_no_steps() -> None:
 
 
 @pytest.fixture(scope="module")
-def mrclam() -> tuple[RobotLog, RobotLog, Calibration]:
+def mrclam(
+    mrclam6_robot1: RobotLog, mrclam6_robot1_calibration: Calibration
+) -> tuple[RobotLog, RobotLog, Calibration]:
     """Robots 1 and 2 of MRCLAM Dataset 6, and the calibration on robot 1 (the acceptance setup)."""
-    if not MRCLAM.is_dir():
-        pytest.skip(f"MRCLAM data not found at {MRCLAM}")
-    robot1, robot2 = read_mrclam(MRCLAM, 1), read_mrclam(MRCLAM, 2)
-    return robot1, robot2, calibrate_logs([robot1])
+    return mrclam6_robot1, read_mrclam(MRCLAM, 2), mrclam6_robot1_calibration
 
 
 def calibrated(calibration: Calibration, landmark_class: LandmarkClass) -> ReplayOptions:

@@ -17,6 +17,7 @@ import pytest
 from aura_ums.camera import load_camera
 from aura_ums.errors import InputError
 from aura_ums.logs import (
+    Calibration,
     LogLandmark,
     LogMeta,
     LogObservation,
@@ -24,7 +25,6 @@ from aura_ums.logs import (
     RobotLog,
     SensorBounds,
     WindowReport,
-    calibrate_logs,
     ekf_noise,
     read_mrclam,
     replay_log,
@@ -247,8 +247,8 @@ MRCLAM6 = SHARED_DATA / "mrclam6"
 
 
 @pytest.mark.skipif(not MRCLAM6.is_dir(), reason=f"MRCLAM Dataset 6 not found at {MRCLAM6}")
-def test_real_log_windows_on_mrclam6() -> None:
-    calibration = calibrate_logs([read_mrclam(MRCLAM6, 1)])
+def test_real_log_windows_on_mrclam6(mrclam6_robot1_calibration: Calibration) -> None:
+    calibration = mrclam6_robot1_calibration
     log = read_mrclam(MRCLAM6, 2)
     # The first 600 observations: the test judges the machinery, the benchmark the whole runs.
     log = dataclasses.replace(log, observations=log.observations[:600])

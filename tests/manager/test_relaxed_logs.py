@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from aura_ums.logs import (
+    Calibration,
     GroundTruth,
     LogObservation,
     Odometry,
     ReplayOptions,
     RobotLog,
-    calibrate_logs,
     read_mrclam,
     replay_log,
     synthetic_log,
@@ -74,8 +74,10 @@ def test_synthetic_logs_keep_the_truth_through_wrong_sightings_with_q_1(seed: in
 
 
 @pytest.mark.skipif(not (SHARED_DATA / "mrclam6").is_dir(), reason="no MRCLAM data at ../shared/data/mrclam6")
-def test_a_real_log_with_injected_wrong_sightings_keeps_what_the_clean_log_kept() -> None:
-    calibration = calibrate_logs([read_mrclam(SHARED_DATA / "mrclam6", robot=1)])
+def test_a_real_log_with_injected_wrong_sightings_keeps_what_the_clean_log_kept(
+    mrclam6_robot1_calibration: Calibration,
+) -> None:
+    calibration = mrclam6_robot1_calibration
     log = read_mrclam(SHARED_DATA / "mrclam6", robot=2)
     start = log.observations[0].time
     log = dataclasses.replace(log, observations=tuple(o for o in log.observations if o.time < start + 300.0))
@@ -124,11 +126,13 @@ def stretch(log: RobotLog, start: float, stop: float) -> RobotLog:
     not (SHARED_DATA / "mrclam6").is_dir() or not (SHARED_DATA / "mrclam7").is_dir(),
     reason="no MRCLAM data at ../shared/data/mrclam6 and mrclam7",
 )
-def test_a_real_misread_barcode_seen_twice_is_tolerated_as_one_wrong_landmark() -> None:
+def test_a_real_misread_barcode_seen_twice_is_tolerated_as_one_wrong_landmark(
+    mrclam6_robot1_calibration: Calibration,
+) -> None:
     # MRCLAM7 robot 5 misreads a barcode twice within ten sightings about 617 s in (bearing
     # off by about 3 rad); the gate-and-q=1 map lost the truth for 61 s (0.94 of the whole
     # log inside; 0.58 of this stretch); counting repeats of one landmark once keeps it.
-    calibration = calibrate_logs([read_mrclam(SHARED_DATA / "mrclam6", robot=1)])
+    calibration = mrclam6_robot1_calibration
     log = stretch(read_mrclam(SHARED_DATA / "mrclam7", robot=5), 560.0, 700.0)
     table = TerrainTable({log.meta.terrain: calibration.stats})
     options = ReplayOptions(
