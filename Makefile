@@ -1,5 +1,10 @@
 # Quick start: `make demo` then `make test`. Both create .venv when missing.
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
+# Python writes its bytecode caches (__pycache__, ignored by git) under make, whatever the
+# shell says: with PYTHONDONTWRITEBYTECODE set, every process (each CLI run a test starts,
+# each pytest worker) compiled aura_ums and its dependencies from source again, and
+# collecting the tests took 20 s instead of 7.
+unexport PYTHONDONTWRITEBYTECODE
 VENV := .venv
 BIN := $(VENV)/bin
 REPORT ?= report
