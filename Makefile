@@ -82,7 +82,10 @@ pytest: $(VENV)/.stamp-dev
 	$(PYTEST)
 	AURA_UMS_NATIVE=0 $(PYTEST) $(REFERENCE_PASS)
 
-test: lint typecheck pytest
+# The three checks run side by side (mypy keeps one core busy, pytest every core); each one's
+# output is printed whole when it ends. Any failure fails `make test`.
+test: $(VENV)/.stamp-dev
+	@$(MAKE) --no-print-directory -j3 --output-sync=target lint typecheck pytest
 
 # Speed against named baselines, measured in the same run (prints tables; asserts nothing).
 bench: $(VENV)/.stamp-dev
