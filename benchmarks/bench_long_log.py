@@ -49,8 +49,11 @@ keeps every position report (about 290 bytes each). Parsing (numpy's ``loadtxt``
 once (kept checked in a scratch file), the observations.
 
 Since the blackboard forgets the reports its manager consumed (all but the last), the
-peak is 99, 115 and 150 MB for 10^5, 10^6 and 3 x 10^6 rows (27 November, 21:25 UTC, with
-the test suite running beside it: its times are not comparable). At the end of a replay
+peak is 99, 115 and 150 MB for 10^5, 10^6 and 3 x 10^6 rows (27 November, about 20:50 UTC, with
+the test suite running beside it: its times are not comparable). With scipy and networkx
+no longer imported by the replay too (45962a6, 21:37 UTC, load 0.9 to 1.7), it is 70, 86
+and 121 MB; load / update / total 1.61 / 13.46 / 26.15 s at 10^6 rows and 4.61 / 35.22 /
+69.61 s at 3 x 10^6 (the update time within the run-to-run spread above). At the end of a replay
 only the trace is left of the log (``tracemalloc``: 1.57 MB for 18,679 steps, 84 bytes a
 step); the peak still rises by about 17 MB per 10^6 rows, twice the trace's 8 MB,
 consistent with the trace's chunks and their concatenation held at once at the end.
