@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import contextlib
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -226,3 +228,45 @@ def test_a_local_cluster_replays_logs_as_the_serial_campaign(tmp_path: Path) -> 
         {k: v for k, v in m.items() if k not in timing} for m in serial.values
     ]
     assert [m["log"] for m in parallel.values] == [m["log"] for m in serial.values]
+
+
+class _StuckFuture:
+    key = "aura-ums-test-run0-attempt0"
+
+    def cancel(self) -> None:
+        pass
+
+
+class _ClusterWithoutWorkers:
+    """A client whose stuck worker's nanny never brings a worker back (nor does any other)."""
+
+    def __init__(self) -> None:
+        self.scheduler = self
+        self.restarted: list[str] = []
+
+    def processing(self) -> dict[str, tuple[str, ...]]:
+        return {"tcp://stuck": (_StuckFuture.key,)}
+
+    def restart_workers(self, *, workers: list[str], wait_for_workers: bool, **kwargs: object) -> None:
+        self.restarted.extend(workers)
+        assert wait_for_workers is False  # never the 60 s wait for a worker that may not return
+
+    def sync(self, function: Any, **kwargs: object) -> None:
+        function(**kwargs)
+
+    def wait_for_workers(self, count: int, timeout: float) -> None:
+        raise TimeoutError(f"Only 0/{count} workers arrived after {timeout}")
+
+
+def test_a_restart_after_which_no_worker_returns_fails_the_campaign_by_name() -> None:
+    import aura_ums.campaign._engine as engine
+
+    runs = engine._Runs(abs, [1], CampaignSettings(retries=2, timeout_s=1.0))
+    runs.in_flight[_StuckFuture()] = (0, time.monotonic() - 5.0)  # type: ignore[index]
+    client = _ClusterWithoutWorkers()
+    with pytest.raises(
+        RunLostError, match=r"scheduler: expected a worker within 60 s of restarting 1 stuck worker"
+    ):
+        engine._time_out(client, runs, 1.0)  # type: ignore[arg-type]
+    assert client.restarted == ["tcp://stuck"]
+    assert runs.retried == {0}
