@@ -131,4 +131,3 @@ def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
     assert not grown.contains(x, y, heading)
     poses = np.array([[x, y, heading]] * 2)
     assert _contains([grown, grown.without_slices()], poses).tolist() == [0, 1]
-
