@@ -252,7 +252,7 @@ class Blackboard:
             at_least = (
                 f"an integer >= {self._released} (older reports were forgotten)"
                 if self._released
-                else ("a non-negative integer")
+                else "a non-negative integer"
             )
             raise InputError(f"start: expected {at_least}, got {start!r}")
         reports, first = self._reports, start - self._released

@@ -891,12 +891,13 @@ class UncertaintyMapManager:
                 f"blackboard: expected the one this manager reads, with at least {self._consumed} "
                 f"position reports (consumed so far), got {count}"
             )
-        if self._consumed and blackboard.released_reports >= self._consumed:
-            raise InputError(
-                f"blackboard: expected the one this manager reads, keeping its last consumed report "
-                f"{self._consumed - 1}, got one that forgot the reports before {blackboard.released_reports}"
-            )
         if self._consumed:
+            released = blackboard.released_reports
+            if released >= self._consumed:
+                raise InputError(
+                    f"blackboard: expected the one this manager reads, keeping its last consumed report "
+                    f"{self._consumed - 1}, got one that forgot the reports before {released}"
+                )
             last = blackboard.report(self._consumed - 1).time
             if last != self._map_time:
                 raise InputError(
