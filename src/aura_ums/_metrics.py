@@ -302,8 +302,8 @@ _TABLE: tuple[MetricKey, ...] = (
         _K.FRACTION,
         (CAMERA, CAMERA_ROW),
         "Fraction of the judged observations whose measured pixel (Class I: column; Class II: "
-        "column and row) lies inside the window asked for before the observation was applied; "
-        "null: none judged.",
+        "column and row) is one the window asked for before the observation was applied meets "
+        "(the window as whole pixels); null: none judged.",
     ),
     _key(
         "window_truth_containment",

@@ -141,10 +141,11 @@ def test_csv_rows_match_the_metrics(clean_log: RobotLog) -> None:
             if row["u_min_px"] == "":
                 assert row["in_window"] == "0"
                 continue
+            # Judged by whole pixels: the window meets the unit square the measured point is in.
             u, v = float(row["measured_u_px"]), float(row["measured_v_px"])
-            inside = float(row["u_min_px"]) <= u <= float(row["u_max_px"]) and (
-                float(row["v_min_px"]) <= v <= float(row["v_max_px"])
-            )
+            column, line = math.floor(u + 0.5), math.floor(v + 0.5)
+            inside = float(row["u_min_px"]) <= column + 0.5 and column - 0.5 <= float(row["u_max_px"])
+            inside = inside and float(row["v_min_px"]) <= line + 0.5 and line - 0.5 <= float(row["v_max_px"])
             assert row["in_window"] == str(int(inside))
             width = (float(row["u_max_px"]) - float(row["u_min_px"])) / CAMERA.intrinsics.width
             assert float(row["window_width_frac"]) == pytest.approx(width, abs=1e-12)

@@ -107,16 +107,40 @@ class ImageWindow:
         NaN pixels (points behind the camera, as :meth:`Camera.project` gives them) are
         outside. Returns a boolean array of shape ``(...)``.
         """
-        try:
-            points = np.asarray(pixels, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"pixels: expected an (n, 2) array of numbers, got {pixels!r}") from exc
-        if points.ndim == 0 or points.shape[-1] != 2:
-            raise InputError(f"pixels: expected shape (..., 2), got {points.shape}")
-        u = points[..., 0]
-        v = points[..., 1]
+        u, v = _pixel_points(pixels)
         inside = (u >= self.u_min) & (u <= self.u_max) & (v >= self.v_min) & (v <= self.v_max)
         return np.asarray(inside, dtype=np.bool_)
+
+    def meets_pixel_of(self, pixels: ArrayLike) -> NDArray[np.bool_]:
+        """Tell, for points ``(..., 2)`` (u, v), whether the window meets the pixel each falls in.
+
+        Pixel ``(i, j)`` is the unit square centred on ``(i, j)``; a point on the edge
+        between two pixels falls in the one to its right (or below). A perception module
+        scans whole pixels, so it scans every pixel the window meets, and finds a feature
+        whose pixel is one of them even where the window's bound cuts that pixel: this is
+        :meth:`contains` widened by less than a pixel on each side. NaN points are outside.
+        Returns a boolean array of shape ``(...)``.
+
+        Examples
+        --------
+        >>> w = ImageWindow(10.2, 20.0, 50.0, 40.0)
+        >>> w.contains([(9.7, 30.0), (9.4, 30.0)]).tolist()
+        [False, False]
+        >>> w.meets_pixel_of([(9.7, 30.0), (9.4, 30.0)]).tolist()   # pixel 10 (9.5 to 10.5) meets it
+        [True, False]
+        >>> ImageWindow(3.5, 0.0, 3.5, 0.0).meets_pixel_of([(3.5, 0.0), (3.49, 0.0)]).tolist()
+        [True, True]
+        """
+        u, v = _pixel_points(pixels)
+        column = np.floor(u + 0.5)
+        row = np.floor(v + 0.5)
+        meets = (
+            (column + 0.5 >= self.u_min)
+            & (column - 0.5 <= self.u_max)
+            & (row + 0.5 >= self.v_min)
+            & (row - 0.5 <= self.v_max)
+        )
+        return np.asarray(meets, dtype=np.bool_)
 
     def expanded(self, margin: float) -> ImageWindow:
         """Return the window grown by ``margin`` pixels (>= 0) on every side."""
@@ -142,6 +166,17 @@ class ImageWindow:
         if u_lo > u_hi or v_lo > v_hi:
             return None
         return ImageWindow(u_lo, v_lo, u_hi, v_hi)
+
+
+def _pixel_points(pixels: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the u and v of points ``(..., 2)``, pixels, checked for shape."""
+    try:
+        points = np.asarray(pixels, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"pixels: expected an (n, 2) array of numbers, got {pixels!r}") from exc
+    if points.ndim == 0 or points.shape[-1] != 2:
+        raise InputError(f"pixels: expected shape (..., 2), got {points.shape}")
+    return points[..., 0], points[..., 1]
 
 
 def _saturate(value: float) -> float:

@@ -6,7 +6,9 @@ asked for each observed landmark's window from the map of that moment (grown to 
 frame's time, not yet reduced); the EKF, run alongside on the same position reports and
 observations, gives its 3-sigma box's window, and the disk model the window of the circle
 around the same map. Each real observation is then judged: does its measured pixel lie
-inside each window?
+inside each window? A window is judged as a set of whole pixels, as a perception module
+scans it: an observation is inside when the window meets the pixel its point falls in
+(:meth:`~aura_ums.geometry.ImageWindow.meets_pixel_of`).
 
 The measured pixel is the landmark's image where the observation puts it: the point at
 the measured bearing, at the measured range (Class I rows without a range: the distance
@@ -527,9 +529,9 @@ class _Judge:
 
     def _contains(self, window: ImageWindow, pixel: tuple[float, float]) -> bool:
         u, v = pixel
-        if not window.u_min <= u <= window.u_max:
-            return False
-        return self._class is not LandmarkClass.POINT or window.v_min <= v <= window.v_max
+        if self._class is not LandmarkClass.POINT:
+            v = window.v_min  # a vertical line: its column alone is judged
+        return bool(window.meets_pixel_of((u, v)))
 
 
 def _judged_landmark(landmark: object) -> VerticalLineLandmark | PointLandmark:
