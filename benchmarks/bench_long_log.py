@@ -58,6 +58,25 @@ only the trace is left of the log (``tracemalloc``: 1.57 MB for 18,679 steps, 84
 step); the peak still rises by about 17 MB per 10^6 rows, twice the trace's 8 MB. Not
 from joining the trace's chunks at the end: joining them column by column, each chunk's
 column let go once joined, left the peak at 87 and 119 MB (tried, not kept).
+
+The gain depends on the log's shape: how many odometry rows fall between camera frames.
+The steps (one a frame) cost the same per step in both trees, so the more frames a log has,
+the smaller the gain. Measured back to back, 27 November about 22:35-22:45 UTC, on the
+machine shared with a CLI sweep and a real-log benchmark (load average 3.5 to 5, which
+punishes the older tree's memory traffic more than this one's), total seconds:
+
+==============================  =======  =========  ===========  ==========
+log                             steps    f47bbb6    this tree    vs f47bbb6
+==============================  =======  =========  ===========  ==========
+10^6 rows, a frame every 100    9,335    80.04      15.40        5.2x
+10^6 rows, a frame every 10     93,359   73.08      19.06        3.8x (idle, above)
+10^5 rows, a frame every row    93,487   228.99     76.57        3.0x
+==============================  =======  =========  ===========  ==========
+
+(``--rows 1000000 --frame-every 100`` and ``--rows 100000 --frame-every 1``, each then with
+``--src`` of f47bbb6.) The manager's update, about 100 us a step on an idle machine, two
+maps a step, is most of the time once frames are frequent; its compiled kernels take
+about a third of it (cProfile, 10^6 rows, a frame every 10), the Python around them the rest.
 """
 
 from __future__ import annotations
