@@ -60,8 +60,9 @@ from joining the trace's chunks at the end: joining them column by column, each 
 column let go once joined, left the peak at 87 and 119 MB (tried, not kept).
 
 The gain depends on the log's shape: how many odometry rows fall between camera frames.
-The steps (one a frame) cost the same per step in both trees, so the more frames a log has,
-the smaller the gain. Measured back to back, 27 November about 22:35-22:45 UTC, on the
+Reading the log and recording the steps gained the most; the manager's update per step (one
+a frame) the least (15.07 against 9.99 s above, 1.5x), so the more frames a log has, the
+smaller the gain. Measured back to back, 27 November about 22:35-22:45 UTC, on the
 machine shared with a CLI sweep and a real-log benchmark (load average 3.5 to 5, which
 punishes the older tree's memory traffic more than this one's), total seconds:
 
