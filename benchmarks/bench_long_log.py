@@ -57,7 +57,14 @@ and 121 MB; load / update / total 1.61 / 13.46 / 26.15 s at 10^6 rows and 4.61 /
 only the trace is left of the log (``tracemalloc``: 1.57 MB for 18,679 steps, 84 bytes a
 step); the peak still rises by about 17 MB per 10^6 rows, twice the trace's 8 MB. Not
 from joining the trace's chunks at the end: joining them column by column, each chunk's
-column let go once joined, left the peak at 87 and 119 MB (tried, not kept).
+column let go once joined, left the peak at 87 and 119 MB (tried, not kept). The peak is
+reached inside the loop, before that join (10^6 rows: VmHWM 88.0 MB before it, RSS 82.3
+then 86.3 MB after). Between the 30th and the 90th chunk of 1,024 steps the resident memory
+grows by about 130 bytes a step, while ``tracemalloc`` sees only the trace's chunks grow
+(84 bytes a step, every other allocation flat): the rest is outside Python's allocations,
+most likely the allocator's heap around the trace's 8 KB chunk columns, which sit among the
+replay's short-lived arrays. One array per column that grows by doubling (large allocations,
+returned to the system when replaced) would leave the trace's 84 bytes; not tried.
 
 The gain depends on the log's shape: how many odometry rows fall between camera frames.
 Reading the log and recording the steps gained the most; the manager's update per step (one
