@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import itertools
 import json
 from importlib.metadata import version
 from pathlib import Path
@@ -45,6 +46,23 @@ def test_help_shows_flags_and_brackets_as_written(command: str) -> None:
         assert "[manager]" in result.stdout
         assert "--prune" in result.stdout
         assert "--no-prune" in result.stdout
+
+
+HELPED = ["", "figures", "demo", "simulate", "replay", "compare", "calibrate"]
+HELPED += ["import", "import mrclam", "import rosbag"]
+
+
+@pytest.mark.parametrize("command", HELPED)
+def test_help_paragraphs_wrap_to_the_terminal_without_ragged_lines(command: str) -> None:
+    result = runner.invoke(app, [*command.split(), "--help"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    # The description: the lines above the first box, each indented by one space.
+    description = result.stdout.split("\u256d", 1)[0].splitlines()
+    width = 80 - 2
+    for line, following in itertools.pairwise(description):
+        if line.strip() and following.strip() and not line.lstrip().startswith("Usage:"):
+            # Greedy wrapping: the next line's first word would not have fit on this one.
+            assert len(line.strip()) + 1 + len(following.split()[0]) > width, (line, following)
 
 
 def test_progress_is_drawn_on_a_terminal_and_not_with_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
