@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import sys
 from pathlib import Path
 from typing import Any
@@ -319,3 +320,28 @@ def test_frames_in_a_ground_truth_gap_are_not_scored(tmp_path: Path) -> None:
         figures[label] = strict_json(out.read_text())
     assert (figures["default"]["steps_with_truth"], figures["default"]["containment_rate"]) == (0, None)
     assert figures["no limit"]["steps_with_truth"] == 2
+
+
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_a_start_in_a_ground_truth_gap_is_refused_naming_the_file(
+    command: str, log_folder: Path, tmp_path: Path
+) -> None:
+    # No [start] pose in meta.toml: the start comes from the truth, whose first two rows
+    # (-1 s and 0.1 s) are further apart than the 0.5 s interpolated across.
+    folder = tmp_path / "log"
+    shutil.copytree(log_folder, folder)
+    truth = folder / "groundtruth.csv"
+    lines = truth.read_text().splitlines(keepends=True)
+    first = next(index for index, line in enumerate(lines) if line[:1].isdigit())
+    lines[first] = "-1" + lines[first][lines[first].index(",") :]
+    truth.write_text("".join(lines))
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    result = runner.invoke(app, [command, str(folder), "--terrain", str(terrain)])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.stderr
+    assert "error" not in result.stdout
+    assert (
+        "groundtruth.csv: expected a ground-truth pose at the replay's start, 0 s (meta.toml gives no "
+        "[start] pose), got none: the start lies between two rows more than 0.5 s apart" in result.stderr
+    )
