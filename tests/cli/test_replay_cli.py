@@ -345,3 +345,21 @@ def test_a_start_in_a_ground_truth_gap_is_refused_naming_the_file(
         "groundtruth.csv: expected a ground-truth pose at the replay's start, 0 s (meta.toml gives no "
         "[start] pose), got none: the start lies between two rows more than 0.5 s apart" in result.stderr
     )
+
+
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_a_terrain_file_without_the_logs_terrain_is_named(
+    command: str, log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    grass = tmp_path / "grass.toml"
+    grass.write_text(TerrainTable({"grass": TerrainTable.default()["grass"]}).to_toml())
+    sensors = terrain.with_suffix(".sensors.toml")
+    result = runner.invoke(
+        app, [command, str(log_folder), "--terrain", str(grass), "--sensors", str(sensors)]
+    )
+    assert result.exit_code == 2
+    assert f"--terrain: expected {grass} to hold the log's terrain 'floor' (meta.toml), got 'grass'" in (
+        result.stderr
+    )

@@ -45,6 +45,7 @@ from aura_ums.cli._outputs import (
 if TYPE_CHECKING:
     from aura_ums.logs import LogStream, ReplayOptions, ReplayResult
     from aura_ums.manager import ManagerSettings
+    from aura_ums.uncertainty import TerrainTable
 
 
 # draw_replay's file name after the log's name
@@ -109,6 +110,19 @@ _WindowsCsv = Annotated[
     Path | None,
     typer.Option("--windows-csv", help="Write one row per observation and window method (--camera)."),
 ]
+
+
+def _terrain_table(terrain: Path, name: str) -> TerrainTable:
+    """Read ``--terrain``; refuse (exit 2, naming the file) a table without the log's terrain."""
+    from aura_ums.uncertainty import TerrainTable
+
+    table = TerrainTable.from_toml(terrain)
+    if name not in table:
+        held = ", ".join(repr(entry) for entry in table) or "none"
+        raise fail(
+            f"--terrain: expected {terrain} to hold the log's terrain {name!r} (meta.toml), got {held}"
+        )
+    return table
 
 
 def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
@@ -355,7 +369,7 @@ def replay(
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
-        table = TerrainTable.from_toml(terrain)
+        table = _terrain_table(terrain, log.meta.terrain)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
         saved = None if resume is None else ReplayState.load(resume)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
@@ -459,7 +473,6 @@ def compare(
     from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
-    from aura_ums.uncertainty import TerrainTable
 
     if particles < 1:
         raise fail(f"--particles: expected an integer >= 1, got {particles}")
@@ -473,7 +486,7 @@ def compare(
     check_outputs([json_target], sources, overwrite=overwrite)
     try:
         log = LoadLog(max_truth_gap)(log_dir)
-        table = TerrainTable.from_toml(terrain)
+        table = _terrain_table(terrain, log.meta.terrain)
         sensors_file = _sensors_file(sensors, terrain)
         options = _options(classes, sensors_file, settings.over(), reverse)
         if calibration_logs:
