@@ -363,3 +363,15 @@ def test_a_terrain_file_without_the_logs_terrain_is_named(
     assert f"--terrain: expected {grass} to hold the log's terrain 'floor' (meta.toml), got 'grass'" in (
         result.stderr
     )
+
+
+def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "short"
+    shutil.copytree(log_folder, folder)
+    commands = folder / "commands.csv"
+    commands.write_text("".join(commands.read_text().splitlines(keepends=True)[:3]))  # one row
+    result = runner.invoke(app, ["calibrate", str(folder), "--out", str(tmp_path / "t.toml")])
+    assert result.exit_code == 2
+    assert f"error: LOG_DIRS ({folder}): calibrating from their contents: " in result.stderr
+    assert "expected at least 10 1.0-second windows of motion, got 0" in result.stderr
+    assert not (tmp_path / "t.toml").exists()

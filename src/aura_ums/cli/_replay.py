@@ -214,7 +214,10 @@ def calibrate(
     try:
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
             loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
-        logs = list(loaded.values)
+    except AuraUmsError as exc:
+        raise fail(str(exc)) from None
+    logs = list(loaded.values)
+    try:
         if horizons:
             calibration = calibrate_logs(
                 logs, quantile=quantile, move=move, horizons=tuple(horizons), anchor=anchor
@@ -222,7 +225,9 @@ def calibrate(
         else:  # calibrate_logs' default horizons
             calibration = calibrate_logs(logs, quantile=quantile, move=move, anchor=anchor)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        # The logs read cleanly; what they hold does not calibrate: name them, not the library's arguments.
+        folders = ", ".join(str(folder) for folder in log_dirs)
+        raise fail(f"LOG_DIRS ({folders}): calibrating from their contents: {exc}") from None
     write_text(out_target, calibration.terrain_table().to_toml())
     write_text(sensors_target, calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
