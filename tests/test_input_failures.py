@@ -133,6 +133,18 @@ def test_a_clock_jump_is_refused_with_its_file_line_and_step_estimate(tmp_path: 
         load_log(log_folder(tmp_path, odometry_csv=odometry))
 
 
+def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "odometry.csv").unlink()
+    (folder / "commands.csv").write_text("time,turn,run\n0.5,0.0,0.2\n1.0,0.1,0.2\n2402000.0,0.0,0.2\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"commands\.csv:4: expected at most 86400 s after the previous row \(line 3\), "
+        r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
+    ):
+        load_log(folder)
+
+
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
     odometry = HEADER + "9.0 0.1 0.0\n9.5 0.2 0.1\n2402009.5 0.0 0.0\n"
     with pytest.raises(
