@@ -165,6 +165,12 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
         return
     if where.is_dir():
         raise fail(f"{target.option}: expected a file, got {target.path}, which is a folder")
+    if where.exists() and not where.is_file():
+        # The atomic rename would put a regular file in its place (as root, /dev/null's).
+        raise fail(
+            f"{target.option}: expected a regular file, got {target.path}, which is a device, pipe or "
+            "socket (it would be replaced, not written to)"
+        )
     if where.exists() and not overwrite:
         raise fail(
             f"{target.option}: expected a new file, got {target.path}, which exists "
