@@ -107,6 +107,13 @@ def test_two_outputs_may_not_share_a_path(inputs: Path, tmp_path: Path, untouche
     refused(invoke(*common, "--metrics-json", both, "--steps-csv", both), "--steps-csv", "--metrics-json")
     assert not same.exists()
     assert not both.exists()
+    # One output file as the folder of another: refused before either is written.
+    refused(
+        invoke(*common, "--metrics-json", both, "--steps-csv", both / "steps.csv"),
+        "--steps-csv",
+        "--metrics-json",
+    )
+    assert not both.exists()
 
 
 def test_an_existing_output_is_replaced_only_with_overwrite(inputs: Path, tmp_path: Path) -> None:

@@ -129,6 +129,16 @@ def check_outputs(
                     f"{target.option}: expected a path of its own, got {target.path}, which is also "
                     f"the output of {other.option} ({other.path})"
                 )
+            # A file output cannot also be the folder of another: one of the two would fail
+            # after the computation, with the other written.
+            nested = (taken in where.parents and not other.folder) or (
+                where in taken.parents and not target.folder
+            )
+            if nested:
+                raise fail(
+                    f"{target.option}: expected a path of its own, got {target.path}, which nests with "
+                    f"the output file of {other.option} ({other.path})"
+                )
         seen.append((target, where))
         _replaceable(target, where, overwrite)
         _writable(target, where)
