@@ -9,6 +9,7 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 from __future__ import annotations
 
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -17,7 +18,7 @@ import pytest
 
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import load_log, read_mrclam
+from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, synthetic_log
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
@@ -143,6 +144,18 @@ def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp
         r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
     ):
         load_log(folder)
+
+
+def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:
+    # replay reads the sensors file for its bounds only, yet a NaN anywhere in it is refused.
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    text = calibrate_logs([log]).sensors_toml()
+    path = tmp_path / "terrain.sensors.toml"
+    path.write_text(re.sub(r"bearing_sd = .*", "bearing_sd = nan", text))
+    with pytest.raises(
+        FileFormatError, match=r"terrain\.sensors\.toml: \[noise\] bearing_sd: expected a finite number, got nan"
+    ):
+        load_sensors(path)
 
 
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:

@@ -331,9 +331,12 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
     ------
     FileFormatError
         Naming the file and table for a missing file, bad TOML, a missing or unknown key,
-        or a value out of range.
+        or a value out of range (in the optional ``[noise]`` table too).
     """
     reader, document = _read_sensors(path)
+    if "noise" in document:
+        # Checked though unused here: a bad file is refused by every command that reads it.
+        _build(reader, document, "noise", _NOISE_KEYS, FilterNoise)
     motion = _build(reader, document, "motion", _MOTION_KEYS, MotionCalibration)
     working = _build(reader, document, "working", _SENSOR_KEYS, SensorBounds)
     return motion, working, _build(reader, document, "envelope", _SENSOR_KEYS, SensorBounds)
