@@ -153,7 +153,7 @@ def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_p
     path = tmp_path / "terrain.sensors.toml"
     path.write_text(re.sub(r"bearing_sd = .*", "bearing_sd = nan", text))
     with pytest.raises(
-        FileFormatError, match=r"terrain\.sensors\.toml: \[noise\] bearing_sd: expected a finite number, got nan"
+        FileFormatError, match=r"sensors\.toml: \[noise\] bearing_sd: expected a finite number, got nan"
     ):
         load_sensors(path)
 
