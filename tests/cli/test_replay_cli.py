@@ -242,6 +242,12 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
     )
     assert result.exit_code == 2
     assert "--window-margin: expected a finite number of pixels >= 0, got -1.0" in result.output
+    camera_args = ["--camera", str(VIRTUAL_CAMERA), "--window-margin", "1e308"]
+    result = runner.invoke(app, ["replay", str(log_folder), "--terrain", str(floor), *camera_args])
+    assert result.exit_code == 2
+    assert "--window-margin: expected at most 20000 pixels (an image's longest side), got 1e+308" in (
+        result.stderr
+    )
 
 
 def test_replay_reads_the_sensors_file_calibrate_wrote_beside_the_terrain(

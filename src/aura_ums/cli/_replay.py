@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.table import Table
 
+from aura_ums._validate import IMAGE_SIDE
 from aura_ums.cli._campaign import (
     DEFAULTS,
     Retries,
@@ -325,6 +326,11 @@ def replay(
         raise fail("--windows-csv: expected --camera too, got no camera")
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    if window_margin > IMAGE_SIDE.high:
+        raise fail(
+            f"--window-margin: expected at most {IMAGE_SIDE.high:g} pixels (an image's longest side), "
+            f"got {window_margin:g}"
+        )
     campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if len(log_dirs) > 1:
         one_log = {"--steps-csv": steps_csv, "--plot": plot, "--mcap": mcap, "--save-state": save_state,
