@@ -381,3 +381,28 @@ def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: 
     assert f"error: LOG_DIRS ({folder}): calibrating from their contents: " in result.stderr
     assert "expected at least 10 1.0-second windows of motion, got 0" in result.stderr
     assert not (tmp_path / "t.toml").exists()
+
+
+def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    folder = tmp_path / "one-truth-row"
+    shutil.copytree(log_folder, folder)
+    truth = folder / "groundtruth.csv"
+    truth.write_text("".join(truth.read_text().splitlines(keepends=True)[:3]))  # nothing to score
+    out = tmp_path / "compare.json"
+    arguments = [
+        "compare",
+        str(folder),
+        "--terrain",
+        str(terrain),
+        "--particles",
+        "20",
+        "--metrics-json",
+        str(out),
+    ]
+    result = runner.invoke(app, arguments)
+    assert result.exit_code == 0, result.output
+    assert "nan" not in result.stdout
+    assert "n/a" in result.stdout
+    assert strict_json(out.read_text())["methods"][0]["containment_rate"] is None

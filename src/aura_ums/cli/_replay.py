@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import enum
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -111,6 +112,11 @@ _WindowsCsv = Annotated[
     Path | None,
     typer.Option("--windows-csv", help="Write one row per observation and window method (--camera)."),
 ]
+
+
+def _figure(value: float, spec: str) -> str:
+    """Format a table figure; NaN (nothing to measure, e.g. no step with ground truth) as ``n/a``."""
+    return "n/a" if math.isnan(value) else format(value, spec)
 
 
 def _terrain_table(terrain: Path, name: str) -> TerrainTable:
@@ -556,11 +562,11 @@ def compare(
     for row in rows:
         grid.add_row(
             row.method,
-            f"{row.containment_rate:.4f}",
-            f"{row.median_area_m2:.4g}",
-            f"{row.median_wedge_width_rad:.3f}",
-            f"{row.position_rmse_m:.3f}",
-            f"{row.median_update_us:.1f}",
+            _figure(row.containment_rate, ".4f"),
+            _figure(row.median_area_m2, ".4g"),
+            _figure(row.median_wedge_width_rad, ".3f"),
+            _figure(row.position_rmse_m, ".3f"),
+            _figure(row.median_update_us, ".1f"),
             str(row.inconsistent_observations),
         )
     console.print(grid)
