@@ -145,6 +145,27 @@ def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: 
     assert "Traceback" not in result.output
 
 
+def test_a_bad_resume_names_the_option_and_file_and_until_must_be_finite(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    folder, terrain = walk
+    state = tmp_path / "s.json"
+    invoke("replay", folder, "--terrain", terrain, "--until", "10", "--save-state", state)
+    other = write_log(synthetic_log(np.random.default_rng(9), duration=40.0), tmp_path / "other")
+    result = runner.invoke(app, ["replay", str(other), "--terrain", str(terrain), "--resume", str(state)])
+    assert result.exit_code == 2
+    assert f"error: {state}: --resume: expected a state saved from a replay of log" in result.stderr
+    saved = json.loads(state.read_text())
+    saved["manager"]["map"]["vertices"] = []
+    state.write_text(json.dumps(saved))
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(state)])
+    assert result.exit_code == 2
+    assert f"error: {state}: --resume: map.vertices: expected at least one vertex, got none" in result.stderr
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--until", "nan"])
+    assert result.exit_code == 2
+    assert "error: --until: expected a finite number of seconds, got nan" in result.stderr
+
+
 @pytest.mark.skipif(
     not (MRCLAM6 / "Robot1_Measurement.dat").is_file(),
     reason=f"UTIAS MRCLAM Dataset 6 not found at {MRCLAM6} (shared data is not part of the repository)",

@@ -330,6 +330,8 @@ def replay(
 
     if windows_csv is not None and camera is None:
         raise fail("--windows-csv: expected --camera too, got no camera")
+    if until is not None and not math.isfinite(until):
+        raise fail(f"--until: expected a finite number of seconds, got {until}")
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
     if window_margin > IMAGE_SIDE.high:
@@ -414,7 +416,11 @@ def replay(
                     save_state=save_state is not None, after_step=None if view is None else view.step,
                 )  # fmt: skip
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        message = str(exc)
+        if resume is not None and message.startswith("resume: "):
+            # the library names its argument; the user gave a file
+            message = f"{resume}: --{message}"
+        raise fail(message) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
