@@ -406,3 +406,24 @@ def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, 
     assert "nan" not in result.stdout
     assert "n/a" in result.stdout
     assert strict_json(out.read_text())["methods"][0]["containment_rate"] is None
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--quantile", "nan", "--quantile: expected a finite number, got nan"),
+        ("--quantile", "1.5", r"--quantile: expected a number in (0.5, 1), got 1.5"),
+        ("--horizon", "0", "--horizon: expected seconds, each >= move (0.5), got [0.0]"),
+        # A move of 1 ns cut 20 s of log into 2e10 moves: a MemoryError traceback before.
+        ("--move", "1e-9", "--move: expected at most 2000000 moves over the logs' "),
+    ],
+)
+def test_calibrate_names_its_options_out_of_range(
+    option: str, value: str, message: str, log_folder: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "t.toml"
+    result = runner.invoke(app, ["calibrate", str(log_folder), "--out", str(out), option, value])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert f"error: {message}" in result.stderr
+    assert not out.exists()

@@ -114,6 +114,10 @@ _WindowsCsv = Annotated[
 ]
 
 
+#: calibrate_logs' arguments that calibrate takes as options.
+_CALIBRATE_OPTIONS = {"quantile": "--quantile", "move": "--move", "horizons": "--horizon"}
+
+
 def _figure(value: float, spec: str) -> str:
     """Format a table figure; NaN (nothing to measure, e.g. no step with ground truth) as ``n/a``."""
     return "n/a" if math.isnan(value) else format(value, spec)
@@ -232,9 +236,13 @@ def calibrate(
         else:  # calibrate_logs' default horizons
             calibration = calibrate_logs(logs, quantile=quantile, move=move, anchor=anchor)
     except AuraUmsError as exc:
+        message = str(exc)
+        name, _, rest = message.partition(": ")
+        if name in _CALIBRATE_OPTIONS:  # an option out of range: named as the user gave it
+            raise fail(f"{_CALIBRATE_OPTIONS[name]}: {rest}") from None
         # The logs read cleanly; what they hold does not calibrate: name them, not the library's arguments.
         folders = ", ".join(str(folder) for folder in log_dirs)
-        raise fail(f"LOG_DIRS ({folders}): calibrating from their contents: {exc}") from None
+        raise fail(f"LOG_DIRS ({folders}): calibrating from their contents: {message}") from None
     write_text(out_target, calibration.terrain_table().to_toml())
     write_text(sensors_target, calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope

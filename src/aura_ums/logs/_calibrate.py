@@ -405,6 +405,18 @@ class _Moves:
     valid: NDArray[np.bool_]
 
 
+#: Most moves :func:`calibrate_logs` cuts its logs into (about 100 bytes each, per horizon).
+MAX_MOVES = 2_000_000
+
+
+def _truth_span(log: RobotLog) -> float:
+    """Seconds during which the log has both motion and ground truth (at most: before any delay)."""
+    truth = log.groundtruth
+    assert truth is not None
+    first, last = log.motion_span
+    return max(0.0, min(last, float(truth.time[-1])) - max(first, float(truth.time[0])))
+
+
 def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
     truth = log.groundtruth
     assert truth is not None
@@ -952,6 +964,13 @@ def calibrate_logs(
     if delay_limit < 0.0:
         raise InputError(f"max_delay: expected a number >= 0, got {delay_limit!r}")
 
+    # Arrays of a few floats per move are allocated per log: estimated before any.
+    seconds = sum(_truth_span(log) for log in logs)
+    if seconds / step > MAX_MOVES:
+        raise InputError(
+            f"move: expected at most {MAX_MOVES} moves over the logs' {seconds:g} s with ground truth, "
+            f"got about {seconds / step:.3g} moves of {step:g} s"
+        )
     delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, _DELAY_STEP), step)
     moves = [_moves(log, delay, step) for log in logs]
     raw = [_windows(moves, max(1, round(h / step))) for h in spans]
