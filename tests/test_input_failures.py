@@ -18,7 +18,7 @@ import pytest
 
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, synthetic_log
+from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, read_rosbag, synthetic_log
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
@@ -27,6 +27,7 @@ from aura_ums.world import MeadowMap, make_grid_world
 from tests.logs.test_mrclam import HEADER, TINY, tiny_dataset
 
 REPOSITORY = Path(__file__).resolve().parents[1]
+SAMPLE_LANDMARKS = REPOSITORY / "examples" / "logs" / "r1" / "landmarks.csv"
 LOG = {
     "meta.toml": 'name = "tiny"\nterrain = "tile"\n[start]\nx = 0.0\ny = 0.0\nheading = 0.0\nradius = 0.5\n',
     "landmarks.csv": "id,x,y,position_uncertainty\nA,3.0,0.0,0.1\nB,0.0,4.0,0.1\n",
@@ -156,6 +157,17 @@ def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_p
         FileFormatError, match=r"sensors\.toml: \[noise\] bearing_sd: expected a finite number, got nan"
     ):
         load_sensors(path)
+
+
+def test_bytes_that_are_no_bag_are_refused_naming_the_file(tmp_path: Path) -> None:
+    pytest.importorskip("rosbags")
+    junk = tmp_path / "junk.bag"
+    # a UnicodeDecodeError traceback before
+    junk.write_bytes(bytes((i * 7919 + 13) % 256 for i in range(4096)))
+    with pytest.raises(
+        FileFormatError, match=r"junk\.bag: expected a readable ROS bag, got UnicodeDecodeError"
+    ):
+        read_rosbag(junk, odom_topic="/odom", observations_topic="/obs", landmarks=SAMPLE_LANDMARKS)
 
 
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
