@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from aura_ums.errors import InputError
+from aura_ums.uncertainty._slices import MAX_CELLS, MIN_SLICE_WIDTH
 
 #: What a setting holds.
 SettingValue = float | int | bool | None
@@ -415,6 +416,13 @@ def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]
         if problem is not None:
             raise fail(name, problem)
         checked[name] = info.normalize(value)
+    width = checked["slice_width"]
+    if isinstance(width, float) and width < MIN_SLICE_WIDTH:
+        # 2 pi / 1e-12 heading cells failed deep in the kernel, as a traceback
+        raise fail(
+            "slice_width",
+            f"expected at least {MIN_SLICE_WIDTH:g} rad ({MAX_CELLS} heading cells), got {width!r}",
+        )
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
         raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")
