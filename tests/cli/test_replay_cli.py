@@ -427,3 +427,21 @@ def test_calibrate_names_its_options_out_of_range(
     assert "Traceback" not in result.output
     assert f"error: {message}" in result.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--particles", "1000000000", "--particles: expected an integer in [1, 1000000], got 1000000000"),
+        ("--seed", "-1", "--seed: expected an integer >= 0, got -1"),
+    ],
+)
+def test_compare_refuses_bad_particle_filter_options_by_name(
+    option: str, value: str, message: str, log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    result = runner.invoke(app, ["compare", str(log_folder), "--terrain", str(terrain), option, value])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert result.stderr == f"error: {message}\n"

@@ -114,6 +114,9 @@ _WindowsCsv = Annotated[
 ]
 
 
+#: Most particles of compare's particle filter (about 100 bytes each, several arrays).
+_MOST_PARTICLES = 1_000_000
+
 #: calibrate_logs' arguments that calibrate takes as options.
 _CALIBRATE_OPTIONS = {"quantile": "--quantile", "move": "--move", "horizons": "--horizon"}
 
@@ -505,8 +508,11 @@ def compare(
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
 
-    if particles < 1:
-        raise fail(f"--particles: expected an integer >= 1, got {particles}")
+    if not 1 <= particles <= _MOST_PARTICLES:
+        # a billion particles was a MemoryError traceback
+        raise fail(f"--particles: expected an integer in [1, {_MOST_PARTICLES}], got {particles}")
+    if seed < 0:
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
