@@ -445,3 +445,23 @@ def test_compare_refuses_bad_particle_filter_options_by_name(
     assert result.exit_code == 2
     assert "Traceback" not in result.output
     assert result.stderr == f"error: {message}\n"
+
+
+@pytest.mark.parametrize("command", ["replay", "compare", "calibrate"])
+def test_a_bad_max_truth_gap_is_named_as_the_option(command: str, log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    where = ["--out", str(tmp_path / "t.toml")] if command == "calibrate" else ["--terrain", str(terrain)]
+    result = runner.invoke(app, [command, str(log_folder), *where, "--max-truth-gap", "nan"])
+    assert result.exit_code == 2
+    # was "GroundTruth.max_gap: ..." or "max_gap: ...", the library's names
+    assert (
+        result.stderr == "error: --max-truth-gap: expected a positive number of seconds (or inf), got nan\n"
+    )
+
+
+def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
+    result = runner.invoke(app, ["calibrate", str(log_folder), "--out", ""])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output  # a ValueError of Path.with_suffix before
+    assert result.stderr == "error: --out: expected a file path, got '.'\n"

@@ -121,6 +121,12 @@ _MOST_PARTICLES = 1_000_000
 _CALIBRATE_OPTIONS = {"quantile": "--quantile", "move": "--move", "horizons": "--horizon"}
 
 
+def _check_truth_gap(max_truth_gap: float | None) -> None:
+    """Refuse (exit 2) a --max-truth-gap that is not a positive number of seconds (inf: none)."""
+    if max_truth_gap is not None and not max_truth_gap > 0.0:
+        raise fail(f"--max-truth-gap: expected a positive number of seconds (or inf), got {max_truth_gap}")
+
+
 def _figure(value: float, spec: str) -> str:
     """Format a table figure; NaN (nothing to measure, e.g. no step with ground truth) as ``n/a``."""
     return "n/a" if math.isnan(value) else format(value, spec)
@@ -214,6 +220,9 @@ def calibrate(
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import calibrate_logs
 
+    if not out.name:
+        raise fail(f"--out: expected a file path, got {str(out)!r}")
+    _check_truth_gap(max_truth_gap)
     out_target = Target("--out", out)
     sensors_target = Target(
         "--sensors-out" if sensors_out is not None else "--out (its .sensors.toml)",
@@ -343,6 +352,7 @@ def replay(
         raise fail("--windows-csv: expected --camera too, got no camera")
     if until is not None and not math.isfinite(until):
         raise fail(f"--until: expected a finite number of seconds, got {until}")
+    _check_truth_gap(max_truth_gap)
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
     if window_margin > IMAGE_SIDE.high:
@@ -513,6 +523,7 @@ def compare(
         raise fail(f"--particles: expected an integer in [1, {_MOST_PARTICLES}], got {particles}")
     if seed < 0:
         raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    _check_truth_gap(max_truth_gap)
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
