@@ -196,6 +196,29 @@ def test_bytes_that_are_no_bag_are_refused_naming_the_file(tmp_path: Path) -> No
         read_rosbag(junk, odom_topic="/odom", observations_topic="/obs", landmarks=SAMPLE_LANDMARKS)
 
 
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        # Each was imported "successfully", with no observation or with misread landmarks.
+        ({"Barcodes.dat": HEADER}, r"Barcodes\.dat: expected at least one data row, got none"),
+        ({"Landmark_Groundtruth.dat": HEADER}, r"Landmark_Groundtruth\.dat: expected at least one data row"),
+        (
+            {"Barcodes.dat": TINY["Barcodes.dat"] + "8 \t 63\n"},
+            r"Barcodes\.dat:9: expected each barcode once, got 63",
+        ),
+        (
+            {"Landmark_Groundtruth.dat": TINY["Landmark_Groundtruth.dat"] + "6 \t 1 \t 1 \t 0 \t 0\n"},
+            r"Landmark_Groundtruth\.dat:7: expected each subject once, got 6 again",
+        ),
+    ],
+)
+def test_mrclam_files_without_rows_or_with_repeats_are_refused(
+    changes: dict[str, str], message: str, tmp_path: Path
+) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **changes), 1)
+
+
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
     odometry = HEADER + "9.0 0.1 0.0\n9.5 0.2 0.1\n2402009.5 0.0 0.0\n"
     with pytest.raises(
