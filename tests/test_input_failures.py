@@ -8,7 +8,9 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 
 from __future__ import annotations
 
+import json
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -17,7 +19,7 @@ import pytest
 
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import load_log, read_mrclam
+from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, read_rosbag, synthetic_log
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
@@ -26,6 +28,7 @@ from aura_ums.world import MeadowMap, make_grid_world
 from tests.logs.test_mrclam import HEADER, TINY, tiny_dataset
 
 REPOSITORY = Path(__file__).resolve().parents[1]
+SAMPLE_LANDMARKS = REPOSITORY / "examples" / "logs" / "r1" / "landmarks.csv"
 LOG = {
     "meta.toml": 'name = "tiny"\nterrain = "tile"\n[start]\nx = 0.0\ny = 0.0\nheading = 0.0\nradius = 0.5\n',
     "landmarks.csv": "id,x,y,position_uncertainty\nA,3.0,0.0,0.1\nB,0.0,4.0,0.1\n",
@@ -131,6 +134,89 @@ def test_a_clock_jump_is_refused_with_its_file_line_and_step_estimate(tmp_path: 
         r"got a clock jump of 2\.402e\+06 s \(27\.8 days; replayed, about 9607996 steps of 0\.25 s\)",
     ):
         load_log(log_folder(tmp_path, odometry_csv=odometry))
+
+
+def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "odometry.csv").unlink()
+    (folder / "commands.csv").write_text("time,turn,run\n0.5,0.0,0.2\n1.0,0.1,0.2\n2402000.0,0.0,0.2\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"commands\.csv:4: expected at most 86400 s after the previous row \(line 3\), "
+        r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
+    ):
+        load_log(folder)
+
+
+@pytest.mark.parametrize(
+    ("parameters", "message"),
+    [
+        ({"bogus": 1.0}, r"properties\.parameters: expected names among .*, got 'bogus'"),
+        (
+            {"min_length": -5.0},
+            r"properties\.parameters\.min_length: expected a non-negative number, got -5\.0",
+        ),
+    ],
+)
+def test_geojson_strategy_parameters_are_checked_on_reading(
+    parameters: dict[str, float], message: str, tmp_path: Path
+) -> None:
+    # They were checked only when a simulation built the detector, naming the landmark alone.
+    document = make_grid_world(2, 2).to_geojson_dict()
+    features = document["features"]
+    assert isinstance(features, list)
+    landmark = next(item for item in features if item["properties"].get("strategy") == "line_finder")
+    landmark["properties"]["parameters"] = parameters
+    path = tmp_path / "world.geojson"
+    path.write_text(json.dumps(document))
+    with pytest.raises(FileFormatError, match=r"world\.geojson: features\[\d+\] \(id '[^']+'\) " + message):
+        MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
+
+
+def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:
+    # replay reads the sensors file for its bounds only, yet a NaN anywhere in it is refused.
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    text = calibrate_logs([log]).sensors_toml()
+    path = tmp_path / "terrain.sensors.toml"
+    path.write_text(re.sub(r"bearing_sd = .*", "bearing_sd = nan", text))
+    with pytest.raises(
+        FileFormatError, match=r"sensors\.toml: \[noise\] bearing_sd: expected a finite number, got nan"
+    ):
+        load_sensors(path)
+
+
+def test_bytes_that_are_no_bag_are_refused_naming_the_file(tmp_path: Path) -> None:
+    pytest.importorskip("rosbags")
+    junk = tmp_path / "junk.bag"
+    # a UnicodeDecodeError traceback before
+    junk.write_bytes(bytes((i * 7919 + 13) % 256 for i in range(4096)))
+    with pytest.raises(
+        FileFormatError, match=r"junk\.bag: expected a readable ROS bag, got UnicodeDecodeError"
+    ):
+        read_rosbag(junk, odom_topic="/odom", observations_topic="/obs", landmarks=SAMPLE_LANDMARKS)
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        # Each was imported "successfully", with no observation or with misread landmarks.
+        ({"Barcodes.dat": HEADER}, r"Barcodes\.dat: expected at least one data row, got none"),
+        ({"Landmark_Groundtruth.dat": HEADER}, r"Landmark_Groundtruth\.dat: expected at least one data row"),
+        (
+            {"Barcodes.dat": TINY["Barcodes.dat"] + "8 \t 63\n"},
+            r"Barcodes\.dat:9: expected each barcode once, got 63",
+        ),
+        (
+            {"Landmark_Groundtruth.dat": TINY["Landmark_Groundtruth.dat"] + "6 \t 1 \t 1 \t 0 \t 0\n"},
+            r"Landmark_Groundtruth\.dat:7: expected each subject once, got 6 again",
+        ),
+    ],
+)
+def test_mrclam_files_without_rows_or_with_repeats_are_refused(
+    changes: dict[str, str], message: str, tmp_path: Path
+) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **changes), 1)
 
 
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:

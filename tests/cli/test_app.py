@@ -2,6 +2,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from aura_ums.cli import app
@@ -37,3 +38,21 @@ def test_unknown_option_is_a_usage_error() -> None:
     result = runner.invoke(app, ["figures", "--colour", "red"])
     assert result.exit_code == 2
     assert "No such option" in result.output
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        # Each was a traceback from deep inside the computation before.
+        (["demo", "--runs", "0"], "--runs: expected an integer in [1, 100000], got 0"),
+        (["demo", "--runs", "1000000000"], "--runs: expected an integer in [1, 100000], got 1000000000"),
+        (["demo", "--seed", "-1"], "--seed: expected an integer >= 0, got -1"),
+        (["figures", "--seed", "-1"], "--seed: expected an integer >= 0, got -1"),
+    ],
+)
+def test_bad_numbers_are_refused_before_any_work(arguments: list[str], message: str, tmp_path: Path) -> None:
+    result = runner.invoke(app, [*arguments, "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert result.stderr == f"error: {message}\n"
+    assert not (tmp_path / "out").exists()

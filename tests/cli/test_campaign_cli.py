@@ -62,6 +62,12 @@ def test_simulate_on_two_workers_writes_the_serial_metrics(tmp_path: Path) -> No
         (["--retries", "-1"], r"--retries: expected an integer in [0, 100], got -1"),
         (["--run-timeout", "0"], r"--run-timeout: expected a finite number of seconds > 0 or None, got 0.0"),
         (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers: expected 1 with a scheduler"),
+        # Refused before distributed is asked: its Client left a thread that kept the command alive.
+        (
+            ["--scheduler", "nonsense"],
+            "--scheduler: expected a Dask scheduler address [tcp:// or tls://]HOST:PORT",
+        ),
+        (["--scheduler", "tcp://host:99999"], "--scheduler: expected a Dask scheduler address"),
     ],
 )
 def test_bad_campaign_options_are_clean_errors(options: list[str], message: str) -> None:

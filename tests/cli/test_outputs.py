@@ -8,6 +8,8 @@ traceback, and leave every input byte-identical.
 from __future__ import annotations
 
 import hashlib
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -105,6 +107,13 @@ def test_two_outputs_may_not_share_a_path(inputs: Path, tmp_path: Path, untouche
     refused(invoke(*common, "--metrics-json", both, "--steps-csv", both), "--steps-csv", "--metrics-json")
     assert not same.exists()
     assert not both.exists()
+    # One output file as the folder of another: refused before either is written.
+    refused(
+        invoke(*common, "--metrics-json", both, "--steps-csv", both / "steps.csv"),
+        "--steps-csv",
+        "--metrics-json",
+    )
+    assert not both.exists()
 
 
 def test_an_existing_output_is_replaced_only_with_overwrite(inputs: Path, tmp_path: Path) -> None:
@@ -119,6 +128,16 @@ def test_an_existing_output_is_replaced_only_with_overwrite(inputs: Path, tmp_pa
     assert f"wrote {out}" in result.stderr
     assert "containment_rate" in result.stdout
     assert [p.name for p in tmp_path.iterdir()] == ["metrics.json"]  # no scratch file left
+
+
+def test_a_pipe_or_device_is_never_replaced_by_an_output(inputs: Path, tmp_path: Path) -> None:
+    # The atomic write renames a scratch file onto its target: a FIFO (or, as root, /dev/null)
+    # would become a regular file. It is refused, with --overwrite too.
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", pipe)
+    refused(invoke(*common, "--overwrite"), "--metrics-json", str(pipe), "expected a regular file")
+    assert stat.S_ISFIFO(pipe.lstat().st_mode)
 
 
 def test_an_unwritable_output_is_refused_before_the_computation(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import itertools
 import json
 from importlib.metadata import version
 from pathlib import Path
@@ -45,6 +46,23 @@ def test_help_shows_flags_and_brackets_as_written(command: str) -> None:
         assert "[manager]" in result.stdout
         assert "--prune" in result.stdout
         assert "--no-prune" in result.stdout
+
+
+HELPED = ["", "figures", "demo", "simulate", "replay", "compare", "calibrate"]
+HELPED += ["import", "import mrclam", "import rosbag"]
+
+
+@pytest.mark.parametrize("command", HELPED)
+def test_help_paragraphs_wrap_to_the_terminal_without_ragged_lines(command: str) -> None:
+    result = runner.invoke(app, [*command.split(), "--help"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    # The description: the lines above the first box, each indented by one space.
+    description = result.stdout.split("\u256d", 1)[0].splitlines()
+    width = 80 - 2
+    for line, following in itertools.pairwise(description):
+        if line.strip() and following.strip() and not line.lstrip().startswith("Usage:"):
+            # Greedy wrapping: the next line's first word would not have fit on this one.
+            assert len(line.strip()) + 1 + len(following.split()[0]) > width, (line, following)
 
 
 def test_progress_is_drawn_on_a_terminal_and_not_with_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -125,6 +143,27 @@ def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: 
     assert result.exit_code == 2
     assert str(broken) in result.stderr
     assert "Traceback" not in result.output
+
+
+def test_a_bad_resume_names_the_option_and_file_and_until_must_be_finite(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    folder, terrain = walk
+    state = tmp_path / "s.json"
+    invoke("replay", folder, "--terrain", terrain, "--until", "10", "--save-state", state)
+    other = write_log(synthetic_log(np.random.default_rng(9), duration=40.0), tmp_path / "other")
+    result = runner.invoke(app, ["replay", str(other), "--terrain", str(terrain), "--resume", str(state)])
+    assert result.exit_code == 2
+    assert f"error: {state}: --resume: expected a state saved from a replay of log" in result.stderr
+    saved = json.loads(state.read_text())
+    saved["manager"]["map"]["vertices"] = []
+    state.write_text(json.dumps(saved))
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(state)])
+    assert result.exit_code == 2
+    assert f"error: {state}: --resume: map.vertices: expected at least one vertex, got none" in result.stderr
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--until", "nan"])
+    assert result.exit_code == 2
+    assert "error: --until: expected a finite number of seconds, got nan" in result.stderr
 
 
 @pytest.mark.skipif(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import sys
 from pathlib import Path
 from typing import Any
@@ -241,6 +242,12 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
     )
     assert result.exit_code == 2
     assert "--window-margin: expected a finite number of pixels >= 0, got -1.0" in result.output
+    camera_args = ["--camera", str(VIRTUAL_CAMERA), "--window-margin", "1e308"]
+    result = runner.invoke(app, ["replay", str(log_folder), "--terrain", str(floor), *camera_args])
+    assert result.exit_code == 2
+    assert "--window-margin: expected at most 20000 pixels (an image's longest side), got 1e+308" in (
+        result.stderr
+    )
 
 
 def test_replay_reads_the_sensors_file_calibrate_wrote_beside_the_terrain(
@@ -319,3 +326,142 @@ def test_frames_in_a_ground_truth_gap_are_not_scored(tmp_path: Path) -> None:
         figures[label] = strict_json(out.read_text())
     assert (figures["default"]["steps_with_truth"], figures["default"]["containment_rate"]) == (0, None)
     assert figures["no limit"]["steps_with_truth"] == 2
+
+
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_a_start_in_a_ground_truth_gap_is_refused_naming_the_file(
+    command: str, log_folder: Path, tmp_path: Path
+) -> None:
+    # No [start] pose in meta.toml: the start comes from the truth, whose first two rows
+    # (-1 s and 0.1 s) are further apart than the 0.5 s interpolated across.
+    folder = tmp_path / "log"
+    shutil.copytree(log_folder, folder)
+    truth = folder / "groundtruth.csv"
+    lines = truth.read_text().splitlines(keepends=True)
+    first = next(index for index, line in enumerate(lines) if line[:1].isdigit())
+    lines[first] = "-1" + lines[first][lines[first].index(",") :]
+    truth.write_text("".join(lines))
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    result = runner.invoke(app, [command, str(folder), "--terrain", str(terrain)])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.stderr
+    assert "error" not in result.stdout
+    assert (
+        "groundtruth.csv: expected a ground-truth pose at the replay's start, 0 s (meta.toml gives no "
+        "[start] pose), got none: the start lies between two rows more than 0.5 s apart" in result.stderr
+    )
+
+
+@pytest.mark.parametrize("command", ["replay", "compare"])
+def test_a_terrain_file_without_the_logs_terrain_is_named(
+    command: str, log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    grass = tmp_path / "grass.toml"
+    grass.write_text(TerrainTable({"grass": TerrainTable.default()["grass"]}).to_toml())
+    sensors = terrain.with_suffix(".sensors.toml")
+    result = runner.invoke(
+        app, [command, str(log_folder), "--terrain", str(grass), "--sensors", str(sensors)]
+    )
+    assert result.exit_code == 2
+    assert f"--terrain: expected {grass} to hold the log's terrain 'floor' (meta.toml), got 'grass'" in (
+        result.stderr
+    )
+
+
+def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "short"
+    shutil.copytree(log_folder, folder)
+    commands = folder / "commands.csv"
+    commands.write_text("".join(commands.read_text().splitlines(keepends=True)[:3]))  # one row
+    result = runner.invoke(app, ["calibrate", str(folder), "--out", str(tmp_path / "t.toml")])
+    assert result.exit_code == 2
+    assert f"error: LOG_DIRS ({folder}): calibrating from their contents: " in result.stderr
+    assert "expected at least 10 1.0-second windows of motion, got 0" in result.stderr
+    assert not (tmp_path / "t.toml").exists()
+
+
+def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "cal" / "terrain.toml"
+    assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0
+    folder = tmp_path / "one-truth-row"
+    shutil.copytree(log_folder, folder)
+    truth = folder / "groundtruth.csv"
+    truth.write_text("".join(truth.read_text().splitlines(keepends=True)[:3]))  # nothing to score
+    out = tmp_path / "compare.json"
+    arguments = [
+        "compare",
+        str(folder),
+        "--terrain",
+        str(terrain),
+        "--particles",
+        "20",
+        "--metrics-json",
+        str(out),
+    ]
+    result = runner.invoke(app, arguments)
+    assert result.exit_code == 0, result.output
+    assert "nan" not in result.stdout
+    assert "n/a" in result.stdout
+    assert strict_json(out.read_text())["methods"][0]["containment_rate"] is None
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--quantile", "nan", "--quantile: expected a finite number, got nan"),
+        ("--quantile", "1.5", r"--quantile: expected a number in (0.5, 1), got 1.5"),
+        ("--horizon", "0", "--horizon: expected seconds, each >= move (0.5), got [0.0]"),
+        # A move of 1 ns cut 20 s of log into 2e10 moves: a MemoryError traceback before.
+        ("--move", "1e-9", "--move: expected at most 2000000 moves over the logs' "),
+    ],
+)
+def test_calibrate_names_its_options_out_of_range(
+    option: str, value: str, message: str, log_folder: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "t.toml"
+    result = runner.invoke(app, ["calibrate", str(log_folder), "--out", str(out), option, value])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert f"error: {message}" in result.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--particles", "1000000000", "--particles: expected an integer in [1, 1000000], got 1000000000"),
+        ("--seed", "-1", "--seed: expected an integer >= 0, got -1"),
+    ],
+)
+def test_compare_refuses_bad_particle_filter_options_by_name(
+    option: str, value: str, message: str, log_folder: Path, tmp_path: Path
+) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    result = runner.invoke(app, ["compare", str(log_folder), "--terrain", str(terrain), option, value])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    assert result.stderr == f"error: {message}\n"
+
+
+@pytest.mark.parametrize("command", ["replay", "compare", "calibrate"])
+def test_a_bad_max_truth_gap_is_named_as_the_option(command: str, log_folder: Path, tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    where = ["--out", str(tmp_path / "t.toml")] if command == "calibrate" else ["--terrain", str(terrain)]
+    result = runner.invoke(app, [command, str(log_folder), *where, "--max-truth-gap", "nan"])
+    assert result.exit_code == 2
+    # was "GroundTruth.max_gap: ..." or "max_gap: ...", the library's names
+    assert (
+        result.stderr == "error: --max-truth-gap: expected a positive number of seconds (or inf), got nan\n"
+    )
+
+
+def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
+    result = runner.invoke(app, ["calibrate", str(log_folder), "--out", ""])
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output  # a ValueError of Path.with_suffix before
+    assert result.stderr == "error: --out: expected a file path, got '.'\n"

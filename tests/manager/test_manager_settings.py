@@ -58,6 +58,17 @@ def test_the_defaults_are_the_library_defaults() -> None:
         ({"joint_sector": 7.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 7.0"),
         ({"max_vertices": 2}, "max_vertices: expected an integer >= 3, got 2"),
         ({"max_vertices": 16.0}, "max_vertices: expected an integer >= 3, got 16.0"),
+        ({"max_vertices": 10**9}, r"max_vertices: expected an integer in \[3, 100000\], got 1000000000"),
+        (
+            {"envelope_max_vertices": 10**9},
+            r"envelope_max_vertices: expected an integer in \[3, 100000\], got 1000000000",
+        ),
+        ({"max_slices": 10**9}, r"max_slices: expected an integer in \[1, 100000\], got 1000000000"),
+        # 2 pi / 1e-12 heading cells: a ValueError traceback from the kernel before
+        (
+            {"slice_width": 1e-12},
+            r"slice_width: expected at least 3\.74507e-07 rad \(16777216 heading cells\), got 1e-12",
+        ),
         ({"robust": 1}, "robust: expected true or false, got 1"),
         ({"envelope_factor": 0.9}, "envelope_factor: expected a number >= 1, got 0.9"),
         ({"envelope_max_vertices": 1.5}, "envelope_max_vertices: expected an integer >= 3 or none, got 1.5"),

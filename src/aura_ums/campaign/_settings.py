@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 from dataclasses import dataclass
 
 from aura_ums.errors import InputError
@@ -18,6 +19,10 @@ def _count(value: object, name: str, low: int, high: int) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not low <= int(value) <= high:
         raise InputError(f"{name}: expected an integer in [{low}, {high}], got {value!r}")
     return int(value)
+
+
+#: A scheduler's address: optional tcp:// or tls://, a host (or [IPv6]) and a port.
+_ADDRESS = re.compile(r"(?:(?:tcp|tls)://)?(?:[^\s:/\[\]]+|\[[0-9A-Fa-f:.]+\]):(?P<port>[0-9]{1,5})")
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,6 +74,14 @@ class CampaignSettings:
         if self.scheduler is not None:
             if not isinstance(self.scheduler, str) or not self.scheduler.strip():
                 raise InputError(f"scheduler: expected a Dask scheduler address, got {self.scheduler!r}")
+            address = _ADDRESS.fullmatch(self.scheduler)
+            if address is None or not 1 <= int(address["port"]) <= 65535:
+                # Checked here: distributed's Client left a thread running after refusing it,
+                # and the command never exited.
+                raise InputError(
+                    f"scheduler: expected a Dask scheduler address [tcp:// or tls://]HOST:PORT, "
+                    f"got {self.scheduler!r}"
+                )
             if self.workers != 1:
                 raise InputError(
                     f"workers: expected 1 with a scheduler (its workers run the campaign), got {self.workers}"

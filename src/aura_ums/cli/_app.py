@@ -75,12 +75,18 @@ def figures(
     overwrite: Overwrite = False,
 ) -> None:
     """Draw the paper's figures 3-7 (maps, windows, growth) with sampled true outcomes over them."""
+    from aura_ums.errors import AuraUmsError
     from aura_ums.plot import draw_all_figures
 
+    if seed < 0:
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
     target = Target("--out", out, folder=True)
     check_outputs([target], [], overwrite=overwrite)
-    with staged(target) as stage:
-        draw_all_figures(stage, seed=seed)
+    try:
+        with staged(target) as stage:
+            draw_all_figures(stage, seed=seed)
+    except AuraUmsError as exc:
+        raise fail(str(exc)) from None
 
 
 @app.command(cls=PlainCommand)
@@ -92,12 +98,22 @@ def demo(
     overwrite: Overwrite = False,
 ) -> None:
     """Run the paper's experiment and write its report (figures and summary.md) into OUT."""
+    from aura_ums.errors import AuraUmsError
     from aura_ums.plot import write_experiment_report
+    from aura_ums.sim._scenario import MAX_RUNS
 
+    # Checked before the report's first Monte Carlo: a traceback from deep inside it before.
+    if seed < 0:
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    if not 1 <= runs <= MAX_RUNS:
+        raise fail(f"--runs: expected an integer in [1, {MAX_RUNS}], got {runs}")
     target = Target("--out", out, folder=True)
     check_outputs([target], [], overwrite=overwrite)
-    with staged(target) as stage:
-        write_experiment_report(stage, seed=seed, runs=runs)
+    try:
+        with staged(target) as stage:
+            write_experiment_report(stage, seed=seed, runs=runs)
+    except AuraUmsError as exc:
+        raise fail(str(exc)) from None
 
 
 @app.command(cls=PlainCommand)

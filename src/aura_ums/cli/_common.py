@@ -226,12 +226,39 @@ def _plain_help(params: list[Any]) -> list[Any]:
     return params
 
 
+def unwrapped(text: str) -> str:
+    r"""Join each paragraph's hard-wrapped lines into one, so rich wraps it to the terminal.
+
+    Typer shows a docstring's paragraphs with their line breaks kept, so a paragraph
+    wrapped at 90 columns in the source shows ragged at 80 ("A refused" alone on a line).
+    A paragraph marked ``\b`` or holding an indented or bulleted line keeps its breaks.
+
+    Examples
+    --------
+    >>> unwrapped("Summary.\n\n    First line of a\n    paragraph.\n\n    - a list\n    - kept")
+    'Summary.\n\nFirst line of a paragraph.\n\n- a list\n- kept'
+    >>> unwrapped("")
+    ''
+    """
+    kept = ("\b", " ", "\t", "- ", "* ")
+    paragraphs = []
+    for paragraph in inspect.cleandoc(text).split("\n\n"):
+        lines = paragraph.split("\n")
+        paragraphs.append(paragraph if any(line.startswith(kept) for line in lines) else " ".join(lines))
+    return "\n\n".join(paragraphs)
+
+
+def _plain_text(text: str | None) -> str | None:
+    """Return a command's help as shown: paragraphs unwrapped (see :func:`unwrapped`), markup escaped."""
+    return escape(unwrapped(text)) if text else text
+
+
 class PlainCommand(TyperCommand):
     """A typer command whose help shows flags and bracketed text as written (see :func:`_plain_help`)."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        self.help = escape(self.help) if self.help else self.help
+        self.help = _plain_text(self.help)
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _plain_help(super().get_params(ctx))
@@ -239,6 +266,10 @@ class PlainCommand(TyperCommand):
 
 class PlainGroup(TyperGroup):
     """A typer group whose help shows flags and bracketed text as written (see :func:`_plain_help`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help = _plain_text(self.help)
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _plain_help(super().get_params(ctx))

@@ -129,6 +129,16 @@ def check_outputs(
                     f"{target.option}: expected a path of its own, got {target.path}, which is also "
                     f"the output of {other.option} ({other.path})"
                 )
+            # A file output cannot also be the folder of another: one of the two would fail
+            # after the computation, with the other written.
+            nested = (taken in where.parents and not other.folder) or (
+                where in taken.parents and not target.folder
+            )
+            if nested:
+                raise fail(
+                    f"{target.option}: expected a path of its own, got {target.path}, which nests with "
+                    f"the output file of {other.option} ({other.path})"
+                )
         seen.append((target, where))
         _replaceable(target, where, overwrite)
         _writable(target, where)
@@ -165,6 +175,12 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
         return
     if where.is_dir():
         raise fail(f"{target.option}: expected a file, got {target.path}, which is a folder")
+    if where.exists() and not where.is_file():
+        # The atomic rename would put a regular file in its place (as root, /dev/null's).
+        raise fail(
+            f"{target.option}: expected a regular file, got {target.path}, which is a device, pipe or "
+            "socket (it would be replaced, not written to)"
+        )
     if where.exists() and not overwrite:
         raise fail(
             f"{target.option}: expected a new file, got {target.path}, which exists "

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import contextlib
 import enum
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
 
+from aura_ums._validate import IMAGE_SIDE
 from aura_ums.cli._campaign import (
     DEFAULTS,
     Retries,
@@ -45,6 +47,7 @@ from aura_ums.cli._outputs import (
 if TYPE_CHECKING:
     from aura_ums.logs import LogStream, ReplayOptions, ReplayResult
     from aura_ums.manager import ManagerSettings
+    from aura_ums.uncertainty import TerrainTable
 
 
 # draw_replay's file name after the log's name
@@ -109,6 +112,37 @@ _WindowsCsv = Annotated[
     Path | None,
     typer.Option("--windows-csv", help="Write one row per observation and window method (--camera)."),
 ]
+
+
+#: Most particles of compare's particle filter (about 100 bytes each, several arrays).
+_MOST_PARTICLES = 1_000_000
+
+#: calibrate_logs' arguments that calibrate takes as options.
+_CALIBRATE_OPTIONS = {"quantile": "--quantile", "move": "--move", "horizons": "--horizon"}
+
+
+def _check_truth_gap(max_truth_gap: float | None) -> None:
+    """Refuse (exit 2) a --max-truth-gap that is not a positive number of seconds (inf: none)."""
+    if max_truth_gap is not None and not max_truth_gap > 0.0:
+        raise fail(f"--max-truth-gap: expected a positive number of seconds (or inf), got {max_truth_gap}")
+
+
+def _figure(value: float, spec: str) -> str:
+    """Format a table figure; NaN (nothing to measure, e.g. no step with ground truth) as ``n/a``."""
+    return "n/a" if math.isnan(value) else format(value, spec)
+
+
+def _terrain_table(terrain: Path, name: str) -> TerrainTable:
+    """Read ``--terrain``; refuse (exit 2, naming the file) a table without the log's terrain."""
+    from aura_ums.uncertainty import TerrainTable
+
+    table = TerrainTable.from_toml(terrain)
+    if name not in table:
+        held = ", ".join(repr(entry) for entry in table) or "none"
+        raise fail(
+            f"--terrain: expected {terrain} to hold the log's terrain {name!r} (meta.toml), got {held}"
+        )
+    return table
 
 
 def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
@@ -186,6 +220,9 @@ def calibrate(
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import calibrate_logs
 
+    if not out.name:
+        raise fail(f"--out: expected a file path, got {str(out)!r}")
+    _check_truth_gap(max_truth_gap)
     out_target = Target("--out", out)
     sensors_target = Target(
         "--sensors-out" if sensors_out is not None else "--out (its .sensors.toml)",
@@ -200,7 +237,10 @@ def calibrate(
     try:
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
             loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
-        logs = list(loaded.values)
+    except AuraUmsError as exc:
+        raise fail(str(exc)) from None
+    logs = list(loaded.values)
+    try:
         if horizons:
             calibration = calibrate_logs(
                 logs, quantile=quantile, move=move, horizons=tuple(horizons), anchor=anchor
@@ -208,7 +248,13 @@ def calibrate(
         else:  # calibrate_logs' default horizons
             calibration = calibrate_logs(logs, quantile=quantile, move=move, anchor=anchor)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        message = str(exc)
+        name, _, rest = message.partition(": ")
+        if name in _CALIBRATE_OPTIONS:  # an option out of range: named as the user gave it
+            raise fail(f"{_CALIBRATE_OPTIONS[name]}: {rest}") from None
+        # The logs read cleanly; what they hold does not calibrate: name them, not the library's arguments.
+        folders = ", ".join(str(folder) for folder in log_dirs)
+        raise fail(f"LOG_DIRS ({folders}): calibrating from their contents: {message}") from None
     write_text(out_target, calibration.terrain_table().to_toml())
     write_text(sensors_target, calibration.sensors_toml())
     motion, working, envelope = calibration.motion, calibration.working, calibration.envelope
@@ -304,8 +350,16 @@ def replay(
 
     if windows_csv is not None and camera is None:
         raise fail("--windows-csv: expected --camera too, got no camera")
+    if until is not None and not math.isfinite(until):
+        raise fail(f"--until: expected a finite number of seconds, got {until}")
+    _check_truth_gap(max_truth_gap)
     if not 0.0 <= window_margin < float("inf"):
         raise fail(f"--window-margin: expected a finite number of pixels >= 0, got {window_margin}")
+    if window_margin > IMAGE_SIDE.high:
+        raise fail(
+            f"--window-margin: expected at most {IMAGE_SIDE.high:g} pixels (an image's longest side), "
+            f"got {window_margin:g}"
+        )
     campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if len(log_dirs) > 1:
         one_log = {"--steps-csv": steps_csv, "--plot": plot, "--mcap": mcap, "--save-state": save_state,
@@ -355,7 +409,7 @@ def replay(
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
-        table = TerrainTable.from_toml(terrain)
+        table = _terrain_table(terrain, log.meta.terrain)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
         saved = None if resume is None else ReplayState.load(resume)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
@@ -383,7 +437,11 @@ def replay(
                     save_state=save_state is not None, after_step=None if view is None else view.step,
                 )  # fmt: skip
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        message = str(exc)
+        if resume is not None and message.startswith("resume: "):
+            # the library names its argument; the user gave a file
+            message = f"{resume}: --{message}"
+        raise fail(message) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
@@ -459,10 +517,13 @@ def compare(
     from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import compare_on_log, load_log, load_noise, observation_errors
-    from aura_ums.uncertainty import TerrainTable
 
-    if particles < 1:
-        raise fail(f"--particles: expected an integer >= 1, got {particles}")
+    if not 1 <= particles <= _MOST_PARTICLES:
+        # a billion particles was a MemoryError traceback
+        raise fail(f"--particles: expected an integer in [1, {_MOST_PARTICLES}], got {particles}")
+    if seed < 0:
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    _check_truth_gap(max_truth_gap)
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
@@ -473,7 +534,7 @@ def compare(
     check_outputs([json_target], sources, overwrite=overwrite)
     try:
         log = LoadLog(max_truth_gap)(log_dir)
-        table = TerrainTable.from_toml(terrain)
+        table = _terrain_table(terrain, log.meta.terrain)
         sensors_file = _sensors_file(sensors, terrain)
         options = _options(classes, sensors_file, settings.over(), reverse)
         if calibration_logs:
@@ -532,11 +593,11 @@ def compare(
     for row in rows:
         grid.add_row(
             row.method,
-            f"{row.containment_rate:.4f}",
-            f"{row.median_area_m2:.4g}",
-            f"{row.median_wedge_width_rad:.3f}",
-            f"{row.position_rmse_m:.3f}",
-            f"{row.median_update_us:.1f}",
+            _figure(row.containment_rate, ".4f"),
+            _figure(row.median_area_m2, ".4g"),
+            _figure(row.median_wedge_width_rad, ".3f"),
+            _figure(row.position_rmse_m, ".3f"),
+            _figure(row.median_update_us, ".1f"),
             str(row.inconsistent_observations),
         )
     console.print(grid)

@@ -331,9 +331,12 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
     ------
     FileFormatError
         Naming the file and table for a missing file, bad TOML, a missing or unknown key,
-        or a value out of range.
+        or a value out of range (in the optional ``[noise]`` table too).
     """
     reader, document = _read_sensors(path)
+    if "noise" in document:
+        # Checked though unused here: a bad file is refused by every command that reads it.
+        _build(reader, document, "noise", _NOISE_KEYS, FilterNoise)
     motion = _build(reader, document, "motion", _MOTION_KEYS, MotionCalibration)
     working = _build(reader, document, "working", _SENSOR_KEYS, SensorBounds)
     return motion, working, _build(reader, document, "envelope", _SENSOR_KEYS, SensorBounds)
@@ -400,6 +403,18 @@ class _Moves:
     heading: NDArray[np.float64]
     pose: NDArray[np.float64]
     valid: NDArray[np.bool_]
+
+
+#: Most moves :func:`calibrate_logs` cuts its logs into (about 100 bytes each, per horizon).
+MAX_MOVES = 2_000_000
+
+
+def _truth_span(log: RobotLog) -> float:
+    """Seconds during which the log has both motion and ground truth (at most: before any delay)."""
+    truth = log.groundtruth
+    assert truth is not None
+    first, last = log.motion_span
+    return max(0.0, min(last, float(truth.time[-1])) - max(first, float(truth.time[0])))
 
 
 def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
@@ -949,6 +964,13 @@ def calibrate_logs(
     if delay_limit < 0.0:
         raise InputError(f"max_delay: expected a number >= 0, got {delay_limit!r}")
 
+    # Arrays of a few floats per move are allocated per log: estimated before any.
+    seconds = sum(_truth_span(log) for log in logs)
+    if seconds / step > MAX_MOVES:
+        raise InputError(
+            f"move: expected at most {MAX_MOVES} moves over the logs' {seconds:g} s with ground truth, "
+            f"got about {seconds / step:.3g} moves of {step:g} s"
+        )
     delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, _DELAY_STEP), step)
     moves = [_moves(log, delay, step) for log in logs]
     raw = [_windows(moves, max(1, round(h / step))) for h in spans]

@@ -369,12 +369,14 @@ class _CsvFile:
             )
         return time
 
-    def no_clock_jump(self, time: NDArray[np.float64]) -> None:
+    def no_clock_jump(self, time: NDArray[np.float64], *, held: bool = True) -> None:
         """Refuse a gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
 
-        A row's velocities hold until the next row, and a replay cuts the motion at least
-        every :data:`~aura_ums.logs._odometry.DEFAULT_MAX_INTERVAL` seconds: a gap of days
-        is a clock jump, and would become millions of steps.
+        An odometry row's velocities hold until the next row (``held``), and a replay cuts
+        the motion at least every :data:`~aura_ums.logs._odometry.DEFAULT_MAX_INTERVAL`
+        seconds: a gap of days is a clock jump, and would become millions of steps. A
+        recorded command is one motion whatever its time, but a day between two of them
+        is the same clock jump, which would put every later observation out of step.
         """
         gaps = np.diff(time)
         jumps = gaps > ROW_GAP.high
@@ -382,11 +384,11 @@ class _CsvFile:
             row = int(np.argmax(jumps)) + 1
             gap = float(gaps[row - 1])
             steps = math.ceil(gap / DEFAULT_MAX_INTERVAL)
+            replayed = f"; replayed, about {steps} steps of {DEFAULT_MAX_INTERVAL:g} s" if held else ""
             self.fail_at(
                 row,
                 f"expected at most {ROW_GAP.high:g} s after the previous row (line {self.lines[row - 1]}), "
-                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days; replayed, about {steps} steps "
-                f"of {DEFAULT_MAX_INTERVAL:g} s)",
+                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days{replayed})",
             )
 
     def need_rows(self) -> None:
@@ -692,6 +694,7 @@ def odometry_blocks(
 def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
     table = _CsvFile(path, _COMMAND_COLUMNS, ("time", "turn", "run"))
     times = table.times(units, strict=True)
+    table.no_clock_jump(times, held=False)
     turn, run = table.numbers("turn", units), table.numbers("run", units)
     table.at_least("run", run)
     return tuple(

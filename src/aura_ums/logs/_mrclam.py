@@ -103,13 +103,17 @@ class _DatFile:
     def fail_at(self, line: int, message: str) -> NoReturn:
         raise FileFormatError(self.source, "", message, line=line)
 
+    def need_rows(self) -> None:
+        """Refuse a file without data rows."""
+        if len(self.data) == 0:
+            self.fail("", "expected at least one data row, got none")
+
     def increasing(self) -> tuple[NDArray[np.float64], int]:
         """Rows with strictly increasing times: an exact repeat of a time keeps the last row.
 
         Returns the rows and how many repeats were dropped; a time going back is an error.
         """
-        if len(self.data) == 0:
-            self.fail("", "expected at least one data row, got none")
+        self.need_rows()
         time = self.data[:, 0]
         steps = np.diff(time)
         if np.any(steps < 0.0):
@@ -217,12 +221,24 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
         )
 
     barcodes = _DatFile(folder / "Barcodes.dat", ("subject", "barcode"))
-    subject_of = {int(barcode): int(subject) for subject, barcode in barcodes.data}
+    # Without rows, or with a barcode twice, every measurement would be dropped or misread
+    # in silence: the import would succeed with no observation or the wrong landmark.
+    barcodes.need_rows()
+    subject_of: dict[int, int] = {}
+    for number, (subject, barcode) in zip(barcodes.lines.tolist(), barcodes.data.tolist(), strict=True):
+        if int(barcode) in subject_of:
+            barcodes.fail_at(number, f"expected each barcode once, got {int(barcode)} again")
+        subject_of[int(barcode)] = int(subject)
     landmark_file = _DatFile(folder / "Landmark_Groundtruth.dat", ("subject", "x", "y", "x_sd", "y_sd"))
+    landmark_file.need_rows()
     landmarks: list[LogLandmark] = []
+    seen: set[int] = set()
     for number, (subject, x, y, x_sd, y_sd) in zip(
         landmark_file.lines.tolist(), landmark_file.data.tolist(), strict=True
     ):
+        if int(subject) in seen:
+            landmark_file.fail_at(number, f"expected each subject once, got {int(subject)} again")
+        seen.add(int(subject))
         try:
             landmarks.append(
                 LogLandmark(str(int(subject)), x, y, 3.0 * max(abs(x_sd), abs(y_sd)), symbol=LANDMARK_SYMBOL)

@@ -502,8 +502,23 @@ def replay_start(log: RobotLog) -> tuple[float, Pose]:
             f"log {log.meta.name!r}: expected a [start] pose in meta.toml or a groundtruth.csv, got neither"
         )
     start = max(first_motion, float(log.groundtruth.time[0]))
-    x, y, heading = log.groundtruth.at([start])[0]
-    return start, Pose(float(x), float(y), float(heading))
+    return start, _truth_start(log.meta.name, start, log.groundtruth.at([start])[0], log.groundtruth.max_gap)
+
+
+def _truth_start(name: str, start: float, pose: NDArray[np.float64], max_gap: float) -> Pose:
+    """Return the start pose taken from the ground truth at ``start``; refuse one in a gap of it.
+
+    The truth is NaN strictly inside two rows more than ``max_gap`` apart (a lost track):
+    the log then has no start pose, and the message says where the start fell.
+    """
+    x, y, heading = (float(value) for value in pose)
+    if math.isnan(x):
+        raise InputError(
+            f"log {name!r}: groundtruth.csv: expected a ground-truth pose at the replay's start, "
+            f"{start:g} s (meta.toml gives no [start] pose), got none: the start lies between two "
+            f"rows more than {max_gap:g} s apart (--max-truth-gap)"
+        )
+    return Pose(x, y, heading)
 
 
 def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: float = 5.0) -> MeadowMap:
@@ -1042,8 +1057,7 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
         )
     else:
         start_time = max(first_motion, truth.first)
-        x, y, heading = truth.at(np.array([start_time]))[0]
-        start_pose = Pose(float(x), float(y), float(heading))
+        start_pose = _truth_start(meta.name, start_time, truth.at(np.array([start_time]))[0], truth.max_gap)
     meadow_map = _meadow_map(meta, stream.landmarks, stream.truth_box, opts.landmark_class, opts.arena_margin)
     reports: _WholeReports | _StreamReports
     if odometry is not None:

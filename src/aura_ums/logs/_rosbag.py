@@ -42,6 +42,7 @@ import importlib
 import itertools
 import math
 import os
+import struct
 from collections.abc import Iterator, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -49,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
+from aura_ums.errors import AuraUmsError, FileFormatError, InputError, MissingDependencyError
 from aura_ums.logs._io import Units, _read_landmarks, renumbered, write_log
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
 
@@ -324,8 +325,16 @@ def read_rosbag(
             odometry = _motion(bag, odom, kinds[odom])
             observations = _observations(bag, observed, {item.id: item for item in listed})
             groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
+    except AuraUmsError:
+        raise
     except (AnyReaderError, OSError) as exc:  # no metadata.yaml, unreadable storage, bad definitions
         raise FileFormatError(str(path), "", f"expected a readable ROS bag, got {exc}") from exc
+    except (ValueError, LookupError, EOFError, struct.error) as exc:
+        # Bytes that are no bag at all: rosbags' parsers fail as they meet them (a UnicodeDecodeError
+        # on a header, a short read), not with AnyReaderError.
+        raise FileFormatError(
+            str(path), "", f"expected a readable ROS bag, got {type(exc).__name__}: {exc}"
+        ) from exc
     if meta is None:
         topics = f"motion {odom}, observations {observed}" + (f", ground truth {truth}" if truth else "")
         meta = LogMeta(path.stem or path.name, source=f"ROS bag {path.name} ({topics})")

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from aura_ums.errors import InputError
+from aura_ums.uncertainty._slices import MAX_CELLS, MIN_SLICE_WIDTH
 
 #: What a setting holds.
 SettingValue = float | int | bool | None
@@ -95,6 +96,9 @@ class SettingInfo:
         if self.kind is int:
             if not isinstance(value, numbers.Integral) or (self.low is not None and value < self.low):
                 return f"expected {self.expected}, got {value!r}"
+            if self.high is not None and int(value) > self.high:
+                # a cap sizes arrays: 1e9 vertices allocated 7.45 GiB before any work
+                return f"expected an integer in [{_shown(self.low)}, {_shown(self.high)}], got {value!r}"
             return None
         number = float(value)
         if not math.isfinite(number):
@@ -123,6 +127,10 @@ class SettingInfo:
         if not isinstance(info, SettingInfo):
             raise InputError(f"field: expected a field of ManagerSettings, got {field.name!r}")
         return info
+
+
+#: The largest vertex and slice caps: arrays are sized by them (a cap of 1e9 is 7.45 GiB).
+_MOST = 100_000
 
 
 def _shown(value: float | None) -> str:
@@ -221,7 +229,13 @@ relocalize_after (2), got 1
     )
     max_vertices: int = _setting(
         64,
-        SettingInfo("Cap on the map polygon's vertices: fewer is faster and looser", "", int, low=3),
+        SettingInfo(
+            "Cap on the map polygon's vertices (at most 100000): fewer is faster and looser",
+            "",
+            int,
+            low=3,
+            high=_MOST,
+        ),
     )
     # max_slices defaults to what SpatialUncertaintyMap.with_slices takes (tests/manager/
     # test_sliced_manager.py holds them equal).
@@ -243,10 +257,12 @@ relocalize_after (2), got 1
     max_slices: int = _setting(
         48,
         SettingInfo(
-            "Cap on a sliced map's slice count: beyond it neighbours merge (fewer is faster and looser)",
+            "Cap on a sliced map's slice count, at most 100000: beyond it neighbours merge (fewer is "
+            "faster and looser)",
             "",
             int,
             low=1,
+            high=_MOST,
         ),
     )
     anchor_growth: bool = _setting(
@@ -291,7 +307,12 @@ relocalize_after (2), got 1
     envelope_max_vertices: int | None = _setting(
         None,
         SettingInfo(
-            "Cap on the envelope map polygon's vertices (none: max_vertices)", "", int, low=3, nullable=True
+            "Cap on the envelope map polygon's vertices, at most 100000 (none: max_vertices)",
+            "",
+            int,
+            low=3,
+            high=_MOST,
+            nullable=True,
         ),
     )
     relocalize_after: int = _setting(
@@ -395,6 +416,13 @@ def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]
         if problem is not None:
             raise fail(name, problem)
         checked[name] = info.normalize(value)
+    width = checked["slice_width"]
+    if isinstance(width, float) and width < MIN_SLICE_WIDTH:
+        # 2 pi / 1e-12 heading cells failed deep in the kernel, as a traceback
+        raise fail(
+            "slice_width",
+            f"expected at least {MIN_SLICE_WIDTH:g} rad ({MAX_CELLS} heading cells), got {width!r}",
+        )
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
         raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums import _native
+from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, points_in_convex
 
 Array = NDArray[np.float64]
@@ -105,6 +106,11 @@ class HeadingSlice(NamedTuple):
         return HeadingWedge._trusted(self.lo + half, half, half)
 
 
+#: Most heading cells round the circle (the C kernel's limit), so the narrowest slice width.
+MAX_CELLS = 1 << 24
+MIN_SLICE_WIDTH = _TWO_PI / MAX_CELLS
+
+
 def cell_count(width: float) -> int:
     """Return the number of grid cells for a requested cell width (radians, in (0, 2 pi]).
 
@@ -114,7 +120,16 @@ def cell_count(width: float) -> int:
     --------
     >>> cell_count(math.radians(2.0)), cell_count(2.0 * math.pi), cell_count(1.0)
     (180, 1, 7)
+    >>> cell_count(1e-12)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: slice_width: expected at least 3.74507e-07 rad (...), got 1e-12
     """
+    if width < MIN_SLICE_WIDTH:
+        raise InputError(
+            f"slice_width: expected at least {MIN_SLICE_WIDTH:g} rad ({MAX_CELLS} heading cells), "
+            f"got {width!r}"
+        )
     return max(1, math.ceil(_TWO_PI / width - 1e-9))
 
 
