@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -314,3 +315,13 @@ def test_ranges_keys_and_json_vocabulary() -> None:
 def test_every_error_is_an_aura_ums_value_error() -> None:
     assert issubclass(FileFormatError, AuraUmsError)
     assert issubclass(FileFormatError, ValueError)
+
+
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path: Path) -> None:
+    # open() of a FIFO waits for a writer: `replay --terrain FIFO` hung until killed.
+    pipe = tmp_path / "terrain.toml"
+    os.mkfifo(pipe)
+    with pytest.raises(
+        FileFormatError, match=r"terrain\.toml: expected a TOML file, got a named pipe or socket"
+    ):
+        read_bytes(pipe, kind="TOML")

@@ -219,6 +219,14 @@ def test_mrclam_files_without_rows_or_with_repeats_are_refused(
         read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **changes), 1)
 
 
+def test_recorded_commands_without_rows_are_refused(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "odometry.csv").unlink()
+    (folder / "commands.csv").write_text("time,turn,run\n")  # replayed from a start time of nan before
+    with pytest.raises(FileFormatError, match=r"commands\.csv: expected at least one data row, got none"):
+        load_log(folder)
+
+
 def test_an_mrclam_clock_jump_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
     odometry = HEADER + "9.0 0.1 0.0\n9.5 0.2 0.1\n2402009.5 0.0 0.0\n"
     with pytest.raises(

@@ -30,6 +30,7 @@ import math
 import os
 import re
 import secrets
+import stat
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -138,6 +139,13 @@ def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None
     """
     limit = _limit(max_bytes, MAX_BYTES)
     source = str(path)
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        mode = 0  # the open below says why
+    if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
+        # Opening one waits for a writer: the command hung, silent, until killed.
+        raise FileFormatError(source, "", f"expected a {kind} file, got a named pipe or socket")
     try:
         with open(path, "rb") as handle:
             # One byte more than the limit tells a larger file without reading all of it.

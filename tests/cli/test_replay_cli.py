@@ -414,6 +414,7 @@ def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, 
         ("--quantile", "nan", "--quantile: expected a finite number, got nan"),
         ("--quantile", "1.5", r"--quantile: expected a number in (0.5, 1), got 1.5"),
         ("--horizon", "0", "--horizon: expected seconds, each >= move (0.5), got [0.0]"),
+        ("--horizon", "1e308", "--horizon: expected seconds, each <= 86400 (a day), got [1e+308]"),
         # A move of 1 ns cut 20 s of log into 2e10 moves: a MemoryError traceback before.
         ("--move", "1e-9", "--move: expected at most 2000000 moves over the logs' "),
     ],

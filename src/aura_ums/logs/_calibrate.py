@@ -405,6 +405,8 @@ class _Moves:
     valid: NDArray[np.bool_]
 
 
+#: Longest horizon of :func:`calibrate_logs`, s: no map goes a day without a correction.
+MAX_HORIZON = 86_400.0
 #: Most moves :func:`calibrate_logs` cuts its logs into (about 100 bytes each, per horizon).
 MAX_MOVES = 2_000_000
 
@@ -956,6 +958,9 @@ def calibrate_logs(
     spans = tuple(finite_float(h, "horizons") for h in horizons)
     if not spans or min(spans) < step:
         raise InputError(f"horizons: expected seconds, each >= move ({step!r}), got {list(spans)}")
+    if max(spans) > MAX_HORIZON:
+        # a horizon of 1e308 s was an OverflowError traceback (its moves counted as an integer)
+        raise InputError(f"horizons: expected seconds, each <= {MAX_HORIZON:g} (a day), got {list(spans)}")
     sigma = positive_float(sigmas, "sigmas")
     margin = finite_float(envelope_margin, "envelope_margin")
     if margin < 1.0:

@@ -693,6 +693,7 @@ def odometry_blocks(
 
 def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
     table = _CsvFile(path, _COMMAND_COLUMNS, ("time", "turn", "run"))
+    table.need_rows()  # as odometry.csv: without a motion the replay had no start time (nan)
     times = table.times(units, strict=True)
     table.no_clock_jump(times, held=False)
     turn, run = table.numbers("turn", units), table.numbers("run", units)
