@@ -8,7 +8,6 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import shutil
@@ -146,31 +145,6 @@ def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp
         r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
     ):
         load_log(folder)
-
-
-@pytest.mark.parametrize(
-    ("parameters", "message"),
-    [
-        ({"bogus": 1.0}, r"properties\.parameters: expected names among .*, got 'bogus'"),
-        (
-            {"min_length": -5.0},
-            r"properties\.parameters\.min_length: expected a non-negative number, got -5\.0",
-        ),
-    ],
-)
-def test_geojson_strategy_parameters_are_checked_on_reading(
-    parameters: dict[str, float], message: str, tmp_path: Path
-) -> None:
-    # They were checked only when a simulation built the detector, naming the landmark alone.
-    document = make_grid_world(2, 2).to_geojson_dict()
-    features = document["features"]
-    assert isinstance(features, list)
-    landmark = next(item for item in features if item["properties"].get("strategy") == "line_finder")
-    landmark["properties"]["parameters"] = parameters
-    path = tmp_path / "world.geojson"
-    path.write_text(json.dumps(document))
-    with pytest.raises(FileFormatError, match=r"world\.geojson: features\[\d+\] \(id '[^']+'\) " + message):
-        MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
 
 
 def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:

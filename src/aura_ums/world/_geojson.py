@@ -270,22 +270,11 @@ class _Reader:
         activation = required_number("activation_range")
         threshold = required_number("recognition_threshold")
         try:
-            record = LandmarkRecord(
+            return LandmarkRecord(
                 landmark, _STRATEGIES[strategy_name], checked, activation, threshold, frames
             )
         except InputError as exc:
             self.fail_from(where, exc)
-        from aura_ums.schemas._perceive import build_detector
-
-        try:
-            # The strategy's parameters, checked here where the file is known (a simulation
-            # built the detector later and named only the landmark).
-            build_detector(record)
-        except InputError as exc:
-            key, _, message = str(exc).partition(": ")
-            prop = key.split(".", 1)[1] if key.startswith(f"{record.id}.") else f"parameters.{key}"
-            self.fail(f"{where} properties.{prop}", message)
-        return record
 
     def fail_from(self, where: str, exc: InputError) -> NoReturn:
         """Re-raise a validation error of a landmark or record as a file error at its property."""
