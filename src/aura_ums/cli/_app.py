@@ -99,14 +99,15 @@ def demo(
 ) -> None:
     """Run the paper's experiment and write its report (figures and summary.md) into OUT."""
     from aura_ums.errors import AuraUmsError
-    from aura_ums.plot import write_experiment_report
-    from aura_ums.sim._scenario import MAX_RUNS
+    from aura_ums.plot import paper_scenario, write_experiment_report
 
     # Checked before the report's first Monte Carlo: a traceback from deep inside it before.
     if seed < 0:
         raise fail(f"--seed: expected an integer >= 0, got {seed}")
-    if not 1 <= runs <= MAX_RUNS:
-        raise fail(f"--runs: expected an integer in [1, {MAX_RUNS}], got {runs}")
+    try:
+        paper_scenario().check_runs(runs)
+    except AuraUmsError as exc:
+        raise fail(f"--{exc}") from None
     target = Target("--out", out, folder=True)
     check_outputs([target], [], overwrite=overwrite)
     try:

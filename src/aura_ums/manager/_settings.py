@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from aura_ums.errors import InputError
-from aura_ums.uncertainty._slices import MAX_CELLS, MIN_SLICE_WIDTH
+from aura_ums.uncertainty import cell_count
 
 #: What a setting holds.
 SettingValue = float | int | bool | None
@@ -417,12 +417,12 @@ def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]
             raise fail(name, problem)
         checked[name] = info.normalize(value)
     width = checked["slice_width"]
-    if isinstance(width, float) and width < MIN_SLICE_WIDTH:
+    if isinstance(width, float):
         # 2 pi / 1e-12 heading cells failed deep in the kernel, as a traceback
-        raise fail(
-            "slice_width",
-            f"expected at least {MIN_SLICE_WIDTH:g} rad ({MAX_CELLS} heading cells), got {width!r}",
-        )
+        try:
+            cell_count(width)
+        except InputError as exc:
+            raise fail("slice_width", str(exc).partition(": ")[2]) from None
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
         raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")

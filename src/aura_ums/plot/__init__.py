@@ -1,7 +1,7 @@
 """Matplotlib figures of maps, wedges, windows and sampled outcomes, and the demo report."""
 
 from aura_ums.plot._expecter import draw_expecter_figures
-from aura_ums.plot._experiment import experiment_table, write_experiment_report
+from aura_ums.plot._experiment import experiment_table, paper_scenario, write_experiment_report
 from aura_ums.plot._growth import draw_all_figures, draw_growth_figures, write_growth_report
 from aura_ums.plot._reduction import PathRunStep, draw_path_figure, run_down_path
 from aura_ums.plot._replay import draw_replay
@@ -14,6 +14,7 @@ __all__ = [
     "draw_path_figure",
     "draw_replay",
     "experiment_table",
+    "paper_scenario",
     "run_down_path",
     "write_experiment_report",
     "write_growth_report",

@@ -239,6 +239,21 @@ def _cell(value: object) -> str:
     return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
+def paper_scenario() -> Scenario:
+    """Return the paper's sidewalk experiment (``scenarios/paper_sidewalk.toml``), as the report runs it.
+
+    Examples
+    --------
+    >>> paper_scenario().check_runs(40)
+    40
+    >>> paper_scenario().check_runs(0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: runs: expected an integer in [1, 100000], got 0
+    """
+    return Scenario.from_toml(scenarios_folder() / PAPER)
+
+
 def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -> Path:
     """Write the report: the earlier figures and summary, then the paper's experiment in the loop.
 
@@ -250,16 +265,23 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
     -------
     Path
         The written ``summary.md``.
+
+    Raises
+    ------
+    InputError
+        When ``runs`` is not an integer in [1, 100,000] (``Scenario.check_runs``), before
+        anything is written.
     """
     from aura_ums.plot._growth import write_growth_report
 
+    base = scenarios_folder()
+    paper = paper_scenario()
+    paper.check_runs(runs)  # before any work: a count out of range is refused with its estimate
     folder = Path(out)
     summary = write_growth_report(folder, seed=seed)
     figures = folder / "figures"
     figures.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    base = scenarios_folder()
-    paper = Scenario.from_toml(base / PAPER)
     result = run_scenario(paper, np.random.default_rng(seed), keep_images=True)
     f12 = figure12(figures / "figure12_maps.png", paper, result)
     f13 = figure13(figures / "figure13_windows.png", paper, result)

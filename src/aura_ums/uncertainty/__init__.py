@@ -27,7 +27,7 @@ from aura_ums.uncertainty._landmarks import (
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import FOOT, TurnAndRun
 from aura_ums.uncertainty._reduce import Reduction
-from aura_ums.uncertainty._slices import HeadingSlice
+from aura_ums.uncertainty._slices import HeadingSlice, cell_count
 from aura_ums.uncertainty._terrain import TerrainStats, TerrainTable
 from aura_ums.uncertainty._union import union_of_maps, union_of_wedges
 
@@ -54,6 +54,7 @@ __all__ = [
     "TurnAndRun",
     "VerticalLineLandmark",
     "anchor_bounds",
+    "cell_count",
     "grow_from_anchor",
     "growth_tightness",
     "intersect_maps",

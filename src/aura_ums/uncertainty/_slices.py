@@ -112,9 +112,10 @@ MIN_SLICE_WIDTH = _TWO_PI / MAX_CELLS
 
 
 def cell_count(width: float) -> int:
-    """Return the number of grid cells for a requested cell width (radians, in (0, 2 pi]).
+    """Return the number of heading cells of a sliced map's grid for a cell width (radians, in (0, 2 pi]).
 
-    The grid has a whole number of cells round the circle, each at most ``width`` wide.
+    The grid has a whole number of cells round the circle, each at most ``width`` wide
+    (``ManagerSettings.slice_width``); a width under ``2 pi / 2**24`` is refused.
 
     Examples
     --------
