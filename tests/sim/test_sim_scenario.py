@@ -403,3 +403,19 @@ def test_over_size_scenario_is_refused_stating_the_limit(folder: Path) -> None:
         handle.truncate(64 * 1024 * 1024 + 1)
     with pytest.raises(FileFormatError, match=r"huge\.toml: expected a scenario file of at most 64 MiB"):
         Scenario.from_toml(folder / "huge.toml")
+
+
+@pytest.mark.parametrize("spacing", [0.4, 0.3, 0.1, 0.7, 1e-3])
+def test_legs_end_when_rounding_leaves_a_frame_just_short_of_its_place(spacing: float) -> None:
+    # 0.4 + 0.4 + 0.4 falls 1e-16 short of 1.2: the next leg was 1e-17 m long, which left
+    # the distance travelled unchanged, and legs() appended such legs until memory ran out.
+    paper = Scenario.from_toml(SCENARIOS / "paper_sidewalk.toml")
+    scenario = dataclasses.replace(paper, frame_spacing=spacing)
+    legs = scenario.legs()
+    assert len(legs) <= scenario.frame_count()
+    assert sum(leg.run for leg in legs) == pytest.approx(sum(c.run for c in paper.commands), abs=1e-9)
+    # No leg of a rounding error's length; shorter than the spacing only a command's first
+    # (the rest of a spacing begun by the command before) and last.
+    assert min(leg.run for leg in legs) > 1e-6
+    short = [leg.run for leg in legs if leg.run < spacing * (1.0 - 1e-6)]
+    assert len(short) <= 2 * len(paper.commands)

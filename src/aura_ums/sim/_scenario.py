@@ -616,6 +616,10 @@ class Scenario:
             turn, remaining = command.turn, command.run
             while True:
                 to_next = self.frame_spacing - math.fmod(travelled, self.frame_spacing)
+                if to_next <= tolerance:
+                    # On a frame's place but for rounding (0.4 + 0.4 + ... just short of 1.2):
+                    # a leg of 1e-17 m would leave `travelled` unchanged, and this loop with it.
+                    to_next += self.frame_spacing
                 if to_next >= remaining - tolerance:
                     legs.append(TurnAndRun(turn, remaining))
                     travelled += remaining
