@@ -15,6 +15,7 @@ from aura_ums.cli._common import (
     PlainGroup,
     Quiet,
     SettingOptions,
+    check_seed,
     console,
     fail,
     manager_options,
@@ -78,8 +79,7 @@ def figures(
     from aura_ums.errors import AuraUmsError
     from aura_ums.plot import draw_all_figures
 
-    if seed < 0:
-        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    check_seed(seed)
     target = Target("--out", out, folder=True)
     check_outputs([target], [], overwrite=overwrite)
     try:
@@ -102,8 +102,7 @@ def demo(
     from aura_ums.plot import paper_scenario, write_experiment_report
 
     # Checked before the report's first Monte Carlo: a traceback from deep inside it before.
-    if seed < 0:
-        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    check_seed(seed)
     try:
         paper_scenario().check_runs(runs)
     except AuraUmsError as exc:
@@ -161,8 +160,7 @@ def simulate(
     campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
     if runs < 1:
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
-    if seed < 0:
-        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    check_seed(seed)
     if not scenario.is_file():
         raise fail(f"{scenario}: expected a scenario TOML file, got no such file")
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)

@@ -47,6 +47,12 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def check_seed(seed: int) -> None:
+    """Refuse (exit 2) a negative ``--seed``: numpy's generators take none, deep in the work."""
+    if seed < 0:
+        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+
+
 @contextmanager
 def progress_bar(
     label: str, *, quiet: bool, total: int | None = None

@@ -25,6 +25,7 @@ from aura_ums.cli._common import (
     NO_OPTIONS,
     Quiet,
     SettingOptions,
+    check_seed,
     console,
     err_console,
     fail,
@@ -521,8 +522,7 @@ def compare(
     if not 1 <= particles <= _MOST_PARTICLES:
         # a billion particles was a MemoryError traceback
         raise fail(f"--particles: expected an integer in [1, {_MOST_PARTICLES}], got {particles}")
-    if seed < 0:
-        raise fail(f"--seed: expected an integer >= 0, got {seed}")
+    check_seed(seed)
     _check_truth_gap(max_truth_gap)
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     sources = [
