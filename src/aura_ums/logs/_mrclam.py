@@ -108,6 +108,15 @@ class _DatFile:
         if len(self.data) == 0:
             self.fail("", "expected at least one data row, got none")
 
+    def once(self, column: int, what: str) -> None:
+        """Refuse a value of ``column`` that a row repeats, at the line of its second row."""
+        values = self.data[:, column]
+        _, first = np.unique(values, return_index=True)
+        if len(first) < len(values):
+            repeat = int(np.setdiff1d(np.arange(len(values)), first)[0])
+            again = int(values[repeat])
+            self.fail_at(int(self.lines[repeat]), f"expected each {what} once, got {again} again")
+
     def increasing(self) -> tuple[NDArray[np.float64], int]:
         """Rows with strictly increasing times: an exact repeat of a time keeps the last row.
 
@@ -224,21 +233,15 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     # Without rows, or with a barcode twice, every measurement would be dropped or misread
     # in silence: the import would succeed with no observation or the wrong landmark.
     barcodes.need_rows()
-    subject_of: dict[int, int] = {}
-    for number, (subject, barcode) in zip(barcodes.lines.tolist(), barcodes.data.tolist(), strict=True):
-        if int(barcode) in subject_of:
-            barcodes.fail_at(number, f"expected each barcode once, got {int(barcode)} again")
-        subject_of[int(barcode)] = int(subject)
+    barcodes.once(1, "barcode")
+    subject_of = {int(barcode): int(subject) for subject, barcode in barcodes.data}
     landmark_file = _DatFile(folder / "Landmark_Groundtruth.dat", ("subject", "x", "y", "x_sd", "y_sd"))
     landmark_file.need_rows()
+    landmark_file.once(0, "subject")
     landmarks: list[LogLandmark] = []
-    seen: set[int] = set()
     for number, (subject, x, y, x_sd, y_sd) in zip(
         landmark_file.lines.tolist(), landmark_file.data.tolist(), strict=True
     ):
-        if int(subject) in seen:
-            landmark_file.fail_at(number, f"expected each subject once, got {int(subject)} again")
-        seen.add(int(subject))
         try:
             landmarks.append(
                 LogLandmark(str(int(subject)), x, y, 3.0 * max(abs(x_sd), abs(y_sd)), symbol=LANDMARK_SYMBOL)
