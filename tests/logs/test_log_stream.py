@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -231,3 +235,37 @@ def test_odometry_reports_are_odometry_report_arrays(
                 column.append(values)
     for column, values in zip(found, expected, strict=True):
         assert np.array_equal(np.concatenate(column), values)
+
+
+_KILLED_AFTER_OPEN = """
+import os, signal, sys
+from aura_ums.logs import open_log
+stream = open_log(sys.argv[1])
+next(stream.groundtruth_blocks())
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGKILL and unnamed scratch files are POSIX's")
+def test_a_killed_replay_leaves_no_scratch_file_behind(folder: Path, tmp_path: Path) -> None:
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = {**os.environ, "TMPDIR": str(scratch)}
+    done = subprocess.run([sys.executable, "-c", _KILLED_AFTER_OPEN, str(folder)], env=env, check=False)
+    assert done.returncode == -signal.SIGKILL
+    assert sorted(path.name for path in scratch.iterdir()) == []
+
+
+def test_ground_truth_readers_of_one_stream_keep_their_own_places(folder: Path) -> None:
+    stream = open_log(folder, block_bytes=4096)
+    first, second = stream.groundtruth_blocks(), stream.groundtruth_blocks()
+    one = [next(first) for _ in range(3)]
+    two = [next(second) for _ in range(2)]
+    one.extend(first)
+    two.extend(second)
+    for blocks in (one, two):
+        joined = [np.concatenate(column) for column in zip(*blocks, strict=True)]
+        truth = load_log(folder).groundtruth
+        assert truth is not None
+        assert np.array_equal(joined[0], truth.time)
+        assert np.array_equal(joined[3], truth.heading)

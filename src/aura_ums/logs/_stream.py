@@ -16,10 +16,12 @@ import dataclasses
 import math
 import os
 import tempfile
+import threading
 import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,13 +56,26 @@ Array = NDArray[np.float64]
 
 
 class ScratchFile:
-    """A scratch file removed when the last object holding it is (copies of a stream share it)."""
+    """A scratch file without a name, closed when the last object holding it is (copies of a stream share it).
 
-    __slots__ = ("__weakref__", "path")
+    It is made by :func:`tempfile.TemporaryFile`: on POSIX its name is removed as it is
+    created, so the system frees it when its last descriptor closes, even when the process
+    is killed (``SIGKILL``) and no clean-up code runs. A named scratch file was left behind
+    in the temporary folder by every killed replay.
+    """
 
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        weakref.finalize(self, _remove, path)
+    __slots__ = ("__weakref__", "_handle", "_lock")
+
+    def __init__(self, handle: BinaryIO) -> None:
+        self._handle = handle
+        self._lock = threading.Lock()
+        weakref.finalize(self, handle.close)
+
+    def read(self, offset: int, count: int) -> bytes:
+        """At most ``count`` bytes from ``offset`` (each reader keeps its own place in the file)."""
+        with self._lock:
+            self._handle.seek(offset)
+            return self._handle.read(count)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -115,13 +130,13 @@ class LogStream:
     def groundtruth_blocks(self) -> Iterator[TruthColumns]:
         """Yield the ground truth's checked time, x, y, heading (wrapped to (-pi, pi]) block by block."""
         if self.truth_scratch is not None:
-            rows = max(self.block_bytes // 32, 1)
-            with self.truth_scratch.path.open("rb") as handle:
-                while True:
-                    block = np.fromfile(handle, dtype=np.float64, count=4 * rows).reshape(-1, 4)
-                    if not len(block):
-                        return
-                    yield block[:, 0].copy(), block[:, 1].copy(), block[:, 2].copy(), block[:, 3].copy()
+            size, offset = 32 * max(self.block_bytes // 32, 1), 0  # four float64 a row
+            while True:
+                block = np.frombuffer(self.truth_scratch.read(offset, size), dtype=np.float64).reshape(-1, 4)
+                if not len(block):
+                    return
+                offset += block.nbytes
+                yield block[:, 0].copy(), block[:, 1].copy(), block[:, 2].copy(), block[:, 3].copy()
         yield from _wrapped_truth(groundtruth_blocks(self.path / GROUNDTRUTH, self.units, self.block_bytes))
 
     def load(self) -> RobotLog:
@@ -197,18 +212,17 @@ def open_log(
     box, scratch = None, None
     if (base / GROUNDTRUTH).exists():
         box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
-    held = None if scratch is None else ScratchFile(scratch)
-    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, held)
+    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch)
 
 
 def _read_truth(
     path: Path, units: Units, block_bytes: int
-) -> tuple[tuple[float, float, float, float], Path | None]:
+) -> tuple[tuple[float, float, float, float], ScratchFile | None]:
     """Check the whole ground truth block by block: its extent, and the scratch copy of its rows."""
     low, high = np.full(2, np.inf), np.full(2, -np.inf)
-    handle = None
+    handle: BinaryIO | None = None
     with contextlib.suppress(OSError):  # no scratch file: the replay parses the file again
-        handle = tempfile.NamedTemporaryFile(prefix="aura-ums-truth-", suffix=".f8", delete=False)  # noqa: SIM115
+        handle = tempfile.TemporaryFile(prefix="aura-ums-truth-", suffix=".f8")  # noqa: SIM115
     try:
         for block in _wrapped_truth(groundtruth_blocks(path, units, block_bytes)):
             _, x, y, _ = block
@@ -218,23 +232,27 @@ def _read_truth(
                 try:
                     handle.write(np.column_stack(block).tobytes())
                 except OSError:  # no room: the replay parses the file again
-                    handle.close()
-                    _remove(Path(handle.name))
+                    _discard(handle)
                     handle = None
     except BaseException:
         if handle is not None:
-            handle.close()
-            _remove(Path(handle.name))
+            _discard(handle)
         raise
     box = (float(low[0]), float(low[1]), float(high[0]), float(high[1]))
     if handle is None:
         return box, None
-    handle.close()
-    return box, Path(handle.name)
+    try:
+        handle.flush()
+    except OSError:  # no room for the last rows: the replay parses the file again
+        _discard(handle)
+        return box, None
+    return box, ScratchFile(handle)
 
 
-def _remove(path: Path) -> None:
-    path.unlink(missing_ok=True)
+def _discard(handle: BinaryIO) -> None:
+    """Close a scratch file that could not be written (closing flushes, which may fail again)."""
+    with contextlib.suppress(OSError):
+        handle.close()
 
 
 def _wrapped_truth(blocks: Iterator[TruthColumns]) -> Iterator[TruthColumns]:
