@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import tempfile
 import traceback
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,8 @@ def test_tutorial_blocks_run_in_order(tmp_path: Path, monkeypatch: pytest.Monkey
     assert len(blocks) >= 10, "the tutorial lost its code blocks"
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
     monkeypatch.chdir(tmp_path)
+    # The tutorial's scratch folder (tempfile.mkdtemp) goes under tmp_path, not /tmp for good.
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     monkeypatch.setenv("MPLBACKEND", "Agg")
     import matplotlib
 
