@@ -69,17 +69,28 @@ returned to the system when replaced) would leave the trace's 84 bytes; not trie
 The gain depends on the log's shape: how many odometry rows fall between camera frames.
 Reading the log and recording the steps gained the most; the manager's update per step (one
 a frame) the least (15.07 against 9.99 s above, 1.5x), so the more frames a log has, the
-smaller the gain. Measured back to back, 27 November about 22:35-22:45 UTC, on the
-machine shared with a CLI sweep and a real-log benchmark (load average 3.5 to 5, which
-punishes the older tree's memory traffic more than this one's), total seconds:
+smaller the gain. Two series of back-to-back runs, total seconds:
 
-==============================  =======  =========  ===========  ==========
-log                             steps    f47bbb6    this tree    vs f47bbb6
-==============================  =======  =========  ===========  ==========
-10^6 rows, a frame every 100    9,335    80.04      15.40        5.2x
-10^6 rows, a frame every 10     93,359   73.08      19.06        3.8x (idle, above)
-10^5 rows, a frame every row    93,487   228.99     76.57        3.0x
-==============================  =======  =========  ===========  ==========
+==============================  =======  ================  ================  =================
+log                             steps    f47bbb6 / this    f47bbb6 / this    gain, 27 / 28 Nov
+                                         tree, 27 Nov      tree, 28 Nov
+==============================  =======  ================  ================  =================
+10^6 rows, a frame every 100    9,335    80.04 / 15.40     30.69 / 8.38      5.2x / 3.7x
+10^6 rows, a frame every 10     93,359   73.08 / 19.06     72.10 / 37.25     3.8x / 1.9x
+10^5 rows, a frame every row    93,487   228.99 / 76.57    85.26 / 30.73     3.0x / 2.8x
+==============================  =======  ================  ================  =================
+
+The 27 November series ran about 22:35-22:45 UTC, on the machine shared with a CLI sweep
+and a real-log benchmark (load average 3.5 to 5). Its frame-every-10 row was measured idle
+(above). The 28 November series ran 01:03-01:10 UTC beside one test-running helper (load
+average 2.5 to 3.2). Load alone moves the gain by up to 2x: at one frame every 100 rows,
+the older tree took 18.10 s idle (00:56 UTC, against 4.95 s for this tree, 3.7x) and
+80.04 s at load 3.5 to 5, while this tree's time varied less; the older tree holds the whole log
+in memory (750 to 810 MB against 50 to 110 MB). The
+command line as a user runs it, on the 10^6-row log with a frame every 10 rows, Class I (the
+CLI's default), the steps CSV and metrics JSON written (``/usr/bin/time``, 28 November
+01:50 UTC, load average 2): f47bbb6 61.75 s and 811 MB peak, this tree 24.40 s and 106 MB
+peak, 2.5x. The issue's tenfold gain is not reached in any of these runs.
 
 (``--rows 1000000 --frame-every 100`` and ``--rows 100000 --frame-every 1``, each then with
 ``--src`` of f47bbb6.) The manager's update, about 100 us a step on an idle machine, two
