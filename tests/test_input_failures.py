@@ -19,6 +19,7 @@ import pytest
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, read_rosbag, synthetic_log
+from aura_ums.logs._io import Units, groundtruth_blocks, observation_blocks
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
@@ -145,6 +146,56 @@ def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp
         r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
     ):
         load_log(folder)
+
+
+JUMPED = (
+    r"expected at most 86400 s after the previous row \(line 3\), "
+    r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$"
+)
+
+
+def test_a_clock_jump_in_observations_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    observations = "time,landmark_id,bearing,range\n0.5,A,0.1,3.0\n1.0,B,1.5,4.0\n2402000.0,A,0.1,3.0\n"
+    folder = log_folder(tmp_path, observations_csv=observations)
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: " + JUMPED):
+        load_log(folder)
+    # Streamed block by block, a jump between two blocks gives the same message.
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: " + JUMPED):
+        list(observation_blocks(folder / "observations.csv", Units(), {"A", "B"}, block_bytes=48))
+
+
+def test_a_clock_jump_in_ground_truth_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "groundtruth.csv").write_text("time,x,y,heading\n0.0,0,0,0\n1.0,0,0,0\n2402000.0,0,0,0\n")
+    with pytest.raises(FileFormatError, match=r"groundtruth\.csv:4: " + JUMPED):
+        load_log(folder)
+    with pytest.raises(FileFormatError, match=r"groundtruth\.csv:4: " + JUMPED):
+        list(groundtruth_blocks(folder / "groundtruth.csv", Units(), block_bytes=40))
+
+
+@pytest.mark.parametrize(
+    ("name", "rows", "line"),
+    [
+        # Measurements are sorted on reading: the jump is found in time order (line 8 is last).
+        ("Robot1_Measurement.dat", "10.0 \t 63 \t 2.0 \t 0.5\n11.0 \t 81 \t 4.0 \t -0.1\n", None),
+        ("Robot1_Groundtruth.dat", "8.0 \t 0.0 \t 0.0 \t 3.1\n12.0 \t 1.0 \t 0.0 \t -3.1\n", 7),
+    ],
+    ids=["measurement", "groundtruth"],
+)
+def test_a_clock_jump_in_mrclam_files_is_refused_with_its_file_and_line(
+    tmp_path: Path, name: str, rows: str, line: int | None
+) -> None:
+    later = "2400011.0 \t 63 \t 2.5 \t 0.2\n" if line is None else "2400012.0 \t 1.0 \t 1.0 \t 0.0\n"
+    text = HEADER + (later + rows if line is None else rows + later)
+    folder = tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{name: text})
+    where = 5 if line is None else line
+    previous = 7 if line is None else 6
+    with pytest.raises(
+        FileFormatError,
+        match=rf"{name}:{where}: expected at most 86400 s after the previous row \(line {previous}\), "
+        r"got a clock jump of 2\.4e\+06 s \(27\.8 days\)$",
+    ):
+        read_mrclam(folder, 1)
 
 
 def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:
