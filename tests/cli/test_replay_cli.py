@@ -466,3 +466,19 @@ def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
     assert result.exit_code == 2
     assert "Traceback" not in result.output  # a ValueError of Path.with_suffix before
     assert result.stderr == "error: --out: expected a file path, got '.'\n"
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["replay", "", "--terrain", "t.toml"], "LOG_DIR"),
+        (["compare", "", "--terrain", "t.toml"], "LOG_DIR"),
+        (["calibrate", "", "--out", "t.toml"], "LOG_DIRS"),
+    ],
+    ids=["replay", "compare", "calibrate"],
+)
+def test_an_empty_log_argument_is_named(argv: list[str], name: str) -> None:
+    # '' was Path("."), the current folder: "meta.toml: expected an existing log metadata ..."
+    result = runner.invoke(app, argv)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {name}: expected a log folder, got an empty path ''\n"
