@@ -387,7 +387,7 @@ def replay(
             lens = None if camera is None else load_camera(camera)
         except AuraUmsError as exc:
             raise fail(str(exc)) from None
-        replay_logs(log_dirs, many, options, camera=lens, window_margin=window_margin,
+        replay_logs(log_dirs, many, options, table_file=terrain, camera=lens, window_margin=window_margin,
                     max_truth_gap=max_truth_gap, until=until, json_target=json_target,
                     settings=campaign_options, quiet=quiet)  # fmt: skip
         return
