@@ -198,6 +198,20 @@ def test_a_clock_jump_in_mrclam_files_is_refused_with_its_file_and_line(
         read_mrclam(folder, 1)
 
 
+@pytest.mark.parametrize("text", ["", HEADER], ids=["zero-bytes", "header-only"])
+def test_an_empty_mrclam_measurement_file_is_a_log_without_observations_and_says_so(
+    tmp_path: Path, text: str
+) -> None:
+    empty = read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{"Robot1_Measurement.dat": text}), 1)
+    assert empty.observations == ()
+    assert empty.odometry is not None  # replayable on odometry alone
+    assert "; no measurement rows in Robot1_Measurement.dat: a log without observations;" in (
+        empty.meta.source
+    )
+    # As an observations.csv with its header alone (a CSV without its header is refused).
+    assert load_log(log_folder(tmp_path, observations_csv="time,landmark_id,bearing\n")).observations == ()
+
+
 def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:
     # replay reads the sensors file for its bounds only, yet a NaN anywhere in it is refused.
     log = synthetic_log(np.random.default_rng(1), duration=60.0)

@@ -167,9 +167,11 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     to "20"); their ``position_uncertainty`` is 3 times the larger of the x and y
     standard deviations. Exact repeats of an odometry (or ground-truth) time keep the last
     row, and are counted in ``meta.source`` too. Measurements outside the ground truth's
-    time span are kept. The meta has terrain ``"floor"`` and :class:`LogMeta`'s default
-    bounds (placeholders for calibration). Each observation's ``line`` is its line in
-    ``RobotN_Measurement.dat``.
+    time span are kept; a ``RobotN_Measurement.dat`` without data rows (empty, or ``#``
+    lines alone) gives a log without observations, as an ``observations.csv`` with its
+    header alone does, and says so in ``meta.source``. The meta has terrain ``"floor"``
+    and :class:`LogMeta`'s default bounds (placeholders for calibration). Each
+    observation's ``line`` is its line in ``RobotN_Measurement.dat``.
 
     Parameters
     ----------
@@ -266,6 +268,10 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     truth_rows, truth_repeats = truth_file.increasing()
 
     notes = [f"dropped {robots} robot and {unknown} unknown-barcode measurements"]
+    if not len(measurements.data):
+        # As an observations.csv with its header alone: a log without observations is one
+        # to replay on odometry alone, so it is kept, but said (a truncated download?).
+        notes.append(f"no measurement rows in {prefix}Measurement.dat: a log without observations")
     if odometry_repeats:
         notes.append(f"dropped {_plural(odometry_repeats, 'repeated odometry time')} (kept the last row)")
     if truth_repeats:
