@@ -429,6 +429,33 @@ def test_an_image_width_of_2e6_is_refused(tmp_path: Path) -> None:
         load_opencv_calibration(opencv, CameraMount(1.0))
 
 
+def test_a_distortion_of_1e300_is_refused_in_both_camera_formats(tmp_path: Path) -> None:
+    # accepted before: every window was garbage (the replay printed n/a) with exit 0
+    camera = tmp_path / "camera.toml"
+    camera.write_text(
+        (REPOSITORY / "examples" / "camera.toml")
+        .read_text()
+        .replace("# distortion = [k1, k2, p1, p2, k3]", "distortion = [1e300, 0.0, 0.0, 0.0, 0.0]")
+    )
+    with pytest.raises(
+        FileFormatError,
+        match=r"camera\.toml: \[intrinsics\] distortion\[0\]: "
+        r"expected a number in \[-1000, 1000\], got 1e\+300",
+    ):
+        load_camera(camera)
+    opencv = tmp_path / "calib.json"
+    opencv.write_text(
+        '{"image_width": 640, "image_height": 480, "camera_matrix": {"type_id": "opencv-matrix", '
+        '"rows": 3, "cols": 3, "dt": "d", "data": [500, 0, 320, 0, 500, 240, 0, 0, 1]}, '
+        '"distortion_coefficients": {"type_id": "opencv-matrix", "rows": 1, "cols": 5, "dt": "d", '
+        '"data": [0.1, -0.2, 0, 0, -1e300]}}'
+    )
+    with pytest.raises(
+        FileFormatError, match=r"calib\.json: distortion_coefficients\[4\]: expected a number in"
+    ):
+        load_opencv_calibration(opencv, CameraMount(1.0))
+
+
 def test_a_camera_too_big_to_render_is_refused_with_the_estimate(tmp_path: Path) -> None:
     camera = (
         (REPOSITORY / "scenarios" / "paper_camera.toml")
