@@ -8,6 +8,7 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import shutil
@@ -111,6 +112,32 @@ def test_geojson_position_uncertainty_1e300_is_refused(tmp_path: Path) -> None:
     path.write_text(json.dumps(document))
     with pytest.raises(
         FileFormatError, match=r"world\.geojson: .*position_uncertainty: expected a number in \[0, 1000\] m"
+    ):
+        MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "bounds"),
+    [
+        ("tolerance", 1e308, r"\[0, 3\.14159\] rad"),
+        ("tolerance", -0.1, r"\[0, 3\.14159\] rad"),
+        ("min_length", 1e300, r"\[-1e\+09, 1e\+09\]"),
+    ],
+)
+def test_geojson_strategy_parameters_out_of_range_are_refused(
+    tmp_path: Path, name: str, value: float, bounds: str
+) -> None:
+    # tolerance 1e308 was accepted: the detector took every line of every frame
+    document = make_grid_world(2, 2).to_geojson_dict()
+    features = document["features"]
+    assert isinstance(features, list)
+    landmark = next(item for item in features if "class" in item["properties"])
+    landmark["properties"]["parameters"] = {name: value}
+    path = tmp_path / "world.geojson"
+    path.write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError,
+        match=rf"world\.geojson: .*properties\.parameters\.{name}: expected a number in {bounds}",
     ):
         MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
 
