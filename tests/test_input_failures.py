@@ -416,6 +416,17 @@ def test_scenario_clutter_1e8_is_refused(tmp_path: Path) -> None:
         Scenario.from_toml(path)
 
 
+def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path) -> None:
+    # was estimated as strips (35 us, 140 s a run) and accepted: about 13 minutes a run
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 40\nclutter_lines = 1000000")
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk\.toml: \[render\] clutter_lines: expected at most 600 s and 4 GB a run, got 4 frames "
+        r"of 512 x 480 px, 40 clutter strips and 1000000 lines: about 760 s",
+    ):
+        Scenario.from_toml(path)
+
+
 def test_scenario_frame_spacing_1e_6_is_refused_with_the_estimate(tmp_path: Path) -> None:
     path = scenario_file(tmp_path, "[start]\n", "frame_spacing = 1e-6\n\n[start]\n")
     with pytest.raises(

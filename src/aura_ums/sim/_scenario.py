@@ -142,10 +142,13 @@ KEY_RANGES: dict[str, Range] = {
 }
 # The synthetic camera's costs, measured on one core with scenarios/paper_sidewalk.toml
 # (a 512 x 480 frame in 10 ms; 0.15 s with 4000 clutter strips; 45 MB of buffers): a frame
-# renders each pixel in about 40 ns and each clutter strip or line in about 35 us; the
-# camera keeps about 180 bytes a pixel, the scene about 400 a strip.
+# renders each pixel in about 40 ns and each clutter strip in about 35 us; the
+# camera keeps about 180 bytes a pixel, the scene about 400 a strip. A clutter line is
+# drawn as its own polygon in every frame: about 190 us (2000 and 8000 lines, 0.40 and 1.49
+# s a frame; it was counted as a strip, and 1e6 lines, 13 minutes a run, were let through).
 _SECONDS_PER_PIXEL = 4e-8
 _SECONDS_PER_STRIP = 3.5e-5
+_SECONDS_PER_LINE = 1.9e-4
 _BYTES_PER_PIXEL = 200
 _BYTES_PER_STRIP = 400
 #: Longest estimated time of one simulated run, seconds.
@@ -442,8 +445,8 @@ class Scenario:
     def estimate(self) -> tuple[float, float]:
         """Return the estimated time (seconds) and memory (bytes) of one run of :meth:`simulate`.
 
-        From the synthetic camera's measured costs: pixels and clutter strips of every
-        frame, the camera's buffers and the scene's strips.
+        From the synthetic camera's measured costs: pixels, clutter strips and clutter
+        lines of every frame, the camera's buffers and the scene's strips.
 
         Examples
         --------
@@ -455,9 +458,12 @@ class Scenario:
         """
         k = self.camera.intrinsics
         pixels = float(k.width) * float(k.height)
-        strips = float(self.render.clutter) + float(self.render.clutter_lines)
         frames = float(self.frame_count())
-        seconds = frames * (pixels * _SECONDS_PER_PIXEL + strips * _SECONDS_PER_STRIP)
+        seconds = frames * (
+            pixels * _SECONDS_PER_PIXEL
+            + float(self.render.clutter) * _SECONDS_PER_STRIP
+            + float(self.render.clutter_lines) * _SECONDS_PER_LINE
+        )
         memory = pixels * _BYTES_PER_PIXEL + float(self.render.clutter) * _BYTES_PER_STRIP
         return seconds, memory
 
@@ -482,6 +488,8 @@ class Scenario:
             name = "Scenario.frame_spacing"
         elif frames * self.render.clutter * _SECONDS_PER_STRIP > seconds / 2:
             name = "Scenario.render.clutter"
+        elif frames * self.render.clutter_lines * _SECONDS_PER_LINE > seconds / 2:
+            name = "Scenario.render.clutter_lines"
         else:
             name = "Scenario.camera"
         raise InputError(f"{name}: expected {limits}, got {work}")
@@ -586,6 +594,7 @@ class Scenario:
             field_name, _, message = str(exc).partition(": ")
             where = {
                 "Scenario.render.clutter": "[render] clutter",
+                "Scenario.render.clutter_lines": "[render] clutter_lines",
                 "Scenario.frame_spacing": "frame_spacing" if "frame_spacing" in document else "frame_rate",
             }.get(field_name, field_name.removeprefix("Scenario."))
             raise reader.fail(where, message) from None
