@@ -57,7 +57,7 @@ from aura_ums._validate import (
 )
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
-from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL
+from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL, ReversingError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
@@ -700,6 +700,22 @@ def _odometry_columns(table: _CsvFile, units: Units) -> OdometryColumns:
     time = table.times(units, strict=True)
     table.no_clock_jump(time)
     return time, table.numbers("v", units), table.numbers("omega", units)
+
+
+def reversed_at(path: Path, refused: ReversingError) -> FileFormatError:
+    """Return the refusal of a negative forward velocity naming its file and line.
+
+    The replay knows the row's index in the record, not its line: the file's data lines
+    are read again (on this error path only) to find it.
+    """
+    line = int(np.asarray(_CsvFile(path, _ODOMETRY_COLUMNS, ("time", "v", "omega")).lines)[refused.row])
+    return FileFormatError(
+        str(path),
+        "",
+        f"expected forward velocities >= 0 in column 'v' (the turn-and-run model has no reverse; "
+        f"pass --reverse flip to aura-ums, or reverse=ReverseMotion.FLIP), got {refused.value!r}",
+        line=line,
+    )
 
 
 def odometry_blocks(
