@@ -427,6 +427,31 @@ def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path)
         Scenario.from_toml(path)
 
 
+@pytest.mark.parametrize(
+    ("parameters", "message"),
+    [
+        ({"bogus": 1}, r"pole_a\.parameters: expected names among orientation, .*, got 'bogus'"),
+        ({"min_length": -5}, r"min_length: expected a non-negative number, got -5\.0"),
+    ],
+)
+def test_a_strategy_parameter_perception_refuses_names_the_scenarios_map(
+    tmp_path: Path, parameters: dict[str, float], message: str
+) -> None:
+    # refused only when a run built the schema, naming the landmark but not the file
+    for name in ("four_terrains.toml", "paper_camera.toml"):
+        shutil.copy(REPOSITORY / "scenarios" / name, tmp_path / name)
+    document = json.loads((REPOSITORY / "scenarios" / "four_terrains.geojson").read_text())
+    pole = next(item for item in document["features"] if item["properties"].get("id") == "pole_a")
+    pole["properties"]["parameters"] = parameters
+    (tmp_path / "four_terrains.geojson").write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError,
+        match=r"four_terrains\.toml: map: expected a meadow map file that loads, "
+        r"got: four_terrains\.geojson: " + message,
+    ):
+        Scenario.from_toml(tmp_path / "four_terrains.toml")
+
+
 def test_scenario_frame_spacing_1e_6_is_refused_with_the_estimate(tmp_path: Path) -> None:
     path = scenario_file(tmp_path, "[start]\n", "frame_spacing = 1e-6\n\n[start]\n")
     with pytest.raises(

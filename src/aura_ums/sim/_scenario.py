@@ -73,8 +73,10 @@ from aura_ums._validate import (
 )
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
+from aura_ums.expecter import Expecter
 from aura_ums.geometry import wrap_angle
 from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.schemas import FindLandmarkSchema
 from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scene import Scene
@@ -565,6 +567,7 @@ class Scenario:
             camera = load_camera(camera_path)
         except FileFormatError as exc:
             raise reader.fail("camera", f"expected a camera file that loads, got: {exc}") from None
+        _check_strategies(meadow_map, camera, reader, str(document["map"]))
         landmark_ids = _landmark_ids(document, reader, meadow_map)
         start = _start(reader.table(document, "start", required=True), reader, meadow_map)
         commands = _route(reader.table(document, "route", required=True), reader, meadow_map, start.pose)
@@ -755,6 +758,21 @@ def _load_map(
         return MeadowMap.from_geojson(path, terrain_table=terrain)
     except FileFormatError as exc:
         raise reader.fail("map", f"expected a meadow map file that loads, got: {exc}") from None
+
+
+def _check_strategies(meadow_map: MeadowMap, camera: Camera, reader: _Reader, source: str) -> None:
+    """Refuse, naming the map, a landmark whose strategy or parameters perception cannot run.
+
+    The map's reader (world) sits below perception and cannot build a detector; each
+    landmark's find-landmark schema is built once here, where the scenario is read,
+    rather than when a run starts (where the message named the landmark, not the file).
+    """
+    expecter = Expecter(camera)
+    for record in meadow_map.landmarks:
+        try:
+            FindLandmarkSchema(record, expecter)
+        except InputError as exc:
+            raise reader.fail("map", f"expected a meadow map file that loads, got: {source}: {exc}") from None
 
 
 def _with_confirm_frames(meadow_map: MeadowMap, document: Mapping[str, object], reader: _Reader) -> MeadowMap:
