@@ -8,6 +8,7 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import shutil
@@ -19,6 +20,7 @@ import pytest
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, read_rosbag, synthetic_log
+from aura_ums.logs._io import Units, groundtruth_blocks, observation_blocks
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
@@ -114,6 +116,32 @@ def test_geojson_position_uncertainty_1e300_is_refused(tmp_path: Path) -> None:
         MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
 
 
+@pytest.mark.parametrize(
+    ("name", "value", "bounds"),
+    [
+        ("tolerance", 1e308, r"\[0, 3\.14159\] rad"),
+        ("tolerance", -0.1, r"\[0, 3\.14159\] rad"),
+        ("min_length", 1e300, r"\[-1e\+09, 1e\+09\]"),
+    ],
+)
+def test_geojson_strategy_parameters_out_of_range_are_refused(
+    tmp_path: Path, name: str, value: float, bounds: str
+) -> None:
+    # tolerance 1e308 was accepted: the detector took every line of every frame
+    document = make_grid_world(2, 2).to_geojson_dict()
+    features = document["features"]
+    assert isinstance(features, list)
+    landmark = next(item for item in features if "class" in item["properties"])
+    landmark["properties"]["parameters"] = {name: value}
+    path = tmp_path / "world.geojson"
+    path.write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError,
+        match=rf"world\.geojson: .*properties\.parameters\.{name}: expected a number in {bounds}",
+    ):
+        MeadowMap.from_geojson(path, terrain_table=TerrainTable.default())
+
+
 # --- tracebacks and hangs: v = 1e300 and a clock jump -----------------------------------------
 
 
@@ -145,6 +173,70 @@ def test_a_clock_jump_in_recorded_commands_is_refused_with_its_file_and_line(tmp
         r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$",
     ):
         load_log(folder)
+
+
+JUMPED = (
+    r"expected at most 86400 s after the previous row \(line 3\), "
+    r"got a clock jump of 2\.402e\+06 s \(27\.8 days\)$"
+)
+
+
+def test_a_clock_jump_in_observations_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    observations = "time,landmark_id,bearing,range\n0.5,A,0.1,3.0\n1.0,B,1.5,4.0\n2402000.0,A,0.1,3.0\n"
+    folder = log_folder(tmp_path, observations_csv=observations)
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: " + JUMPED):
+        load_log(folder)
+    # Streamed block by block, a jump between two blocks gives the same message.
+    with pytest.raises(FileFormatError, match=r"observations\.csv:4: " + JUMPED):
+        list(observation_blocks(folder / "observations.csv", Units(), {"A", "B"}, block_bytes=48))
+
+
+def test_a_clock_jump_in_ground_truth_is_refused_with_its_file_and_line(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "groundtruth.csv").write_text("time,x,y,heading\n0.0,0,0,0\n1.0,0,0,0\n2402000.0,0,0,0\n")
+    with pytest.raises(FileFormatError, match=r"groundtruth\.csv:4: " + JUMPED):
+        load_log(folder)
+    with pytest.raises(FileFormatError, match=r"groundtruth\.csv:4: " + JUMPED):
+        list(groundtruth_blocks(folder / "groundtruth.csv", Units(), block_bytes=40))
+
+
+@pytest.mark.parametrize(
+    ("name", "rows", "line"),
+    [
+        # Measurements are sorted on reading: the jump is found in time order (line 8 is last).
+        ("Robot1_Measurement.dat", "10.0 \t 63 \t 2.0 \t 0.5\n11.0 \t 81 \t 4.0 \t -0.1\n", None),
+        ("Robot1_Groundtruth.dat", "8.0 \t 0.0 \t 0.0 \t 3.1\n12.0 \t 1.0 \t 0.0 \t -3.1\n", 7),
+    ],
+    ids=["measurement", "groundtruth"],
+)
+def test_a_clock_jump_in_mrclam_files_is_refused_with_its_file_and_line(
+    tmp_path: Path, name: str, rows: str, line: int | None
+) -> None:
+    later = "2400011.0 \t 63 \t 2.5 \t 0.2\n" if line is None else "2400012.0 \t 1.0 \t 1.0 \t 0.0\n"
+    text = HEADER + (later + rows if line is None else rows + later)
+    folder = tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{name: text})
+    where = 5 if line is None else line
+    previous = 7 if line is None else 6
+    with pytest.raises(
+        FileFormatError,
+        match=rf"{name}:{where}: expected at most 86400 s after the previous row \(line {previous}\), "
+        r"got a clock jump of 2\.4e\+06 s \(27\.8 days\)$",
+    ):
+        read_mrclam(folder, 1)
+
+
+@pytest.mark.parametrize("text", ["", HEADER], ids=["zero-bytes", "header-only"])
+def test_an_empty_mrclam_measurement_file_is_a_log_without_observations_and_says_so(
+    tmp_path: Path, text: str
+) -> None:
+    empty = read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{"Robot1_Measurement.dat": text}), 1)
+    assert empty.observations == ()
+    assert empty.odometry is not None  # replayable on odometry alone
+    assert "; no measurement rows in Robot1_Measurement.dat: a log without observations;" in (
+        empty.meta.source
+    )
+    # As an observations.csv with its header alone (a CSV without its header is refused).
+    assert load_log(log_folder(tmp_path, observations_csv="time,landmark_id,bearing\n")).observations == ()
 
 
 def test_a_bad_noise_table_is_refused_by_the_sensor_reader_that_ignores_it(tmp_path: Path) -> None:
@@ -324,6 +416,42 @@ def test_scenario_clutter_1e8_is_refused(tmp_path: Path) -> None:
         Scenario.from_toml(path)
 
 
+def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path) -> None:
+    # was estimated as strips (35 us, 140 s a run) and accepted: about 13 minutes a run
+    path = scenario_file(tmp_path, "clutter = 40", "clutter = 40\nclutter_lines = 1000000")
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk\.toml: \[render\] clutter_lines: expected at most 600 s and 4 GB a run, got 4 frames "
+        r"of 512 x 480 px, 40 clutter strips and 1000000 lines: about 760 s",
+    ):
+        Scenario.from_toml(path)
+
+
+@pytest.mark.parametrize(
+    ("parameters", "message"),
+    [
+        ({"bogus": 1}, r"pole_a\.parameters: expected names among orientation, .*, got 'bogus'"),
+        ({"min_length": -5}, r"min_length: expected a non-negative number, got -5\.0"),
+    ],
+)
+def test_a_strategy_parameter_perception_refuses_names_the_scenarios_map(
+    tmp_path: Path, parameters: dict[str, float], message: str
+) -> None:
+    # refused only when a run built the schema, naming the landmark but not the file
+    for name in ("four_terrains.toml", "paper_camera.toml"):
+        shutil.copy(REPOSITORY / "scenarios" / name, tmp_path / name)
+    document = json.loads((REPOSITORY / "scenarios" / "four_terrains.geojson").read_text())
+    pole = next(item for item in document["features"] if item["properties"].get("id") == "pole_a")
+    pole["properties"]["parameters"] = parameters
+    (tmp_path / "four_terrains.geojson").write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError,
+        match=r"four_terrains\.toml: map: expected a meadow map file that loads, "
+        r"got: four_terrains\.geojson: " + message,
+    ):
+        Scenario.from_toml(tmp_path / "four_terrains.toml")
+
+
 def test_scenario_frame_spacing_1e_6_is_refused_with_the_estimate(tmp_path: Path) -> None:
     path = scenario_file(tmp_path, "[start]\n", "frame_spacing = 1e-6\n\n[start]\n")
     with pytest.raises(
@@ -361,6 +489,33 @@ def test_an_image_width_of_2e6_is_refused(tmp_path: Path) -> None:
         '"data": [0, 0, 0, 0]}}'
     )
     with pytest.raises(FileFormatError, match=r"calib\.json: image_width: expected at most 20000 px"):
+        load_opencv_calibration(opencv, CameraMount(1.0))
+
+
+def test_a_distortion_of_1e300_is_refused_in_both_camera_formats(tmp_path: Path) -> None:
+    # accepted before: every window was garbage (the replay printed n/a) with exit 0
+    camera = tmp_path / "camera.toml"
+    camera.write_text(
+        (REPOSITORY / "examples" / "camera.toml")
+        .read_text()
+        .replace("# distortion = [k1, k2, p1, p2, k3]", "distortion = [1e300, 0.0, 0.0, 0.0, 0.0]")
+    )
+    with pytest.raises(
+        FileFormatError,
+        match=r"camera\.toml: \[intrinsics\] distortion\[0\]: "
+        r"expected a number in \[-1000, 1000\], got 1e\+300",
+    ):
+        load_camera(camera)
+    opencv = tmp_path / "calib.json"
+    opencv.write_text(
+        '{"image_width": 640, "image_height": 480, "camera_matrix": {"type_id": "opencv-matrix", '
+        '"rows": 3, "cols": 3, "dt": "d", "data": [500, 0, 320, 0, 500, 240, 0, 0, 1]}, '
+        '"distortion_coefficients": {"type_id": "opencv-matrix", "rows": 1, "cols": 5, "dt": "d", '
+        '"data": [0.1, -0.2, 0, 0, -1e300]}}'
+    )
+    with pytest.raises(
+        FileFormatError, match=r"calib\.json: distortion_coefficients\[4\]: expected a number in"
+    ):
         load_opencv_calibration(opencv, CameraMount(1.0))
 
 

@@ -141,6 +141,9 @@ DELAY = Range(0.0, 3600.0, "s")
 ROW_GAP = Range(0.0, 86_400.0, "s", low_open=True)
 #: Pixels along one side of an image.
 IMAGE_SIDE = Range(1, 20_000, "px")
+#: One coefficient of a lens's OpenCV distortion (k1, k2, p1, p2 or k3), dimensionless: real
+#: lenses fit within a few units, strong wide-angle fits reach tens; beyond 1000 is no lens.
+DISTORTION = Range(-1000.0, 1000.0)
 #: A focal length, pixels (1e6 px is a field of view of 1 mrad on a 1000 px image).
 FOCAL_LENGTH = Range(0.0, 1e6, "px", low_open=True)
 #: A principal point or pixel coordinate, pixels.

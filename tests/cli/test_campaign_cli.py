@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 from aura_ums import Metrics
 from aura_ums.cli import app
 from aura_ums.logs import synthetic_log, write_log
+from aura_ums.uncertainty import TerrainTable
 
 runner = CliRunner()
 SCENARIO = str(Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml")
@@ -105,6 +106,20 @@ def test_replay_of_several_logs_lists_each_as_its_own_replay(log_folders: list[P
         )
         assert result.exit_code == 0, result.output
         assert untimed(entry) == untimed(strict_json(alone.read_text()))
+
+
+def test_replay_of_several_logs_names_the_terrain_file_and_the_log_without_its_terrain(
+    log_folders: list[Path], tmp_path: Path
+) -> None:
+    terrain = tmp_path / "other.toml"
+    terrain.write_text(TerrainTable.default().to_toml())  # no 'floor', the logs' terrain
+    result = runner.invoke(app, ["replay", *map(str, log_folders), "--terrain", str(terrain), "-q"])
+    assert result.exit_code == 2
+    # was "table: expected a terrain 'floor' (the log's), got none of that name"
+    assert result.stderr == (
+        f"error: {terrain}: expected the terrain 'floor' of the log in {log_folders[0]} (its meta.toml), "
+        "got 'tile', 'concrete', 'grass', 'gravel'\n"
+    )
 
 
 def test_replay_of_several_logs_refuses_the_outputs_of_one(log_folders: list[Path], tmp_path: Path) -> None:

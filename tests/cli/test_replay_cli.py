@@ -17,7 +17,7 @@ from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
 from aura_ums.logs import ReverseMotion, load_noise, synthetic_log, write_log
 from aura_ums.uncertainty import TerrainTable
-from tests.logs.log_helpers import VALID_FILES, write_files
+from tests.logs.log_helpers import VALID_FILES, long_odometry_log, write_files
 
 runner = CliRunner()
 
@@ -466,3 +466,41 @@ def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
     assert result.exit_code == 2
     assert "Traceback" not in result.output  # a ValueError of Path.with_suffix before
     assert result.stderr == "error: --out: expected a file path, got '.'\n"
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["replay", "", "--terrain", "t.toml"], "LOG_DIR"),
+        (["compare", "", "--terrain", "t.toml"], "LOG_DIR"),
+        (["calibrate", "", "--out", "t.toml"], "LOG_DIRS"),
+    ],
+    ids=["replay", "compare", "calibrate"],
+)
+def test_an_empty_log_argument_is_named(argv: list[str], name: str) -> None:
+    # '' was Path("."), the current folder: "meta.toml: expected an existing log metadata ..."
+    result = runner.invoke(app, argv)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {name}: expected a log folder, got an empty path ''\n"
+
+
+@pytest.mark.parametrize("whole", [False, True], ids=["streamed", "whole (--plot)"])
+def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(tmp_path: Path, whole: bool) -> None:
+    folder = write_log(long_odometry_log(200, rate=50.0, frame_every=5), tmp_path / "log")
+    lines = (folder / "odometry.csv").read_text().splitlines()
+    row = next(number for number, text in enumerate(lines) if text[:1].isdigit()) + 2  # a later data row
+    cells = lines[row].split(",")
+    lines[row] = ",".join([cells[0], "-1", *cells[2:]])
+    (folder / "odometry.csv").write_text("\n".join(lines) + "\n")
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(
+        TerrainTable({"tile": TerrainTable.default()["tile"]}).to_toml().replace("tile", "floor")
+    )
+    plot = ["--plot", str(tmp_path / "plot")] if whole else []
+    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "-q", *plot])
+    assert result.exit_code == 2
+    # was "v: expected forward velocities >= 0 (...), got -1.0 at row 2": an argument's name
+    assert result.stderr.startswith(
+        f"error: {folder / 'odometry.csv'}:{row + 1}: expected forward velocities >= 0 in column 'v' "
+    )
+    assert result.stderr.endswith("--reverse flip to aura-ums, or reverse=ReverseMotion.FLIP), got -1.0\n")

@@ -82,7 +82,10 @@ def random_logs(draw: st.DrawFn) -> RobotLog:
         LogLandmark(ident, draw(within(COORDINATE)), draw(within(COORDINATE)), draw(positive))
         for ident in ids
     )
-    times = sorted(draw(st.lists(within(TIME), min_size=0, max_size=6)))
+    # Observations at most a day apart too (half a day: rounding the sums keeps them within).
+    steps = draw(st.lists(st.floats(0.0, ROW_GAP.high / 2.0), min_size=0, max_size=5))
+    first = draw(st.floats(TIME.low, TIME.high - 3.0 * ROW_GAP.high))
+    times = list(itertools.accumulate(steps, initial=first))[: draw(st.integers(0, 6))]
     observations = tuple(
         LogObservation(
             time,

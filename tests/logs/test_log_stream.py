@@ -123,8 +123,13 @@ def test_reversing_odometry_a_truth_gap_and_the_frame_hook_stream_as_the_whole_l
     _same(stream, whole)
     assert seen["stream"] == seen["whole"]
     assert np.any(whole.trace.inside < 0)  # the gap is judged as no truth
-    with pytest.raises(InputError, match=r"^v: expected forward velocities >= 0 .* at row \d+$"):
+    # Refused, streamed or whole, naming the file and the first reversing row's line.
+    first = int(np.argmax(v < 0.0)) + 3  # a comment line and the header before the rows
+    refused = rf"odometry\.csv:{first}: expected forward velocities >= 0 in column 'v' .*, got -"
+    with pytest.raises(FileFormatError, match=refused):
         replay_log(open_log(folder, block_bytes=200), FLOOR, OPTIONS)
+    with pytest.raises(FileFormatError, match=refused):
+        replay_log(load_log(folder), FLOOR, OPTIONS)
 
 
 def test_a_commands_log_streams_as_the_whole_log(tmp_path: Path) -> None:

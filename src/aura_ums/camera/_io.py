@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, describe, load_toml, parse_json, read_text
-from aura_ums._validate import ANGLE, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, Range
+from aura_ums._validate import ANGLE, DISTORTION, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, Range
 from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
 from aura_ums.camera._observe import CalibrationBounds
 from aura_ums.errors import FileFormatError, InputError
@@ -63,6 +63,7 @@ KEY_RANGES: dict[str, dict[str, Range]] = {
         "cy": PIXEL,
         "width": IMAGE_SIDE,
         "height": IMAGE_SIDE,
+        "distortion": DISTORTION,  # each coefficient (OpenCV files too)
     },
     "mount": {
         "height": MOUNT_OFFSET,
@@ -119,6 +120,10 @@ def _distortion(values: Array, source: str, where: str) -> tuple[float, float, f
             "expected the coefficients beyond k3 (k4-k6, s1-s4, tau) to be zero (aura-ums models k1, k2, "
             f"p1, p2, k3 only), got {values[5:].tolist()}",
         )
+    bounds = KEY_RANGES["intrinsics"]["distortion"]
+    for index, value in enumerate(values[:5].tolist()):
+        if not bounds.contains(value):
+            raise FileFormatError(source, f"{where}[{index}]", f"expected {bounds.text()}, got {value!r}")
     k = [float(v) for v in values[:5]] + [0.0] * (5 - min(values.size, 5))
     return (k[0], k[1], k[2], k[3], k[4])
 

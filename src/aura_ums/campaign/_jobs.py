@@ -234,6 +234,18 @@ class LogReplay:
         How the folder is read.
     until : float or None
         Stop after the last frame at or before this log time, s.
+    table_file : str
+        Where ``table`` was read (the terrain TOML), named when it lacks a log's terrain.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import ReplayOptions, synthetic_log, write_log
+    >>> import numpy as np, tempfile
+    >>> folder = write_log(synthetic_log(np.random.default_rng(0), duration=5.0), tempfile.mkdtemp() + "/log")
+    >>> LogReplay(TerrainTable({}), ReplayOptions(), table_file="none.toml")(folder)  # the edge: no terrain
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: none.toml: expected the terrain 'floor' of the log in ...), got none
     """
 
     table: TerrainTable
@@ -242,6 +254,7 @@ class LogReplay:
     window_margin: float = 0.0
     load: LoadLog = LoadLog()
     until: float | None = None
+    table_file: str = "table"
 
     def __call__(self, folder: str | os.PathLike[str]) -> Metrics:
         """Replay the log in ``folder`` and return its metrics (with the windows', given a camera).
@@ -249,6 +262,14 @@ class LogReplay:
         The metrics are :meth:`ReplayResult.metrics <aura_ums.logs.ReplayResult.metrics>`.
         """
         log = self.load(folder)
+        # Checked here, where the log's terrain is first known: the replay's own check
+        # names neither the table's file nor the log among the campaign's many.
+        if log.meta.terrain not in self.table:
+            held = ", ".join(repr(name) for name in self.table) or "none"
+            raise InputError(
+                f"{self.table_file}: expected the terrain {log.meta.terrain!r} of the log in {folder} "
+                f"(its meta.toml), got {held}"
+            )
         if self.camera is None:
             return replay_log(log, self.table, self.options, keep_maps=False, until=self.until).metrics()
         result, windows = replay_windows(

@@ -78,6 +78,7 @@ def replay_logs(
     table: TerrainTable,
     options: ReplayOptions,
     *,
+    table_file: Path,
     camera: Camera | None,
     window_margin: float,
     max_truth_gap: float | None,
@@ -86,12 +87,15 @@ def replay_logs(
     settings: CampaignSettings,
     quiet: bool,
 ) -> None:
-    """Replay several logs as one campaign; print their metrics and write them (``replays``) as JSON."""
+    """Replay several logs as one campaign; print their metrics and write them (``replays``) as JSON.
+
+    ``table`` was read from ``table_file`` (``--terrain``), named when it lacks a log's terrain.
+    """
     from aura_ums import Metrics
     from aura_ums.campaign import LoadLog, LogReplay, run_campaign
     from aura_ums.errors import AuraUmsError
 
-    job = LogReplay(table, options, camera, window_margin, LoadLog(max_truth_gap), until)
+    job = LogReplay(table, options, camera, window_margin, LoadLog(max_truth_gap), until, str(table_file))
     try:
         with progress_bar("replay: logs", quiet=quiet, total=len(log_dirs)) as advance:
             campaign = run_campaign(job, log_dirs, settings, progress=advance)

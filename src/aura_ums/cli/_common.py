@@ -15,6 +15,7 @@ from collections import Counter
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
@@ -45,6 +46,21 @@ def fail(message: str) -> typer.Exit:
     """Print ``error: <message>`` (markup-safe) on stderr; return the exit (code 2) to raise."""
     err_console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
     return typer.Exit(code=2)
+
+
+def folder_argument(name: str) -> Callable[[str], Path]:
+    """Return the parser of a folder argument that refuses an empty path (exit 2, naming it).
+
+    The empty string would otherwise become ``Path("")``, the current folder, and the
+    error would name a file inside it (``meta.toml: expected ...``) instead of the argument.
+    """
+
+    def parse(text: str) -> Path:
+        if not text:
+            raise fail(f"{name}: expected a log folder, got an empty path ''")
+        return Path(text)
+
+    return parse
 
 
 def check_seed(seed: int) -> None:

@@ -29,6 +29,7 @@ from aura_ums.cli._common import (
     console,
     err_console,
     fail,
+    folder_argument,
     manager_options,
     progress_bar,
 )
@@ -179,7 +180,12 @@ def _options(
 
 
 def calibrate(
-    log_dirs: Annotated[list[Path], typer.Argument(help="Log folders with groundtruth.csv, one terrain.")],
+    log_dirs: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Log folders with groundtruth.csv, one terrain.", parser=folder_argument("LOG_DIRS")
+        ),
+    ],
     out: Annotated[Path, typer.Option("--out", help="Terrain table TOML to write.")],
     sensors_out: Annotated[
         Path | None,
@@ -281,7 +287,8 @@ def replay(
     log_dirs: Annotated[
         list[Path],
         typer.Argument(
-            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers)."
+            help="Log folder (docs/log-format.md); several are replayed as one campaign (--workers).",
+            parser=folder_argument("LOG_DIR"),
         ),
     ],
     terrain: _Terrain,
@@ -380,7 +387,7 @@ def replay(
             lens = None if camera is None else load_camera(camera)
         except AuraUmsError as exc:
             raise fail(str(exc)) from None
-        replay_logs(log_dirs, many, options, camera=lens, window_margin=window_margin,
+        replay_logs(log_dirs, many, options, table_file=terrain, camera=lens, window_margin=window_margin,
                     max_truth_gap=max_truth_gap, until=until, json_target=json_target,
                     settings=campaign_options, quiet=quiet)  # fmt: skip
         return
@@ -484,7 +491,10 @@ def _draw(result: ReplayResult, target: Target) -> None:
 
 @manager_options()
 def compare(
-    log_dir: Annotated[Path, typer.Argument(help="Log folder with groundtruth.csv.")],
+    log_dir: Annotated[
+        Path,
+        typer.Argument(help="Log folder with groundtruth.csv.", parser=folder_argument("LOG_DIR")),
+    ],
     terrain: _Terrain,
     sensors: _Sensors = None,
     calibration_logs: Annotated[

@@ -57,7 +57,7 @@ from aura_ums._validate import (
 )
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
-from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL
+from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL, ReversingError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
@@ -370,30 +370,66 @@ class _CsvFile:
         return time
 
     def no_clock_jump(self, time: NDArray[np.float64], *, held: bool = True) -> None:
-        """Refuse a gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
-
-        An odometry row's velocities hold until the next row (``held``), and a replay cuts
-        the motion at least every :data:`~aura_ums.logs._odometry.DEFAULT_MAX_INTERVAL`
-        seconds: a gap of days is a clock jump, and would become millions of steps. A
-        recorded command is one motion whatever its time, but a day between two of them
-        is the same clock jump, which would put every later observation out of step.
-        """
-        gaps = np.diff(time)
-        jumps = gaps > ROW_GAP.high
-        if np.any(jumps):
-            row = int(np.argmax(jumps)) + 1
-            gap = float(gaps[row - 1])
-            steps = math.ceil(gap / DEFAULT_MAX_INTERVAL)
-            replayed = f"; replayed, about {steps} steps of {DEFAULT_MAX_INTERVAL:g} s" if held else ""
-            self.fail_at(
-                row,
-                f"expected at most {ROW_GAP.high:g} s after the previous row (line {self.lines[row - 1]}), "
-                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days{replayed})",
-            )
+        """Refuse a clock jump between two rows (:func:`clock_jump`), naming the later row's line."""
+        jump = clock_jump(time, np.asarray(self.lines, dtype=np.int64), held=held)
+        if jump is not None:
+            self.fail_at(jump[0], jump[1])
 
     def need_rows(self) -> None:
         if not len(self.lines):
             self.fail("", "expected at least one data row, got none")
+
+
+def clock_jump(time: NDArray[np.float64], lines: NDArray[np.int64], *, held: bool) -> tuple[int, str] | None:
+    """Find the first gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
+
+    The one rule for every file of rows in time (``odometry.csv``, ``commands.csv``,
+    ``observations.csv``, ``groundtruth.csv`` and MRCLAM's ``.dat`` files). An odometry
+    row's velocities hold until the next row (``held``), and a replay cuts the motion at
+    least every :data:`~aura_ums.logs._odometry.DEFAULT_MAX_INTERVAL` seconds: a gap of
+    days is a clock jump, and would become millions of steps. A recorded command, an
+    observation or a ground-truth pose is one instant, but a day between two of them is
+    the same clock jump, which would put every later row out of step with the others.
+    Real logs stay far below the limit (MRCLAM's longest gaps: about 3 minutes without
+    a measurement, 1.4 s of odometry, 0.33 s of ground truth).
+
+    Parameters
+    ----------
+    time : ndarray of float
+        The rows' times, seconds, in file order (a gap backwards is not a jump).
+    lines : ndarray of int
+        Each row's line in its file, for the message.
+    held : bool
+        Whether a row holds until the next (the message then estimates the replay's steps).
+
+    Returns
+    -------
+    tuple of (int, str) or None
+        The index of the row after the jump and the message, or None without a jump.
+
+    Examples
+    --------
+    >>> lines = np.array([2, 3, 4])
+    >>> clock_jump(np.array([0.0, 1.0, 90_000.0]), lines, held=False)
+    (2, 'expected at most 86400 s after the previous row (line 3), got a clock jump of 89999 s (1.0 days)')
+    >>> clock_jump(np.array([0.0, 86_400.0, 1.0]), lines, held=True) is None  # a day exactly; a step back
+    True
+    """
+    gaps = np.diff(time)
+    jumps = gaps > ROW_GAP.high
+    if not np.any(jumps):
+        return None
+    row = int(np.argmax(jumps)) + 1
+    gap = float(gaps[row - 1])
+    replayed = (
+        f"; replayed, about {math.ceil(gap / DEFAULT_MAX_INTERVAL)} steps of {DEFAULT_MAX_INTERVAL:g} s"
+        if held
+        else ""
+    )
+    return row, (
+        f"expected at most {ROW_GAP.high:g} s after the previous row (line {int(lines[row - 1])}), "
+        f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days{replayed})"
+    )
 
 
 def _text_table(path: Path, columns: Mapping[str, str], required: Sequence[str]) -> CsvTable:
@@ -574,6 +610,7 @@ ObservationColumns = tuple[
 def _observation_columns(table: _CsvFile, units: Units, known: set[str]) -> ObservationColumns:
     """Check and convert the rows of one table (a whole file or a block) of ``observations.csv``."""
     times = table.times(units, strict=False)
+    table.no_clock_jump(times, held=False)
     ids = table.texts("landmark_id")
     for row, ident in enumerate(ids):
         if ident not in known:
@@ -616,8 +653,9 @@ def observation_blocks(
     """Yield the checked columns of ``observations.csv`` block by block (:meth:`_CsvFile.blocks`).
 
     Each block is checked as :func:`load_log` checks the whole file, and its times
-    against the previous block's; when a check fails, the whole file is read again, so
-    the message is exactly :func:`load_log`'s (naming the fault it finds first).
+    against the previous block's (in order, without a clock jump); when a check fails,
+    the whole file is read again, so the message is exactly :func:`load_log`'s (naming
+    the fault it finds first).
     """
 
     def whole() -> None:
@@ -629,7 +667,7 @@ def observation_blocks(
             columns = _observation_columns(table, units, known)
         times = columns[0]
         if times.size:
-            if times[0] < previous:
+            if times[0] < previous or (math.isfinite(previous) and times[0] - previous > ROW_GAP.high):
                 _whole_fails(whole)
             previous = float(times[-1])
             yield columns
@@ -662,6 +700,22 @@ def _odometry_columns(table: _CsvFile, units: Units) -> OdometryColumns:
     time = table.times(units, strict=True)
     table.no_clock_jump(time)
     return time, table.numbers("v", units), table.numbers("omega", units)
+
+
+def reversed_at(path: Path, refused: ReversingError) -> FileFormatError:
+    """Return the refusal of a negative forward velocity naming its file and line.
+
+    The replay knows the row's index in the record, not its line: the file's data lines
+    are read again (on this error path only) to find it.
+    """
+    line = int(np.asarray(_CsvFile(path, _ODOMETRY_COLUMNS, ("time", "v", "omega")).lines)[refused.row])
+    return FileFormatError(
+        str(path),
+        "",
+        f"expected forward velocities >= 0 in column 'v' (the turn-and-run model has no reverse; "
+        f"pass --reverse flip to aura-ums, or reverse=ReverseMotion.FLIP), got {refused.value!r}",
+        line=line,
+    )
 
 
 def odometry_blocks(
@@ -715,6 +769,7 @@ TruthColumns = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float6
 
 def _groundtruth_columns(table: _CsvFile, units: Units) -> TruthColumns:
     time = table.times(units, strict=True)
+    table.no_clock_jump(time, held=False)
     return time, table.numbers("x", units), table.numbers("y", units), table.numbers("heading", units)
 
 
@@ -723,9 +778,9 @@ def groundtruth_blocks(
 ) -> Iterator[TruthColumns]:
     """Yield the checked time (s), x, y (m) and heading (rad) of ``groundtruth.csv`` block by block.
 
-    Checked as :func:`load_log` checks the whole file (times strictly increasing across
-    blocks too); a failing check fails with the whole file's message. At least one block
-    is yielded.
+    Checked as :func:`load_log` checks the whole file (times strictly increasing and
+    without clock jumps across blocks too); a failing check fails with the whole file's
+    message. At least one block is yielded.
     """
 
     def whole() -> None:
@@ -737,7 +792,7 @@ def groundtruth_blocks(
             columns = _groundtruth_columns(table, units)
         time = columns[0]
         if time.size:
-            if not math.isnan(previous) and not time[0] > previous:
+            if not math.isnan(previous) and (not time[0] > previous or time[0] - previous > ROW_GAP.high):
                 _whole_fails(whole)
             previous = float(time[-1])
             yield columns

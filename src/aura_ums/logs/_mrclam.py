@@ -26,15 +26,13 @@ from aura_ums._validate import (
     ANGULAR_SPEED,
     COORDINATE,
     LENGTH,
-    ROW_GAP,
     SPEED,
     TIME,
     Range,
 )
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs._io import renumbered, write_log
+from aura_ums.logs._io import clock_jump, renumbered, write_log
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
-from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL
 
 #: Subjects 1-5 are the robots; 6-20 the landmarks.
 ROBOT_SUBJECTS = range(1, 6)
@@ -134,24 +132,15 @@ class _DatFile:
         keep = np.concatenate((steps > 0.0, [True]))
         return self.data[keep], int(np.count_nonzero(~keep))
 
-    def no_clock_jump(self) -> None:
-        """Refuse a gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
+    def no_clock_jump(self, *, held: bool, order: NDArray[np.intp] | None = None) -> None:
+        """Refuse a clock jump between two rows (:func:`~aura_ums.logs._io.clock_jump`).
 
-        Velocities hold until the next row: a gap of days is a clock jump, and a replay
-        would cut it into millions of steps.
+        ``order`` sorts the rows by time first (measurements are sorted on reading).
         """
-        gaps = np.diff(self.data[:, 0])
-        jumps = gaps > ROW_GAP.high
-        if np.any(jumps):
-            row = int(np.argmax(jumps)) + 1
-            gap = float(gaps[row - 1])
-            self.fail_at(
-                int(self.lines[row]),
-                f"expected at most {ROW_GAP.high:g} s after the previous row "
-                f"(line {int(self.lines[row - 1])}), "
-                f"got a clock jump of {gap:g} s ({gap / 86_400.0:.1f} days; replayed, about "
-                f"{math.ceil(gap / DEFAULT_MAX_INTERVAL)} steps of {DEFAULT_MAX_INTERVAL:g} s)",
-            )
+        rows = slice(None) if order is None else order
+        jump = clock_jump(self.data[rows, 0], self.lines[rows], held=held)
+        if jump is not None:
+            self.fail_at(int(self.lines[rows][jump[0]]), jump[1])
 
 
 def _shown(text: str) -> str:
@@ -178,9 +167,11 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     to "20"); their ``position_uncertainty`` is 3 times the larger of the x and y
     standard deviations. Exact repeats of an odometry (or ground-truth) time keep the last
     row, and are counted in ``meta.source`` too. Measurements outside the ground truth's
-    time span are kept. The meta has terrain ``"floor"`` and :class:`LogMeta`'s default
-    bounds (placeholders for calibration). Each observation's ``line`` is its line in
-    ``RobotN_Measurement.dat``.
+    time span are kept; a ``RobotN_Measurement.dat`` without data rows (empty, or ``#``
+    lines alone) gives a log without observations, as an ``observations.csv`` with its
+    header alone does, and says so in ``meta.source``. The meta has terrain ``"floor"``
+    and :class:`LogMeta`'s default bounds (placeholders for calibration). Each
+    observation's ``line`` is its line in ``RobotN_Measurement.dat``.
 
     Parameters
     ----------
@@ -251,6 +242,8 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     known = {landmark.id for landmark in landmarks}
 
     measurements = _DatFile(folder / f"{prefix}Measurement.dat", ("time", "barcode", "range", "bearing"))
+    # Real gaps (the robot sees no barcode for minutes) stay far below the limit.
+    measurements.no_clock_jump(held=False, order=np.argsort(measurements.data[:, 0], kind="stable"))
     observations: list[LogObservation] = []
     robots = unknown = 0
     for number, (time, barcode, distance, bearing) in zip(
@@ -268,13 +261,17 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     observations.sort(key=lambda item: item.time)  # stable: frames keep their order
 
     odometry_file = _DatFile(folder / f"{prefix}Odometry.dat", ("time", "v", "omega"))
-    odometry_file.no_clock_jump()
+    odometry_file.no_clock_jump(held=True)
     odometry_rows, odometry_repeats = odometry_file.increasing()
-    truth_rows, truth_repeats = _DatFile(
-        folder / f"{prefix}Groundtruth.dat", ("time", "x", "y", "heading")
-    ).increasing()
+    truth_file = _DatFile(folder / f"{prefix}Groundtruth.dat", ("time", "x", "y", "heading"))
+    truth_file.no_clock_jump(held=False)
+    truth_rows, truth_repeats = truth_file.increasing()
 
     notes = [f"dropped {robots} robot and {unknown} unknown-barcode measurements"]
+    if not len(measurements.data):
+        # As an observations.csv with its header alone: a log without observations is one
+        # to replay on odometry alone, so it is kept, but said (a truncated download?).
+        notes.append(f"no measurement rows in {prefix}Measurement.dat: a log without observations")
     if odometry_repeats:
         notes.append(f"dropped {_plural(odometry_repeats, 'repeated odometry time')} (kept the last row)")
     if truth_repeats:

@@ -23,6 +23,22 @@ REPORT_BYTES = 250
 MAX_REPORTS = 500_000_000 // REPORT_BYTES
 
 
+class ReversingError(InputError):
+    """A negative forward velocity refused (``ReverseMotion.ERROR``), with its row's index.
+
+    ``row`` counts the record's rows from 0, so that a reader of the record's file can
+    name the row's line (:func:`~aura_ums.logs._io.reversed_at`).
+    """
+
+    def __init__(self, row: int, value: float) -> None:
+        super().__init__(
+            f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
+            f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), got {value!r} at row {row}"
+        )
+        self.row = row
+        self.value = value
+
+
 class ReverseMotion(enum.Enum):
     """What :func:`odometry_to_commands` does with negative forward velocities.
 
@@ -198,11 +214,7 @@ def odometry_report_arrays(
     reversing = forward < 0.0
     if reverse is ReverseMotion.ERROR and np.any(reversing):
         row = int(np.argmax(reversing))
-        raise InputError(
-            f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
-            f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), "
-            f"got {float(forward[row])!r} at row {row}"
-        )
+        raise ReversingError(row, float(forward[row]))
 
     t = t + delay
     low = None if start is None else finite_float(start, "start")

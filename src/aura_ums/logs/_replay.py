@@ -23,9 +23,9 @@ from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, polygon_area, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
-from aura_ums.logs._io import _given
+from aura_ums.logs._io import ODOMETRY, _given, reversed_at
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
-from aura_ums.logs._odometry import ReverseMotion
+from aura_ums.logs._odometry import ReverseMotion, ReversingError
 from aura_ums.logs._state import ReplayState
 from aura_ums.logs._stream import LogStream, OdometryReports, TruthWindow
 from aura_ums.manager import (
@@ -998,9 +998,14 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
-    report_arrays = log.position_report_arrays(
-        frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
-    )
+    try:
+        report_arrays = log.position_report_arrays(
+            frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
+        )
+    except ReversingError as refused:
+        if log.path is None or log.odometry is None:
+            raise
+        raise reversed_at(log.path / ODOMETRY, refused) from None
     first, posted = 0, 0
     if resume is not None:
         first, posted = _resumed_at(resume, log, frames, frame_times, int(report_arrays[0].size))
@@ -1041,7 +1046,9 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
     odometry = None
     meta = stream.meta
     if stream.commands is None:
-        odometry = OdometryReports(stream.odometry_blocks(), meta, 0.0, opts.max_interval, opts.reverse)
+        odometry = OdometryReports(
+            stream.odometry_blocks(), meta, 0.0, opts.max_interval, opts.reverse, stream.path / ODOMETRY
+        )
         first_motion = odometry.first_time
     else:
         commands = stream.commands

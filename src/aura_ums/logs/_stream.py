@@ -47,9 +47,10 @@ from aura_ums.logs._io import (
     load_log,
     observation_blocks,
     odometry_blocks,
+    reversed_at,
 )
 from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
-from aura_ums.logs._odometry import ReverseMotion, report_times, turned_round
+from aura_ums.logs._odometry import ReverseMotion, ReversingError, report_times, turned_round
 from aura_ums.manager import PositionReport
 
 Array = NDArray[np.float64]
@@ -357,8 +358,10 @@ class OdometryReports:
         start: float,
         max_interval: float,
         reverse: ReverseMotion,
+        source: Path | None = None,
     ) -> None:
         self.blocks = blocks
+        self.source = source  # the odometry file, named with a refused row's line
         self.meta = meta
         self.low = start
         self.max_interval = max_interval
@@ -386,11 +389,10 @@ class OdometryReports:
         reversing = v < 0.0
         if self.reverse is ReverseMotion.ERROR and np.any(reversing):
             row = int(np.argmax(reversing))
-            raise InputError(
-                f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
-                f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), "
-                f"got {float(v[row])!r} at row {self.read + row}"
-            )
+            refused = ReversingError(self.read + row, float(v[row]))
+            if self.source is None:
+                raise refused
+            raise reversed_at(self.source, refused)
         self.read += len(time)
         self.time = np.concatenate((self.time, time + self.meta.delay_s))
         self.v = np.concatenate((self.v, v))

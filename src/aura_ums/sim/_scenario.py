@@ -73,8 +73,10 @@ from aura_ums._validate import (
 )
 from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
+from aura_ums.expecter import Expecter
 from aura_ums.geometry import wrap_angle
 from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.schemas import FindLandmarkSchema
 from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
 from aura_ums.sim._scene import Scene
@@ -142,10 +144,13 @@ KEY_RANGES: dict[str, Range] = {
 }
 # The synthetic camera's costs, measured on one core with scenarios/paper_sidewalk.toml
 # (a 512 x 480 frame in 10 ms; 0.15 s with 4000 clutter strips; 45 MB of buffers): a frame
-# renders each pixel in about 40 ns and each clutter strip or line in about 35 us; the
-# camera keeps about 180 bytes a pixel, the scene about 400 a strip.
+# renders each pixel in about 40 ns and each clutter strip in about 35 us; the
+# camera keeps about 180 bytes a pixel, the scene about 400 a strip. A clutter line is
+# drawn as its own polygon in every frame: about 190 us (2000 and 8000 lines, 0.40 and 1.49
+# s a frame; it was counted as a strip, and 1e6 lines, 13 minutes a run, were let through).
 _SECONDS_PER_PIXEL = 4e-8
 _SECONDS_PER_STRIP = 3.5e-5
+_SECONDS_PER_LINE = 1.9e-4
 _BYTES_PER_PIXEL = 200
 _BYTES_PER_STRIP = 400
 #: Longest estimated time of one simulated run, seconds.
@@ -442,8 +447,8 @@ class Scenario:
     def estimate(self) -> tuple[float, float]:
         """Return the estimated time (seconds) and memory (bytes) of one run of :meth:`simulate`.
 
-        From the synthetic camera's measured costs: pixels and clutter strips of every
-        frame, the camera's buffers and the scene's strips.
+        From the synthetic camera's measured costs: pixels, clutter strips and clutter
+        lines of every frame, the camera's buffers and the scene's strips.
 
         Examples
         --------
@@ -455,9 +460,12 @@ class Scenario:
         """
         k = self.camera.intrinsics
         pixels = float(k.width) * float(k.height)
-        strips = float(self.render.clutter) + float(self.render.clutter_lines)
         frames = float(self.frame_count())
-        seconds = frames * (pixels * _SECONDS_PER_PIXEL + strips * _SECONDS_PER_STRIP)
+        seconds = frames * (
+            pixels * _SECONDS_PER_PIXEL
+            + float(self.render.clutter) * _SECONDS_PER_STRIP
+            + float(self.render.clutter_lines) * _SECONDS_PER_LINE
+        )
         memory = pixels * _BYTES_PER_PIXEL + float(self.render.clutter) * _BYTES_PER_STRIP
         return seconds, memory
 
@@ -482,6 +490,8 @@ class Scenario:
             name = "Scenario.frame_spacing"
         elif frames * self.render.clutter * _SECONDS_PER_STRIP > seconds / 2:
             name = "Scenario.render.clutter"
+        elif frames * self.render.clutter_lines * _SECONDS_PER_LINE > seconds / 2:
+            name = "Scenario.render.clutter_lines"
         else:
             name = "Scenario.camera"
         raise InputError(f"{name}: expected {limits}, got {work}")
@@ -557,6 +567,7 @@ class Scenario:
             camera = load_camera(camera_path)
         except FileFormatError as exc:
             raise reader.fail("camera", f"expected a camera file that loads, got: {exc}") from None
+        _check_strategies(meadow_map, camera, reader, str(document["map"]))
         landmark_ids = _landmark_ids(document, reader, meadow_map)
         start = _start(reader.table(document, "start", required=True), reader, meadow_map)
         commands = _route(reader.table(document, "route", required=True), reader, meadow_map, start.pose)
@@ -586,6 +597,7 @@ class Scenario:
             field_name, _, message = str(exc).partition(": ")
             where = {
                 "Scenario.render.clutter": "[render] clutter",
+                "Scenario.render.clutter_lines": "[render] clutter_lines",
                 "Scenario.frame_spacing": "frame_spacing" if "frame_spacing" in document else "frame_rate",
             }.get(field_name, field_name.removeprefix("Scenario."))
             raise reader.fail(where, message) from None
@@ -746,6 +758,21 @@ def _load_map(
         return MeadowMap.from_geojson(path, terrain_table=terrain)
     except FileFormatError as exc:
         raise reader.fail("map", f"expected a meadow map file that loads, got: {exc}") from None
+
+
+def _check_strategies(meadow_map: MeadowMap, camera: Camera, reader: _Reader, source: str) -> None:
+    """Refuse, naming the map, a landmark whose strategy or parameters perception cannot run.
+
+    The map's reader (world) sits below perception and cannot build a detector; each
+    landmark's find-landmark schema is built once here, where the scenario is read,
+    rather than when a run starts (where the message named the landmark, not the file).
+    """
+    expecter = Expecter(camera)
+    for record in meadow_map.landmarks:
+        try:
+            FindLandmarkSchema(record, expecter)
+        except InputError as exc:
+            raise reader.fail("map", f"expected a meadow map file that loads, got: {source}: {exc}") from None
 
 
 def _with_confirm_frames(meadow_map: MeadowMap, document: Mapping[str, object], reader: _Reader) -> MeadowMap:

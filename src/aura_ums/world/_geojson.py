@@ -8,6 +8,7 @@ writes them with ``repr`` precision), so a saved map reads back equal.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import NoReturn
@@ -15,7 +16,7 @@ from typing import NoReturn
 import numpy as np
 
 from aura_ums._files import Fields, describe, load_json
-from aura_ums._validate import COORDINATE, HEIGHT, POSITION_UNCERTAINTY
+from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, POSITION_UNCERTAINTY, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import (
@@ -26,6 +27,13 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
 )
 from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy, _MapError
+
+#: The range of a perceptual strategy's parameter (docs/formats.md): counts, pixel sizes and
+#: thresholds, within 1e9 (the area of a 20000 x 20000 px image is 4e8 px^2) ...
+PARAMETER_RANGE = Range(-1e9, 1e9)
+#: ... but the angles, in radians: a line's image orientation, and a tolerance at most pi
+#: (orientations repeat every pi, so pi/2 already admits every line).
+PARAMETER_RANGES: dict[str, Range] = {"orientation": ANGLE, "tolerance": Range(0.0, math.pi, "rad")}
 
 _MEADOW_KEYS = ("kind", "id", "terrain", "landmarks")
 _COMMON_LANDMARK_KEYS = (
@@ -261,7 +269,11 @@ class _Reader:
                 f"{where} properties.parameters", f"expected an object of numbers, got {_kind(parameters)}"
             )
         checked = {
-            str(key): self.number(f"{where} properties.parameters.{key}", value)
+            str(key): self.fields.ranged(
+                value,
+                f"{where} properties.parameters.{key}",
+                PARAMETER_RANGES.get(str(key), PARAMETER_RANGE),
+            )
             for key, value in parameters.items()
         }
         frames = props.get("confirm_frames", 3)
