@@ -82,9 +82,18 @@ def test_an_off_flag_sets_none_and_bad_values_name_their_option() -> None:
     both = runner.invoke(tool, ["x", "--one-by-one", "--joint-above", "1.0"])
     assert both.exit_code == 2
     assert "--joint-above: expected it or --one-by-one, got both" in both.output
+    # the option given is named, not the default it conflicts with
     bad = runner.invoke(tool, ["x", "--relocalize-after", "3"])
     assert bad.exit_code == 2
-    assert "--relocalize-window: expected an integer >= relocalize_after (3), got 1" in bad.output
+    assert "--relocalize-after: expected an integer <= relocalize_window (1), got 3" in bad.output
+    bad = runner.invoke(tool, ["x", "--relaxed-q", "100000"])
+    assert bad.exit_code == 2
+    assert "--relaxed-q: expected an integer < relaxed_window (10), got 100000" in bad.output
+    both = runner.invoke(tool, ["x", "--relaxed-q", "3", "--relaxed-window", "3"])
+    assert both.exit_code == 2
+    assert "--relaxed-window: expected an integer > relaxed_q (3), got 3" in both.output
+    window = runner.invoke(tool, ["x", "--relocalize-window", "1", "--relocalize-after", "3"])
+    assert "--relocalize-window: expected an integer >= relocalize_after (3), got 1" in window.output
 
 
 def test_simulate_options_override_the_scenarios_manager_table(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -12,7 +12,7 @@ import dataclasses
 import math
 import numbers
 import textwrap
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -399,7 +399,7 @@ relocalize_after, relocalize_window, relaxed_q, relaxed_window), got 'sigma'
                     str(key), f"expected a field of ManagerSettings ({', '.join(_INFOS)}), got {key!r}"
                 )
             values[key] = value
-        changes: dict[str, Any] = _checked(values, report)
+        changes: dict[str, Any] = _checked(values, report, given=frozenset(map(str, data)))
         return dataclasses.replace(start, **changes)
 
 
@@ -407,8 +407,14 @@ _FIELDS = dataclasses.fields(ManagerSettings)
 _INFOS = {f.name: SettingInfo.of(f) for f in _FIELDS}
 
 
-def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]) -> dict[str, SettingValue]:
-    """Check every field of ``values`` and the fields' relations; return them normalized."""
+def _checked(
+    values: Mapping[str, object], fail: Callable[[str, str], Exception], given: Collection[str] = ()
+) -> dict[str, SettingValue]:
+    """Check every field of ``values`` and the fields' relations; return them normalized.
+
+    ``given`` names the fields the caller set (the others are defaults or a base's): when
+    two fields conflict, the one set is named.
+    """
     checked: dict[str, SettingValue] = {}
     for name, info in _INFOS.items():
         value = values[name]
@@ -425,11 +431,26 @@ def _checked(values: Mapping[str, object], fail: Callable[[str, str], Exception]
             raise fail("slice_width", str(exc).partition(": ")[2]) from None
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
+        if _blames_count("relocalize_after", "relocalize_window", given):
+            raise fail(
+                "relocalize_after", f"expected an integer <= relocalize_window ({window}), got {after}"
+            )
         raise fail("relocalize_window", f"expected an integer >= relocalize_after ({after}), got {window}")
     allowed, span = checked["relaxed_q"], checked["relaxed_window"]
     if isinstance(allowed, int) and isinstance(span, int) and allowed > 0 and span <= allowed:
+        if _blames_count("relaxed_q", "relaxed_window", given):
+            raise fail("relaxed_q", f"expected an integer < relaxed_window ({span}), got {allowed}")
         raise fail("relaxed_window", f"expected an integer > relaxed_q ({allowed}), got {span}")
     return checked
+
+
+def _blames_count(count: str, window: str, given: Collection[str]) -> bool:
+    """Whether a count too large for its window is the count's fault: set, while the window was not.
+
+    A command line that sets ``--relaxed-q 100000`` alone is told about ``--relaxed-q``,
+    not about the default ``--relaxed-window`` it never gave.
+    """
+    return count in given and window not in given
 
 
 def _document() -> str:
