@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import enum
+import inspect
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -257,6 +258,13 @@ def calibrate(
     except AuraUmsError as exc:
         message = str(exc)
         name, _, rest = message.partition(": ")
+        if name == "horizons" and not horizons:
+            # no --horizon given: the defaults are too short for the --move given, the option at fault
+            defaults = inspect.signature(calibrate_logs).parameters["horizons"].default
+            raise fail(
+                f"--move: expected seconds <= the shortest horizon ({min(defaults):g} s of the defaults "
+                f"{', '.join(f'{h:g}' for h in defaults)}; --horizon sets others), got {move!r}"
+            ) from None
         if name in _CALIBRATE_OPTIONS:  # an option out of range: named as the user gave it
             raise fail(f"{_CALIBRATE_OPTIONS[name]}: {rest}") from None
         # The logs read cleanly; what they hold does not calibrate: name them, not the library's arguments.

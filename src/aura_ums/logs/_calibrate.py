@@ -955,6 +955,9 @@ def calibrate_logs(
     if not 0.5 < q < 1.0:
         raise InputError(f"quantile: expected a number in (0.5, 1), got {q!r}")
     step = positive_float(move, "move")
+    if step > MAX_HORIZON:
+        longest = f"{MAX_HORIZON:g} (a day, the longest horizon)"
+        raise InputError(f"move: expected seconds <= {longest}, got {step!r}")
     spans = tuple(finite_float(h, "horizons") for h in horizons)
     if not spans or min(spans) < step:
         raise InputError(f"horizons: expected seconds, each >= move ({step!r}), got {list(spans)}")
