@@ -433,6 +433,20 @@ def test_calibrate_names_its_options_out_of_range(
     assert not out.exists()
 
 
+def test_compare_names_a_log_folder_without_ground_truth(log_folder: Path, tmp_path: Path) -> None:
+    bare = tmp_path / "bare"
+    shutil.copytree(log_folder, bare)
+    (bare / "groundtruth.csv").unlink()
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    result = runner.invoke(app, ["compare", str(bare), "--terrain", str(terrain)])
+    assert result.exit_code == 2
+    assert (
+        f"error: LOG_DIR: expected a log folder with groundtruth.csv to compare against, got {bare}"
+        in result.stderr
+    )
+
+
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [

@@ -552,6 +552,10 @@ def compare(
     check_outputs([json_target], sources, overwrite=overwrite)
     try:
         log = LoadLog(max_truth_gap)(log_dir)
+        if log.groundtruth is None:  # was named by the log's name alone, deep in the comparison
+            raise fail(
+                f"LOG_DIR: expected a log folder with groundtruth.csv to compare against, got {log_dir}"
+            )
         table = _terrain_table(terrain, log.meta.terrain)
         sensors_file = _sensors_file(sensors, terrain)
         options = _options(classes, sensors_file, settings.over(), reverse)
