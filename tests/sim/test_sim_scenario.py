@@ -260,7 +260,13 @@ MALFORMED = [
     ("area_limit = 20.0", "area_limit = 0", r"\[manager\] area_limit", "positive number or none, got 0"),
     ("missed_limit = 2", "missed_limit = 1.5", r"\[manager\] missed_limit", "integer >= 1, got 1.5"),
     ("missed_limit = 2", "sigma = 2", r"\[manager\] sigma", "unknown key 'sigma'"),
-    ("missed_limit = 2", "relocalize_after = 2", r"\[manager\] relocalize_window", r"relocalize_after \(2\)"),
+    # the key the file sets is named, not the default it conflicts with
+    (
+        "missed_limit = 2",
+        "relocalize_after = 2",
+        r"\[manager\] relocalize_after",
+        r"relocalize_window \(1\), got 2",
+    ),
     (
         "missed_limit = 2",
         "joint_above = 0.5\njoint_above_deg = 30",
