@@ -23,7 +23,7 @@ from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, r
 from aura_ums.logs._io import Units, groundtruth_blocks, observation_blocks
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
-from aura_ums.sim import Scenario
+from aura_ums.sim import Scenario, check_render_consistency
 from aura_ums.uncertainty import TerrainStats, TerrainTable, VerticalLineLandmark
 from aura_ums.world import MeadowMap, make_grid_world
 from tests.logs.test_mrclam import HEADER, TINY, tiny_dataset
@@ -414,6 +414,17 @@ def test_scenario_clutter_1e8_is_refused(tmp_path: Path) -> None:
         match=r"walk\.toml: \[render\] clutter: expected at most 600 s and 4 GB a run, got 4 frames",
     ):
         Scenario.from_toml(path)
+
+
+def test_a_pole_radius_the_maps_landmarks_do_not_allow_names_the_scenario(tmp_path: Path) -> None:
+    # named the landmark alone, not the file or the setting (checked when a run starts)
+    scenario = Scenario.from_toml(scenario_file(tmp_path, "pole_radius = 0.1 ", "pole_radius = 100 "))
+    with pytest.raises(
+        InputError,
+        match=r"walk\.toml: \[render\] pole_radius: telephone_pole_12: expected position_uncertainty "
+        r">= the rendered pole radius 100 m, got 0\.15",
+    ):
+        check_render_consistency(scenario)
 
 
 def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path) -> None:

@@ -288,7 +288,8 @@ def check_render_consistency(scenario: Scenario, world: MeadowMap | None = None)
     >>> check_render_consistency(thick)           # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: telephone_pole_12: expected position_uncertainty >= ... got 0.15
+    aura_ums.errors.InputError: scenarios/paper_sidewalk.toml: [render] pole_radius: telephone_pole_12: \
+expected position_uncertainty >= the rendered pole radius 0.5 m, got 0.15
     """
     drawn = scenario.meadow_map if world is None else world
     corners = [r.landmark for r in drawn.landmarks if isinstance(r.landmark, PointLandmark)]
@@ -301,14 +302,23 @@ def check_render_consistency(scenario: Scenario, world: MeadowMap | None = None)
             )
             if not edge and landmark.position_uncertainty < radius:
                 raise InputError(
-                    f"{record.id}: expected position_uncertainty >= the rendered pole radius "
-                    f"{radius:g} m, got {landmark.position_uncertainty:g}"
+                    f"{_render_key(scenario, 'pole_radius')}{record.id}: expected position_uncertainty "
+                    f">= the rendered pole radius {radius:g} m, got {landmark.position_uncertainty:g}"
                 )
         elif isinstance(landmark, GroundLineLandmark) and landmark.position_uncertainty < half:
             raise InputError(
-                f"{record.id}: expected position_uncertainty >= half the rendered strip width "
-                f"{half:g} m, got {landmark.position_uncertainty:g}"
+                f"{_render_key(scenario, 'stripe_width')}{record.id}: expected position_uncertainty "
+                f">= half the rendered strip width {half:g} m, got {landmark.position_uncertainty:g}"
             )
+
+
+def _render_key(scenario: Scenario, key: str) -> str:
+    """Return the scenario file and render setting at fault, as a message's prefix ("" when built in code).
+
+    The check runs when a run starts (with the world drawn), long after the file was read:
+    the message names the file and the setting, as the reader's would.
+    """
+    return f"{scenario.source}: [render] {key}: " if scenario.source else ""
 
 
 def _generator(state: dict[str, Any]) -> np.random.Generator:
