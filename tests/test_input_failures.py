@@ -473,6 +473,18 @@ def test_scenario_frame_spacing_1e_6_is_refused_with_the_estimate(tmp_path: Path
         Scenario.from_toml(path)
 
 
+def test_scenario_frames_the_loop_cannot_run_in_time_are_refused(tmp_path: Path) -> None:
+    # 40,640 frames: rendering alone was estimated at about 455 s and accepted; with the
+    # loop's 8 ms a frame (19-25 ms a frame measured in all) it is about 780 s
+    path = scenario_file(tmp_path, "[start]\n", "frame_spacing = 0.0003\n\n[start]\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk\.toml: frame_spacing: expected at most 600 s and 4 GB a run, got 40\d{3} frames "
+        r"of 512 x 480 px, 40 clutter strips and 0 lines: about 7\d\d s",
+    ):
+        Scenario.from_toml(path)
+
+
 def test_scenario_start_radius_1e15_is_refused(tmp_path: Path) -> None:
     path = scenario_file(tmp_path, "position_radius = 0.3048", "position_radius = 1e15")
     with pytest.raises(

@@ -48,7 +48,7 @@ def test_unknown_option_is_a_usage_error() -> None:
         (
             ["demo", "--runs", "1000000000"],
             "--runs: expected an integer in [1, 100000], got 1000000000 "
-            "(about 4.49e+07 s and 2e+04 GB of results)",
+            "(about 7.69e+07 s and 2e+04 GB of results)",
         ),
         (["demo", "--seed", "-1"], "--seed: expected an integer >= 0, got -1"),
         (["figures", "--seed", "-1"], "--seed: expected an integer >= 0, got -1"),

@@ -148,6 +148,11 @@ KEY_RANGES: dict[str, Range] = {
 # camera keeps about 180 bytes a pixel, the scene about 400 a strip. A clutter line is
 # drawn as its own polygon in every frame: about 190 us (2000 and 8000 lines, 0.40 and 1.49
 # s a frame; it was counted as a strip, and 1e6 lines, 13 minutes a run, were let through).
+# Besides rendering, a frame costs the loop about 8 ms (perception, the Expecter, the manager):
+# paper_sidewalk.toml with frame_spacing 0.02, 0.01 and 0.005 m (610, 1219 and 2438 frames)
+# ran in 13.8, 30.2 and 45.5 s, 19 to 25 ms a frame, where rendering alone was estimated
+# at 11 ms, so a run estimated at 290 s took about twice that.
+_SECONDS_PER_FRAME = 8e-3
 _SECONDS_PER_PIXEL = 4e-8
 _SECONDS_PER_STRIP = 3.5e-5
 _SECONDS_PER_LINE = 1.9e-4
@@ -447,8 +452,9 @@ class Scenario:
     def estimate(self) -> tuple[float, float]:
         """Return the estimated time (seconds) and memory (bytes) of one run of :meth:`simulate`.
 
-        From the synthetic camera's measured costs: pixels, clutter strips and clutter
-        lines of every frame, the camera's buffers and the scene's strips.
+        From the measured costs: the loop's per frame, the synthetic camera's pixels,
+        clutter strips and clutter lines of every frame, the camera's buffers and the
+        scene's strips.
 
         Examples
         --------
@@ -456,13 +462,14 @@ class Scenario:
         >>> scenario = Scenario.from_toml(pathlib.Path("scenarios") / "paper_sidewalk.toml")
         >>> seconds, memory = scenario.estimate()
         >>> round(seconds, 2), round(memory / 1e6)
-        (0.04, 49)
+        (0.08, 49)
         """
         k = self.camera.intrinsics
         pixels = float(k.width) * float(k.height)
         frames = float(self.frame_count())
         seconds = frames * (
-            pixels * _SECONDS_PER_PIXEL
+            _SECONDS_PER_FRAME
+            + pixels * _SECONDS_PER_PIXEL
             + float(self.render.clutter) * _SECONDS_PER_STRIP
             + float(self.render.clutter_lines) * _SECONDS_PER_LINE
         )
