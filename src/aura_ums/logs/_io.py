@@ -18,7 +18,7 @@ import shutil
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,7 +57,7 @@ from aura_ums._validate import (
 )
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
-from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL, ReversingError
+from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL, NO_REVERSE, ReversingError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
 
@@ -661,16 +661,44 @@ def observation_blocks(
     def whole() -> None:
         _read_observations(path, units, known)
 
-    previous = -math.inf
-    for table in _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"), block_bytes):
+    tables = _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"), block_bytes)
+    yield from _checked_blocks(
+        tables, lambda table: _observation_columns(table, units, known), whole, strict=False, need_rows=False
+    )
+
+
+#: A block's checked columns, its times first (observations, odometry, ground truth).
+ColumnsT = TypeVar("ColumnsT", bound=tuple[Any, ...])
+
+
+def _checked_blocks(
+    tables: Iterator[_CsvFile],
+    columns_of: Callable[[_CsvFile], ColumnsT],
+    whole: Callable[[], object],
+    *,
+    strict: bool,
+    need_rows: bool,
+) -> Iterator[ColumnsT]:
+    """Yield each block's checked columns (time first), checked across blocks as the whole file is.
+
+    Across two blocks, as within one: times in order (``strict``: increasing) and no clock
+    jump (:func:`clock_jump`'s limit); ``need_rows``: at least one row. A failing check
+    fails as ``whole`` (the whole file's reader) fails, with its message.
+    """
+    previous = math.nan
+    for table in tables:
         with _as_whole(whole):
-            columns = _observation_columns(table, units, known)
-        times = columns[0]
-        if times.size:
-            if times[0] < previous or (math.isfinite(previous) and times[0] - previous > ROW_GAP.high):
-                _whole_fails(whole)
-            previous = float(times[-1])
+            columns = columns_of(table)
+        time = columns[0]
+        if time.size:
+            if not math.isnan(previous):
+                gap = float(time[0]) - previous
+                if gap < 0.0 or (strict and gap == 0.0) or gap > ROW_GAP.high:
+                    _whole_fails(whole)
+            previous = float(time[-1])
             yield columns
+    if need_rows and math.isnan(previous):
+        _whole_fails(whole)  # no rows
 
 
 @contextlib.contextmanager
@@ -712,8 +740,7 @@ def reversed_at(path: Path, refused: ReversingError) -> FileFormatError:
     return FileFormatError(
         str(path),
         "",
-        f"expected forward velocities >= 0 in column 'v' (the turn-and-run model has no reverse; "
-        f"pass --reverse flip to aura-ums, or reverse=ReverseMotion.FLIP), got {refused.value!r}",
+        f"expected forward velocities >= 0 in column 'v' ({NO_REVERSE}), got {refused.value!r}",
         line=line,
     )
 
@@ -731,18 +758,10 @@ def odometry_blocks(
     def whole() -> None:
         _read_odometry(path, units)
 
-    previous = math.nan
-    for table in _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"), block_bytes):
-        with _as_whole(whole):
-            columns = _odometry_columns(table, units)
-        time = columns[0]
-        if time.size:
-            if not math.isnan(previous) and (not time[0] > previous or time[0] - previous > ROW_GAP.high):
-                _whole_fails(whole)
-            previous = float(time[-1])
-            yield columns
-    if math.isnan(previous):
-        _whole_fails(whole)  # no rows
+    tables = _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"), block_bytes)
+    yield from _checked_blocks(
+        tables, lambda table: _odometry_columns(table, units), whole, strict=True, need_rows=True
+    )
 
 
 def _read_commands(path: Path, units: Units) -> tuple[PositionReport, ...]:
@@ -786,18 +805,10 @@ def groundtruth_blocks(
     def whole() -> None:
         _read_groundtruth(path, units)
 
-    previous = math.nan
-    for table in _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"), block_bytes):
-        with _as_whole(whole):
-            columns = _groundtruth_columns(table, units)
-        time = columns[0]
-        if time.size:
-            if not math.isnan(previous) and (not time[0] > previous or time[0] - previous > ROW_GAP.high):
-                _whole_fails(whole)
-            previous = float(time[-1])
-            yield columns
-    if math.isnan(previous):
-        _whole_fails(whole)  # no rows
+    tables = _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"), block_bytes)
+    yield from _checked_blocks(
+        tables, lambda table: _groundtruth_columns(table, units), whole, strict=True, need_rows=True
+    )
 
 
 # --- writing -----------------------------------------------------------------------------------

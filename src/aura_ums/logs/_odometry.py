@@ -23,6 +23,12 @@ REPORT_BYTES = 250
 MAX_REPORTS = 500_000_000 // REPORT_BYTES
 
 
+#: Why a negative forward velocity is refused, and what to pass instead (every such message).
+NO_REVERSE = (
+    "the turn-and-run model has no reverse; pass --reverse flip to aura-ums, or reverse=ReverseMotion.FLIP"
+)
+
+
 class ReversingError(InputError):
     """A negative forward velocity refused (``ReverseMotion.ERROR``), with its row's index.
 
@@ -31,10 +37,7 @@ class ReversingError(InputError):
     """
 
     def __init__(self, row: int, value: float) -> None:
-        super().__init__(
-            f"v: expected forward velocities >= 0 (the turn-and-run model has no reverse; "
-            f"pass reverse=ReverseMotion.FLIP, or --reverse flip to aura-ums), got {value!r} at row {row}"
-        )
+        super().__init__(f"v: expected forward velocities >= 0 ({NO_REVERSE}), got {value!r} at row {row}")
         self.row = row
         self.value = value
 
