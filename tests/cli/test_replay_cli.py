@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
+from typer.testing import CliRunner, Result
 
 from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
@@ -433,13 +433,18 @@ def test_calibrate_names_its_options_out_of_range(
     assert not out.exists()
 
 
+def _compare(folder: Path, tmp_path: Path, *options: str) -> Result:
+    """Run ``compare`` on ``folder`` with the floor terrain table and ``options``."""
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    return runner.invoke(app, ["compare", str(folder), "--terrain", str(terrain), *options])
+
+
 def test_compare_names_a_log_folder_without_ground_truth(log_folder: Path, tmp_path: Path) -> None:
     bare = tmp_path / "bare"
     shutil.copytree(log_folder, bare)
     (bare / "groundtruth.csv").unlink()
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(FLOOR_TOML)
-    result = runner.invoke(app, ["compare", str(bare), "--terrain", str(terrain)])
+    result = _compare(bare, tmp_path)
     assert result.exit_code == 2
     assert (
         f"error: LOG_DIR: expected a log folder with groundtruth.csv to compare against, got {bare}"
@@ -457,9 +462,7 @@ def test_compare_names_a_log_folder_without_ground_truth(log_folder: Path, tmp_p
 def test_compare_refuses_bad_particle_filter_options_by_name(
     option: str, value: str, message: str, log_folder: Path, tmp_path: Path
 ) -> None:
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(FLOOR_TOML)
-    result = runner.invoke(app, ["compare", str(log_folder), "--terrain", str(terrain), option, value])
+    result = _compare(log_folder, tmp_path, option, value)
     assert result.exit_code == 2
     assert "Traceback" not in result.output
     assert result.stderr == f"error: {message}\n"
