@@ -244,7 +244,8 @@ relocalize_after (2), got 1
         SettingInfo(
             "Width of the global heading grid's cells of a heading-sliced map, which keeps a "
             "polygon of positions per heading interval (none: the paper's product map, one "
-            "polygon for every heading)",
+            "polygon for every heading). The grid has a whole number of cells, each at most this "
+            "wide: 0.034907 gives 180 cells of 2 degrees, 0.0349 gives 181",
             "rad",
             float,
             low=0.0,
