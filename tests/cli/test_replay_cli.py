@@ -504,6 +504,39 @@ def test_an_empty_log_argument_is_named(argv: list[str], name: str) -> None:
     assert result.stderr == f"error: {name}: expected a log folder, got an empty path ''\n"
 
 
+_NAMED = "OUT_DIR: expected a path ending in the new log folder's name, got"
+_TOPICS = ["--odom", "/odom", "--observations", "/obs"]
+_EMPTY = "got an empty path ''"
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["import", "mrclam", "", "o", "--robot", "1"], f"DATASET_DIR: expected a dataset folder, {_EMPTY}"),
+        (["import", "mrclam", "data", "", "--robot", "1"], f"{_NAMED} an empty path ''"),
+        (["import", "mrclam", "data", ".", "--robot", "1"], f"{_NAMED} '.'"),
+        (["import", "mrclam", "data", "logs/..", "--robot", "1"], f"{_NAMED} 'logs/..'"),
+        (["import", "rosbag", "", "out", *_TOPICS], "BAG: expected a ROS bag, got an empty path ''"),
+        (["import", "rosbag", "bag", ".", *_TOPICS], f"{_NAMED} '.'"),
+        (["replay", "log", "--terrain", "t.toml", "--plot", ""], f"--plot: expected a folder, {_EMPTY}"),
+        (["figures", "--out", ""], "--out: expected a folder, got an empty path ''"),
+        (["demo", "--out", ""], "--out: expected a folder, got an empty path ''"),
+    ],
+    ids=["import-dataset", "import-out-empty", "import-out-dot", "import-out-dotdot", "rosbag-bag",
+         "rosbag-out-dot", "replay-plot", "figures-out", "demo-out"],
+)  # fmt: skip
+def test_an_empty_or_nameless_path_is_refused_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, argv: list[str], message: str
+) -> None:
+    # '' was the current folder: `--plot ''` wrote its figure there, and `import ... .` in an
+    # empty folder raised ValueError from pathlib (no name to put the scratch folder beside).
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, argv)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {message}\n"
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("whole", [False, True], ids=["streamed", "whole (--plot)"])
 def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(tmp_path: Path, whole: bool) -> None:
     folder = write_log(long_odometry_log(200, rate=50.0, frame_every=5), tmp_path / "log")

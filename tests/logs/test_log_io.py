@@ -123,6 +123,18 @@ def test_write_log_refuses_an_existing_log_unless_told(tmp_path: Path) -> None:
     assert loaded.groundtruth is None
 
 
+@pytest.mark.parametrize("name", [".", "", "..", "/"])
+def test_write_log_refuses_a_folder_without_a_name_of_its_own(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str
+) -> None:
+    # "." raised ValueError from pathlib (no name to put the scratch folder beside): the
+    # log is written under a scratch name and renamed onto its folder, which needs a name.
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"folder: expected a path ending in the log folder's name, got"):
+        write_log(small_log(), name)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_write_log_refuses_a_file_as_folder(tmp_path: Path) -> None:
     (tmp_path / "file").write_text("x")
     with pytest.raises(InputError, match="folder: expected a folder, got the file"):

@@ -18,6 +18,7 @@ from aura_ums.cli._common import (
     check_seed,
     console,
     fail,
+    folder_argument,
     manager_options,
     progress_bar,
 )
@@ -69,9 +70,12 @@ def _root(
 @app.command(cls=PlainCommand)
 @interruptible
 def figures(
-    out: Annotated[Path, typer.Option("--out", help="Folder to write the PNG figures into.")] = Path(
-        "report/figures"
-    ),
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", help="Folder to write the PNG figures into.", parser=folder_argument("--out", "a folder")
+        ),
+    ] = Path("report/figures"),
     seed: Annotated[int, typer.Option(help="Seed of the sampled true outcomes drawn over the maps.")] = 0,
     overwrite: Overwrite = False,
 ) -> None:
@@ -92,7 +96,10 @@ def figures(
 @app.command(cls=PlainCommand)
 @interruptible
 def demo(
-    out: Annotated[Path, typer.Option("--out", help="Folder for the report.")] = Path("report"),
+    out: Annotated[
+        Path,
+        typer.Option("--out", help="Folder for the report.", parser=folder_argument("--out", "a folder")),
+    ] = Path("report"),
     seed: Annotated[int, typer.Option(help="Seed of every random draw in the report.")] = 0,
     runs: Annotated[int, typer.Option(help="Monte Carlo runs per variant in the summary.")] = 40,
     overwrite: Overwrite = False,

@@ -48,17 +48,35 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(code=2)
 
 
-def folder_argument(name: str) -> Callable[[str], Path]:
-    """Return the parser of a folder argument that refuses an empty path (exit 2, naming it).
+def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Path]:
+    """Return the parser of a path argument or option that refuses an empty path (exit 2, naming it).
 
-    The empty string would otherwise become ``Path("")``, the current folder, and the
-    error would name a file inside it (``meta.toml: expected ...``) instead of the argument.
+    The empty string would otherwise become ``Path("")``, the current folder: an input's
+    error would name a file inside it (``meta.toml: expected ...``) instead of the argument,
+    and an output would land beside whatever the user ran the command in.
     """
 
     def parse(text: str) -> Path:
         if not text:
-            raise fail(f"{name}: expected a log folder, got an empty path ''")
+            raise fail(f"{name}: expected {what}, got an empty path ''")
         return Path(text)
+
+    return parse
+
+
+def new_folder_argument(name: str) -> Callable[[str], Path]:
+    """Return the parser of a log folder to write: a path that ends in the folder's own name.
+
+    The folder is written under a scratch name beside it and renamed into place, so
+    ``.``, ``..`` or ``/`` (no name of their own; the first would replace the folder the
+    user works in) are refused, as is the empty path.
+    """
+
+    def parse(text: str) -> Path:
+        path = folder_argument(name, "a path ending in the new log folder's name")(text)
+        if path.name in ("", ".."):
+            raise fail(f"{name}: expected a path ending in the new log folder's name, got {text!r}")
+        return path
 
     return parse
 

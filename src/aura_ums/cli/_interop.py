@@ -14,7 +14,15 @@ from typing import TYPE_CHECKING, Annotated, TypeVar
 
 import typer
 
-from aura_ums.cli._common import Quiet, err_console, fail, print_log_summary, progress_bar
+from aura_ums.cli._common import (
+    Quiet,
+    err_console,
+    fail,
+    folder_argument,
+    new_folder_argument,
+    print_log_summary,
+    progress_bar,
+)
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, resolved, wrote
 from aura_ums.export import LiveOptions
 
@@ -27,9 +35,15 @@ if TYPE_CHECKING:
 
 def rosbag_command(
     bag: Annotated[
-        Path, typer.Argument(help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.")
+        Path,
+        typer.Argument(
+            help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.",
+            parser=folder_argument("BAG", "a ROS bag"),
+        ),
     ],
-    out_dir: Annotated[Path, typer.Argument(help="Log folder to write.")],
+    out_dir: Annotated[
+        Path, typer.Argument(help="Log folder to write.", parser=new_folder_argument("OUT_DIR"))
+    ],
     odom: Annotated[
         str,
         typer.Option(

@@ -7,7 +7,16 @@ from typing import Annotated
 
 import typer
 
-from aura_ums.cli._common import PlainCommand, PlainGroup, Quiet, fail, print_log_summary, progress_bar
+from aura_ums.cli._common import (
+    PlainCommand,
+    PlainGroup,
+    Quiet,
+    fail,
+    folder_argument,
+    new_folder_argument,
+    print_log_summary,
+    progress_bar,
+)
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, wrote
 
 import_app = typer.Typer(
@@ -22,9 +31,15 @@ import_app = typer.Typer(
 @interruptible
 def mrclam(
     dataset_dir: Annotated[
-        Path, typer.Argument(help="UTIAS MRCLAM dataset folder (Barcodes.dat, RobotN_*.dat, ...).")
+        Path,
+        typer.Argument(
+            help="UTIAS MRCLAM dataset folder (Barcodes.dat, RobotN_*.dat, ...).",
+            parser=folder_argument("DATASET_DIR", "a dataset folder"),
+        ),
     ],
-    out_dir: Annotated[Path, typer.Argument(help="Log folder to write.")],
+    out_dir: Annotated[
+        Path, typer.Argument(help="Log folder to write.", parser=new_folder_argument("OUT_DIR"))
+    ],
     robot: Annotated[int, typer.Option("--robot", help="Robot number, 1 to 5.")],
     overwrite: Overwrite = False,
     quiet: Quiet = False,

@@ -311,7 +311,12 @@ def replay(
     steps_csv: Annotated[
         Path | None, typer.Option("--steps-csv", help="Write one row per time step to this CSV file.")
     ] = None,
-    plot: Annotated[Path | None, typer.Option("--plot", help="Folder for a figure of the replay.")] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option(
+            "--plot", help="Folder for a figure of the replay.", parser=folder_argument("--plot", "a folder")
+        ),
+    ] = None,
     mcap: Annotated[
         Path | None, typer.Option("--mcap", help="Write the replay as MCAP for Foxglove.")
     ] = None,

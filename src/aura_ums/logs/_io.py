@@ -951,7 +951,7 @@ def write_log(
     ------
     InputError
         When the folder already holds log files and ``overwrite`` is False, or ``folder``
-        is not a folder.
+        is not a folder, or has no name of its own (``.``, ``..``, ``/``).
     FileFormatError
         When a file cannot be written.
 
@@ -972,6 +972,9 @@ def write_log(
     if not isinstance(log, RobotLog):
         raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
     base = Path(folder)
+    if base.name in ("", ".."):
+        # The log is written under a scratch name beside the folder, then renamed onto it.
+        raise InputError(f"folder: expected a path ending in the log folder's name, got {str(folder)!r}")
     if base.exists() and not base.is_dir():
         raise InputError(f"folder: expected a folder, got the file {base}")
     existing = log_files_in(base)
