@@ -341,7 +341,13 @@ relocalize_after (2), got 1
     )
     relaxed_window: int = _setting(
         10,
-        SettingInfo("Consecutive observations over which relaxed_q wrong ones are tolerated", "", int, low=1),
+        SettingInfo(
+            "Consecutive observations over which relaxed_q wrong ones are tolerated (shorter: fewer "
+            "branches, so faster, and a guarantee that holds on more logs, for somewhat larger maps)",
+            "",
+            int,
+            low=1,
+        ),
     )
 
     def __post_init__(self) -> None:
