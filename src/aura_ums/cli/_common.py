@@ -71,11 +71,12 @@ def new_folder_argument(name: str) -> Callable[[str], Path]:
     ``.``, ``..`` or ``/`` (no name of their own; the first would replace the folder the
     user works in) are refused, as is the empty path.
     """
+    what = "a path ending in the new log folder's name"
 
     def parse(text: str) -> Path:
-        path = folder_argument(name, "a path ending in the new log folder's name")(text)
+        path = folder_argument(name, what)(text)
         if path.name in ("", ".."):
-            raise fail(f"{name}: expected a path ending in the new log folder's name, got {text!r}")
+            raise fail(f"{name}: expected {what}, got {text!r}")
         return path
 
     return parse
