@@ -145,6 +145,28 @@ def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: 
     assert "Traceback" not in result.output
 
 
+def test_until_before_the_resumed_state_is_refused_naming_both(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    # It was accepted: nothing after the state was replayed, and the empty result exited 0.
+    folder, terrain = walk
+    state = tmp_path / "s.json"
+    invoke("replay", folder, "--terrain", terrain, "--until", "20", "--save-state", state)
+    last = json.loads(state.read_text())["last_time"]
+    result = runner.invoke(
+        app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(state), "--until", "10"]
+    )
+    assert result.exit_code == 2
+    assert result.stderr == (
+        f"error: --until: expected a time at or after the state in {state}'s last frame ({last!r} s), "
+        "got 10.0\n"
+    )
+    resumed = runner.invoke(
+        app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(state), "--until", str(last)]
+    )
+    assert resumed.exit_code == 0  # at the state's own last frame: nothing left, but no contradiction
+
+
 def test_a_bad_resume_names_the_option_and_file_and_until_must_be_finite(
     walk: tuple[Path, Path], tmp_path: Path
 ) -> None:

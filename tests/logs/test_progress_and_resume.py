@@ -66,6 +66,10 @@ def test_a_state_before_any_frame_and_bad_states() -> None:
     state = replay_log(log, TABLE, until=5.0, save_state=True).state
     with pytest.raises(InputError, match="resume: expected a state saved from a replay of log 'synthetic'"):
         replay_log(other, TABLE, resume=state)
+    with pytest.raises(
+        InputError, match=r"until: expected a time at or after the resumed state's last frame"
+    ):
+        replay_log(log, TABLE, resume=state, until=1.0)
     with pytest.raises(FileFormatError, match="log_digest: expected a string"):
         ReplayState.from_json(
             '{"format": "aura_ums.ReplayState", "version": 1, "log": "x", "frames_done": 0, '

@@ -716,8 +716,8 @@ def replay_log(
     Raises
     ------
     InputError
-        For a bad argument, a terrain missing from ``table``, a log without a start, or a
-        ``resume`` state saved from another log.
+        For a bad argument, a terrain missing from ``table``, a log without a start, a
+        ``resume`` state saved from another log, or an ``until`` before that state's last frame.
     FileFormatError
         When ``steps_csv`` cannot be written.
 
@@ -756,6 +756,12 @@ def replay_log(
     stop = math.inf if until is None else finite_float(until, "until")
     if resume is not None and not isinstance(resume, ReplayState):
         raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")
+    if resume is not None and stop < resume.last_time:
+        # Nothing after the state would be replayed: an empty result is no answer.
+        raise InputError(
+            f"until: expected a time at or after the resumed state's last frame "
+            f"({resume.last_time!r} s), got {stop!r}"
+        )
     if isinstance(log, LogStream) and (resume is not None or save_state):
         raise InputError(
             "log: expected a RobotLog (load_log) to resume or save a replay's state "
