@@ -128,6 +128,17 @@ def test_a_resumed_replay_ends_with_the_same_map(walk: tuple[Path, Path], tmp_pa
     resumed_alike(folder, terrain, tmp_path, 15.0, 40.0)
 
 
+def test_a_resumed_sliced_relaxed_replay_ends_with_the_same_map(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    # The configuration the README recommends where the truth must stay inside.
+    folder, terrain = walk
+    options = ("--slice-width", "0.034907", "--relaxed-q", "1", "--relaxed-window", "5", "--classes", "II")
+    resumed_alike(folder, terrain, tmp_path, 15.0, 40.0, *options)
+    saved = json.loads((tmp_path / "rest.json").read_text())
+    assert saved["manager"]["settings"]["relaxed_window"] == 5
+
+
 def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: Path) -> None:
     folder, terrain = walk
     invoke("replay", folder, "--terrain", terrain, "--until", "10", "--save-state", tmp_path / "s.json")
