@@ -64,22 +64,22 @@ def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Pa
     return parse
 
 
-def new_folder_argument(name: str) -> Callable[[str], Path]:
-    """Return the parser of a log folder to write: a path that ends in the folder's own name.
+def _new_log_folder(text: str) -> Path:
+    """Parse ``OUT_DIR``, the log folder an import writes: a path that ends in the folder's own name.
 
     The folder is written under a scratch name beside it and renamed into place, so
     ``.``, ``..`` or ``/`` (no name of their own; the first would replace the folder the
     user works in) are refused, as is the empty path.
     """
     what = "a path ending in the new log folder's name"
+    path = folder_argument("OUT_DIR", what)(text)
+    if path.name in ("", ".."):
+        raise fail(f"OUT_DIR: expected {what}, got {text!r}")
+    return path
 
-    def parse(text: str) -> Path:
-        path = folder_argument(name, what)(text)
-        if path.name in ("", ".."):
-            raise fail(f"{name}: expected {what}, got {text!r}")
-        return path
 
-    return parse
+#: The log folder an import writes (every import command's ``OUT_DIR``).
+NewLogFolder = Annotated[Path, typer.Argument(help="Log folder to write.", parser=_new_log_folder)]
 
 
 def check_seed(seed: int) -> None:

@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING, Annotated, TypeVar
 import typer
 
 from aura_ums.cli._common import (
+    NewLogFolder,
     Quiet,
     err_console,
     fail,
     folder_argument,
-    new_folder_argument,
     print_log_summary,
     progress_bar,
 )
@@ -41,9 +41,7 @@ def rosbag_command(
             parser=folder_argument("BAG", "a ROS bag"),
         ),
     ],
-    out_dir: Annotated[
-        Path, typer.Argument(help="Log folder to write.", parser=new_folder_argument("OUT_DIR"))
-    ],
+    out_dir: NewLogFolder,
     odom: Annotated[
         str,
         typer.Option(

@@ -8,12 +8,12 @@ from typing import Annotated
 import typer
 
 from aura_ums.cli._common import (
+    NewLogFolder,
     PlainCommand,
     PlainGroup,
     Quiet,
     fail,
     folder_argument,
-    new_folder_argument,
     print_log_summary,
     progress_bar,
 )
@@ -37,9 +37,7 @@ def mrclam(
             parser=folder_argument("DATASET_DIR", "a dataset folder"),
         ),
     ],
-    out_dir: Annotated[
-        Path, typer.Argument(help="Log folder to write.", parser=new_folder_argument("OUT_DIR"))
-    ],
+    out_dir: NewLogFolder,
     robot: Annotated[int, typer.Option("--robot", help="Robot number, 1 to 5.")],
     overwrite: Overwrite = False,
     quiet: Quiet = False,
