@@ -366,8 +366,9 @@ def test_a_terrain_file_without_the_logs_terrain_is_named(
         app, [command, str(log_folder), "--terrain", str(grass), "--sensors", str(sensors)]
     )
     assert result.exit_code == 2
-    assert f"--terrain: expected {grass} to hold the log's terrain 'floor' (meta.toml), got 'grass'" in (
-        result.stderr
+    assert result.stderr == (
+        f"error: --terrain {grass}: expected the terrain 'floor' of the log in {log_folder} (its meta.toml), "
+        "got 'grass'\n"
     )
 
 

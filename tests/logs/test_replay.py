@@ -92,7 +92,9 @@ def test_observation_for_uses_row_bounds_first() -> None:
 
 
 def test_replay_rejects_bad_arguments(clean_log: RobotLog) -> None:
-    with pytest.raises(InputError, match="expected a terrain 'floor' \\(the log's\\)"):
+    with pytest.raises(
+        InputError, match=r"^table: expected the terrain 'floor' of the log \(its meta\.toml\), got 'tile', "
+    ):
         replay_log(clean_log, TerrainTable.default())
     with pytest.raises(InputError, match="log: expected a RobotLog"):
         replay_log("log", FLOOR)  # type: ignore[arg-type]

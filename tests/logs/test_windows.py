@@ -230,7 +230,9 @@ def test_bad_arguments_are_named(clean_log: RobotLog) -> None:
         replay_windows(clean_log, FLOOR, CAMERA, sigmas=0.0)
     with pytest.raises(InputError, match="bearing_sd, range_sd_fraction: expected positive numbers"):
         replay_windows(clean_log, FLOOR, CAMERA, bearing_sd=0.0)
-    with pytest.raises(InputError, match="table: expected a terrain 'floor'"):
+    with pytest.raises(
+        InputError, match=r"^table: expected the terrain 'floor' of the log \(its meta\.toml\), got 'tile', "
+    ):
         replay_windows(clean_log, TerrainTable.default(), CAMERA)
     with pytest.raises(InputError, match="method: expected one of"):
         WindowReport(CAMERA, 0.0, ()).judged("EKF")

@@ -245,7 +245,7 @@ class LogReplay:
     >>> LogReplay(TerrainTable({}), ReplayOptions(), table_file="none.toml")(folder)  # the edge: no terrain
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: none.toml: expected the terrain 'floor' of the log in ...), got none
+    aura_ums.errors.UnknownTerrainError: none.toml: expected the terrain 'floor' of the log in ...), got none
     """
 
     table: TerrainTable
@@ -264,12 +264,9 @@ class LogReplay:
         log = self.load(folder)
         # Checked here, where the log's terrain is first known: the replay's own check
         # names neither the table's file nor the log among the campaign's many.
-        if log.meta.terrain not in self.table:
-            held = ", ".join(repr(name) for name in self.table) or "none"
-            raise InputError(
-                f"{self.table_file}: expected the terrain {log.meta.terrain!r} of the log in {folder} "
-                f"(its meta.toml), got {held}"
-            )
+        self.table.require(
+            log.meta.terrain, where=str(self.table_file), whose=f"the log in {folder} (its meta.toml)"
+        )
         if self.camera is None:
             return replay_log(log, self.table, self.options, keep_maps=False, until=self.until).metrics()
         result, windows = replay_windows(

@@ -135,16 +135,16 @@ def _figure(value: float, spec: str) -> str:
     return "n/a" if math.isnan(value) else format(value, spec)
 
 
-def _terrain_table(terrain: Path, name: str) -> TerrainTable:
-    """Read ``--terrain``; refuse (exit 2, naming the file) a table without the log's terrain."""
+def _terrain_table(terrain: Path, name: str, log_dir: Path) -> TerrainTable:
+    """Read ``--terrain``; refuse (exit 2, naming the option and file) a table without the log's terrain."""
+    from aura_ums.errors import InputError
     from aura_ums.uncertainty import TerrainTable
 
     table = TerrainTable.from_toml(terrain)
-    if name not in table:
-        held = ", ".join(repr(entry) for entry in table) or "none"
-        raise fail(
-            f"--terrain: expected {terrain} to hold the log's terrain {name!r} (meta.toml), got {held}"
-        )
+    try:
+        table.require(name, where=f"--terrain {terrain}", whose=f"the log in {log_dir} (its meta.toml)")
+    except InputError as exc:
+        raise fail(str(exc)) from None
     return table
 
 
@@ -430,7 +430,7 @@ def replay(
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
-        table = _terrain_table(terrain, log.meta.terrain)
+        table = _terrain_table(terrain, log.meta.terrain, log_dir)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
         saved = None if resume is None else ReplayState.load(resume)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
@@ -563,7 +563,7 @@ def compare(
             raise fail(
                 f"LOG_DIR: expected a log folder with groundtruth.csv to compare against, got {log_dir}"
             )
-        table = _terrain_table(terrain, log.meta.terrain)
+        table = _terrain_table(terrain, log.meta.terrain, log_dir)
         sensors_file = _sensors_file(sensors, terrain)
         options = _options(classes, sensors_file, settings.over(), reverse)
         if calibration_logs:

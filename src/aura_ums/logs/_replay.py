@@ -731,10 +731,10 @@ def replay_log(
     >>> lean = replay_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}), keep_maps=False)
     >>> lean.maps is None, lean.metrics()["steps"] == len(result.steps)
     (True, True)
-    >>> replay_log(log, TerrainTable.default())
+    >>> replay_log(log, TerrainTable.default())  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: table: expected a terrain 'floor' (the log's), got none of that name
+    aura_ums.errors.UnknownTerrainError: table: expected the terrain 'floor' of the log (its meta.toml), ...
     """
     if not isinstance(log, (RobotLog, LogStream)):
         raise InputError(f"log: expected a RobotLog or a LogStream, got {type(log).__name__}")
@@ -743,8 +743,7 @@ def replay_log(
     opts = ReplayOptions() if options is None else options
     if not isinstance(opts, ReplayOptions):
         raise InputError(f"options: expected ReplayOptions or None, got {type(opts).__name__}")
-    if log.meta.terrain not in table:
-        raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
+    table.require(log.meta.terrain, where="table", whose="the log (its meta.toml)")
     if not isinstance(keep_maps, bool):
         raise InputError(f"keep_maps: expected True or False, got {keep_maps!r}")
     if not isinstance(save_state, bool):

@@ -358,8 +358,7 @@ def replay_windows(
         raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
     if not isinstance(table, TerrainTable):
         raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
-    if log.meta.terrain not in table:
-        raise InputError(f"table: expected a terrain {log.meta.terrain!r} (the log's), got none of that name")
+    table.require(log.meta.terrain, where="table", whose="the log (its meta.toml)")
     bounds = opts.working if opts.working is not None else meta_bounds(log)
     default_b, default_r = ekf_noise(bounds)
     b_sd = default_b if bearing_sd is None else finite_float(bearing_sd, "bearing_sd")

@@ -288,6 +288,40 @@ class TerrainTable(Mapping[str, TerrainStats]):
             lines.append("")
         return "\n".join(lines)
 
+    def require(self, name: str, *, where: str, whose: str) -> None:
+        """Refuse a table without the terrain ``name`` that ``whose`` needs, naming ``where``.
+
+        The one check behind every command and reader that pairs a log (or a scenario)
+        with a terrain table, so that each says the same thing.
+
+        Parameters
+        ----------
+        name : str
+            The terrain needed.
+        where : str
+            What to name in the error: an argument, option or file (``"table"``).
+        whose : str
+            Who needs it (``"the log (its meta.toml)"``).
+
+        Raises
+        ------
+        UnknownTerrainError
+            Reading "<where>: expected the terrain <name> of <whose>, got <the table's terrains>".
+
+        Examples
+        --------
+        >>> table = TerrainTable.default()
+        >>> table.require("grass", where="table", whose="the log")   # present: nothing happens
+        >>> table.require("floor", where="t.toml", whose="the log")  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.UnknownTerrainError: t.toml: expected the terrain 'floor' of the log, got 'tile', ...
+        """
+        if name in self.entries:
+            return
+        held = ", ".join(repr(entry) for entry in self.entries) or "none"
+        raise UnknownTerrainError(f"{where}: expected the terrain {name!r} of {whose}, got {held}")
+
     def __getitem__(self, name: str) -> TerrainStats:
         try:
             return self.entries[name]
