@@ -133,7 +133,7 @@ def test_a_resumed_sliced_relaxed_replay_ends_with_the_same_map(
 ) -> None:
     # The configuration the README recommends where the truth must stay inside.
     folder, terrain = walk
-    options = ("--slice-width", "0.034907", "--relaxed-q", "1", "--relaxed-window", "5", "--classes", "II")
+    options = ("--slice-width", "2deg", "--relaxed-q", "1", "--relaxed-window", "5", "--classes", "II")
     resumed_alike(folder, terrain, tmp_path, 15.0, 40.0, *options)
     saved = json.loads((tmp_path / "rest.json").read_text())
     assert saved["manager"]["settings"]["relaxed_window"] == 5

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ from aura_ums.cli import app
 from aura_ums.cli._common import NO_OPTIONS, SettingOptions, manager_options, setting_flag
 from aura_ums.manager import ManagerSettings, SettingInfo
 from aura_ums.sim import Scenario
+from aura_ums.uncertainty import cell_count
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 DEFAULTS = ManagerSettings().to_dict()
@@ -117,3 +119,37 @@ def test_simulate_options_override_the_scenarios_manager_table(monkeypatch: pyte
     bad = runner.invoke(app, ["simulate", path, "--runs", "1", "--envelope-factor", "0.5"])
     assert bad.exit_code == 2
     assert "--envelope-factor: expected a number >= 1, got 0.5" in bad.output
+
+
+@pytest.mark.parametrize(
+    ("text", "radians"),
+    [("2deg", math.radians(2.0)), ("2 deg", math.radians(2.0)), ("90°", math.pi / 2), ("0.034907", 0.034907)],
+)
+def test_an_angle_option_takes_radians_or_degrees(text: str, radians: float) -> None:
+    tool, seen = recorder()
+    result = runner.invoke(tool, ["x", "--slice-width", text, "--joint-sector", text])
+    assert result.exit_code == 0, result.output
+    assert seen[-1].slice_width == seen[-1].joint_sector == radians
+    # 2 degrees is 180 cells of the heading grid, as 0.034907 is (0.0349 is 181)
+    assert cell_count(seen[-1].slice_width) == (4 if radians > 1.0 else 180)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "2 degrees",
+            "expected a number in (0, 2 pi] or none (radians, or degrees as 2deg), got '2 degrees'",
+        ),
+        ("deg", "expected a number in (0, 2 pi] or none (radians, or degrees as 2deg), got 'deg'"),
+        ("400deg", "expected a number in (0, 2 pi] or none, got '400deg' (6.98132 rad)"),
+        ("-1deg", "expected a number in (0, 2 pi] or none, got '-1deg' (-0.0174533 rad)"),
+        ("nandeg", "expected a number in (0, 2 pi] or none, got 'nandeg' (nan rad)"),
+    ],
+)
+def test_a_bad_angle_is_named_as_typed(text: str, message: str) -> None:
+    tool, seen = recorder()
+    result = runner.invoke(tool, ["x", "--slice-width", text])
+    assert result.exit_code == 2
+    assert result.stderr == f"error: --slice-width: {message}\n"
+    assert not seen

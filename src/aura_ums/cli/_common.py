@@ -235,8 +235,15 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
         return [
             inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[bool | None, option])
         ]
+    if info.unit == "rad":
+        unit += " (or in degrees: 2deg)"
     help_text = f"{info.help}{unit}; {info.expected.removesuffix(' or none')}."
-    option = typer.Option(flag, help=help_text, show_default=default)
+    if info.unit == "rad":
+        option = typer.Option(
+            flag, help=help_text, show_default=default, parser=_angle_option(flag, info), metavar="<angle>"
+        )
+    else:
+        option = typer.Option(flag, help=help_text, show_default=default)
     parameters = [
         inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[info.kind | None, option])
     ]
@@ -248,6 +255,25 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
             )
         )
     return parameters
+
+
+def _angle_option(flag: str, info: SettingInfo) -> Callable[[str], float]:
+    """Return the parser of an angle option: radians, or degrees with a suffix (``2deg``, ``2°``)."""
+
+    def parse(text: str) -> float:
+        value = info.read(text)
+        if isinstance(value, float):
+            if info.problem(value) is not None:  # named as typed, not as the radians it became
+                raise fail(f"{flag}: expected {info.expected}, got {text!r} ({value:.6g} rad)")
+            return value
+        try:
+            return float(text)
+        except ValueError:
+            raise fail(
+                f"{flag}: expected {info.expected} (radians, or degrees as 2deg), got {text!r}"
+            ) from None
+
+    return parse
 
 
 def _plain_help(params: list[Any]) -> list[Any]:

@@ -110,6 +110,33 @@ class SettingInfo:
             return f"expected {self.expected}, got {number!r}"
         return None
 
+    def read(self, value: object) -> object:
+        """Return the text of an angle in degrees, ``"2deg"`` or ``"2°"``, as radians.
+
+        Only for a setting whose unit is ``"rad"``: on the command line its value may be
+        written in degrees, since 2 degrees is 0.0349066 rad to seven figures (a scenario's
+        ``[manager]`` table says ``<name>_deg`` instead). Every other value is returned as
+        it is.
+
+        Examples
+        --------
+        >>> info = SettingInfo("Cell width", "rad", float, low=0.0, low_open=True)
+        >>> info.read("2deg") == math.radians(2.0), info.read(" 90 ° ") == math.pi / 2
+        (True, True)
+        >>> info.read("2 degrees"), info.read(0.5)   # not an angle in degrees: as it is
+        ('2 degrees', 0.5)
+        """
+        if self.unit != "rad" or not isinstance(value, str):
+            return value
+        text = value.strip()
+        for suffix in _DEGREES:
+            if text.endswith(suffix):
+                try:
+                    return math.radians(float(text.removesuffix(suffix)))
+                except ValueError:
+                    return value
+        return value
+
     def normalize(self, value: object) -> SettingValue:
         """Return a valid ``value`` (see :meth:`problem`) as the setting's type."""
         if value is None or isinstance(value, bool):
@@ -128,6 +155,9 @@ class SettingInfo:
             raise InputError(f"field: expected a field of ManagerSettings, got {field.name!r}")
         return info
 
+
+#: The suffixes of an angle in degrees (``SettingInfo.read``).
+_DEGREES = ("deg", "\N{DEGREE SIGN}")
 
 #: The largest vertex and slice caps: arrays are sized by them (a cap of 1e9 is 7.45 GiB).
 _MOST = 100_000
@@ -245,7 +275,7 @@ relocalize_after (2), got 1
             "Width of the global heading grid's cells of a heading-sliced map, which keeps a "
             "polygon of positions per heading interval (none: the paper's product map, one "
             "polygon for every heading). The grid has a whole number of cells, each at most this "
-            "wide: 0.034907 gives 180 cells of 2 degrees, 0.0349 gives 181",
+            "wide: 0.034907 (2 degrees) gives 180 cells, 0.0349 gives 181",
             "rad",
             float,
             low=0.0,
