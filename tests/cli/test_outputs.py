@@ -7,10 +7,14 @@ traceback, and leave every input byte-identical.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import os
+import shutil
 import stat
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -245,3 +249,183 @@ def test_an_output_through_a_symlink_replaces_the_file_it_leads_to(inputs: Path,
     assert result.exit_code == 0, result.output
     assert link.is_symlink()
     assert real.read_text().startswith("{")
+
+
+# --- a folder the user may not write into --------------------------------------------------------
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+#: Where each command's computation starts: none may be reached when an output is unwritable.
+COMPUTATIONS = [
+    ("aura_ums.logs", "replay_log"),
+    ("aura_ums.logs", "replay_windows"),
+    ("aura_ums.logs", "calibrate_logs"),
+    ("aura_ums.logs", "compare_on_log"),
+    ("aura_ums.logs", "read_mrclam"),
+    ("aura_ums.logs", "read_rosbag"),
+    ("aura_ums.campaign", "run_campaign"),
+    ("aura_ums.campaign", "simulate_campaign"),
+    ("aura_ums.plot", "write_experiment_report"),
+    ("aura_ums.plot", "draw_all_figures"),
+]
+
+
+@pytest.fixture
+def locked(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A folder this process may not create files in, and nothing may start computing.
+
+    By its mode when the tests run as a user; as root, who may write anywhere, by the
+    system's own refusal (EACCES) of every file opened for writing in it.
+    """
+    import importlib
+
+    folder = tmp_path / "locked"
+    folder.mkdir()
+
+    def never(*_: object, **__: object) -> None:
+        raise AssertionError("the computation started")
+
+    for module, name in COMPUTATIONS:
+        monkeypatch.setattr(importlib.import_module(module), name, never)
+    if os.geteuid() != 0:
+        folder.chmod(0o555)
+        yield folder
+        folder.chmod(0o755)
+        return
+    opened = Path.open
+
+    def refusing(path: Path, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+        if folder in path.parents and any(flag in mode for flag in "wxa+"):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return opened(path, mode, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "open", refusing)
+    yield folder
+
+
+@pytest.mark.parametrize(
+    ("arguments", "option"),
+    [
+        (
+            ("replay", "{log}", "--terrain", "{terrain}", "--metrics-json", "{locked}/m.json"),
+            "--metrics-json",
+        ),
+        (("replay", "{log}", "--terrain", "{terrain}", "--steps-csv", "{locked}/s.csv"), "--steps-csv"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--plot", "{locked}/plots"), "--plot"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--mcap", "{locked}/r.mcap"), "--mcap"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--save-state", "{locked}/s.json"), "--save-state"),
+        (
+            (
+                "replay",
+                "{log}",
+                "--terrain",
+                "{terrain}",
+                "--camera",
+                "{camera}",
+                "--windows-csv",
+                "{locked}/w.csv",
+            ),
+            "--windows-csv",
+        ),
+        (
+            ("replay", "{log}", "{log}", "--terrain", "{terrain}", "--metrics-json", "{locked}/m.json"),
+            "--metrics-json",
+        ),
+        (("calibrate", "{log}", "--out", "{locked}/t.toml"), "--out"),
+        (
+            ("calibrate", "{log}", "--out", "{free}/t.toml", "--sensors-out", "{locked}/s.toml"),
+            "--sensors-out",
+        ),
+        (
+            ("compare", "{log}", "--terrain", "{terrain}", "--metrics-json", "{locked}/c.json"),
+            "--metrics-json",
+        ),
+        (("simulate", "{scenario}", "--runs", "1", "--metrics-json", "{locked}/m.json"), "--metrics-json"),
+        (("demo", "--out", "{locked}/report", "--runs", "1"), "--out"),
+        (("figures", "--out", "{locked}/figures"), "--out"),
+        (("import", "mrclam", "{log}", "{locked}/new", "--robot", "1"), "OUT_DIR"),
+        (
+            (
+                *("import", "rosbag", "{log}", "{locked}/new", "--odom", "/odom", "--observations", "/seen"),
+                *("--landmarks", "{log}/landmarks.csv"),
+            ),
+            "OUT_DIR",
+        ),
+    ],
+    ids=[
+        *(f"replay {o}" for o in ("--metrics-json", "--steps-csv", "--plot", "--mcap", "--save-state")),
+        "replay --windows-csv",
+        "replay of two logs",
+        "calibrate --out",
+        "calibrate --sensors-out",
+        "compare",
+        "simulate",
+        "demo",
+        "figures",
+        "import mrclam",
+        "import rosbag",
+    ],
+)
+def test_an_output_in_a_folder_without_write_permission_is_refused_before_the_computation(
+    arguments: tuple[str, ...], option: str, inputs: Path, locked: Path, tmp_path: Path, untouched: object
+) -> None:
+    # was an OSError traceback, and only after the whole computation (issue 19)
+    places = {
+        "log": inputs / "log",
+        "terrain": inputs / "terrain.toml",
+        "camera": EXAMPLES / "virtual_camera_60deg.toml",
+        "scenario": SCENARIO,
+        "locked": locked,
+        "free": tmp_path,
+    }
+    result = invoke(*(argument.format(**places) for argument in arguments))
+    refused(result, f"{option}: expected a writable place, got {locked}: Permission denied")
+    assert list(locked.iterdir()) == []
+
+
+# --- an input the user may not read --------------------------------------------------------------
+
+
+@pytest.fixture
+def deny(monkeypatch: pytest.MonkeyPatch) -> Callable[[Path], None]:
+    """Make a file unreadable to this process: by its mode as a user; as root, by EACCES on open."""
+    import aura_ums._files
+
+    denied: list[Path] = []
+
+    def refusing(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if Path(path) in denied:
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return open(path, *args, **kwargs)
+
+    if os.geteuid() == 0:
+        # every reader opens its file in aura_ums._files, the one place that reads
+        monkeypatch.setattr(aura_ums._files, "open", refusing, raising=False)
+
+    def deny_path(path: Path) -> None:
+        denied.append(path)
+        path.chmod(0)
+
+    return deny_path
+
+
+@pytest.mark.parametrize(
+    "name", ["meta.toml", "commands.csv", "observations.csv", "groundtruth.csv", "landmarks.csv"]
+)
+@pytest.mark.parametrize("command", ["replay", "calibrate", "compare"])
+def test_an_unreadable_log_file_is_named_with_the_reason(
+    command: str, name: str, inputs: Path, tmp_path: Path, deny: Callable[[Path], None]
+) -> None:
+    log = tmp_path / "log"
+    shutil.copytree(inputs / "log", log)
+    deny(log / name)
+    out = tmp_path / "out.json"
+    options = (
+        ("--out", out)
+        if command == "calibrate"
+        else ("--terrain", inputs / "terrain.toml", "--metrics-json", out)
+    )
+    result = invoke(command, log, *options)
+    refused(result, f"error: {log / name}: expected a readable ")
+    assert result.stderr.endswith(f" file, got {os.strerror(errno.EACCES)}\n")
+    assert not out.exists()
