@@ -25,6 +25,7 @@ from aura_ums._files import (
     parse_json,
     parse_toml,
     read_bytes,
+    read_folder,
     read_text,
 )
 from aura_ums.errors import AuraUmsError, FileFormatError, InputError
@@ -325,3 +326,26 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path: Path) -> None:
         FileFormatError, match=r"terrain\.toml: expected a TOML file, got a named pipe or socket"
     ):
         read_bytes(pipe, kind="TOML")
+
+
+def test_a_folder_is_read_only_when_it_is_a_folder_this_process_may_enter(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert read_folder(tmp_path, kind="log folder") == tmp_path
+    file = tmp_path / "meta.toml"
+    file.write_text("")
+    with pytest.raises(FileFormatError, match=r"meta\.toml: expected a log folder, got a file$"):
+        read_folder(file, kind="log folder")
+    with pytest.raises(FileFormatError, match=r"/gone: expected a dataset folder, got no such folder$"):
+        read_folder(tmp_path / "gone", kind="dataset folder")
+    with pytest.raises(FileFormatError, match=r"expected a log folder, got no such folder$"):
+        read_folder(str(tmp_path / "a\0b"), kind="log folder")
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o600)  # listable by its owner, not enterable
+    if os.geteuid() == 0:  # root enters anything: the system's answer for a user, given here
+        monkeypatch.setattr(os, "access", lambda path, mode: Path(path) != locked)
+    with pytest.raises(
+        FileFormatError, match=r"locked: expected a readable log folder, got Permission denied$"
+    ):
+        read_folder(locked, kind="log folder")
+    locked.chmod(0o755)

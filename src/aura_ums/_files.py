@@ -24,6 +24,7 @@ command killed half-way) sees the old file or the whole new one, never a part.
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import math
@@ -66,6 +67,7 @@ __all__ = [
     "parse_toml",
     "read_bytes",
     "read_csv_floats",
+    "read_folder",
     "read_text",
     "scratch_path",
     "write_text_atomic",
@@ -166,6 +168,39 @@ def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None
             source, "", f"expected a {kind} file of at most {_size(limit)}, got a larger one"
         )
     return data
+
+
+def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
+    """Return ``path`` as a folder whose files can be read, or refuse it naming why.
+
+    The one check of every folder a reader takes (a log, a dataset): a path that is
+    missing, a file, or a folder this process may not list or enter is refused here,
+    rather than as "unreadable" on the first file read inside it.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the path: "expected a <kind>, got no such folder", "... got a file" or
+        "expected a readable <kind>, got Permission denied".
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> read_folder(tempfile.gettempdir(), kind="log folder").is_dir()
+    True
+    >>> read_folder("/nowhere", kind="log folder")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: /nowhere: expected a log folder, got no such folder
+    """
+    folder = Path(path)
+    if not folder.is_dir():
+        got = "a file" if folder.exists() else "no such folder"
+        raise FileFormatError(str(folder), "", f"expected a {kind}, got {got}")
+    # Listing needs read permission, opening a file inside needs execute (search).
+    if not os.access(folder, os.R_OK | os.X_OK):
+        raise FileFormatError(str(folder), "", f"expected a readable {kind}, got {os.strerror(errno.EACCES)}")
+    return folder
 
 
 def decode(data: bytes, source: str) -> str:

@@ -398,9 +398,15 @@ def deny(monkeypatch: pytest.MonkeyPatch) -> Callable[[Path], None]:
             raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
         return open(path, *args, **kwargs)
 
+    access = os.access
+
+    def no_access(path: Any, mode: int, *args: Any, **kwargs: Any) -> bool:
+        return Path(path) not in denied and access(path, mode, *args, **kwargs)
+
     if os.geteuid() == 0:
-        # every reader opens its file in aura_ums._files, the one place that reads
+        # every reader opens its file, and checks its folder, in aura_ums._files
         monkeypatch.setattr(aura_ums._files, "open", refusing, raising=False)
+        monkeypatch.setattr(os, "access", no_access)
 
     def deny_path(path: Path) -> None:
         denied.append(path)
@@ -429,3 +435,36 @@ def test_an_unreadable_log_file_is_named_with_the_reason(
     refused(result, f"error: {log / name}: expected a readable ")
     assert result.stderr.endswith(f" file, got {os.strerror(errno.EACCES)}\n")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["replay", "calibrate", "compare"])
+def test_an_unreadable_log_folder_is_named_not_its_first_file(
+    command: str, inputs: Path, tmp_path: Path, deny: Callable[[Path], None]
+) -> None:
+    # was "LOG/meta.toml: expected a readable ... file", for a folder the user may not enter
+    log = tmp_path / "log"
+    shutil.copytree(inputs / "log", log)
+    deny(log)
+    out = tmp_path / "out.json"
+    options = (
+        ("--out", out)
+        if command == "calibrate"
+        else ("--terrain", inputs / "terrain.toml", "--metrics-json", out)
+    )
+    result = invoke(command, log, *options)
+    log.chmod(0o755)
+    refused(result)
+    assert result.stderr == f"error: {log}: expected a readable log folder, got {os.strerror(errno.EACCES)}\n"
+    assert not out.exists()
+
+
+def test_an_unreadable_dataset_folder_is_named(tmp_path: Path, deny: Callable[[Path], None]) -> None:
+    dataset = tmp_path / "MRCLAM_Dataset1"
+    dataset.mkdir()
+    deny(dataset)
+    result = invoke("import", "mrclam", dataset, tmp_path / "new", "--robot", "1")
+    dataset.chmod(0o755)
+    refused(result)
+    what = "a readable UTIAS MRCLAM dataset folder"
+    assert result.stderr == f"error: {dataset}: expected {what}, got {os.strerror(errno.EACCES)}\n"
+    assert not (tmp_path / "new").exists()

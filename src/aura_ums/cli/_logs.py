@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from aura_ums._files import read_folder
 from aura_ums.cli._common import (
     NewLogFolder,
     PlainCommand,
@@ -53,8 +54,11 @@ def mrclam(
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import read_mrclam, write_log
 
-    if not dataset_dir.is_dir():
-        raise fail(f"{dataset_dir}: expected a UTIAS MRCLAM dataset folder, got no such folder")
+    try:
+        # before the outputs are checked: a mistyped DATASET_DIR is the likelier mistake
+        read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder")
+    except AuraUmsError as exc:
+        raise fail(str(exc)) from None
     target = Target("OUT_DIR", out_dir, folder=True)
     check_outputs([target], [Source("DATASET_DIR", dataset_dir, folder=True)], overwrite=overwrite)
     try:

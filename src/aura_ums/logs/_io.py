@@ -35,6 +35,7 @@ from aura_ums._files import (
     load_toml,
     parse_csv,
     read_csv_floats,
+    read_folder,
     read_text,
     scratch_path,
 )
@@ -550,9 +551,7 @@ def load_log(folder: str | os.PathLike[str]) -> RobotLog:
     ...
     aura_ums.errors.FileFormatError: .../observations.csv:2: expected a landmark id ..., got 'post'
     """
-    base = Path(folder)
-    if not base.is_dir():
-        raise FileFormatError(str(base), "", "expected a log folder, got no such folder")
+    base = read_folder(folder, kind="log folder")
     meta, units = _MetaReader(base / META).read(base.name)
     landmarks = _read_landmarks(base / LANDMARKS, units)
     observations = _read_observations(base / OBSERVATIONS, units, {item.id for item in landmarks})

@@ -20,7 +20,7 @@ from typing import NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import MAX_ROWS, read_text
+from aura_ums._files import MAX_ROWS, read_folder, read_text
 from aura_ums._validate import (
     ANGLE,
     ANGULAR_SPEED,
@@ -207,9 +207,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     ):
         raise InputError(f"robot: expected a robot number from 1 to 5, got {robot!r}")
     robot = int(robot)
-    folder = Path(dataset_dir)
-    if not folder.is_dir():
-        raise FileFormatError(str(folder), "", "expected a UTIAS MRCLAM dataset folder, got no such folder")
+    folder = read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder")
     prefix = f"Robot{robot}_"
     if not (folder / f"{prefix}Measurement.dat").is_file():
         present = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})

@@ -26,6 +26,7 @@ from typing import BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import read_folder
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -197,9 +198,7 @@ def open_log(
     ...
     aura_ums.errors.FileFormatError: .../missing: expected a log folder, got no such folder
     """
-    base = Path(folder)
-    if not base.is_dir():
-        raise FileFormatError(str(base), "", "expected a log folder, got no such folder")
+    base = read_folder(folder, kind="log folder")
     gap = _max_gap(max_gap, "max_gap")
     if isinstance(block_bytes, bool) or not isinstance(block_bytes, int) or block_bytes < 1:
         raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
