@@ -126,7 +126,13 @@ _TABLE: tuple[MetricKey, ...] = (
         (REPLAY,),
         "Wedge width above which a frame's observations reduce the map together; null: one by one.",
     ),
-    _key("max_vertices", "count", _K.COUNT, (REPLAY,), "Cap on the map polygon's vertices."),
+    _key(
+        "max_vertices",
+        "count",
+        _K.COUNT,
+        (REPLAY,),
+        "Cap on the map polygon's vertices (a sliced map's: each slice's).",
+    ),
     _key(
         "envelope_max_vertices",
         "count",

@@ -260,7 +260,8 @@ relocalize_after (2), got 1
     max_vertices: int = _setting(
         64,
         SettingInfo(
-            "Cap on the map polygon's vertices (at most 100000): fewer is faster and looser",
+            "Cap on the map polygon's vertices, a sliced map's on each slice's (at most 100000): fewer "
+            "is faster and looser",
             "",
             int,
             low=3,
