@@ -32,6 +32,7 @@ replays nothing: it prints (and with ``--write-docs`` writes) the tables of an e
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime
 import json
 import math
@@ -68,7 +69,7 @@ from aura_ums.logs import (
     replay_log,
     replay_windows,
 )
-from aura_ums.manager import ManagerSettings
+from aura_ums.manager import ManagerSettings, SettingInfo
 from aura_ums.manager._settings import SettingValue
 from aura_ums.uncertainty import LandmarkClass, Pose
 from filterpy_ekf import FilterpyLogEkf
@@ -432,13 +433,17 @@ def document(
 
 
 def setting(text: str) -> tuple[str, SettingValue]:
-    """Parse ``KEY=VALUE``: ``none``, ``true``, ``false``, an integer or a number."""
+    """Parse ``KEY=VALUE``: ``none``, ``true``, ``false``, an integer, a number or an angle (``2deg``)."""
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
         raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
     word = value.strip().lower()
     parsed: SettingValue
-    if word in ("none", "true", "false"):
+    fields = {field.name: field for field in dataclasses.fields(ManagerSettings)}
+    angle = SettingInfo.of(fields[key.strip()]).read(word) if key.strip() in fields else word
+    if isinstance(angle, float):  # an angle setting in degrees, as on the command line
+        parsed = angle
+    elif word in ("none", "true", "false"):
         parsed = {"none": None, "true": True, "false": False}[word]
     elif re.fullmatch(r"[+-]?\d+", word):
         parsed = int(word)

@@ -109,13 +109,17 @@ def test_settings_come_from_the_defaults_then_the_options() -> None:
 @pytest.mark.parametrize(
     ("text", "expected"),
     [("relaxed_q=1", ("relaxed_q", 1)), ("slice_width=None", ("slice_width", None)),
-     ("robust=false", ("robust", False)), ("sigmas = 2.5", ("sigmas", 2.5))],
+     ("robust=false", ("robust", False)), ("sigmas = 2.5", ("sigmas", 2.5)),
+     ("slice_width=2deg", ("slice_width", math.radians(2.0))), ("joint_sector=0.1", ("joint_sector", 0.1))],
 )  # fmt: skip
 def test_a_setting_option_is_parsed(text: str, expected: tuple[str, object]) -> None:
     assert bench.setting(text) == expected
 
 
-@pytest.mark.parametrize(("text", "message"), [("sigmas", "expected KEY=VALUE"), ("sigmas=big", "a number")])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [("sigmas", "expected KEY=VALUE"), ("sigmas=big", "a number"), ("relaxed_q=2deg", "a number")],
+)
 def test_a_bad_setting_option_is_refused(text: str, message: str) -> None:
     with pytest.raises(argparse.ArgumentTypeError, match=message):
         bench.setting(text)
