@@ -415,6 +415,13 @@ def deny(monkeypatch: pytest.MonkeyPatch) -> Callable[[Path], None]:
     return deny_path
 
 
+def read_log(command: str, log: Path, inputs: Path, out: Path) -> Result:
+    """Run a command that reads a log folder (replay, calibrate, compare), writing ``out``."""
+    if command == "calibrate":
+        return invoke(command, log, "--out", out)
+    return invoke(command, log, "--terrain", inputs / "terrain.toml", "--metrics-json", out)
+
+
 @pytest.mark.parametrize(
     "name", ["meta.toml", "commands.csv", "observations.csv", "groundtruth.csv", "landmarks.csv"]
 )
@@ -426,12 +433,7 @@ def test_an_unreadable_log_file_is_named_with_the_reason(
     shutil.copytree(inputs / "log", log)
     deny(log / name)
     out = tmp_path / "out.json"
-    options = (
-        ("--out", out)
-        if command == "calibrate"
-        else ("--terrain", inputs / "terrain.toml", "--metrics-json", out)
-    )
-    result = invoke(command, log, *options)
+    result = read_log(command, log, inputs, out)
     refused(result, f"error: {log / name}: expected a readable ")
     assert result.stderr.endswith(f" file, got {os.strerror(errno.EACCES)}\n")
     assert not out.exists()
@@ -446,12 +448,7 @@ def test_an_unreadable_log_folder_is_named_not_its_first_file(
     shutil.copytree(inputs / "log", log)
     deny(log)
     out = tmp_path / "out.json"
-    options = (
-        ("--out", out)
-        if command == "calibrate"
-        else ("--terrain", inputs / "terrain.toml", "--metrics-json", out)
-    )
-    result = invoke(command, log, *options)
+    result = read_log(command, log, inputs, out)
     log.chmod(0o755)
     refused(result)
     assert result.stderr == f"error: {log}: expected a readable log folder, got {os.strerror(errno.EACCES)}\n"
