@@ -192,6 +192,26 @@ def test_the_update_records_are_those_the_public_constructors_build() -> None:
         step.time = 0.0  # type: ignore[misc]
 
 
+@pytest.mark.parametrize("slice_width", [None, math.radians(2.0)])
+def test_outcomes_keep_the_maps_and_take_their_areas_and_widths_from_them(slice_width: float | None) -> None:
+    # The areas are read from the maps when asked: a sliced map's is a hull of every slice.
+    _, first, second = by_hand()
+    unknown = BearingObservation("nowhere", 3.0, 0.0, 0.01)
+    board = board_with(*[(float(t), STRIDE) for t in (1, 2, 3, 4)], observations=(first, second, unknown))
+    step = manager_for(slice_width=slice_width).update(board, now=4.0)
+    accepted_first, rejected, accepted_second = step.outcomes
+    assert rejected.map_before is rejected.map_after
+    assert rejected.area_before == rejected.area_after == rejected.map_before.area
+    for outcome in (accepted_first, accepted_second):
+        assert outcome.map_after is not outcome.map_before
+        assert outcome.map_after.is_sliced == outcome.map_before.is_sliced == (slice_width is not None)
+        assert outcome.area_after == outcome.map_after.polygon.area <= outcome.area_before
+        assert outcome.wedge_width_after == outcome.map_after.wedge.width <= outcome.wedge_width_before
+    assert accepted_second.area_after < accepted_second.area_before
+    # Between them the map grew (reports at t = 3): the second starts from a grown map.
+    assert accepted_second.map_before.area > accepted_first.map_after.area
+
+
 def test_split_updates_consume_each_report_once_and_give_the_same_map() -> None:
     (_, _, final), first, second = by_hand()
     board = board_with(*[(float(t), STRIDE) for t in (1, 2, 3, 4)], observations=(first, second))

@@ -283,3 +283,30 @@ def test_a_pair_of_mismatched_classes_is_refused() -> None:
     corner = PointLandmark("a", 5.0, 0.0, 2.0)
     with pytest.raises(InputError, match="for a BearingObservation, got PointLandmark"):
         reduce_jointly(prior, [(BearingObservation("a", 0.0, 0.0, 0.01), corner)] * 2)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(math.radians(3.0), TWO_PI), st.booleans())
+def test_the_managers_joint_reduction_is_reduce_jointly_without_the_areas(
+    seed: int, sector: float, sliced: bool
+) -> None:
+    # The manager reads no area: its entry gives reduce_jointly's map, bit for bit, or its reason.
+    rng = np.random.default_rng(seed)
+    prior = wide_prior(rng)
+    if sliced:
+        prior = prior.with_slices(math.radians(4.0))
+    x, y = rng.uniform(-10.0, 10.0, 2).tolist()
+    pose = Pose(x, y, float(rng.uniform(-math.pi, math.pi)))
+    sightings = sightings_of(rng, prior, pose, int(rng.integers(1, 4)))
+    public = reduce_jointly(prior, sightings, sector=sector, max_vertices=16)
+    found = prior._reduce_jointly(sightings, sector, 16)
+    if isinstance(found, str):
+        assert not public.consistent
+        assert found == public.reason
+        return
+    assert public.consistent
+    assert found.polygon.vertices.tobytes() == public.map.polygon.vertices.tobytes()
+    assert found.center.tobytes() == public.map.center.tobytes()
+    assert found.wedge == public.map.wedge
+    assert found.is_sliced == sliced
+    assert public.area_after == found.area

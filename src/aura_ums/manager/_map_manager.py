@@ -35,7 +35,6 @@ from aura_ums.uncertainty import (
     TurnAndRun,
     grow_from_anchor,
     intersect_maps,
-    reduce_jointly,
 )
 from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
 
@@ -72,6 +71,9 @@ class ManagerState(enum.Enum):
 class ObservationOutcome:
     """What the manager did with one identified observation.
 
+    The maps are kept, not their areas: a sliced map's area is a hull of every slice, the
+    costliest part of a reduction, so it is taken only when asked for.
+
     Attributes
     ----------
     observation : BearingObservation or RangeBearingObservation or GroundLineObservation
@@ -81,21 +83,49 @@ class ObservationOutcome:
         ``relaxed_q > 0``: some branch of the relaxed intersection kept it).
     reason : RejectReason or None
         Why it was rejected; None when accepted.
+    map_before, map_after : SpatialUncertaintyMap
+        The map before and after (the same map when rejected). With ``relaxed_q > 0``:
+        the primary branch's (the fewest exclusions), the tight map.
     area_before, area_after : float
-        Area of the map's polygon before and after, square metres (equal when rejected).
-        With ``relaxed_q > 0``: of the primary branch (the fewest exclusions), the tight map.
+        Area of the maps' polygons, square metres (equal when rejected).
     wedge_width_before, wedge_width_after : float
-        Width of the heading wedge before and after, radians (equal when rejected); with
-        ``relaxed_q > 0``, of the primary branch.
+        Width of the maps' heading wedges, radians (equal when rejected).
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import BearingObservation, Pose
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.2)
+    >>> seen = BearingObservation("pole", 0.0, 0.5, 0.01)
+    >>> kept = ObservationOutcome(seen, False, RejectReason.UNKNOWN_LANDMARK, start, start)
+    >>> kept.area_after == kept.area_before == start.area, kept.wedge_width_after
+    (True, 0.4)
     """
 
     observation: Observation
     accepted: bool
     reason: RejectReason | None
-    area_before: float
-    area_after: float
-    wedge_width_before: float
-    wedge_width_after: float
+    map_before: SpatialUncertaintyMap
+    map_after: SpatialUncertaintyMap
+
+    @property
+    def area_before(self) -> float:
+        """Area of the map before, square metres."""
+        return self.map_before.area
+
+    @property
+    def area_after(self) -> float:
+        """Area of the map after, square metres."""
+        return self.map_after.area
+
+    @property
+    def wedge_width_before(self) -> float:
+        """Width of the heading wedge before, radians."""
+        return self.map_before.wedge.width
+
+    @property
+    def wedge_width_after(self) -> float:
+        """Width of the heading wedge after, radians."""
+        return self.map_after.wedge.width
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -698,10 +728,8 @@ class UncertaintyMapManager:
                         observation,
                         not dropped,
                         RejectReason.EXCLUDED if dropped else None,
-                        prior.area,
-                        prior.area if dropped else after.area,
-                        prior.wedge.width,
-                        prior.wedge.width if dropped else after.wedge.width,
+                        prior,
+                        prior if dropped else after,
                     )
                 continue
             # Every branch died: the gate, branch by branch; the primary's outcomes are reported.
@@ -720,10 +748,9 @@ class UncertaintyMapManager:
                         verdicts[position] = outcome
             state = dataclasses.replace(state, branches=tuple(gated))
         if outcomes is not None:
-            area, width = before.area, before.wedge.width
             for position, (observation, found) in enumerate(zip(observations, checked, strict=True)):
                 if isinstance(found, RejectReason):
-                    outcomes.append(ObservationOutcome(observation, False, found, area, area, width, width))
+                    outcomes.append(ObservationOutcome(observation, False, found, before, before))
                 else:
                     outcomes.append(verdicts[position])
         return state
@@ -746,11 +773,9 @@ class UncertaintyMapManager:
             and self._joint_above is not None
             and current.wedge.width > self._joint_above
         ):
-            together = reduce_jointly(
-                current, pairs, sector=self._joint_sector, max_vertices=self._max_vertices
-            )
-            if together.consistent:
-                return together.map
+            together = current._reduce_jointly(pairs, self._joint_sector, self._max_vertices)
+            if not isinstance(together, str):
+                return together
         for observation, landmark in pairs:
             # Inside the prior with its area (> 0) and its wedge's width: the same set.
             found = current._reduce_kept(observation, landmark, self._max_vertices)
@@ -1023,31 +1048,17 @@ class UncertaintyMapManager:
                 if not isinstance(found, RejectReason)
             ]
             if len(sightings) >= 2:
-                joint = reduce_jointly(
-                    current, sightings, sector=self._joint_sector, max_vertices=self._max_vertices
-                )
-                if joint.consistent:
-                    reduced = joint.map
+                # Paired by id and class (_landmark_for): the pairs reduce_jointly would check.
+                joint = current._reduce_jointly(sightings, self._joint_sector, self._max_vertices)
+                if not isinstance(joint, str):
+                    reduced = joint
                     if outcomes is None:
                         return reduced
-                    area, width = current.area, current.wedge.width
                     for observation, found in zip(observations, checked, strict=True):
                         if isinstance(found, RejectReason):
-                            outcomes.append(
-                                ObservationOutcome(observation, False, found, area, area, width, width)
-                            )
+                            outcomes.append(ObservationOutcome(observation, False, found, current, current))
                         else:
-                            outcomes.append(
-                                ObservationOutcome(
-                                    observation,
-                                    True,
-                                    None,
-                                    area,
-                                    joint.area_after,
-                                    width,
-                                    reduced.wedge.width,
-                                )
-                            )
+                            outcomes.append(ObservationOutcome(observation, True, None, current, reduced))
                     return reduced
         for observation, found in zip(observations, checked, strict=True):
             current = self._reduce(current, observation, found, outcomes)
@@ -1077,23 +1088,17 @@ class UncertaintyMapManager:
             reason = landmark
         else:
             # Found by the observation's id, of its class: the pair reduce() would check.
-            found = current._reduce_checked(observation, landmark, self._max_vertices)
+            found = current._reduce_checked(observation, landmark, self._max_vertices, measured=False)
             if not isinstance(found, str):
-                reduced, area_before, area_after = found
+                reduced = found[0]
                 if outcomes is not None:
-                    width_before, width_after = current.wedge.width, reduced.wedge.width
-                    outcomes.append(
-                        ObservationOutcome(
-                            observation, True, None, area_before, area_after, width_before, width_after
-                        )
-                    )
+                    outcomes.append(ObservationOutcome(observation, True, None, current, reduced))
                 return reduced
             # The reductions word their reasons; each is a RejectReason's value.
             reason = RejectReason(found)
         if outcomes is not None:
             # Rejected: the map stays, and so do its area and width.
-            area, width = current.area, current.wedge.width
-            outcomes.append(ObservationOutcome(observation, False, reason, area, area, width, width))
+            outcomes.append(ObservationOutcome(observation, False, reason, current, current))
         return current
 
     def _update_state(self, found: bool, missed_in_a_row: int) -> None:

@@ -26,10 +26,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from aura_ums import _native
 from aura_ums._native import TOLERANCE, cap_inside
 from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
-from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs
+from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, intersect_arcs
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -114,18 +115,28 @@ def reduce_jointly(
     pairs = _checked_sightings(sightings)
     width_limit = check_sector(sector, "sector")
     cap = integer_at_least(max_vertices, "max_vertices", 3)
+    wedge = prior.wedge
+    found = joint_reduced(prior, pairs, width_limit, cap)
+    if isinstance(found, str):
+        area = prior.area
+        return Reduction(prior, False, area, area, wedge, wedge, found)
+    return Reduction(found, True, prior.area, found.area, wedge, found.wedge)
 
+
+def joint_reduced(
+    prior: SpatialUncertaintyMap, pairs: Sequence[tuple[Observation, Landmark]], sector: float, cap: int
+) -> SpatialUncertaintyMap | str:
+    """:func:`reduce_jointly` for checked arguments: the reduced map, or why no heading agrees.
+
+    For the map manager, which reads neither area (a sliced map's is a hull of every slice).
+    """
     wedge = prior.wedge
     lo, width = wedge.center - wedge.cw, min(wedge.width, _TWO_PI)
-    count = max(1, math.ceil(width / width_limit - 1e-9))
+    count = max(1, math.ceil(width / sector - 1e-9))
     if count == 1 or prior.is_sliced:
         # A sliced map's slices are its sectors: each is reduced by every observation in
         # turn, and a slice that disagrees with one drops out.
-        found = _in_turn(prior, pairs, cap)
-        if isinstance(found, str):
-            area = prior.area
-            return Reduction(prior, False, area, area, wedge, wedge, found)
-        return Reduction(found, True, prior.area, found.area, wedge, found.wedge)
+        return _in_turn(prior, pairs, cap)
     step = width / count
     # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
     half = 0.5 * step + TOLERANCE
@@ -140,8 +151,7 @@ def reduce_jointly(
         if not isinstance(found, str):
             kept.append((start, found))
     if not kept:
-        area = prior.area
-        return Reduction(prior, False, area, area, wedge, wedge, JOINT_INCONSISTENT)
+        return JOINT_INCONSISTENT
     return _combined(prior, kept, wedge.is_full_circle, cap)
 
 
@@ -174,7 +184,7 @@ def _in_turn(
 ) -> SpatialUncertaintyMap | str:
     """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is."""
     for observation, landmark in pairs:
-        found = reduce_checked(current, observation, landmark, cap)
+        found = reduce_checked(current, observation, landmark, cap, measured=False)
         if isinstance(found, str):
             return found
         current = found[0]
@@ -186,9 +196,11 @@ def _combined(
     kept: Sequence[tuple[float, SpatialUncertaintyMap]],
     full_circle: bool,
     cap: int,
-) -> Reduction:
+) -> SpatialUncertaintyMap:
     """One map holding every sector's result: their hull, and one wedge over their headings."""
-    outline = convex_hull(np.concatenate([m.polygon.vertices for _, m in kept]))
+    points = np.concatenate([m.polygon.vertices for _, m in kept])
+    # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
+    outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
     if len(outline) > cap:
         # As a single reduction's tail does: an outer polygon inside the prior, or, when
         # the hull hugs the prior too closely for that, the prior itself, which holds it.
@@ -224,13 +236,11 @@ def _combined(
     # possible) in the sector result nearest to it, with that result's centre.
     heading_kept = (prior.wedge.center - arc[0]) % _TWO_PI <= arc[1]
     if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
-        reduced = SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
-        return Reduction(reduced, True, prior.area, reduced.area, prior.wedge, reduced.wedge)
+        return SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
     nearest = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[1]
     heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center
-    reduced = SpatialUncertaintyMap(polygon, nearest.center, arc_wedge(arc, heading))
-    return Reduction(reduced, True, prior.area, reduced.area, prior.wedge, reduced.wedge)
+    return SpatialUncertaintyMap(polygon, nearest.center, arc_wedge(arc, heading))
 
 
 def _angular_gap(angle: float, wedge: HeadingWedge) -> float:

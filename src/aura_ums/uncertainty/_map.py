@@ -535,14 +535,33 @@ class SpatialUncertaintyMap:
         return reduce_map(self, observation, landmark, max_vertices)
 
     def _reduce_checked(
-        self, observation: Observation, landmark: Landmark, max_vertices: int = DEFAULT_MAX_VERTICES
+        self,
+        observation: Observation,
+        landmark: Landmark,
+        max_vertices: int = DEFAULT_MAX_VERTICES,
+        *,
+        measured: bool = True,
     ) -> Reduced:
         """:meth:`reduce` for a caller that paired the landmark with the observation by id and class.
 
         Returns (reduced map, area before, area after), or why no pose agrees: the
-        manager reads nothing else, so no :class:`Reduction` is built.
+        manager reads nothing else, so no :class:`Reduction` is built. Without
+        ``measured`` a sliced map's areas may be NaN (see ``reduce_checked``).
         """
-        return reduce_checked(self, observation, landmark, max_vertices)
+        return reduce_checked(self, observation, landmark, max_vertices, measured=measured)
+
+    def _reduce_jointly(
+        self, pairs: Sequence[tuple[Observation, Landmark]], sector: float, max_vertices: int
+    ) -> SpatialUncertaintyMap | str:
+        """:func:`~aura_ums.uncertainty.reduce_jointly` for checked pairs: the map, or why none agrees.
+
+        For the map manager, which reads no area and pairs each observation with its
+        landmark by id and class itself (``sector`` in (0, 2 pi], ``max_vertices >= 3``).
+        """
+        # The joint reduction builds maps of this class: its module imports this one.
+        from aura_ums.uncertainty._joint import joint_reduced
+
+        return joint_reduced(self, pairs, sector, max_vertices)
 
     def _reduce_kept(
         self, observation: Observation, landmark: Landmark, max_vertices: int = DEFAULT_MAX_VERTICES

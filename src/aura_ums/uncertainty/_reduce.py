@@ -164,16 +164,23 @@ def reduce_map(
 
 
 def reduce_checked(
-    prior: SpatialUncertaintyMap, observation: Observation, landmark: Landmark, max_vertices: int
+    prior: SpatialUncertaintyMap,
+    observation: Observation,
+    landmark: Landmark,
+    max_vertices: int,
+    *,
+    measured: bool = True,
 ) -> Reduced:
     """:func:`reduce_map` for arguments already checked, without its :class:`Reduction` record.
 
     For the map manager, which pairs each observation with its landmark by id and class
-    itself and reads only the reduced map and the areas (``max_vertices >= 3``).
+    itself (``max_vertices >= 3``). Without ``measured``, a sliced map's areas are NaN:
+    each is a hull of every slice, and the manager keeps the maps, not their areas. A
+    product map's come from its kernel at no cost, so they are always given.
     """
     slices = prior._slices
     if slices is not None:
-        return _reduce_sliced(prior, slices, observation, landmark, max_vertices)
+        return _reduce_sliced(prior, slices, observation, landmark, max_vertices, measured=measured)
     wedge = prior.wedge
     center_x, center_y = prior.center.tolist()
     kernel, _, arguments = _kernel_call(observation, landmark, max_vertices)
