@@ -21,6 +21,12 @@ busy machine (load average about 25 on 2 cores): Class I 760-1,860 -> 470-1,310 
 Class II 570-650 -> 350-400 µs, 1.4-1.9x faster with every metric unchanged. With
 ``relaxed_q=1, relaxed_window=10`` on Dataset 6 robot 2 and Dataset 7 robot 5: 65,000-86,000 ->
 53,000-61,000 µs (Class I) and 40,000-78,000 -> 28,000-49,000 µs (Class II), 1.2-1.6x.
+
+Measured (28 November 2026, the manager no longer taking the areas it never reads: 038176d
+against 09c1b76, run alternately twice with ``--logs mrclam6:2,mrclam7:1,mrclam7:3,mrclam7:5``,
+the older tree through ``PYTHONPATH``, load about 1): 2-degree cells, Class I 820-1,611 ->
+489-1,070 µs per frame, Class II 589-953 -> 358-566, every other figure identical; the product
+map's Class I replays 3.1-4.6 -> 1.6-3.4 s wall time, its median µs within the noise.
 """
 
 from __future__ import annotations
