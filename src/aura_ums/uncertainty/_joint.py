@@ -22,7 +22,7 @@ reduction's result is: both only add.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -141,18 +141,28 @@ def joint_reduced(
     # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
     half = 0.5 * step + TOLERANCE
     kept: list[tuple[float, SpatialUncertaintyMap]] = []
+    restricted_by_start: dict[float, SpatialUncertaintyMap] = {}
     for k in range(count):
         start = lo + k * step
         # start is finite and half > 0: the checks of HeadingWedge() would all pass.
         restricted = SpatialUncertaintyMap._trusted(
             prior.polygon, prior.center, HeadingWedge._trusted(start + 0.5 * step, half, half)
         )
-        found = _in_turn(restricted, pairs, cap)
+        # Centres not held: at most one sector's is read, and that one is reduced again.
+        found = _in_turn(restricted, pairs, cap, held=False)
         if not isinstance(found, str):
             kept.append((start, found))
+            restricted_by_start[start] = restricted
+
+    def held_again(start: float) -> SpatialUncertaintyMap:
+        again = _in_turn(restricted_by_start[start], pairs, cap)
+        # The same polygons as without held centres (they never depend on the centre).
+        assert not isinstance(again, str)
+        return again
+
     if not kept:
         return JOINT_INCONSISTENT
-    return _combined(prior, kept, wedge.is_full_circle, cap)
+    return _combined(prior, kept, wedge.is_full_circle, cap, held_again)
 
 
 def check_sector(value: object, name: str) -> float:
@@ -180,11 +190,18 @@ def _checked_sightings(sightings: object) -> list[tuple[Observation, Landmark]]:
 
 
 def _in_turn(
-    current: SpatialUncertaintyMap, pairs: Sequence[tuple[Observation, Landmark]], cap: int
+    current: SpatialUncertaintyMap,
+    pairs: Sequence[tuple[Observation, Landmark]],
+    cap: int,
+    *,
+    held: bool = True,
 ) -> SpatialUncertaintyMap | str:
-    """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is."""
+    """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is.
+
+    Without ``held``, moved centres are left as the kernel gives them (see ``reduce_checked``).
+    """
     for observation, landmark in pairs:
-        found = reduce_checked(current, observation, landmark, cap, measured=False)
+        found = reduce_checked(current, observation, landmark, cap, measured=False, held=held)
         if isinstance(found, str):
             return found
         current = found[0]
@@ -196,8 +213,14 @@ def _combined(
     kept: Sequence[tuple[float, SpatialUncertaintyMap]],
     full_circle: bool,
     cap: int,
+    held_again: Callable[[float], SpatialUncertaintyMap],
 ) -> SpatialUncertaintyMap:
-    """One map holding every sector's result: their hull, and one wedge over their headings."""
+    """One map holding every sector's result: their hull, and one wedge over their headings.
+
+    The results' centres were not held inside their polygons; ``held_again(start)`` gives
+    the result of the sector starting at ``start`` with its centre held, for the one whose
+    centre the map takes.
+    """
     points = np.concatenate([m.polygon.vertices for _, m in kept])
     # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
     outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
@@ -238,7 +261,8 @@ def _combined(
     if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
         return SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
-    nearest = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[1]
+    nearest_start = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[0]
+    nearest = held_again(nearest_start)
     heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center
     return SpatialUncertaintyMap(polygon, nearest.center, arc_wedge(arc, heading))
 
