@@ -465,3 +465,62 @@ def test_an_unreadable_dataset_folder_is_named(tmp_path: Path, deny: Callable[[P
     what = "a readable UTIAS MRCLAM dataset folder"
     assert result.stderr == f"error: {dataset}: expected {what}, got {os.strerror(errno.EACCES)}\n"
     assert not (tmp_path / "new").exists()
+
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "source"),
+    [
+        (("replay", "{log}", "--terrain", "{file}"), "{terrain}"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--sensors", "{file}"), "{terrain}"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--camera", "{file}"), "examples/camera.toml"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--resume", "{file}"), "{terrain}"),
+        (("compare", "{log}", "--terrain", "{file}"), "{terrain}"),
+        (("simulate", "{file}", "--runs", "1"), "scenarios/paper_sidewalk.toml"),
+    ],
+)
+def test_an_unreadable_input_file_is_named_by_our_reader_not_the_parser(
+    arguments: tuple[str, ...], source: str, inputs: Path, tmp_path: Path, deny: Callable[[Path], None]
+) -> None:
+    # The parser's own check answered in its boxed usage format ("Invalid value for
+    # '--terrain': path 'ut.toml' is not readable."); our readers give the one-line error.
+    given = Path(source.format(terrain=inputs / "terrain.toml"))
+    file = tmp_path / ("input" + given.suffix)
+    shutil.copyfile(given if given.is_absolute() else ROOT / given, file)
+    deny(file)
+    values = {"log": inputs / "log", "terrain": inputs / "terrain.toml", "file": file}
+    out = tmp_path / "out.json"
+    result = invoke(*(a.format(**values) for a in arguments), "--metrics-json", out)
+    file.chmod(0o644)
+    refused(result, str(file), os.strerror(errno.EACCES))
+    assert "Invalid value" not in result.output
+    assert result.stderr.count("\n") == 1
+    assert not out.exists()
+
+
+def _commands(group: typer.Typer) -> Iterator[Callable[..., Any]]:
+    for command in group.registered_commands:
+        assert command.callback is not None
+        yield command.callback
+    for sub in group.registered_groups:
+        assert sub.typer_instance is not None
+        yield from _commands(sub.typer_instance)
+
+
+def test_no_path_is_checked_by_the_parser_before_our_readers() -> None:
+    # Every path is read (or written) by aura-ums itself, which names it with the reason.
+    import typing
+
+    from typer.models import ArgumentInfo, OptionInfo
+
+    checked = []
+    for callback in _commands(app):
+        for name, hint in typing.get_type_hints(callback, include_extras=True).items():
+            if typing.get_origin(hint) is not typing.Annotated or "Path" not in str(hint.__origin__):
+                continue
+            info = next(m for m in hint.__metadata__ if isinstance(m, (OptionInfo, ArgumentInfo)))
+            checked.append(name)
+            assert info.parser is not None or info.readable is False, f"{callback.__name__}: {name}"
+    assert len(checked) >= 20

@@ -127,17 +127,18 @@ def demo(
 @interruptible
 @manager_options(default_from="the scenario's [manager]")
 def simulate(
-    scenario: Annotated[Path, typer.Argument(help="Scenario TOML file (see aura_ums.sim).")],
+    scenario: Annotated[Path, typer.Argument(readable=False, help="Scenario TOML file (see aura_ums.sim).")],
     runs: Annotated[int, typer.Option("--runs", help="Monte Carlo runs, >= 1.")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the whole Monte Carlo, >= 0.")] = 0,
     metrics_json: Annotated[
-        Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
+        Path | None,
+        typer.Option("--metrics-json", readable=False, help="Write the metrics as JSON to this file."),
     ] = None,
     prune: Annotated[
         bool,
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
-    mcap: Annotated[Path | None, typer.Option("--mcap", help=MCAP_HELP)] = None,
+    mcap: Annotated[Path | None, typer.Option("--mcap", readable=False, help=MCAP_HELP)] = None,
     live: Live = False,
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,

@@ -57,7 +57,10 @@ def rosbag_command(
         ),
     ],
     landmarks: Annotated[
-        Path, typer.Option("--landmarks", help="landmarks.csv in the log format (id, x, y, ...; SI units).")
+        Path,
+        typer.Option(
+            "--landmarks", readable=False, help="landmarks.csv in the log format (id, x, y, ...; SI units)."
+        ),
     ],
     groundtruth: Annotated[
         str | None,

@@ -76,11 +76,14 @@ class Reverse(enum.StrEnum):
 
 
 _Classes = Annotated[Classes, typer.Option("--classes", help="I: bearings only; II: range and bearing.")]
-_Terrain = Annotated[Path, typer.Option("--terrain", help="Terrain table TOML holding the log's terrain.")]
+_Terrain = Annotated[
+    Path, typer.Option("--terrain", readable=False, help="Terrain table TOML holding the log's terrain.")
+]
 _Sensors = Annotated[
     Path | None,
     typer.Option(
         "--sensors",
+        readable=False,
         help="Sensor calibration TOML from `aura-ums calibrate` (default: the one it wrote beside "
         "--terrain, TERRAIN.sensors.toml, when there is one; else the log's meta.toml).",
     ),
@@ -104,6 +107,7 @@ _Camera = Annotated[
     Path | None,
     typer.Option(
         "--camera",
+        readable=False,
         help="Camera TOML (e.g. examples/virtual_camera_60deg.toml): judge each observation's image window.",
     ),
 ]
@@ -113,7 +117,9 @@ _WindowMargin = Annotated[
 ]
 _WindowsCsv = Annotated[
     Path | None,
-    typer.Option("--windows-csv", help="Write one row per observation and window method (--camera)."),
+    typer.Option(
+        "--windows-csv", readable=False, help="Write one row per observation and window method (--camera)."
+    ),
 ]
 
 
@@ -187,11 +193,13 @@ def calibrate(
             help="Log folders with groundtruth.csv, one terrain.", parser=folder_argument("LOG_DIRS")
         ),
     ],
-    out: Annotated[Path, typer.Option("--out", help="Terrain table TOML to write.")],
+    out: Annotated[Path, typer.Option("--out", readable=False, help="Terrain table TOML to write.")],
     sensors_out: Annotated[
         Path | None,
         typer.Option(
-            "--sensors-out", help="Motion and sensor bounds TOML (default: OUT with .sensors.toml)."
+            "--sensors-out",
+            readable=False,
+            help="Motion and sensor bounds TOML (default: OUT with .sensors.toml).",
         ),
     ] = None,
     quantile: Annotated[float, typer.Option(help="Quantile the motion and working bounds cover.")] = 0.99,
@@ -306,10 +314,12 @@ def replay(
     max_truth_gap: _MaxTruthGap = None,
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
-        Path | None, typer.Option("--metrics-json", help="Write the metrics as JSON to this file.")
+        Path | None,
+        typer.Option("--metrics-json", readable=False, help="Write the metrics as JSON to this file."),
     ] = None,
     steps_csv: Annotated[
-        Path | None, typer.Option("--steps-csv", help="Write one row per time step to this CSV file.")
+        Path | None,
+        typer.Option("--steps-csv", readable=False, help="Write one row per time step to this CSV file."),
     ] = None,
     plot: Annotated[
         Path | None,
@@ -318,7 +328,7 @@ def replay(
         ),
     ] = None,
     mcap: Annotated[
-        Path | None, typer.Option("--mcap", help="Write the replay as MCAP for Foxglove.")
+        Path | None, typer.Option("--mcap", readable=False, help="Write the replay as MCAP for Foxglove.")
     ] = None,
     camera: _Camera = None,
     window_margin: _WindowMargin = 0.0,
@@ -326,12 +336,18 @@ def replay(
     save_state: Annotated[
         Path | None,
         typer.Option(
-            "--save-state", help="Write where the replay stopped (versioned JSON), to --resume from."
+            "--save-state",
+            readable=False,
+            help="Write where the replay stopped (versioned JSON), to --resume from.",
         ),
     ] = None,
     resume: Annotated[
         Path | None,
-        typer.Option("--resume", help="Continue a replay of this log from a state saved by --save-state."),
+        typer.Option(
+            "--resume",
+            readable=False,
+            help="Continue a replay of this log from a state saved by --save-state.",
+        ),
     ] = None,
     until: Annotated[
         float | None,
@@ -516,6 +532,7 @@ def compare(
         list[Path] | None,
         typer.Option(
             "--noise-from",
+            readable=False,
             help="Calibration logs whose observation errors give the filters' noise (default: the "
             "[noise] of the sensors file; never LOG_DIR itself).",
         ),
@@ -527,7 +544,7 @@ def compare(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
-        Path | None, typer.Option("--metrics-json", help="Write the table as JSON.")
+        Path | None, typer.Option("--metrics-json", readable=False, help="Write the table as JSON.")
     ] = None,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
