@@ -22,7 +22,7 @@ reduction's result is: both only add.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -140,8 +140,7 @@ def joint_reduced(
     step = width / count
     # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
     half = 0.5 * step + TOLERANCE
-    kept: list[tuple[float, SpatialUncertaintyMap]] = []
-    restricted_by_start: dict[float, SpatialUncertaintyMap] = {}
+    kept: list[_Sector] = []
     for k in range(count):
         start = lo + k * step
         # start is finite and half > 0: the checks of HeadingWedge() would all pass.
@@ -151,18 +150,10 @@ def joint_reduced(
         # Centres not held: at most one sector's is read, and that one is reduced again.
         found = _in_turn(restricted, pairs, cap, held=False)
         if not isinstance(found, str):
-            kept.append((start, found))
-            restricted_by_start[start] = restricted
-
-    def held_again(start: float) -> SpatialUncertaintyMap:
-        again = _in_turn(restricted_by_start[start], pairs, cap)
-        # The same polygons as without held centres (they never depend on the centre).
-        assert not isinstance(again, str)
-        return again
-
+            kept.append((start, found, restricted))
     if not kept:
         return JOINT_INCONSISTENT
-    return _combined(prior, kept, wedge.is_full_circle, cap, held_again)
+    return _combined(prior, kept, wedge.is_full_circle, pairs, cap)
 
 
 def check_sector(value: object, name: str) -> float:
@@ -208,20 +199,24 @@ def _in_turn(
     return current
 
 
+#: A sector the joint reduction kept: where it starts (radians), its result (centre not
+#: held) and the map restricted to it that the observations reduced.
+_Sector = tuple[float, SpatialUncertaintyMap, SpatialUncertaintyMap]
+
+
 def _combined(
     prior: SpatialUncertaintyMap,
-    kept: Sequence[tuple[float, SpatialUncertaintyMap]],
+    kept: Sequence[_Sector],
     full_circle: bool,
+    pairs: Sequence[tuple[Observation, Landmark]],
     cap: int,
-    held_again: Callable[[float], SpatialUncertaintyMap],
 ) -> SpatialUncertaintyMap:
     """One map holding every sector's result: their hull, and one wedge over their headings.
 
-    The results' centres were not held inside their polygons; ``held_again(start)`` gives
-    the result of the sector starting at ``start`` with its centre held, for the one whose
-    centre the map takes.
+    The results' centres were not held inside their polygons: the one sector whose centre
+    the map takes is reduced again by ``pairs``, held.
     """
-    points = np.concatenate([m.polygon.vertices for _, m in kept])
+    points = np.concatenate([m.polygon.vertices for _, m, _ in kept])
     # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
     outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
     if len(outline) > cap:
@@ -233,7 +228,7 @@ def _combined(
     polygon = ConvexPolygon._trusted(outline)
     # Each result's headings as an interval unwrapped next to its sector, in sector order.
     spans = []
-    for start, result in kept:
+    for start, result, _ in kept:
         result_wedge = result.wedge
         low = start + math.remainder(result_wedge.center - result_wedge.cw - start, _TWO_PI)
         spans.append((low, low + min(result_wedge.width, _TWO_PI)))
@@ -261,8 +256,10 @@ def _combined(
     if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
         return SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
-    nearest_start = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[0]
-    nearest = held_again(nearest_start)
+    restricted = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[2]
+    nearest = _in_turn(restricted, pairs, cap)
+    # The same polygons and wedges as without held centres: they never depend on the centre.
+    assert not isinstance(nearest, str)
     heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center
     return SpatialUncertaintyMap(polygon, nearest.center, arc_wedge(arc, heading))
 
