@@ -28,6 +28,9 @@ from aura_ums.logs import synthetic_log, write_log
 from aura_ums.uncertainty import TerrainTable
 
 runner = CliRunner()
+REPOSITORY = Path(__file__).resolve().parents[2]
+EXAMPLES = REPOSITORY / "examples"
+SCENARIO = REPOSITORY / "scenarios" / "paper_sidewalk.toml"
 
 
 def invoke(*arguments: str | Path) -> Result:
@@ -155,8 +158,7 @@ def test_an_unwritable_output_is_refused_before_the_computation(
     monkeypatch.setattr(aura_ums.sim, "run_scenario", never)
     blocker = tmp_path / "a-file"
     blocker.write_text("")
-    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
-    result = invoke("simulate", scenario, "--runs", "3", "--metrics-json", blocker / "m.json")
+    result = invoke("simulate", SCENARIO, "--runs", "3", "--metrics-json", blocker / "m.json")
     refused(result, "--metrics-json", str(blocker))
 
 
@@ -253,8 +255,6 @@ def test_an_output_through_a_symlink_replaces_the_file_it_leads_to(inputs: Path,
 
 # --- a folder the user may not write into --------------------------------------------------------
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
 #: Where each command's computation starts: none may be reached when an output is unwritable.
 COMPUTATIONS = [
     ("aura_ums.logs", "replay_log"),
@@ -467,18 +467,15 @@ def test_an_unreadable_dataset_folder_is_named(tmp_path: Path, deny: Callable[[P
     assert not (tmp_path / "new").exists()
 
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
 @pytest.mark.parametrize(
     ("arguments", "source"),
     [
         (("replay", "{log}", "--terrain", "{file}"), "{terrain}"),
         (("replay", "{log}", "--terrain", "{terrain}", "--sensors", "{file}"), "{terrain}"),
-        (("replay", "{log}", "--terrain", "{terrain}", "--camera", "{file}"), "examples/camera.toml"),
+        (("replay", "{log}", "--terrain", "{terrain}", "--camera", "{file}"), "{examples}/camera.toml"),
         (("replay", "{log}", "--terrain", "{terrain}", "--resume", "{file}"), "{terrain}"),
         (("compare", "{log}", "--terrain", "{file}"), "{terrain}"),
-        (("simulate", "{file}", "--runs", "1"), "scenarios/paper_sidewalk.toml"),
+        (("simulate", "{file}", "--runs", "1"), "{scenario}"),
     ],
 )
 def test_an_unreadable_input_file_is_named_by_our_reader_not_the_parser(
@@ -486,9 +483,9 @@ def test_an_unreadable_input_file_is_named_by_our_reader_not_the_parser(
 ) -> None:
     # The parser's own check answered in its boxed usage format ("Invalid value for
     # '--terrain': path 'ut.toml' is not readable."); our readers give the one-line error.
-    given = Path(source.format(terrain=inputs / "terrain.toml"))
+    given = Path(source.format(terrain=inputs / "terrain.toml", examples=EXAMPLES, scenario=SCENARIO))
     file = tmp_path / ("input" + given.suffix)
-    shutil.copyfile(given if given.is_absolute() else ROOT / given, file)
+    shutil.copyfile(given, file)
     deny(file)
     values = {"log": inputs / "log", "terrain": inputs / "terrain.toml", "file": file}
     out = tmp_path / "out.json"
