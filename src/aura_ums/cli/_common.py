@@ -235,15 +235,17 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
         return [
             inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[bool | None, option])
         ]
-    if info.unit == "rad":
+    angle = info.unit == "rad"
+    if angle:
         unit += " (or in degrees: 2deg)"
     help_text = f"{info.help}{unit}; {info.expected.removesuffix(' or none')}."
-    if info.unit == "rad":
-        option = typer.Option(
-            flag, help=help_text, show_default=default, parser=_angle_option(flag, info), metavar="<angle>"
-        )
-    else:
-        option = typer.Option(flag, help=help_text, show_default=default)
+    option = typer.Option(
+        flag,
+        help=help_text,
+        show_default=default,
+        parser=_angle_option(flag, info) if angle else None,
+        metavar="<angle>" if angle else None,
+    )
     parameters = [
         inspect.Parameter(field.name, keyword, default=None, annotation=Annotated[info.kind | None, option])
     ]
