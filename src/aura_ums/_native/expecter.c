@@ -14,7 +14,6 @@ static void to_camera(const double *r, double forward, double left, double x, do
 }
 
 PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
     static const char *const names[] = {"base_ax", "base_ay", "base_bx", "base_by", "radius",  "heading_lo",
                                         "heading_width", "arc_step", "r00",   "r01",     "r02",    "r10",
                                         "r11",     "r12",     "r20",     "r21",     "r22",     "forward",
@@ -46,8 +45,7 @@ PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t narg
     Py_buffer view;
     if (get_vertices(args[0], &view, &n) < 0) return NULL;
     const double *polygon = (const double *)view.buf;
-    Work w;
-    memset(&w, 0, sizeof(w));
+    Work local_work, *w = work_take(self, &local_work);
     PyObject *result = NULL;
     double *disk = NULL, *negated = NULL, *camera = NULL, *normalized = NULL;
 
@@ -64,8 +62,8 @@ PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t narg
         PyErr_NoMemory();
         goto done;
     }
-    Edge *edges = scratch(&w.edges, 2 * total, sizeof(Edge));
-    if (!edges || reserve(&w.sum, total) < 0) goto done;
+    Edge *edges = scratch(&w->edges, 2 * total, sizeof(Edge));
+    if (!edges || reserve(&w->sum, total) < 0) goto done;
     for (Py_ssize_t i = 0; i < 2 * n; i++) negated[i] = -polygon[i];
     const double *parts[3] = {base, NULL, NULL};
     Py_ssize_t sizes[3] = {base_count, 0, 0};
@@ -77,11 +75,11 @@ PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t narg
     }
     parts[part_count] = negated;
     sizes[part_count++] = n;
-    Py_ssize_t m = minkowski_sum(parts, sizes, part_count, edges, w.sum.v);
-    const double *d = w.sum.v;
+    Py_ssize_t m = minkowski_sum(parts, sizes, part_count, edges, w->sum.v);
+    const double *d = w->sum.v;
 
     /* Robot-frame points whose hull holds R(-h) d for every d in D and h in the wedge. */
-    Poly *rel = &w.ping;
+    Poly *rel = &w->ping;
     if (full_circle) {
         double reach = 0.0;
         for (Py_ssize_t i = 0; i < m; i++) reach = greater(reach, hypot(d[2 * i], d[2 * i + 1]));
@@ -169,8 +167,8 @@ PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t narg
                 to_camera(r, forward, left, rel->v[2 * i], rel->v[2 * i + 1], levels[l], camera + 3 * k);
     } else {
         /* Part of the polytope is behind: cut it along its known edges (a prism over the hull). */
-        if (convex_hull(rel->v, rel->n, &w.pong, &w) < 0) goto done;
-        Py_ssize_t h = w.pong.n, layer = h, edge_count = 0;
+        if (convex_hull(rel->v, rel->n, &w->pong, w) < 0) goto done;
+        Py_ssize_t h = w->pong.n, layer = h, edge_count = 0;
         if (h >= 2) edge_count += level_count * h;
         if (level_count == 2) edge_count += h;
         double *layers = PyMem_Malloc(sizeof(double) * 3 * (size_t)(h * level_count));
@@ -182,7 +180,7 @@ PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t narg
         }
         for (Py_ssize_t l = 0; l < level_count; l++)
             for (Py_ssize_t i = 0; i < h; i++)
-                to_camera(r, forward, left, w.pong.v[2 * i], w.pong.v[2 * i + 1], levels[l],
+                to_camera(r, forward, left, w->pong.v[2 * i], w->pong.v[2 * i + 1], levels[l],
                           layers + 3 * (l * layer + i));
         for (Py_ssize_t i = 0; i < h * level_count; i++) {
             if (layers[3 * i + 2] >= cut) {
@@ -239,7 +237,7 @@ done:
     PyMem_Free(negated);
     PyMem_Free(camera);
     PyMem_Free(normalized);
-    work_free(&w);
+    work_give(self, w);
     PyBuffer_Release(&view);
     return result;
 }

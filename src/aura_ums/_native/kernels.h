@@ -110,8 +110,13 @@ typedef struct {
     size_t bytes;
 } Scratch;
 
-/* Every buffer one reduction (or one Expecter call) uses; all start empty (zeroed) and
-   are freed by work_free. */
+/* The most a module's own Work keeps between calls, bytes (see work_give). */
+#define WORK_KEPT_BYTES (1 << 20)
+
+/* Every buffer one kernel call uses (a reduction, a redistribution's hulls, the Expecter).
+   A call borrows the module's own with work_take (every count reset, the buffers kept
+   from earlier calls: no allocation per call once they are large enough) and gives it
+   back with work_give; a zeroed one starts empty. work_free frees the buffers. */
 typedef struct {
     Poly ping, pong;       /* clip_halfplanes: alternate clip results */
     Poly part, parts;      /* clip_to_sector: one piece's part, every part */
@@ -122,7 +127,20 @@ typedef struct {
     Scratch values, flags, cuts, planes, points, edges, lengths;
 } Work;
 
+/* The module's state: its own Work and whether a call has it. */
+typedef struct {
+    Work work;
+    int lent;
+} ModuleState;
+
 void work_free(Work *w);
+/* A Work for one kernel call of `module`: the module's own, unless a call has it already
+   (a kernel called while another runs, e.g. from a garbage-collector callback or a
+   finalizer that one of its allocations let run), then `local`, zeroed. */
+Work *work_take(PyObject *module, Work *local);
+/* End the call's use of `w`: the module's own is kept (freed first if it grew past
+   WORK_KEPT_BYTES, so one huge call does not hold memory for good), a local one is freed. */
+void work_give(PyObject *module, Work *w);
 /* Room for `count` vertices (their values kept); -1 with MemoryError set on failure. */
 int reserve(Poly *p, Py_ssize_t count);
 /* Room for `count` items of `size` bytes (old contents not kept); NULL with MemoryError set. */

@@ -93,12 +93,18 @@ static int add_constants(PyObject *module) {
 
 static int exec_module(PyObject *module) { return add_constants(module); }
 
+/* The module's own Work (see work_take): freed with the module. */
+static void free_module(void *module) {
+    ModuleState *state = PyModule_GetState((PyObject *)module);
+    if (state) work_free(&state->work);
+}
+
 static PyModuleDef_Slot slots[] = {{Py_mod_exec, exec_module}, {0, NULL}};
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_kernels",
     "Compiled kernels of aura-ums (growth, reductions, the Expecter, the schemas' distance); private: use the "
     "typed wrappers of aura_ums._native, which hold the numpy references.",
-    0, methods, slots, NULL, NULL, NULL};
+    sizeof(ModuleState), methods, slots, NULL, NULL, free_module};
 
 PyMODINIT_FUNC PyInit__kernels(void) { return PyModuleDef_Init(&module); }

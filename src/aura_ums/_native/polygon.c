@@ -393,12 +393,48 @@ Py_ssize_t simplify_outer(double *v, Py_ssize_t n, Py_ssize_t max_vertices, doub
     return n;
 }
 
+/* Every buffer of a Work, for work_free, work_take and work_give. */
+#define WORK_POLYS(w)                                                                                  \
+    {&(w)->ping, &(w)->pong, &(w)->part, &(w)->parts, &(w)->arc_points, &(w)->arc, &(w)->mirrored,    \
+     &(w)->sum, &(w)->sensors, &(w)->positions, &(w)->narrowed}
+#define WORK_SCRATCHES(w) {&(w)->values, &(w)->flags, &(w)->cuts, &(w)->planes, &(w)->points, &(w)->edges, &(w)->lengths}
+#define COUNT_OF(array) (sizeof(array) / sizeof((array)[0]))
+
 void work_free(Work *w) {
-    Poly *polys[] = {&w->ping,  &w->pong, &w->part,    &w->parts,     &w->arc_points, &w->arc,
-                     &w->mirrored, &w->sum, &w->sensors, &w->positions, &w->narrowed};
-    Scratch *scratches[] = {&w->values, &w->flags, &w->cuts, &w->planes, &w->points, &w->edges, &w->lengths};
-    for (size_t i = 0; i < sizeof(polys) / sizeof(polys[0]); i++) PyMem_Free(polys[i]->v);
-    for (size_t i = 0; i < sizeof(scratches) / sizeof(scratches[0]); i++) PyMem_Free(scratches[i]->data);
+    Poly *polys[] = WORK_POLYS(w);
+    Scratch *scratches[] = WORK_SCRATCHES(w);
+    for (size_t i = 0; i < COUNT_OF(polys); i++) PyMem_Free(polys[i]->v);
+    for (size_t i = 0; i < COUNT_OF(scratches); i++) PyMem_Free(scratches[i]->data);
+}
+
+Work *work_take(PyObject *module, Work *local) {
+    ModuleState *state = module ? PyModule_GetState(module) : NULL;
+    if (!state || state->lent) {
+        memset(local, 0, sizeof(*local));
+        return local;
+    }
+    state->lent = 1;
+    Poly *polys[] = WORK_POLYS(&state->work);
+    for (size_t i = 0; i < COUNT_OF(polys); i++) polys[i]->n = 0;
+    return &state->work;
+}
+
+void work_give(PyObject *module, Work *w) {
+    ModuleState *state = module ? PyModule_GetState(module) : NULL;
+    if (!state || w != &state->work) {
+        work_free(w);
+        return;
+    }
+    Poly *polys[] = WORK_POLYS(w);
+    Scratch *scratches[] = WORK_SCRATCHES(w);
+    size_t bytes = 0;
+    for (size_t i = 0; i < COUNT_OF(polys); i++) bytes += 2 * sizeof(double) * (size_t)polys[i]->cap;
+    for (size_t i = 0; i < COUNT_OF(scratches); i++) bytes += scratches[i]->bytes;
+    if (bytes > WORK_KEPT_BYTES) {
+        work_free(w);
+        memset(w, 0, sizeof(*w));
+    }
+    state->lent = 0;
 }
 
 /* Make room for `count` vertices (their values are kept); -1 with MemoryError set on failure. */

@@ -301,7 +301,6 @@ static void wedge_arc(double center, double cw, double ccw, double *lo, double *
 }
 
 PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
     static const char *const names[] = {"center_x", "center_y",   "wedge_center", "wedge_cw", "wedge_ccw",
                                         "forward",  "left",       "landmark_x",   "landmark_y", "widen",
                                         "bearing",  "bearing_error", "range_min",  "range_max", "piece"};
@@ -322,8 +321,7 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
     Py_buffer view;
     if (get_vertices(args[0], &view, &n) < 0) return NULL;
     const double *prior = (const double *)view.buf;
-    Work w;
-    memset(&w, 0, sizeof(w));
+    Work local_work, *w = work_take(self, &local_work);
     PyObject *result = NULL;
     double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
     wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
@@ -334,7 +332,7 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
                  a[12], a[13], a[14]};
     int reason = -1;
     Poly *positions = NULL;
-    if (cone_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[10], a[11], &cone, &w, &reason,
+    if (cone_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[10], a[11], &cone, w, &reason,
                        &positions, &arc_lo, &arc_width) < 0)
         goto done;
     if (reason >= 0)
@@ -342,13 +340,12 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
     else
         result = finish(positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
 done:
-    work_free(&w);
+    work_give(self, w);
     PyBuffer_Release(&view);
     return result;
 }
 
 PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
     static const char *const names[] = {"center_x", "center_y", "wedge_center", "wedge_cw",    "wedge_ccw",
                                         "forward",  "left",     "start_x",      "start_y",     "end_x",
                                         "end_y",    "position_uncertainty", "offset", "offset_error", "angle",
@@ -365,21 +362,20 @@ PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs) 
     Py_buffer view;
     if (get_vertices(args[0], &view, &n) < 0) return NULL;
     const double *prior = (const double *)view.buf;
-    Work w;
-    memset(&w, 0, sizeof(w));
+    Work local_work, *w = work_take(self, &local_work);
     PyObject *result = NULL;
     double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
     wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
     int reason = -1;
     if (strip_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[7], a[8], a[9], a[10], a[11], a[12],
-                        a[13], a[14], a[15], &w.positions, &w, &reason, &arc_lo, &arc_width) < 0)
+                        a[13], a[14], a[15], &w->positions, w, &reason, &arc_lo, &arc_width) < 0)
         goto done;
     if (reason >= 0)
         result = PyLong_FromLong(reason);
     else
-        result = finish(&w.positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
+        result = finish(&w->positions, prior, n, max_vertices, a[0], a[1], arc_lo, arc_width);
 done:
-    work_free(&w);
+    work_give(self, w);
     PyBuffer_Release(&view);
     return result;
 }
@@ -418,10 +414,9 @@ typedef struct {
 /* Reduce the slices one by one (_native._slices.reduce_slices_reference); the kept slices,
    narrowed and in heading order, then (x, y, wedge centre, cw, ccw), or the first slice's
    reason when none is kept. */
-static PyObject *reduce_slices(const Packed *p, double center_x, double center_y, double heading,
+static PyObject *reduce_slices(PyObject *self, const Packed *p, double center_x, double center_y, double heading,
                                const SliceReduction *r) {
-    Work w;
-    memset(&w, 0, sizeof(w));
+    Work local_work, *w = work_take(self, &local_work);
     SliceList kept = {0}, ordered = {0};
     double *centers = PyMem_Malloc(sizeof(double) * 2 * (size_t)p->k);
     Py_ssize_t *order = PyMem_Malloc(sizeof(Py_ssize_t) * (size_t)p->k), *starts = NULL;
@@ -445,14 +440,14 @@ static PyObject *reduce_slices(const Packed *p, double center_x, double center_y
         const double *a = r->a;
         if (r->strip) {
             if (strip_reduction(prior, n, heading_lo, heading_width, a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
-                                a[8], a[9], a[10], &w.positions, &w, &reason, &arc_lo, &arc_width) < 0)
+                                a[8], a[9], a[10], &w->positions, w, &reason, &arc_lo, &arc_width) < 0)
                 goto done;
-            positions = &w.positions;
+            positions = &w->positions;
         } else {
             double margin = a[6] + TOLERANCE;
             Cone cone = {a[2], a[3], a[4], heading_lo + a[5] + M_PI - margin, heading_width + 2.0 * margin,
                          a[7], a[8], a[9]};
-            if (cone_reduction(prior, n, heading_lo, heading_width, a[0], a[1], a[5], a[6], &cone, &w, &reason,
+            if (cone_reduction(prior, n, heading_lo, heading_width, a[0], a[1], a[5], a[6], &cone, w, &reason,
                                &positions, &arc_lo, &arc_width) < 0)
                 goto done;
         }
@@ -523,7 +518,7 @@ static PyObject *reduce_slices(const Packed *p, double center_x, double center_y
         result = Py_BuildValue("(NNNNddddd)", items[0], items[1], items[2], items[3], x_y[2 * home],
                                x_y[2 * home + 1], wedge[0], wedge[1], wedge[2]);
 done:
-    work_free(&w);
+    work_give(self, w);
     slices_free(&kept);
     slices_free(&ordered);
     PyMem_Free(centers);
@@ -537,7 +532,7 @@ done:
    max_vertices) and reduce_strip_slices(points, counts, lo, hi, center_x, center_y, heading,
    forward, left, start_x, start_y, end_x, end_y, position_uncertainty, offset, offset_error,
    angle, angle_error, max_vertices). */
-static PyObject *reduce_slices_call(PyObject *const *args, Py_ssize_t nargs, int strip) {
+static PyObject *reduce_slices_call(PyObject *self, PyObject *const *args, Py_ssize_t nargs, int strip) {
     static const char *const cone_names[] = {"center_x", "center_y", "heading", "forward", "left", "landmark_x",
                                              "landmark_y", "widen", "bearing", "bearing_error", "range_min",
                                              "range_max", "piece"};
@@ -563,17 +558,15 @@ static PyObject *reduce_slices_call(PyObject *const *args, Py_ssize_t nargs, int
     }
     Packed p;
     if (get_packed(args, &p) < 0) return NULL;
-    PyObject *result = reduce_slices(&p, values[0], values[1], values[2], &r);
+    PyObject *result = reduce_slices(self, &p, values[0], values[1], values[2], &r);
     packed_release(&p);
     return result;
 }
 
 PyObject *reduce_cone_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
-    return reduce_slices_call(args, nargs, 0);
+    return reduce_slices_call(self, args, nargs, 0);
 }
 
 PyObject *reduce_strip_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
-    return reduce_slices_call(args, nargs, 1);
+    return reduce_slices_call(self, args, nargs, 1);
 }

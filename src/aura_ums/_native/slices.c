@@ -7,7 +7,6 @@
 #include "kernels.h"
 
 PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
     if (nargs != 3) {
         PyErr_Format(PyExc_TypeError, "merge_groups: expected 3 arguments, got %zd", nargs);
         return NULL;
@@ -28,8 +27,7 @@ PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs) 
     double *t = NULL, *scratch_points = NULL;
     Ranked *ranked = NULL;
     char *flags = NULL;
-    Work w;
-    memset(&w, 0, sizeof(w));
+    Work local_work, *w = work_take(self, &local_work);
     Poly hull = {0};
     if (!sizes) {
         PyErr_NoMemory();
@@ -63,7 +61,7 @@ PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs) 
     const double *points = (const double *)view.buf;
     Py_ssize_t offset = 0;
     for (Py_ssize_t g = 0; g < groups; g++) {
-        if (convex_hull(points + 2 * offset, sizes[g], &hull, &w) < 0) {
+        if (convex_hull(points + 2 * offset, sizes[g], &hull, w) < 0) {
             Py_CLEAR(result);
             goto done;
         }
@@ -79,7 +77,7 @@ PyObject *merge_groups(PyObject *self, PyObject *const *args, Py_ssize_t nargs) 
     }
 done:
     PyMem_Free(hull.v);
-    work_free(&w);
+    work_give(self, w);
     PyMem_Free(t);
     PyMem_Free(scratch_points);
     PyMem_Free(ranked);
@@ -307,7 +305,7 @@ static int compare_rows(const void *a, const void *b) {
 /* The hull of a group's points with the outer vertex cap (see merge_groups), into `hull`. */
 typedef struct {
     Poly hull, gathered;
-    Work w;
+    Work *w;
     double *t, *scratch_points;
     Ranked *ranked;
     char *flags;
@@ -320,7 +318,6 @@ typedef struct {
 static void merger_free(Merger *m) {
     PyMem_Free(m->hull.v);
     PyMem_Free(m->gathered.v);
-    work_free(&m->w);
     PyMem_Free(m->t);
     PyMem_Free(m->scratch_points);
     PyMem_Free(m->ranked);
@@ -329,7 +326,7 @@ static void merger_free(Merger *m) {
 }
 
 static int merge_hull(Merger *m, const double *points, Py_ssize_t count, Py_ssize_t max_vertices) {
-    if (convex_hull(points, count, &m->hull, &m->w) < 0) return -1;
+    if (convex_hull(points, count, &m->hull, m->w) < 0) return -1;
     Py_ssize_t n = m->hull.n;
     if (n > max_vertices) {
         if (n > m->room) {
@@ -421,7 +418,7 @@ static long long next_source(const SliceList *s) {
 /* See _native._slices.distribute_reference: the pieces (an unwrapped interval each) onto a
    grid of `cells` cells, then the cap of max_slices by merging neighbours, into `out`. */
 static int distribute(const SliceList *pieces, Py_ssize_t cells, Py_ssize_t max_vertices, Py_ssize_t max_slices,
-                      SliceList *out) {
+                      SliceList *out, Work *w) {
     double step = TWO_PI / (double)cells;
     Py_ssize_t k = pieces->k, total = 0;
     long long *first = PyMem_Malloc(sizeof(long long) * 2 * (size_t)k);
@@ -430,6 +427,7 @@ static int distribute(const SliceList *pieces, Py_ssize_t cells, Py_ssize_t max_
     SliceList grid = {0};
     Merger m;
     memset(&m, 0, sizeof(m));
+    m.w = w;
     int status = -1;
     if (!first) {
         PyErr_NoMemory();
@@ -532,11 +530,14 @@ done:
 }
 
 /* (points, counts, lo, hi, sources bytes, wedge centre, cw, ccw) of distributed slices, or NULL. */
-static PyObject *distributed_result(SliceList *pieces, Py_ssize_t cells, Py_ssize_t max_vertices,
+static PyObject *distributed_result(PyObject *self, SliceList *pieces, Py_ssize_t cells, Py_ssize_t max_vertices,
                                     Py_ssize_t max_slices, double heading) {
     SliceList grid = {0};
     PyObject *items[5], *result = NULL;
-    if (distribute(pieces, cells, max_vertices, max_slices, &grid) == 0 && slices_bytes(&grid, 1, items) == 0) {
+    Work local_work, *w = work_take(self, &local_work);
+    int distributed = distribute(pieces, cells, max_vertices, max_slices, &grid, w);
+    work_give(self, w);
+    if (distributed == 0 && slices_bytes(&grid, 1, items) == 0) {
         double wedge[3];
         summary_wedge(grid.lo, grid.hi, grid.k, heading, wedge);
         result = Py_BuildValue("(NNNNNddd)", items[0], items[1], items[2], items[3], items[4], wedge[0], wedge[1],
@@ -547,7 +548,6 @@ static PyObject *distributed_result(SliceList *pieces, Py_ssize_t cells, Py_ssiz
 }
 
 PyObject *distribute_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
     if (nargs != 9) {
         PyErr_Format(PyExc_TypeError, "distribute_slices: expected 9 arguments, got %zd", nargs);
         return NULL;
@@ -572,7 +572,7 @@ PyObject *distribute_slices(PyObject *self, PyObject *const *args, Py_ssize_t na
     /* The pieces as a SliceList over the caller's buffers (read only: never appended to). */
     SliceList pieces = {{(double *)p.v, p.n, p.n}, (long long *)p.counts, (long long *)sources_view.buf,
                         (double *)p.lo, (double *)p.hi, p.k, p.k};
-    PyObject *result = distributed_result(&pieces, cells, max_vertices, max_slices, heading);
+    PyObject *result = distributed_result(self, &pieces, cells, max_vertices, max_slices, heading);
     PyBuffer_Release(&sources_view);
     packed_release(&p);
     return result;
