@@ -19,7 +19,7 @@ import pytest
 from aura_ums import _native
 from aura_ums._native import _reduce as native_reduce
 from aura_ums._native import _slices as native_slices
-from tests._native.native_helpers import Array, random_polygon, random_wedge
+from tests._native.native_helpers import Array, kernels, random_polygon, random_wedge
 
 pytestmark = pytest.mark.skipif(not _native.BUILT, reason="the compiled kernels are not built")
 
@@ -39,21 +39,17 @@ def _cone_call(rng: np.random.Generator) -> tuple[Any, ...]:
     )  # fmt: skip
 
 
-def _reduced(call: tuple[Any, ...]) -> Any:
-    """reduce_cone's result for ``call``, comparable with ==."""
-    return _as_values(native_reduce.reduce_cone_compiled(*call))
-
-
-def _as_values(found: Any) -> Any:
-    """A kernel's result with its bytes as bytes and its numbers as they are (comparable with ==)."""
-    return found if isinstance(found, int) else tuple(found)
+def _groups(rng: np.random.Generator, count: int) -> tuple[Array, list[int]]:
+    """Arguments of merge_groups: ``count`` groups of 5-40 random points each."""
+    sizes = [int(size) for size in rng.integers(5, 41, count)]
+    return np.ascontiguousarray(rng.normal(0.0, 3.0, (sum(sizes), 2))), sizes
 
 
 class _Nesting:
     """Calls ``inner`` from every garbage collection that starts while :meth:`outer` runs.
 
-    The collector runs at (almost) every allocation of a tracked object once its threshold
-    is 1, such as the tuple a kernel builds for its result while it holds the buffers.
+    With its threshold at 1 the collector runs at every other allocation of a tracked object,
+    such as the tuple a kernel builds for its result while it holds the buffers.
     """
 
     def __init__(self, inner: Callable[[], Any]) -> None:
@@ -62,6 +58,11 @@ class _Nesting:
         self._inside = False
 
     def outer(self, kernel: Callable[[], Any]) -> Any:
+        # With a threshold of 1 the collector runs when its count of new objects reaches 2:
+        # leave it at 1, so that the kernel's first fresh object sets it off.
+        padding: list[list[None]] = []
+        while gc.get_count()[0] != 1:
+            padding.append([])
         self._inside = True
         try:
             return kernel()
@@ -89,17 +90,31 @@ def _collecting_often(nesting: _Nesting) -> Iterator[None]:
         gc.callbacks.remove(nesting.callback)
 
 
+def _fresh_tuples(size: int) -> list[tuple[int, ...]]:
+    """Take every spare tuple of ``size`` items CPython keeps (at most 2,000 per size): the next
+    one made is a fresh allocation, which is when the garbage collector may run."""
+    return [tuple(range(start, start + size)) for start in range(2_500)]
+
+
 def test_a_kernel_called_while_another_holds_the_buffers_gets_its_own() -> None:
     rng = np.random.default_rng(20261128)
-    calls = [_cone_call(rng) for _ in range(40)]
+    calls = [_cone_call(rng) for _ in range(20)]
+    groups = _groups(rng, 30)
     compiled = native_reduce.reduce_cone_compiled
-    expected = [_as_values(compiled(*call)) for call in calls]
-    nesting = _Nesting(partial(_reduced, calls[-1]))
+    expected = [compiled(*call) for call in calls]
+    inner_expected = kernels().merge_groups(*groups, 16)
+    # The nested call's hulls overwrite what the outer one is about to copy out (the kept
+    # positions: reduce_cone makes its result tuple first), had it the same buffers.
+    nesting = _Nesting(partial(kernels().merge_groups, *groups, 16))
+    held = []
     with _collecting_often(nesting):
-        outer = [nesting.outer(partial(_reduced, call)) for call in calls]
+        outer = []
+        for call in calls:
+            held.append(_fresh_tuples(7))  # reduce_cone's result: 7 items
+            outer.append(nesting.outer(partial(compiled, *call)))
     assert outer == expected
     assert nesting.nested, "no kernel ran while another held the buffers: the test proves nothing"
-    assert all(found == expected[-1] for found in nesting.nested)
+    assert all(found == inner_expected for found in nesting.nested)
 
 
 def test_a_call_larger_than_the_kept_buffers_then_small_ones() -> None:

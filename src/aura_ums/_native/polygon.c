@@ -445,6 +445,9 @@ int reserve(Poly *p, Py_ssize_t count) {
         PyErr_NoMemory();
         return -1;
     }
+    /* At least double: a list appended to polygon by polygon (a redistribution's slices)
+       is copied a bounded number of times, not once per append. */
+    if (p->cap <= PY_SSIZE_T_MAX / 4 / (Py_ssize_t)(2 * sizeof(double)) && count < 2 * p->cap) count = 2 * p->cap;
     double *grown = PyMem_Realloc(p->v, 2 * sizeof(double) * (size_t)count);
     if (!grown) {
         PyErr_NoMemory();
@@ -714,8 +717,10 @@ typedef struct {
     double x, y;
 } Point;
 
-/* Whether p sorts strictly before q: by x, then y (total_order, NaN last). */
-static inline int point_before(const Point *p, const Point *q) {
+/* Whether p sorts strictly before q: by x, then y (total_order, NaN last). With `finite`
+   (no coordinate is NaN) the plain comparisons give the same order, at less cost. */
+static inline int point_before(const Point *p, const Point *q, int finite) {
+    if (finite) return p->x < q->x || (p->x == q->x && p->y < q->y);
     int by_x = total_order(p->x, q->x);
     return by_x ? by_x < 0 : total_order(p->y, q->y) < 0;
 }
@@ -724,13 +729,13 @@ static inline int point_before(const Point *p, const Point *q) {
    Any stable sort orders the points alike (qsort's merge sort, before, included), so the
    hull keeps its bits. This one merges the runs the input already has: the points are
    mostly convex polygons one after the other, each at most three monotone runs in x. */
-static void sort_points(Point *p, Py_ssize_t m, Point *tmp) {
+static void sort_points(Point *p, Py_ssize_t m, Point *tmp, int finite) {
     Py_ssize_t *bounds = (Py_ssize_t *)(tmp + m), runs = 0;
     for (Py_ssize_t i = 0; i < m;) {
         Py_ssize_t j = i + 1;
-        if (j < m && point_before(&p[j], &p[i])) {
+        if (j < m && point_before(&p[j], &p[i], finite)) {
             /* Strictly descending: reversed, it stays stable (no two of it are equal). */
-            while (j + 1 < m && point_before(&p[j + 1], &p[j])) j++;
+            while (j + 1 < m && point_before(&p[j + 1], &p[j], finite)) j++;
             j++;
             for (Py_ssize_t a = i, b = j - 1; a < b; a++, b--) {
                 Point swap = p[a];
@@ -738,7 +743,7 @@ static void sort_points(Point *p, Py_ssize_t m, Point *tmp) {
                 p[b] = swap;
             }
         } else {
-            while (j < m && !point_before(&p[j], &p[j - 1])) j++;
+            while (j < m && !point_before(&p[j], &p[j - 1], finite)) j++;
         }
         bounds[runs++] = j;
         i = j;
@@ -754,7 +759,7 @@ static void sort_points(Point *p, Py_ssize_t m, Point *tmp) {
             }
             Py_ssize_t a = begin, mid = bounds[r], b = mid, end = bounds[r + 1], k = begin;
             /* Ties take the left run's first: stable. */
-            while (a < mid && b < end) to[k++] = point_before(&from[b], &from[a]) ? from[b++] : from[a++];
+            while (a < mid && b < end) to[k++] = point_before(&from[b], &from[a], finite) ? from[b++] : from[a++];
             while (a < mid) to[k++] = from[a++];
             while (b < end) to[k++] = from[b++];
             bounds[out++] = end;
@@ -779,11 +784,13 @@ int convex_hull(const double *pts, Py_ssize_t m, Poly *out, Work *w) {
     }
     Point *p = scratch(&w->points, room, sizeof(Point));
     if (!p) return -1;
+    int finite = 1;
     for (Py_ssize_t i = 0; i < m; i++) {
         p[i].x = pts[2 * i];
         p[i].y = pts[2 * i + 1];
+        finite &= p[i].x == p[i].x && p[i].y == p[i].y;
     }
-    sort_points(p, m, p + m);
+    sort_points(p, m, p + m, finite);
     Py_ssize_t u = 0;
     for (Py_ssize_t i = 0; i < m; i++)
         if (u == 0 || p[i].x != p[u - 1].x || p[i].y != p[u - 1].y) p[u++] = p[i];
