@@ -169,3 +169,20 @@ def _one_by_one(wedge: HeadingWedge, heading: float) -> bool:
         return True
     offset = float(np.mod(heading - (wedge.center - wedge.cw), 2 * math.pi))
     return offset <= wedge.width + 1e-9 or offset >= 2 * math.pi - 1e-9
+
+
+@given(
+    st.floats(-10.0, 10.0),
+    st.floats(0.0, 4.0),
+    st.floats(0.0, 4.0),
+    st.sampled_from([0.0, 1e-9, -1e-9, 2e-9, -2e-9, 1e-6, 2.0 * math.pi, -2.0 * math.pi]),
+    st.sampled_from(["lo", "hi", "center"]),
+)
+def test_one_heading_as_a_float_answers_as_an_array(
+    center: float, cw: float, ccw: float, nudge: float, where: str
+) -> None:
+    """The float path of ``contains`` gives the array path's answer, at the ends and past them."""
+    wedge = HeadingWedge(center, cw, ccw)
+    base = {"lo": wedge.center - wedge.cw, "hi": wedge.center + wedge.ccw, "center": wedge.center}[where]
+    heading = base + nudge
+    assert wedge.contains(heading) == bool(np.asarray(wedge.contains(np.array([heading])))[0])

@@ -68,6 +68,40 @@ def inside_prior(
     return bool(np.all(prior.contains(poses[:, 0], poses[:, 1], poses[:, 2]))) and map_inside(reduced, prior)
 
 
+# --- one pose at a time ----------------------------------------------------------------
+
+
+def boundary_poses(
+    subject: SpatialUncertaintyMap, rng: np.random.Generator
+) -> list[tuple[float, float, float]]:
+    """Poses on and a hair either side of the map's edges, vertices and heading ends."""
+    poses = [(float(x), float(y), float(h)) for x, y, h in subject.sample_poses(20, rng).tolist()]
+    for piece in subject.slices:
+        vertices = piece.polygon.vertices
+        ends = [piece.lo, piece.lo + piece.width, piece.lo + 0.5 * piece.width]
+        for index in rng.integers(0, len(vertices), 4).tolist():
+            a, b = vertices[index], vertices[(index + 1) % len(vertices)]
+            point = a + rng.uniform() * (b - a) if rng.uniform() < 0.7 else a
+            for nudge in (0.0, 1e-9, -1e-9, 1e-7, float(rng.normal(0.0, 1e-3))):
+                heading = ends[int(rng.integers(3))] + float(rng.choice([0.0, 1e-9, -1e-9, 1e-6, TWO_PI]))
+                poses.append((float(point[0] + nudge), float(point[1] - nudge), heading))
+    return poses
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_one_pose_at_a_time_gives_what_arrays_give(seed: int) -> None:
+    """The float path of ``contains`` (a Pose, or three floats) answers as the array path does."""
+    rng = np.random.default_rng(seed)
+    subject = coupled_prior(rng) if rng.uniform() < 0.6 else random_prior(rng)
+    poses = boundary_poses(subject, rng)
+    xs, ys, headings = (np.array(column) for column in zip(*poses, strict=True))
+    expected = np.asarray(subject.contains(xs, ys, headings)).tolist()
+    assert [subject.contains(x, y, heading) for x, y, heading in poses] == expected
+    wrapped = [Pose(x, y, heading) for x, y, heading in poses[:10]]
+    as_arrays = subject.contains(xs[:10], ys[:10], np.array([pose.heading for pose in wrapped]))
+    assert [subject.contains(pose) for pose in wrapped] == np.asarray(as_arrays).tolist()
+
+
 # --- building ------------------------------------------------------------------------
 
 

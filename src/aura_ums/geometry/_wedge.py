@@ -153,6 +153,8 @@ class HeadingWedge:
 
         Returns a Python ``bool`` for a scalar and a boolean array otherwise.
         """
+        if type(heading) is float and math.isfinite(heading):
+            return _heading_in(self.center, self.cw, self.ccw, heading)
         headings = float_array(heading, "heading")
         inside = wedges_contain(np.array([self.center, self.cw, self.ccw]), headings)
         if inside.ndim == 0:
@@ -166,6 +168,18 @@ class HeadingWedge:
     def rotated(self, angle: float) -> HeadingWedge:
         """Return the wedge turned by ``angle`` radians (counter-clockwise positive)."""
         return _normalized(self.center + angle, self.cw, self.ccw)
+
+
+def _heading_in(center: float, cw: float, ccw: float, heading: float) -> bool:
+    """:func:`wedges_contain` for one wedge and one heading, with the same operations on floats.
+
+    Python's ``%`` on floats and ``np.mod`` give the same bits (both take ``fmod``, then add
+    the divisor when the signs differ), so this agrees with the array form exactly.
+    """
+    extent = cw + ccw
+    offset = (heading - (center - cw)) % TWO_PI
+    inside = offset <= min(extent, TWO_PI) + ANGLE_TOLERANCE or offset >= TWO_PI - ANGLE_TOLERANCE
+    return inside or extent >= TWO_PI
 
 
 def wedges_contain(wedges: NDArray[np.float64], headings: NDArray[np.float64]) -> NDArray[np.bool_]:

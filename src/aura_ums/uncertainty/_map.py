@@ -50,10 +50,12 @@ from aura_ums.uncertainty._slices import (
     distributed,
     heading_slices,
     packed,
+    point_in,
     split_product,
     summary_polygon,
 )
 from aura_ums.uncertainty._slices import contains as slices_contain
+from aura_ums.uncertainty._slices import contains_one as slices_contain_one
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _START_DISK_SIDES = 16
@@ -585,16 +587,23 @@ class SpatialUncertaintyMap:
         if isinstance(pose, Pose):
             if y is not None or heading is not None:
                 raise InputError("contains: expected a Pose alone, or x, y and heading, got a Pose and more")
-            xs, ys, hs = np.array([pose.x]), np.array([pose.y]), np.array([pose.heading])
-            scalar = True
-        else:
-            if y is None or heading is None:
-                raise InputError("contains: expected a Pose, or x, y and heading, got x alone")
-            xs, ys, hs = float_array(pose, "x"), float_array(y, "y"), float_array(heading, "heading")
-            if not (xs.shape == ys.shape == hs.shape):
-                shapes = f"{xs.shape}, {ys.shape}, {hs.shape}"
-                raise InputError(f"contains: expected x, y and heading of one shape, got {shapes}")
-            scalar = xs.ndim == 0
+            return self._contains_one(pose.x, pose.y, pose.heading)
+        if (
+            type(pose) is float
+            and type(y) is float
+            and type(heading) is float
+            and math.isfinite(pose)
+            and math.isfinite(y)
+            and math.isfinite(heading)
+        ):
+            return self._contains_one(pose, y, heading)
+        if y is None or heading is None:
+            raise InputError("contains: expected a Pose, or x, y and heading, got x alone")
+        xs, ys, hs = float_array(pose, "x"), float_array(y, "y"), float_array(heading, "heading")
+        if not (xs.shape == ys.shape == hs.shape):
+            shapes = f"{xs.shape}, {ys.shape}, {hs.shape}"
+            raise InputError(f"contains: expected x, y and heading of one shape, got {shapes}")
+        scalar = xs.ndim == 0
         shape = xs.shape
         points = np.column_stack([xs.reshape(-1), ys.reshape(-1)])
         if self._slices is not None:
@@ -605,6 +614,19 @@ class SpatialUncertaintyMap:
         if scalar:
             return bool(inside[0])
         return inside.reshape(shape)
+
+    def _contains_one(self, x: float, y: float, heading: float) -> bool:
+        """:meth:`contains` for one pose of finite floats: the same operations, without arrays.
+
+        A replay asks this of every step's map; through one-element arrays it cost about ten
+        times as much.
+        """
+        if self._slices is not None:
+            return slices_contain_one(self._slices, x, y, heading, POSITION_TOLERANCE)
+        polygon = self.polygon
+        return self.wedge.contains(heading) and point_in(
+            polygon.vertices, x, y, POSITION_TOLERANCE, polygon.area
+        )
 
     def sample_poses(self, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
         """Draw ``count`` poses uniformly from the map: rows of x (m), y (m), heading (rad).

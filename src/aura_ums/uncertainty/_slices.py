@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums.errors import InputError
-from aura_ums.geometry import ConvexPolygon, HeadingWedge, points_in_convex
+from aura_ums.geometry import ConvexPolygon, HeadingWedge, checks_every_edge, points_in_convex, polygon_area
 
 Array = NDArray[np.float64]
 Counts = NDArray[np.int64]
@@ -229,6 +229,36 @@ def summary_polygon(slices: SliceSet) -> Array:
         return slices.points[: int(slices.counts[0])]
     total = len(slices.points)
     return _native.merge_groups(slices.points, [total], max(total, 3))[0]
+
+
+def point_in(vertices: Array, x: float, y: float, tolerance: float, area: float | None = None) -> bool:
+    """:func:`~aura_ums.geometry.points_in_convex` for one point, bit for bit, at a tenth of the cost.
+
+    Where that function tests the point edge by edge (a polygon of positive area), the
+    compiled ``point_in_solid_convex`` does the same operations; otherwise it is called.
+    ``area`` is the polygon's :func:`~aura_ums.geometry.polygon_area` when the caller has it.
+    """
+    count = len(vertices)
+    solid = count >= 3 and checks_every_edge(1, count)
+    if solid and (polygon_area(vertices) if area is None else area) > 0.0:
+        return bool(_native.point_in_solid_convex(vertices, x, y, tolerance))
+    return bool(points_in_convex(vertices, np.array([[x, y]]), tolerance)[0])
+
+
+def contains_one(slices: SliceSet, x: float, y: float, heading: float, tolerance: float) -> bool:
+    """:func:`contains` for one pose (finite floats), with the same operations on floats."""
+    slack = _native.ANGLE_SLACK
+    ends = 0
+    for count, lo, hi in zip(slices.counts.tolist(), slices.lo.tolist(), slices.hi.tolist(), strict=True):
+        ends += count
+        width = hi - lo
+        # Python's % on floats gives np.mod's bits.
+        offset = (heading - lo) % _TWO_PI
+        if (offset <= width + slack or offset >= _TWO_PI - slack or width >= _TWO_PI) and point_in(
+            slices.points[ends - count : ends], x, y, tolerance
+        ):
+            return True
+    return False
 
 
 def contains(slices: SliceSet, points: Array, headings: Array, tolerance: float) -> NDArray[np.bool_]:
