@@ -69,7 +69,7 @@ from aura_ums.logs import (
     replay_log,
     replay_windows,
 )
-from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
 from aura_ums.manager._settings import SettingValue
 from aura_ums.uncertainty import LandmarkClass, Pose
 from filterpy_ekf import FilterpyLogEkf
@@ -84,8 +84,8 @@ FIGURES_JSON = ROOT / "docs" / "real-logs.json"
 
 #: The slice width measured best so far (docs/real-logs.md, "The slice width": 2-degree cells
 #: narrow the windows to about a quarter of the frame at under 2 ms a frame), used while
-#: ManagerSettings' own default is the product map.
-BEST_SLICE_WIDTH = math.radians(2.0)
+#: ManagerSettings' own default is the product map: the width of ``MapProfile.SLICED``.
+BEST_SLICE_WIDTH = float(MapProfile.SLICED.settings().slice_width or math.nan)
 PRODUCT = "product map"
 SLICED = "sliced map"
 FILTERPY = "filterpy EKF"

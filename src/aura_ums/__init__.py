@@ -43,6 +43,7 @@ from aura_ums.manager import (
     Blackboard,
     IdentifiedLandmarkBuffer,
     ManagerSettings,
+    MapProfile,
     PositionReport,
     UncertaintyMapManager,
 )
@@ -95,6 +96,7 @@ __all__ = [
     "LandmarkClass",
     "LandmarkRecord",
     "ManagerSettings",
+    "MapProfile",
     "Meadow",
     "MeadowMap",
     "Metrics",

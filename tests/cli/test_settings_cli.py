@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from aura_ums.cli import app
 from aura_ums.cli._common import NO_OPTIONS, SettingOptions, manager_options, setting_flag
-from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
 from aura_ums.sim import Scenario
 from aura_ums.uncertainty import cell_count
 
@@ -153,3 +153,47 @@ def test_a_bad_angle_is_named_as_typed(text: str, message: str) -> None:
     assert result.exit_code == 2
     assert result.stderr == f"error: --slice-width: {message}\n"
     assert not seen
+
+
+def test_a_profile_is_the_base_of_the_options_given_one_by_one() -> None:
+    tool, seen = recorder()
+    assert runner.invoke(tool, ["x", "--profile", "relaxed"]).exit_code == 0
+    assert seen[-1] == MapProfile.RELAXED.settings()
+    given = ["x", "--profile", "relaxed", "--relaxed-window", "7", "--max-vertices", "20"]
+    result = runner.invoke(tool, given)
+    assert result.exit_code == 0, result.output
+    assert seen[-1] == dataclasses.replace(MapProfile.RELAXED.settings(), relaxed_window=7, max_vertices=20)
+    assert runner.invoke(tool, ["x", "--profile", "sliced", "--product-map"]).exit_code == 0
+    assert seen[-1] == ManagerSettings()
+    bad = runner.invoke(tool, ["x", "--profile", "sound"])
+    assert bad.exit_code == 2
+    assert "--profile" in bad.output
+    assert "'sound' is not one of" in bad.output
+
+
+def test_the_profile_help_names_the_options_it_sets() -> None:
+    group = typer.main.get_command(app)
+    option = next(p for p in group.commands["replay"].params if "--profile" in p.opts)  # type: ignore[attr-defined]
+    assert "relaxed = --slice-width 2deg --relaxed-q 1 --relaxed-window 5," in option.help
+    assert "sliced = --slice-width 2deg," in option.help
+    assert "product = the defaults," in option.help
+
+
+def test_simulate_profile_overrides_the_scenarios_map_keeps_the_rest(monkeypatch: pytest.MonkeyPatch) -> None:
+    import aura_ums.campaign
+
+    ran: list[Scenario] = []
+    real = aura_ums.campaign.simulate_campaign
+
+    def spy(scenario: Scenario, *args: Any, **kwargs: Any) -> Any:
+        ran.append(scenario)
+        return real(scenario, *args, **kwargs)
+
+    monkeypatch.setattr(aura_ums.campaign, "simulate_campaign", spy)
+    path = str(SCENARIOS / "paper_sidewalk.toml")
+    file = Scenario.from_toml(path).settings
+    assert file.relaxed_q == 1  # the scenario's own relaxed intersection, which the profile turns off
+    result = runner.invoke(app, ["simulate", path, "--runs", "1", "--profile", "sliced", "-q"])
+    assert result.exit_code == 0, result.output
+    assert ran[-1].settings == MapProfile.SLICED.settings(file)
+    assert ran[-1].settings.area_limit == file.area_limit == 25.0

@@ -13,9 +13,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from aura_ums.errors import InputError
-from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
+from aura_ums.uncertainty import cell_count
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._joint import DEFAULT_SECTOR
+from aura_ums.uncertainty._slices import DEFAULT_SLICE_WIDTH
 
 FIELDS = dataclasses.fields(ManagerSettings)
 
@@ -134,3 +136,37 @@ def test_to_dict_is_strict_json_and_from_dict_restores_it(settings: ManagerSetti
     text = json.dumps(settings.to_dict(), allow_nan=False)
     assert ManagerSettings.from_dict(json.loads(text)) == settings
     assert list(settings.to_dict()) == [field.name for field in FIELDS]
+
+
+# --- profiles --------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("profile", list(MapProfile))
+def test_a_profile_sets_its_fields_and_keeps_the_rest(profile: MapProfile) -> None:
+    base = ManagerSettings(area_limit=25.0, robust=False, max_vertices=32)
+    chosen = profile.settings(base)
+    assert {name: getattr(chosen, name) for name in profile.fields} == dict(profile.fields)
+    for field in FIELDS:
+        if field.name not in profile.fields:
+            assert getattr(chosen, field.name) == getattr(base, field.name), field.name
+    # Whatever profile came before, a profile leads to the same settings: each sets the same fields.
+    for other in MapProfile:
+        assert profile.settings(other.settings(base)) == chosen
+
+
+def test_the_profiles_are_the_product_map_the_sliced_map_and_the_relaxed_intersection() -> None:
+    assert MapProfile.PRODUCT.settings() == ManagerSettings()
+    sliced, relaxed = MapProfile.SLICED.settings(), MapProfile.RELAXED.settings()
+    assert sliced.slice_width is not None
+    assert cell_count(sliced.slice_width) == 180
+    assert (sliced.relaxed_q, relaxed.relaxed_q) == (0, 1)
+    # The width the map's own with_slices takes by default: one width measured best.
+    assert relaxed.slice_width == sliced.slice_width == DEFAULT_SLICE_WIDTH
+    assert relaxed.relaxed_window == 5 < ManagerSettings().relaxed_window
+    assert MapProfile("relaxed") is MapProfile.RELAXED
+
+
+def test_a_profiles_fields_cannot_be_changed() -> None:
+    with pytest.raises(TypeError, match="does not support item assignment"):
+        MapProfile.SLICED.fields["relaxed_q"] = 3  # type: ignore[index]
+    assert MapProfile.SLICED.fields["relaxed_q"] == 0

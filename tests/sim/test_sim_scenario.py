@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from aura_ums.errors import FileFormatError, InputError, UnknownLandmarkError
-from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
 from aura_ums.sim import Scenario, StartState, waypoints_array
 from aura_ums.uncertainty import FOOT, LandmarkClass, TerrainStats, TurnAndRun
 
@@ -390,6 +390,20 @@ def test_the_manager_table_takes_degrees_and_none_and_the_earlier_lost_table(fol
     assert earlier == ManagerSettings(area_limit=20.0, missed_limit=2)
     (folder / "plain.toml").write_text(GOOD.split("[manager]")[0])
     assert Scenario.from_toml(folder / "plain.toml").settings == ManagerSettings()
+
+
+def test_the_manager_table_takes_a_profile_under_its_own_keys(folder: Path) -> None:
+    text = GOOD.replace("missed_limit = 2", 'missed_limit = 2\nprofile = "relaxed"\nrelaxed_window = 7')
+    (folder / "relaxed.toml").write_text(text)
+    settings = Scenario.from_toml(folder / "relaxed.toml").settings
+    expected = MapProfile.RELAXED.settings(ManagerSettings(area_limit=20.0, missed_limit=2))
+    assert settings == dataclasses.replace(expected, relaxed_window=7)
+    for bad in ('"sound"', "3", '["sliced"]'):
+        (folder / "bad.toml").write_text(GOOD.replace("missed_limit = 2", f"profile = {bad}"))
+        with pytest.raises(
+            FileFormatError, match=r"\[manager\] profile: expected one of product, sliced, relaxed, got"
+        ):
+            Scenario.from_toml(folder / "bad.toml")
 
 
 def test_scenario_with_a_byte_order_mark_reads_the_same(folder: Path) -> None:

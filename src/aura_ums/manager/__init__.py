@@ -13,7 +13,8 @@
   live use. The manager and the blackboard save to and restore from JSON.
 - :class:`ManagerSettings`: every setting of the manager, with its unit, range and help
   (:class:`SettingInfo`), from which the command line, scenario files, replay options and
-  saved state are built.
+  saved state are built. :class:`MapProfile` names the three representations measured on
+  real logs (the paper's product map, heading slices, slices with the relaxed intersection).
 """
 
 from aura_ums.manager._blackboard import Blackboard, PositionReport
@@ -25,7 +26,7 @@ from aura_ums.manager._map_manager import (
     UncertaintyMapManager,
 )
 from aura_ums.manager._reasons import RejectReason
-from aura_ums.manager._settings import ManagerSettings, SettingInfo
+from aura_ums.manager._settings import ManagerSettings, MapProfile, SettingInfo
 
 __all__ = [
     "Blackboard",
@@ -33,6 +34,7 @@ __all__ = [
     "ManagerSettings",
     "ManagerState",
     "ManagerStep",
+    "MapProfile",
     "ObservationOutcome",
     "PositionReport",
     "RejectReason",

@@ -9,11 +9,13 @@ range or a help text is written here and nowhere else.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
 import numbers
 import textwrap
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 from aura_ums.errors import InputError
@@ -507,3 +509,73 @@ def _document() -> str:
 
 
 ManagerSettings.__doc__ = _document()
+
+
+class MapProfile(enum.Enum):
+    """How the manager represents the map: the three trade-offs measured on real logs.
+
+    Each profile sets :attr:`fields` and leaves every other setting as it was. Measured
+    on MRCLAM, calibrated on one robot and replayed on six others (``docs/real-logs.md``,
+    "The three profiles"):
+
+    - ``PRODUCT``: the paper's map, one polygon times one heading wedge (the defaults).
+      The fastest, about 0.1-0.2 ms a frame; its windows cover 0.6 to all of the width
+      of a 60 degree camera's frame, and a misread landmark can leave the truth outside
+      (it stayed inside 0.90 to 1.00 of the time).
+    - ``SLICED``: a polygon per 2 degree heading cell (``slice_width``), so position and
+      heading stay coupled: windows about a quarter of the frame and a fifth to a half
+      of the area, at about 0.3-0.9 ms a frame; a misread landmark or an observation beyond its
+      calibrated bounds cuts deeper (the truth stayed inside 0.89 to 1.00 of the time).
+    - ``RELAXED``: ``SLICED`` with the q-relaxed intersection (``relaxed_q = 1`` over
+      ``relaxed_window = 5`` observations): the truth stays inside whenever at most one
+      landmark among any 5 consecutive observations is wrong (it stayed inside 0.998 to
+      1.000 of the time), for windows of 0.34-0.40 of the frame with range and
+      bearing and 0.44-0.83 with bearings only, at about 6-11 ms a frame.
+
+    Examples
+    --------
+    >>> settings = MapProfile.RELAXED.settings(ManagerSettings(area_limit=25.0))
+    >>> settings.relaxed_q, settings.relaxed_window, settings.area_limit
+    (1, 5, 25.0)
+    >>> round(math.degrees(settings.slice_width), 6)
+    2.0
+    >>> MapProfile.PRODUCT.settings(settings) == ManagerSettings(area_limit=25.0)   # back to the paper's
+    True
+    >>> MapProfile("sliced") is MapProfile.SLICED
+    True
+    """
+
+    PRODUCT = "product"
+    SLICED = "sliced"
+    RELAXED = "relaxed"
+
+    @property
+    def fields(self) -> Mapping[str, SettingValue]:
+        """The settings this profile sets, field name to value (read-only)."""
+        return _PROFILE_FIELDS[self]
+
+    def settings(self, base: ManagerSettings | None = None) -> ManagerSettings:
+        """Return ``base`` (default: the defaults) with this profile's :attr:`fields`."""
+        return ManagerSettings.from_dict(self.fields, base=base)
+
+
+#: Radians: the SLICED and RELAXED profiles' heading cells, the width measured best on real logs
+#: (docs/real-logs.md, "The slice width"); SpatialUncertaintyMap.with_slices' default too.
+_PROFILE_SLICE_WIDTH = math.radians(2.0)
+#: Observations over which the RELAXED profile tolerates one wrong landmark: as sound as 10 on
+#: the real logs, at about 0.6 of the time (docs/real-logs.md, "The relaxed window").
+_RELAXED_WINDOW = 5
+# Without the relaxed intersection its window is unused: the field's default, so that a
+# profile leaves the settings as ManagerSettings() has them.
+_UNUSED_WINDOW: int = ManagerSettings().relaxed_window
+_PROFILE_FIELDS = {
+    MapProfile.PRODUCT: MappingProxyType(
+        {"slice_width": None, "relaxed_q": 0, "relaxed_window": _UNUSED_WINDOW}
+    ),
+    MapProfile.SLICED: MappingProxyType(
+        {"slice_width": _PROFILE_SLICE_WIDTH, "relaxed_q": 0, "relaxed_window": _UNUSED_WINDOW}
+    ),
+    MapProfile.RELAXED: MappingProxyType(
+        {"slice_width": _PROFILE_SLICE_WIDTH, "relaxed_q": 1, "relaxed_window": _RELAXED_WINDOW}
+    ),
+}

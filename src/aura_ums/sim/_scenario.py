@@ -33,6 +33,7 @@ says ``_deg``, radians otherwise; every other unit SI)::
     robust = true                       # envelope map and re-localization from it
     # ... any field of ManagerSettings, by its name (its unit, range and default are
     # there); angles in radians, or in degrees as <name>_deg; "none" for None.
+    # profile = "sliced"                # a MapProfile: product, sliced or relaxed, under the keys
 
     [render]                            # optional: the synthetic camera and scene
     noise = 2.0                         # gray levels (sd); clutter = 0 (ground strips);
@@ -75,7 +76,7 @@ from aura_ums.camera import Camera, load_camera
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import Expecter
 from aura_ums.geometry import wrap_angle
-from aura_ums.manager import ManagerSettings, SettingInfo
+from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
 from aura_ums.schemas import FindLandmarkSchema
 from aura_ums.sim._render import SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
@@ -918,12 +919,22 @@ def _settings(document: Mapping[str, object], reader: _Reader) -> ManagerSetting
     lost = reader.table(document, "lost", required=False)
     infos = {f.name: SettingInfo.of(f) for f in dataclasses.fields(ManagerSettings)}
     angles = tuple(f"{name}_deg" for name, info in infos.items() if info.unit == "rad")
-    reader.keys(manager, (*infos, *angles), "[manager]")
+    reader.keys(manager, (*infos, *angles, "profile"), "[manager]")
     reader.keys(lost, ("area_limit", "missed_limit"), "[lost]")
+    base = None
+    if "profile" in manager:
+        # The profile's fields are the base the table's own keys override, as on the command line.
+        named = manager["profile"]
+        names = [profile.value for profile in MapProfile]
+        if not isinstance(named, str) or named not in names:
+            raise reader.fail("[manager] profile", f"expected one of {', '.join(names)}, got {named!r}")
+        base = MapProfile(named).settings()
     values: dict[str, object] = {}
     places: dict[str, str] = {}
     for table, name in ((lost, "lost"), (manager, "manager")):
         for key, value in table.items():
+            if key == "profile" and table is manager:
+                continue
             setting, degrees = (key[:-4], True) if key in angles else (key, False)
             where = f"[{name}] {key}"
             if setting in places:
@@ -934,7 +945,7 @@ def _settings(document: Mapping[str, object], reader: _Reader) -> ManagerSetting
                 value = None
             values[setting], places[setting] = value, where
     return ManagerSettings.from_dict(
-        values, fail=lambda key, message: reader.fail(places.get(key, f"[manager] {key}"), message)
+        values, base=base, fail=lambda key, message: reader.fail(places.get(key, f"[manager] {key}"), message)
     )
 
 
