@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import ReplayState, compare_on_log, replay_log, synthetic_log
+from aura_ums.logs import ReplayOptions, ReplayState, compare_on_log, replay_log, synthetic_log
+from aura_ums.manager import ManagerSettings
 from aura_ums.uncertainty import TerrainTable
 
 TABLE = TerrainTable({"floor": TerrainTable.default()["tile"]})
@@ -51,6 +52,23 @@ def test_until_stops_and_the_state_resumes_bit_for_bit() -> None:
     for ours, theirs in zip(rest.steps, whole.steps[len(half.steps) :], strict=True):
         assert ours.map.polygon.vertices.tobytes() == theirs.map.polygon.vertices.tobytes()
         assert ours.map.wedge == theirs.map.wedge
+    assert rest.state is not None
+    assert json.loads(rest.state.manager_json) == json.loads(whole.state.manager_json)
+
+
+def test_a_resumed_replay_runs_and_reports_the_saved_settings() -> None:
+    # Saved with the relaxed intersection and no envelope; resumed with the default options.
+    log = synthetic_log(np.random.default_rng(12), duration=30.0)
+    saved_settings = ManagerSettings(robust=False, relaxed_q=1, relaxed_window=5)
+    options = ReplayOptions(settings=saved_settings)
+    whole = replay_log(log, TABLE, options, save_state=True)
+    half = replay_log(log, TABLE, options, until=12.0, save_state=True)
+    assert half.state is not None
+    assert whole.state is not None
+    rest = replay_log(log, TABLE, ReplayOptions(), resume=half.state, save_state=True)
+    assert rest.options.settings == saved_settings
+    metrics = rest.metrics()
+    assert (metrics["relaxed_q"], metrics["relaxed_window"], metrics["robust"]) == (1, 5, False)
     assert rest.state is not None
     assert json.loads(rest.state.manager_json) == json.loads(whole.state.manager_json)
 

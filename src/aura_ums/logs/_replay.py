@@ -700,7 +700,8 @@ def replay_log(
     resume : ReplayState or None
         Continue a replay of this same log from a saved :class:`ReplayState` (the
         manager and blackboard as they were, its settings included): the steps are those
-        after it, and the last map is bit for bit that of an uninterrupted replay.
+        after it, and the last map is bit for bit that of an uninterrupted replay. The
+        saved settings replace ``options.settings`` (the result reports them).
     save_state : bool
         Record where the replay stopped (:attr:`ReplayResult.state`, the manager's and
         blackboard's JSON, which grows with the log), to save and resume from.
@@ -768,10 +769,6 @@ def replay_log(
         )
     log = dataclasses.replace(log, meta=_motion_meta(log.meta, opts.motion))
     working_bounds = opts.working if opts.working is not None else meta_bounds(log)
-    robust = opts.settings.robust
-    envelope_bounds = (
-        opts.envelope if opts.envelope is not None else working_bounds.widened(opts.settings.envelope_factor)
-    )
     source = (
         _stream_source(log, opts, stop, keep_rows=before_frame is not None)
         if isinstance(log, LogStream)
@@ -787,6 +784,13 @@ def replay_log(
             resume.manager_json, source.meadow_map, table, source="resume"
         )
         board = Blackboard.from_json(resume.blackboard_json, source="resume")
+        # The saved settings run the rest: the envelope's observations pair with them, and
+        # the result reports them (an uninterrupted replay had them from its first frame).
+        opts = dataclasses.replace(opts, settings=manager.settings)
+    robust = opts.settings.robust
+    envelope_bounds = (
+        opts.envelope if opts.envelope is not None else working_bounds.widened(opts.settings.envelope_factor)
+    )
     trace = _TraceBuilder()
     maps: list[SpatialUncertaintyMap] = []
     offset = log.meta.sensor_offset

@@ -10,6 +10,7 @@ import types
 from collections import deque
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import shapely
 
@@ -1175,6 +1176,34 @@ class UncertaintyMapManager:
             },
         )
 
+    @staticmethod
+    def saved_settings(text: str, *, source: str = "<manager JSON>") -> ManagerSettings:
+        """Return the settings a manager saved by :meth:`to_json` runs with.
+
+        As :meth:`from_json` would restore them (a document saved before a setting
+        existed runs as it did), without restoring the manager.
+
+        Raises
+        ------
+        FileFormatError
+            When the text is not such a document, naming ``source``, the place and what is wrong.
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import Pose, TerrainTable
+        >>> from aura_ums.world import make_grid_world
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+        >>> settings = ManagerSettings(relaxed_q=1, relaxed_window=5)
+        >>> manager = UncertaintyMapManager(start, make_grid_world(1, 3), TerrainTable.default(), settings)
+        >>> UncertaintyMapManager.saved_settings(manager.to_json()) == settings
+        True
+        >>> UncertaintyMapManager.saved_settings('{"format": "aura-ums/uncertainty-map-manager"}')
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.FileFormatError: <manager JSON>: version: expected 1, got nothing
+        """
+        return _saved_document(Reader(source), text)[1]
+
     @classmethod
     def from_json(
         cls,
@@ -1220,18 +1249,7 @@ class UncertaintyMapManager:
         if not isinstance(table, TerrainTable):
             raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
         reader = Reader(source)
-        keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
-        data = reader.mapping(
-            reader.document(text, _KIND),
-            "",
-            (*keys, "counters", "settings"),
-            optional=("envelope", "relaxed"),
-        )
-        settings = ManagerSettings.from_dict(
-            reader.mapping(data["settings"], "settings"),
-            base=_BEFORE_SETTINGS,
-            fail=lambda key, message: FileFormatError(source, f"settings.{key}", message),
-        )
+        data, settings = _saved_document(reader, text)
         uncertainty_map = reader.uncertainty_map(data["map"], "map")
         manager = cls(uncertainty_map, meadow_map, table, settings)
         manager._map_time = reader.optional_number(data["map_time"], "map_time")
@@ -1309,6 +1327,23 @@ class UncertaintyMapManager:
 #: What a saved document lacking a setting ran with: one by one before joint reductions,
 #: without an envelope before outlier recovery; the defaults otherwise.
 _BEFORE_SETTINGS = ManagerSettings(joint_above=None, robust=False, relaxed_q=0)
+
+
+def _saved_document(reader: Reader, text: str) -> tuple[dict[str, Any], ManagerSettings]:
+    """Return a saved manager's top-level keys, checked, and the settings it runs with."""
+    keys = ("format", "version", "map", "map_time", "consumed_reports", "state", "lost_reason")
+    data = reader.mapping(
+        reader.document(text, _KIND),
+        "",
+        (*keys, "counters", "settings"),
+        optional=("envelope", "relaxed"),
+    )
+    settings = ManagerSettings.from_dict(
+        reader.mapping(data["settings"], "settings"),
+        base=_BEFORE_SETTINGS,
+        fail=lambda key, message: FileFormatError(reader.source, f"settings.{key}", message),
+    )
+    return data, settings
 
 
 def _thinned(anchors: tuple[_Anchor, ...], now: float, span: float) -> tuple[_Anchor, ...]:
