@@ -139,6 +139,30 @@ def test_a_resumed_sliced_relaxed_replay_ends_with_the_same_map(
     assert saved["manager"]["settings"]["relaxed_window"] == 5
 
 
+def test_a_resumed_replay_refuses_options_other_than_its_saved_settings(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    folder, terrain = walk
+    state = tmp_path / "s.json"
+    common_args = ("replay", folder, "--terrain", terrain, "--classes", "II", "--quiet")
+    invoke(*common_args, "--profile", "relaxed", "--until", "15", "--save-state", state)
+    # Left out, or given as saved: the saved settings run, and the metrics report them.
+    for same in ((), ("--profile", "relaxed"), ("--relaxed-window", "5", "--robust")):
+        result = invoke(*common_args, "--resume", state, *same)
+        assert "relaxed_q                    1" in result.stdout
+        assert "relaxed_window               5" in result.stdout
+    refused = {
+        ("--relaxed-q", "0"): "--relaxed-q: expected relaxed_q 1, as --resume's state was saved with",
+        ("--profile", "sliced"): "--profile sliced: expected relaxed_q 1, as --resume's state was saved with",
+        ("--gate-only",): "--robust/--gate-only: expected robust true, as --resume's state was saved with",
+    }
+    for other, message in refused.items():
+        result = runner.invoke(app, [str(a) for a in (*common_args, "--resume", state, *other)])
+        assert result.exit_code == 2, other
+        assert message in result.stderr
+        assert "Traceback" not in result.output
+
+
 def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: Path) -> None:
     folder, terrain = walk
     invoke("replay", folder, "--terrain", terrain, "--until", "10", "--save-state", tmp_path / "s.json")

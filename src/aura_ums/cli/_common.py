@@ -159,10 +159,23 @@ class SettingOptions:
     Attributes
     ----------
     given : Mapping[str, object]
-        Field name to value, for the options given only.
+        Field name to value, for the options given only (a ``--profile``'s fields included).
+    profile : MapProfile or None
+        The ``--profile`` given, if any: the fields of ``given`` it set are those of its
+        :attr:`~aura_ums.manager.MapProfile.fields` no option overrode.
     """
 
     given: Mapping[str, object]
+    profile: MapProfile | None = None
+
+    def option_of(self, name: str) -> str:
+        """Return how the user gave field ``name``: its option, or ``--profile NAME`` that set it."""
+        profile = self.profile
+        if profile is not None and name in profile.fields and self.given.get(name) == profile.fields[name]:
+            return f"--profile {profile.value}"
+        info = next(SettingInfo.of(f) for f in dataclasses.fields(ManagerSettings) if f.name == name)
+        flag = setting_flag(name)
+        return f"{flag}/{info.off_flag}" if info.kind is bool else flag
 
     def over(self, base: ManagerSettings | None = None) -> ManagerSettings:
         """Return ``base`` (default: the defaults) with the options given; a bad value exits, named."""
@@ -210,7 +223,7 @@ def manager_options(default_from: str = "") -> Callable[[Callable[..., None]], C
                     given[name] = None
                 elif value is not None:
                     given[name] = value
-            chosen = SettingOptions(given)
+            chosen = SettingOptions(given, profile)
             chosen.over()  # named before any file is read
             command(**kwargs, settings=chosen)
 

@@ -168,6 +168,26 @@ def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
     return None
 
 
+def _refuse_other_settings(settings: SettingOptions, kept: ManagerSettings) -> None:
+    """Refuse (exit 2) an option given with --resume that differs from the saved settings.
+
+    A resumed replay runs on with the settings it was saved with (so that it ends as an
+    uninterrupted one would): an option that asks for another value would be ignored.
+    """
+    wanted = settings.over(kept)
+    for name in settings.given:
+        saved, asked = getattr(kept, name), getattr(wanted, name)
+        if saved != asked:
+            raise fail(
+                f"{settings.option_of(name)}: expected {name} {_setting_text(saved)}, as --resume's state "
+                f"was saved with (a resumed replay runs with its saved settings), got {_setting_text(asked)}"
+            )
+
+
+def _setting_text(value: object) -> str:
+    return "none" if value is None else f"{value:g}" if isinstance(value, float) else str(value).lower()
+
+
 def _options(
     classes: Classes, sensors: Path | None, settings: ManagerSettings, reverse: Reverse = Reverse.ERROR
 ) -> ReplayOptions:
@@ -370,7 +390,7 @@ def replay(
     3-sigma box, the disk model) and how often the observation fell inside.
 
     With --resume the replay continues where a --save-state left it (its settings are the
-    saved ones) and reports the frames after it; it ends with exactly the map of a
+    saved ones: an option asking for another value is refused) and reports the frames after it; it ends with exactly the map of a
     replay run in one go. With --live, the replay is streamed to Foxglove as it computes
     (with --camera, its windows too, on a blank image: logs carry no images).
 
@@ -383,6 +403,7 @@ def replay(
     from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import ReplayState, RobotLog, replay_log, replay_windows
+    from aura_ums.manager import UncertaintyMapManager
     from aura_ums.uncertainty import TerrainTable
 
     if windows_csv is not None and camera is None:
@@ -449,6 +470,9 @@ def replay(
         table = _terrain_table(terrain, log.meta.terrain, log_dir)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
         saved = None if resume is None else ReplayState.load(resume)
+        if saved is not None:
+            kept = UncertaintyMapManager.saved_settings(saved.manager_json, source=f"{resume}: manager")
+            _refuse_other_settings(settings, kept)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
         # The per-step CSV is streamed, through a scratch file renamed onto it whole.
