@@ -234,3 +234,38 @@ def test_a_resumed_mrclam6_replay_ends_with_the_same_map(tmp_path: Path) -> None
     first = float((log / "observations.csv").read_text().splitlines()[2].split(",")[0])
     sensors = ("--sensors", str(tmp_path / "terrain.sensors.toml"), "--classes", "II")
     resumed_alike(log, tmp_path / "terrain.toml", tmp_path, first + 60.0, first + 150.0, *sensors)
+
+
+def test_an_option_that_would_have_no_effect_is_refused(walk: tuple[Path, Path], tmp_path: Path) -> None:
+    folder, terrain = walk
+    replay = ("replay", folder, "--terrain", terrain, "--quiet")
+    cases = {
+        (*replay, "--window-margin", "5"): "--window-margin: expected --camera too, got no camera",
+        (*replay, "--live-port", "9000"): "--live-port: expected --live too, got no --live",
+        (*replay, "--retries", "0"): "--retries: expected --workers above 1 or --scheduler too, got neither",
+        ("simulate", SCENARIO, "--runs", "1", "--live-rate", "2"): "--live-rate: expected --live too",
+        (
+            "simulate",
+            SCENARIO,
+            "--runs",
+            "1",
+            "--run-timeout",
+            "5",
+        ): "--run-timeout: expected --workers above 1",
+        (
+            "calibrate",
+            folder,
+            "--out",
+            tmp_path / "never.toml",
+            "--retries",
+            "2",
+        ): "--retries: expected --workers",
+    }
+    for arguments, message in cases.items():
+        result = runner.invoke(app, [str(a) for a in arguments])
+        assert result.exit_code == 2, arguments
+        assert message in result.stderr
+        assert "Traceback" not in result.output
+    assert not (tmp_path / "never.toml").exists()
+    # The same options with what they need, or left out, run.
+    assert "containment_rate" in invoke(*replay).stdout

@@ -21,6 +21,7 @@ from aura_ums.cli._common import (
     folder_argument,
     manager_options,
     progress_bar,
+    refuse_alone,
 )
 from aura_ums.cli._interop import (
     LIVE_DEFAULTS,
@@ -29,6 +30,7 @@ from aura_ums.cli._interop import (
     LiveHost,
     LivePort,
     LiveRate,
+    live_rules,
     live_simulation,
     rosbag_command,
     write_simulation_mcap_option,
@@ -127,6 +129,7 @@ def demo(
 @interruptible
 @manager_options(default_from="the scenario's [manager]")
 def simulate(
+    context: typer.Context,
     scenario: Annotated[Path, typer.Argument(readable=False, help="Scenario TOML file (see aura_ums.sim).")],
     runs: Annotated[int, typer.Option("--runs", help="Monte Carlo runs, >= 1.")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the whole Monte Carlo, >= 0.")] = 0,
@@ -165,7 +168,8 @@ def simulate(
     from aura_ums.errors import AuraUmsError
     from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
 
-    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
+    refuse_alone(context, live_rules(live))
+    campaign_options = campaign_settings(context, workers, scheduler, retries, run_timeout)
     if runs < 1:
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
     check_seed(seed)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from aura_ums.campaign import CampaignSettings
-from aura_ums.cli._common import console, fail, progress_bar
+from aura_ums.cli._common import console, fail, progress_bar, refuse_alone
 from aura_ums.cli._outputs import Target, write_text
 
 if TYPE_CHECKING:
@@ -61,16 +61,25 @@ _FLAGS = {
 
 
 def campaign_settings(
-    workers: int, scheduler: str | None, retries: int, run_timeout: float | None
+    context: typer.Context, workers: int, scheduler: str | None, retries: int, run_timeout: float | None
 ) -> CampaignSettings:
-    """Return the campaign's settings from its options; a bad value exits, named by its option."""
+    """Return the campaign's settings from its options; a bad value, or one with no effect, exits named."""
     from aura_ums.errors import InputError
 
     try:
-        return CampaignSettings(workers=workers, scheduler=scheduler, retries=retries, timeout_s=run_timeout)
+        settings = CampaignSettings(
+            workers=workers, scheduler=scheduler, retries=retries, timeout_s=run_timeout
+        )
     except InputError as exc:
         name, _, rest = str(exc).partition(": ")
         raise fail(f"{_FLAGS.get(name, name)}: {rest}") from None
+    dask = workers > 1 or scheduler is not None
+    neither = "neither (runs are retried on Dask workers only)"
+    refuse_alone(
+        context,
+        [(name, "--workers above 1 or --scheduler", neither, dask) for name in ("retries", "run_timeout")],
+    )
+    return settings
 
 
 def replay_logs(

@@ -12,7 +12,7 @@ import functools
 import inspect
 import math
 from collections import Counter
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +46,19 @@ def fail(message: str) -> typer.Exit:
     """Print ``error: <message>`` (markup-safe) on stderr; return the exit (code 2) to raise."""
     err_console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
     return typer.Exit(code=2)
+
+
+def refuse_alone(context: typer.Context, rules: Sequence[tuple[str, str, str, bool]]) -> None:
+    """Refuse (exit 2) an option typed on the command line that would have no effect.
+
+    Each rule is ``(parameter, what it needs, what was given instead, whether the need is
+    met)``: an option the user typed meant something, so it is refused rather than ignored.
+    Options left at their defaults are not checked.
+    """
+    for name, needed, instead, met in rules:
+        source = context.get_parameter_source(name)
+        if not met and source is not None and source.name == "COMMANDLINE":
+            raise fail(f"--{name.replace('_', '-')}: expected {needed} too, got {instead}")
 
 
 def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Path]:

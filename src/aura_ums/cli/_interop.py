@@ -156,6 +156,12 @@ def write_replay_mcap_option(
 #: The defaults of ``--live-host``, ``--live-port`` and ``--live-rate``: the library's.
 LIVE_DEFAULTS = LiveOptions()
 
+
+def live_rules(live: bool) -> list[tuple[str, str, str, bool]]:
+    """Return the rules of :func:`~aura_ums.cli._common.refuse_alone` for the options of ``--live``."""
+    return [(name, "--live", "no --live", live) for name in ("live_host", "live_port", "live_rate")]
+
+
 #: ``--live``: stream to Foxglove while computing.
 Live = Annotated[
     bool,

@@ -33,8 +33,9 @@ from aura_ums.cli._common import (
     folder_argument,
     manager_options,
     progress_bar,
+    refuse_alone,
 )
-from aura_ums.cli._interop import LIVE_DEFAULTS, Live, LiveHost, LivePort, LiveRate, live_replay
+from aura_ums.cli._interop import LIVE_DEFAULTS, Live, LiveHost, LivePort, LiveRate, live_replay, live_rules
 from aura_ums.cli._outputs import (
     Overwrite,
     Source,
@@ -207,6 +208,7 @@ def _options(
 
 
 def calibrate(
+    context: typer.Context,
     log_dirs: Annotated[
         list[Path],
         typer.Argument(
@@ -269,7 +271,7 @@ def calibrate(
         [Source("LOG_DIRS", folder, folder=True) for folder in log_dirs],
         overwrite=overwrite,
     )
-    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
+    campaign_options = campaign_settings(context, workers, scheduler, retries, run_timeout)
     try:
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
             loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
@@ -320,6 +322,7 @@ def calibrate(
 
 @manager_options()
 def replay(
+    context: typer.Context,
     log_dirs: Annotated[
         list[Path],
         typer.Argument(
@@ -390,9 +393,10 @@ def replay(
     3-sigma box, the disk model) and how often the observation fell inside.
 
     With --resume the replay continues where a --save-state left it (its settings are the
-    saved ones: an option asking for another value is refused) and reports the frames after it; it ends with exactly the map of a
-    replay run in one go. With --live, the replay is streamed to Foxglove as it computes
-    (with --camera, its windows too, on a blank image: logs carry no images).
+    saved ones: an option asking for another value is refused) and reports the frames
+    after it; it ends with exactly the map of a replay run in one go. With --live, the
+    replay is streamed to Foxglove as it computes (with --camera, its windows too, on a
+    blank image: logs carry no images).
 
     With several LOG_DIRs, each is replayed on its own (on Dask workers with --workers N
     or --scheduler) and the metrics list one entry per log (`replays`); the outputs of
@@ -418,7 +422,8 @@ def replay(
             f"--window-margin: expected at most {IMAGE_SIDE.high:g} pixels (an image's longest side), "
             f"got {window_margin:g}"
         )
-    campaign_options = campaign_settings(workers, scheduler, retries, run_timeout)
+    refuse_alone(context, [("window_margin", "--camera", "no camera", camera is not None), *live_rules(live)])
+    campaign_options = campaign_settings(context, workers, scheduler, retries, run_timeout)
     if len(log_dirs) > 1:
         one_log = {"--steps-csv": steps_csv, "--plot": plot, "--mcap": mcap, "--save-state": save_state,
                    "--resume": resume, "--windows-csv": windows_csv}  # fmt: skip
