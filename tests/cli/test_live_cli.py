@@ -157,3 +157,19 @@ def test_missing_extra_names_it(terrain: Path, monkeypatch: pytest.MonkeyPatch) 
     assert "install aura-ums[foxglove]" in result.stderr
     # without --live nothing changes
     assert runner.invoke(app, ["replay", str(SAMPLE), "--terrain", str(terrain)]).exit_code == 0
+
+
+def test_a_resumed_live_replay_streams_the_slices_of_its_saved_settings(
+    terrain: Path, tmp_path: Path
+) -> None:
+    state = tmp_path / "s.json"
+    arguments = ["replay", str(SAMPLE), "--terrain", str(terrain), "--classes", "II"]
+    saved = runner.invoke(
+        app, [*arguments, "--slice-width", "2deg", "--until", "10", "--save-state", str(state)]
+    )
+    assert saved.exit_code == 0, saved.output
+    # Resumed without --slice-width: the saved (sliced) settings run, and the view shows their slices.
+    done, messages = _watch([*arguments, "--resume", str(state), "--until", "20", "--live-rate", "0", "-q"])
+    assert done.returncode == 0, done.stderr
+    counts = Counter(m.topic for m in messages)
+    assert counts["/map/slices"] == counts["/metrics"] > 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import enum
 import inspect
 import math
@@ -478,6 +479,8 @@ def replay(
         if saved is not None:
             kept = UncertaintyMapManager.saved_settings(saved.manager_json, source=f"{resume}: manager")
             _refuse_other_settings(settings, kept)
+            # What runs from here (replay_log takes them too), so the live view announces the same.
+            options = dataclasses.replace(options, settings=kept)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
         # The per-step CSV is streamed, through a scratch file renamed onto it whole.
