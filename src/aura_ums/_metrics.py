@@ -244,6 +244,13 @@ _TABLE: tuple[MetricKey, ...] = (
     ),
     _key("relocalizations", "count", _K.COUNT, (REPLAY,), "Times the envelope re-seeded the working map."),
     _key(
+        "slice_width_rad",
+        "rad",
+        _K.NUMBER,
+        (SIMULATE, REPLAY),
+        "Width of the heading cells of the sliced map; null: the product map (one polygon x one wedge).",
+    ),
+    _key(
         "relaxed_q",
         "count",
         _K.COUNT,

@@ -197,3 +197,5 @@ def test_simulate_profile_overrides_the_scenarios_map_keeps_the_rest(monkeypatch
     assert result.exit_code == 0, result.output
     assert ran[-1].settings == MapProfile.SLICED.settings(file)
     assert ran[-1].settings.area_limit == file.area_limit == 25.0
+    shown = next(line for line in result.stdout.splitlines() if line.startswith("slice_width_rad"))
+    assert float(shown.split()[1]) == pytest.approx(math.radians(2.0))

@@ -59,7 +59,9 @@ def test_until_stops_and_the_state_resumes_bit_for_bit() -> None:
 def test_a_resumed_replay_runs_and_reports_the_saved_settings() -> None:
     # Saved with the relaxed intersection and no envelope; resumed with the default options.
     log = synthetic_log(np.random.default_rng(12), duration=30.0)
-    saved_settings = ManagerSettings(robust=False, relaxed_q=1, relaxed_window=5)
+    saved_settings = ManagerSettings(
+        robust=False, relaxed_q=1, relaxed_window=5, slice_width=math.radians(4.0)
+    )
     options = ReplayOptions(settings=saved_settings)
     whole = replay_log(log, TABLE, options, save_state=True)
     half = replay_log(log, TABLE, options, until=12.0, save_state=True)
@@ -69,6 +71,8 @@ def test_a_resumed_replay_runs_and_reports_the_saved_settings() -> None:
     assert rest.options.settings == saved_settings
     metrics = rest.metrics()
     assert (metrics["relaxed_q"], metrics["relaxed_window"], metrics["robust"]) == (1, 5, False)
+    assert metrics["slice_width_rad"] == saved_settings.slice_width
+    assert replay_log(log, TABLE).metrics()["slice_width_rad"] is None  # the product map
     assert rest.state is not None
     assert json.loads(rest.state.manager_json) == json.loads(whole.state.manager_json)
 

@@ -219,6 +219,7 @@ def simulate(
             "runs": runs,
             "seed": seed,
             "prune": prune,
+            "slice_width_rad": loaded.settings.slice_width,
             "relaxed_q": loaded.settings.relaxed_q,
             "relaxed_window": loaded.settings.relaxed_window,
             **summarize_runs(values),

@@ -471,6 +471,7 @@ class ReplayResult:
                 "inconsistent_observations": self.inconsistent_observations,
                 "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
+                "slice_width_rad": self.options.settings.slice_width,
                 "relaxed_q": self.options.settings.relaxed_q,
                 "relaxed_window": self.options.settings.relaxed_window,
                 "excluded_observations": int(self.trace.excluded.sum()),
