@@ -249,6 +249,12 @@ def manager_options(default_from: str = "") -> Callable[[Callable[..., None]], C
 
 # The parameter under which ``--profile`` arrives (a name no ManagerSettings field has).
 _PROFILE = "settings_profile"
+# What each profile is for, in a few words (MapProfile's documentation has the measurements).
+_PROFILE_BLURBS = {
+    MapProfile.PRODUCT: "the paper's polygon x wedge, fastest",
+    MapProfile.SLICED: "windows about a quarter of the frame",
+    MapProfile.RELAXED: "the truth kept despite a wrong landmark, at about 6-11 ms a frame",
+}
 
 
 def _profile_parameter(default_from: str) -> inspect.Parameter:
@@ -260,17 +266,17 @@ def _profile_parameter(default_from: str) -> inspect.Parameter:
         shown = (f"{setting_flag(name)} {_shown_setting(name, value)}" for name, value in changed)
         return " ".join(shown) or "the defaults"
 
-    product, sliced, relaxed = (sets(profile) for profile in MapProfile)
+    choices = "; ".join(
+        f"{profile.value} = {sets(profile)}, {_PROFILE_BLURBS[profile]}" for profile in MapProfile
+    )
     source = f"{default_from}, else " if default_from else ""
     option = typer.Option(
         "--profile",
         help=(
-            f"Map representation, as measured on real logs (docs/real-logs.md): product = {product}, "
-            f"the paper's polygon x wedge, fastest; sliced = {sliced}, windows about a quarter of the "
-            f"frame; relaxed = {relaxed}, the truth kept despite a wrong landmark, at about 6-11 ms a frame. "
+            f"Map representation, as measured on real logs (docs/real-logs.md): {choices}. "
             "The options given one by one override it"
         ),
-        show_default=f"{source}product",
+        show_default=f"{source}{MapProfile.PRODUCT.value}",
     )
     keyword = inspect.Parameter.POSITIONAL_OR_KEYWORD
     return inspect.Parameter(_PROFILE, keyword, default=None, annotation=Annotated[MapProfile | None, option])
