@@ -98,18 +98,24 @@ def test_an_off_flag_sets_none_and_bad_values_name_their_option() -> None:
     assert "--relocalize-window: expected an integer >= relocalize_after (3), got 1" in window.output
 
 
-def test_simulate_options_override_the_scenarios_manager_table(monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.fixture
+def ran(monkeypatch: pytest.MonkeyPatch) -> list[Scenario]:
+    """The scenarios ``simulate`` runs, as it hands them to its campaign."""
     import aura_ums.campaign
 
-    ran: list[Scenario] = []
+    seen: list[Scenario] = []
     real = aura_ums.campaign.simulate_campaign
 
     def spy(scenario: Scenario, *args: Any, **kwargs: Any) -> Any:
-        ran.append(scenario)
+        seen.append(scenario)
         return real(scenario, *args, **kwargs)
 
     # simulate runs its Monte Carlo as a campaign (aura_ums.campaign), serially by default.
     monkeypatch.setattr(aura_ums.campaign, "simulate_campaign", spy)
+    return seen
+
+
+def test_simulate_options_override_the_scenarios_manager_table(ran: list[Scenario]) -> None:
     path = str(SCENARIOS / "paper_sidewalk.toml")
     result = runner.invoke(app, ["simulate", path, "--runs", "1", "--gate-only", "--missed-limit", "5"])
     assert result.exit_code == 0, result.output
@@ -179,17 +185,7 @@ def test_the_profile_help_names_the_options_it_sets() -> None:
     assert "product = the defaults," in option.help
 
 
-def test_simulate_profile_overrides_the_scenarios_map_keeps_the_rest(monkeypatch: pytest.MonkeyPatch) -> None:
-    import aura_ums.campaign
-
-    ran: list[Scenario] = []
-    real = aura_ums.campaign.simulate_campaign
-
-    def spy(scenario: Scenario, *args: Any, **kwargs: Any) -> Any:
-        ran.append(scenario)
-        return real(scenario, *args, **kwargs)
-
-    monkeypatch.setattr(aura_ums.campaign, "simulate_campaign", spy)
+def test_simulate_profile_overrides_the_scenarios_map_keeps_the_rest(ran: list[Scenario]) -> None:
     path = str(SCENARIOS / "paper_sidewalk.toml")
     file = Scenario.from_toml(path).settings
     assert file.relaxed_q == 1  # the scenario's own relaxed intersection, which the profile turns off

@@ -186,9 +186,8 @@ class SettingOptions:
         profile = self.profile
         if profile is not None and name in profile.fields and self.given.get(name) == profile.fields[name]:
             return f"--profile {profile.value}"
-        info = next(SettingInfo.of(f) for f in dataclasses.fields(ManagerSettings) if f.name == name)
         flag = setting_flag(name)
-        return f"{flag}/{info.off_flag}" if info.kind is bool else flag
+        return f"{flag}/{_off_flag(name)}" if _INFOS[name].kind is bool else flag
 
     def over(self, base: ManagerSettings | None = None) -> ManagerSettings:
         """Return ``base`` (default: the defaults) with the options given; a bad value exits, named."""
@@ -247,6 +246,8 @@ def manager_options(default_from: str = "") -> Callable[[Callable[..., None]], C
     return decorate
 
 
+# Each ManagerSettings field's info, by name.
+_INFOS = {field.name: SettingInfo.of(field) for field in dataclasses.fields(ManagerSettings)}
 # The parameter under which ``--profile`` arrives (a name no ManagerSettings field has).
 _PROFILE = "settings_profile"
 # What each profile is for, in a few words (MapProfile's documentation has the measurements).
@@ -286,14 +287,13 @@ def _shown_setting(name: str, value: object) -> str:
     """Return a profile's value as typed on the command line (an angle in degrees)."""
     if value is None:
         return "none"
-    info = next(SettingInfo.of(f) for f in dataclasses.fields(ManagerSettings) if f.name == name)
-    if info.unit == "rad" and isinstance(value, float):
+    if _INFOS[name].unit == "rad" and isinstance(value, float):
         return f"{math.degrees(value):g}deg"
     return str(value)
 
 
 def _off_flag(name: str) -> str:
-    return next(SettingInfo.of(f).off_flag for f in dataclasses.fields(ManagerSettings) if f.name == name)
+    return _INFOS[name].off_flag
 
 
 def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspect.Parameter]:
