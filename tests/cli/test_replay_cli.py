@@ -486,7 +486,7 @@ def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
     result = runner.invoke(app, ["calibrate", str(log_folder), "--out", ""])
     assert result.exit_code == 2
     assert "Traceback" not in result.output  # a ValueError of Path.with_suffix before
-    assert result.stderr == "error: --out: expected a file path, got '.'\n"
+    assert result.stderr == "error: --out: expected a file name, got an empty path ''\n"
 
 
 @pytest.mark.parametrize(
@@ -535,6 +535,41 @@ def test_an_empty_or_nameless_path_is_refused_naming_it(
     result = runner.invoke(app, argv)
     assert result.exit_code == 2
     assert result.stderr == f"error: {message}\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+_SCENARIO = str(Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml")
+_REPLAY = ["replay", "log", "--terrain", "t.toml"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "option", "example"),
+    [
+        (["simulate", _SCENARIO, "--runs", "1", "--metrics-json"], "--metrics-json", "metrics.json"),
+        (["simulate", _SCENARIO, "--runs", "1", "--mcap"], "--mcap", "run.mcap"),
+        (["calibrate", "log", "--out"], "--out", "terrain.toml"),
+        (["calibrate", "log", "--out", "t.toml", "--sensors-out"], "--sensors-out", "terrain.sensors.toml"),
+        ([*_REPLAY, "--metrics-json"], "--metrics-json", "metrics.json"),
+        ([*_REPLAY, "--steps-csv"], "--steps-csv", "steps.csv"),
+        ([*_REPLAY, "--mcap"], "--mcap", "run.mcap"),
+        ([*_REPLAY, "--save-state"], "--save-state", "state.json"),
+        ([*_REPLAY, "--windows-csv"], "--windows-csv", "windows.csv"),
+        (["compare", "log", "--terrain", "t.toml", "--metrics-json"], "--metrics-json", "metrics.json"),
+    ],
+    ids=["simulate-json", "simulate-mcap", "calibrate-out", "calibrate-sensors-out", "replay-json",
+         "replay-steps", "replay-mcap", "replay-state", "replay-windows", "compare-json"],
+)  # fmt: skip
+def test_a_file_output_given_as_a_folder_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, argv: list[str], option: str, example: str
+) -> None:
+    # `--metrics-json out/` lost its slash as a Path: the metrics went to a file named `out`.
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, [*argv, "out/"])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        f"error: {option}: expected a file name, got 'out/', which names a folder "
+        f"(give the file's name in it, e.g. out/{example})\n"
+    )
     assert list(tmp_path.iterdir()) == []
 
 

@@ -18,6 +18,7 @@ from aura_ums.cli._common import (
     check_seed,
     console,
     fail,
+    file_output,
     folder_argument,
     manager_options,
     progress_bar,
@@ -75,7 +76,10 @@ def figures(
     out: Annotated[
         Path,
         typer.Option(
-            "--out", help="Folder to write the PNG figures into.", parser=folder_argument("--out", "a folder")
+            "--out",
+            help="Folder to write the PNG figures into.",
+            parser=folder_argument("--out", "a folder"),
+            metavar="<path>",
         ),
     ] = Path("report/figures"),
     seed: Annotated[int, typer.Option(help="Seed of the sampled true outcomes drawn over the maps.")] = 0,
@@ -100,7 +104,12 @@ def figures(
 def demo(
     out: Annotated[
         Path,
-        typer.Option("--out", help="Folder for the report.", parser=folder_argument("--out", "a folder")),
+        typer.Option(
+            "--out",
+            help="Folder for the report.",
+            parser=folder_argument("--out", "a folder"),
+            metavar="<path>",
+        ),
     ] = Path("report"),
     seed: Annotated[int, typer.Option(help="Seed of every random draw in the report.")] = 0,
     runs: Annotated[int, typer.Option(help="Monte Carlo runs per variant in the summary.")] = 40,
@@ -135,13 +144,20 @@ def simulate(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the whole Monte Carlo, >= 0.")] = 0,
     metrics_json: Annotated[
         Path | None,
-        typer.Option("--metrics-json", readable=False, help="Write the metrics as JSON to this file."),
+        typer.Option(
+            "--metrics-json",
+            parser=file_output("--metrics-json"),
+            metavar="<path>",
+            help="Write the metrics as JSON to this file.",
+        ),
     ] = None,
     prune: Annotated[
         bool,
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
-    mcap: Annotated[Path | None, typer.Option("--mcap", readable=False, help=MCAP_HELP)] = None,
+    mcap: Annotated[
+        Path | None, typer.Option("--mcap", parser=file_output("--mcap"), metavar="<path>", help=MCAP_HELP)
+    ] = None,
     live: Live = False,
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,

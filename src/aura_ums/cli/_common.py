@@ -11,6 +11,7 @@ import dataclasses
 import functools
 import inspect
 import math
+import os
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -75,6 +76,38 @@ def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Pa
         return Path(text)
 
     return parse
+
+
+def file_output(name: str) -> Callable[[str], Path]:
+    """Return the parser of an output file option: refuses an empty path or a folder's (exit 2).
+
+    A path ending in a separator (``--metrics-json out/``) names a folder; as a ``Path`` it
+    would lose the separator and the output would be written to a file ``out`` instead.
+    """
+
+    def parse(text: str) -> Path:
+        if not text:
+            raise fail(f"{name}: expected a file name, got an empty path ''")
+        if text.endswith(("/", os.sep)):
+            raise fail(
+                f"{name}: expected a file name, got {text!r}, which names a folder "
+                f"(give the file's name in it, e.g. {text}{_EXAMPLE_NAMES.get(name, 'output')})"
+            )
+        return Path(text)
+
+    return parse
+
+
+#: The file name each output option's refusal of a folder suggests.
+_EXAMPLE_NAMES = {
+    "--metrics-json": "metrics.json",
+    "--steps-csv": "steps.csv",
+    "--windows-csv": "windows.csv",
+    "--mcap": "run.mcap",
+    "--save-state": "state.json",
+    "--out": "terrain.toml",
+    "--sensors-out": "terrain.sensors.toml",
+}
 
 
 def _new_log_folder(text: str) -> Path:

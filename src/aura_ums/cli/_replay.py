@@ -31,6 +31,7 @@ from aura_ums.cli._common import (
     console,
     err_console,
     fail,
+    file_output,
     folder_argument,
     manager_options,
     progress_bar,
@@ -120,7 +121,10 @@ _WindowMargin = Annotated[
 _WindowsCsv = Annotated[
     Path | None,
     typer.Option(
-        "--windows-csv", readable=False, help="Write one row per observation and window method (--camera)."
+        "--windows-csv",
+        parser=file_output("--windows-csv"),
+        metavar="<path>",
+        help="Write one row per observation and window method (--camera).",
     ),
 ]
 
@@ -213,15 +217,22 @@ def calibrate(
     log_dirs: Annotated[
         list[Path],
         typer.Argument(
-            help="Log folders with groundtruth.csv, one terrain.", parser=folder_argument("LOG_DIRS")
+            help="Log folders with groundtruth.csv, one terrain.",
+            parser=folder_argument("LOG_DIRS"),
         ),
     ],
-    out: Annotated[Path, typer.Option("--out", readable=False, help="Terrain table TOML to write.")],
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", parser=file_output("--out"), metavar="<path>", help="Terrain table TOML to write."
+        ),
+    ],
     sensors_out: Annotated[
         Path | None,
         typer.Option(
             "--sensors-out",
-            readable=False,
+            parser=file_output("--sensors-out"),
+            metavar="<path>",
             help="Motion and sensor bounds TOML (default: OUT with .sensors.toml).",
         ),
     ] = None,
@@ -231,6 +242,7 @@ def calibrate(
         list[float] | None,
         typer.Option(
             "--horizon",
+            metavar="<float>",
             help="Seconds without correction over which the motion bound must hold; repeat it "
             "(default 1, 2, 5, 10 and 30).",
         ),
@@ -339,20 +351,39 @@ def replay(
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None,
-        typer.Option("--metrics-json", readable=False, help="Write the metrics as JSON to this file."),
+        typer.Option(
+            "--metrics-json",
+            parser=file_output("--metrics-json"),
+            metavar="<path>",
+            help="Write the metrics as JSON to this file.",
+        ),
     ] = None,
     steps_csv: Annotated[
         Path | None,
-        typer.Option("--steps-csv", readable=False, help="Write one row per time step to this CSV file."),
+        typer.Option(
+            "--steps-csv",
+            parser=file_output("--steps-csv"),
+            metavar="<path>",
+            help="Write one row per time step to this CSV file.",
+        ),
     ] = None,
     plot: Annotated[
         Path | None,
         typer.Option(
-            "--plot", help="Folder for a figure of the replay.", parser=folder_argument("--plot", "a folder")
+            "--plot",
+            help="Folder for a figure of the replay.",
+            parser=folder_argument("--plot", "a folder"),
+            metavar="<path>",
         ),
     ] = None,
     mcap: Annotated[
-        Path | None, typer.Option("--mcap", readable=False, help="Write the replay as MCAP for Foxglove.")
+        Path | None,
+        typer.Option(
+            "--mcap",
+            parser=file_output("--mcap"),
+            metavar="<path>",
+            help="Write the replay as MCAP for Foxglove.",
+        ),
     ] = None,
     camera: _Camera = None,
     window_margin: _WindowMargin = 0.0,
@@ -361,7 +392,8 @@ def replay(
         Path | None,
         typer.Option(
             "--save-state",
-            readable=False,
+            parser=file_output("--save-state"),
+            metavar="<path>",
             help="Write where the replay stopped (versioned JSON), to --resume from.",
         ),
     ] = None,
@@ -565,6 +597,7 @@ def compare(
         typer.Option(
             "--noise-from",
             readable=False,
+            metavar="<path>",
             help="Calibration logs whose observation errors give the filters' noise (default: the "
             "[noise] of the sensors file; never LOG_DIR itself).",
         ),
@@ -576,7 +609,13 @@ def compare(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the particle filter.")] = 0,
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
-        Path | None, typer.Option("--metrics-json", readable=False, help="Write the table as JSON.")
+        Path | None,
+        typer.Option(
+            "--metrics-json",
+            parser=file_output("--metrics-json"),
+            metavar="<path>",
+            help="Write the table as JSON.",
+        ),
     ] = None,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
