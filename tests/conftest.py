@@ -6,7 +6,11 @@ import math
 import os
 from pathlib import Path
 
-import numpy as np
+# Figures draw off screen however pytest is started (`make test` sets it too): an
+# interactive backend found on a developer's machine would open windows, or wait on them.
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import numpy as np  # after the backend is chosen
 import pytest
 from hypothesis import HealthCheck, settings
 
