@@ -20,11 +20,14 @@ from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bo
 from aura_ums._native._reduce import (
     CONE_PIECE,
     SECTOR_PIECE,
+    SECTOR_ROW,
     TOLERANCE,
     ConeKernel,
     EmptyReason,
     RawReduction,
+    ReducedSectors,
     StripKernel,
+    arc_parts,
     cap_inside,
 )
 from aura_ums._native._slices import (
@@ -45,6 +48,7 @@ NATIVE = BUILT and os.environ.get("AURA_UMS_NATIVE", "").strip() != "0"
 grow_commands = _growth.grow_commands_compiled if NATIVE else _growth.grow_commands_reference
 reduce_cone: ConeKernel = _reduce.reduce_cone_compiled if NATIVE else _reduce.reduce_cone_reference
 reduce_strip: StripKernel = _reduce.reduce_strip_compiled if NATIVE else _reduce.reduce_strip_reference
+reduce_sectors = _reduce.reduce_sectors_compiled if NATIVE else _reduce.reduce_sectors_reference
 expecter_points = _expecter.expecter_points_compiled if NATIVE else _expecter.expecter_points_reference
 polygon_distance = _distance.polygon_distance_compiled if NATIVE else _distance.polygon_distance_reference
 point_in_solid_convex = (
@@ -64,6 +68,7 @@ __all__ = [
     "CONE_PIECE",
     "NATIVE",
     "SECTOR_PIECE",
+    "SECTOR_ROW",
     "TOLERANCE",
     "Distributed",
     "EmptyReason",
@@ -73,7 +78,9 @@ __all__ = [
     "MotionBounds",
     "MotionModel",
     "RawReduction",
+    "ReducedSectors",
     "ReducedSlices",
+    "arc_parts",
     "cap_inside",
     "clamp_into",
     "distribute_slices",
@@ -88,6 +95,7 @@ __all__ = [
     "polygon_distance",
     "reduce_cone",
     "reduce_cone_slices",
+    "reduce_sectors",
     "reduce_strip",
     "reduce_strip_slices",
     "summary_wedge",

@@ -121,6 +121,18 @@ def expecter_points(
     cut_plane: float,
     /,
 ) -> tuple[bytes, float, float, float, float] | None: ...
+def reduce_sectors(
+    vertices: Vertices,
+    center_x: float,
+    center_y: float,
+    lo: float,
+    step: float,
+    count: int,
+    half: float,
+    arguments: Sequence[float],
+    max_vertices: int,
+    /,
+) -> tuple[bytes, bytes, bytes, bytes]: ...
 def polygon_distance(vertices: Vertices, ax: float, ay: float, bx: float, by: float, /) -> float: ...
 def point_in_solid_convex(vertices: Vertices, x: float, y: float, tolerance: float, /) -> bool: ...
 def merge_groups(points: Vertices, counts: Sequence[int], max_vertices: int, /) -> tuple[bytes, ...]: ...

@@ -18,14 +18,16 @@ counter-clockwise to ``lo + width``. The numpy functions are the specification;
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from enum import IntEnum
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._native import _extension
 from aura_ums.geometry import (
+    HeadingWedge,
     clip_halfplane,
     convex_hull,
     intersect_arcs,
@@ -99,6 +101,7 @@ if _extension.BUILT:
     # the reductions run dozens of times per step.
     reduce_cone_compiled: ConeKernel = _kernels.reduce_cone
     reduce_strip_compiled: StripKernel = _kernels.reduce_strip
+    _compiled_reduce_sectors = _kernels.reduce_sectors
 
 
 # --- arcs -------------------------------------------------------------------------------
@@ -525,3 +528,143 @@ def reduce_strip_reference(
     if len(positions) == 0:
         return EmptyReason.NO_OFFSET_POSITION
     return _finish(positions, vertices, np.array([center_x, center_y]), headings, max_vertices)
+
+
+# --- every sector of a wedge at once (the joint reduction's sectors) ----------------------
+
+#: Numbers per observation row of :func:`reduce_sectors_reference`: the kind (0 a cone, 1 a
+#: strip), then the kernel's arguments after the wedge, without the cap (a cone's ten are
+#: followed by one unused 0).
+SECTOR_ROW = 12
+
+
+def arc_parts(lo: float, width: float, center: float) -> tuple[float, float, float]:
+    """Return the wedge of an arc ``(lo, width)`` narrower than 2 pi: unwrapped centre, cw, ccw (rad).
+
+    Centred on ``center`` when the arc holds it, else on the arc's end nearer to it (the
+    shorter way round). The centre is not wrapped: ``HeadingWedge._trusted`` wraps it.
+
+    Examples
+    --------
+    >>> arc_parts(0.0, 1.0, 0.25)                   # inside: kept
+    (0.25, 0.25, 0.75)
+    >>> arc_parts(0.0, 1.0, -0.5)                   # outside, nearer the start
+    (0.0, 0.0, 1.0)
+    """
+    offset = (center - lo) % math.tau
+    if offset > width:
+        # Outside: clamp to whichever end is the shorter way round.
+        offset = width if offset - width < math.tau - offset else 0.0
+    return lo + offset, offset, width - offset
+
+
+class ReducedSectors(NamedTuple):
+    """The sectors a :func:`reduce_sectors_reference` kept, in sector order.
+
+    Attributes
+    ----------
+    points : ndarray, shape (n, 2)
+        Every kept sector's polygon, one after the other (metres, counter-clockwise).
+    counts : ndarray of int64, shape (k,)
+        Each kept sector's vertex count.
+    sectors : ndarray of int64, shape (k,)
+        Each kept sector's index, 0 to ``count - 1``.
+    values : ndarray, shape (k, 5)
+        Each kept sector's centre x, y (metres, not held inside its polygon), then its
+        wedge: unwrapped centre, cw and ccw (radians).
+    """
+
+    points: Array
+    counts: NDArray[np.int64]
+    sectors: NDArray[np.int64]
+    values: Array
+
+
+def reduce_sectors_reference(
+    vertices: Array,
+    center_x: float,
+    center_y: float,
+    lo: float,
+    step: float,
+    count: int,
+    half: float,
+    arguments: Sequence[float],
+    max_vertices: int,
+) -> ReducedSectors:
+    """Reduce one polygon over ``count`` heading sectors by every observation in turn, each sector on its own.
+
+    Sector ``s`` is the wedge centred on ``lo + s step + step / 2`` with extents ``half``
+    on both sides (radians), holding the polygon ``vertices`` (metres) and the centre. Each
+    observation row (:data:`SECTOR_ROW` numbers) reduces it as :func:`reduce_cone_reference`
+    or :func:`reduce_strip_reference` would, the next row reducing what the last one left:
+    the centre is the kernel's (not held), and the wedge narrows to the kernel's arc
+    (:func:`arc_parts`) when that is narrower. A sector that one row empties is dropped.
+    This is the joint reduction's loop over sectors (``uncertainty._joint``), one call for
+    them all.
+
+    Examples
+    --------
+    >>> square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    >>> ahead = [0, 0, 0, 5, 0, 0, 0, 0.05, 0, math.inf, CONE_PIECE, 0]   # a pole at (5, 0), dead ahead
+    >>> kept = reduce_sectors_reference(square, 0, 0, -math.pi, math.pi / 2, 4, math.pi / 4, ahead, 16)
+    >>> kept.sectors.tolist()                      # the two sectors that meet facing +x see it ahead
+    [1, 2]
+    >>> len(reduce_sectors_reference(square, 0, 0, 2.0, 0.5, 2, 0.25, ahead, 16).sectors)   # facing away
+    0
+    """
+    rows = [tuple(arguments[at : at + SECTOR_ROW]) for at in range(0, len(arguments), SECTOR_ROW)]
+    polygons: list[Array] = []
+    sectors: list[int] = []
+    values: list[tuple[float, float, float, float, float]] = []
+    for sector in range(count):
+        raw = (lo + sector * step) + 0.5 * step
+        wedge = HeadingWedge._trusted(raw, half, half)
+        polygon, x, y = vertices, center_x, center_y
+        for row in rows:
+            # A strip takes eleven numbers after the wedge, a cone ten.
+            kernel: Callable[..., RawReduction | int] = (
+                reduce_strip_reference if row[0] else reduce_cone_reference
+            )
+            numbers = row[1:12] if row[0] else row[1:11]
+            found = kernel(polygon, x, y, wedge.center, wedge.cw, wedge.ccw, *numbers, max_vertices)
+            if isinstance(found, int):
+                break
+            data, arc_lo, arc_width, x, y, _, _ = found
+            polygon = np.frombuffer(data, dtype=np.float64).reshape(-1, 2)
+            if arc_width < wedge.width:
+                raw, cw, ccw = arc_parts(arc_lo, arc_width, wedge.center)
+                wedge = HeadingWedge._trusted(raw, cw, ccw)
+        else:
+            polygons.append(polygon)
+            sectors.append(sector)
+            values.append((x, y, raw, wedge.cw, wedge.ccw))
+    points = np.concatenate(polygons) if polygons else np.empty((0, 2))
+    return ReducedSectors(
+        points,
+        np.array([len(p) for p in polygons], dtype=np.int64),
+        np.array(sectors, dtype=np.int64),
+        np.array(values, dtype=np.float64).reshape(-1, 5),
+    )
+
+
+def reduce_sectors_compiled(
+    vertices: Array,
+    center_x: float,
+    center_y: float,
+    lo: float,
+    step: float,
+    count: int,
+    half: float,
+    arguments: Sequence[float],
+    max_vertices: int,
+) -> ReducedSectors:
+    """Compiled :func:`reduce_sectors_reference` (needs the extension module: ``_extension.BUILT``)."""
+    raw, raw_counts, raw_sectors, raw_values = _compiled_reduce_sectors(
+        vertices, center_x, center_y, lo, step, count, half, arguments, max_vertices
+    )
+    return ReducedSectors(
+        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2),
+        np.frombuffer(raw_counts, dtype=np.int64),
+        np.frombuffer(raw_sectors, dtype=np.int64),
+        np.frombuffer(raw_values, dtype=np.float64).reshape(-1, 5),
+    )

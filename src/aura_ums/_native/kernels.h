@@ -233,6 +233,7 @@ void summary_wedge(const double *lo, const double *hi, Py_ssize_t k, double head
 PyObject *grow_commands(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_strip(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *reduce_sectors(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *expecter_points(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *polygon_distance(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *point_in_solid_convex(PyObject *self, PyObject *const *args, Py_ssize_t nargs);

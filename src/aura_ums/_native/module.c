@@ -19,6 +19,9 @@ static PyMethodDef methods[] = {
      "reduce_strip(vertices, center_x, center_y, wedge_center, wedge_cw, wedge_ccw, forward, left, start_x, "
      "start_y, end_x, end_y, position_uncertainty, offset, offset_error, angle, angle_error, max_vertices) -> "
      "(vertex bytes, arc_lo, arc_width, center_x, center_y, area_before, area_after), or an int reason code"},
+    {"reduce_sectors", (PyCFunction)(void (*)(void))reduce_sectors, METH_FASTCALL,
+     "reduce_sectors(vertices, center_x, center_y, lo, step, count, half, arguments, max_vertices) -> (points, "
+     "counts, sectors, values bytes): the sectors of a wedge each reduced by every (kind, ...) row in turn"},
     {"expecter_points", (PyCFunction)(void (*)(void))expecter_points, METH_FASTCALL,
      "expecter_points(vertices, base_count, disk_sides, full_circle, level_count, base_ax, base_ay, base_bx, "
      "base_by, radius, heading_lo, heading_width, arc_step, r00, r01, r02, r10, r11, r12, r20, r21, r22, forward, "

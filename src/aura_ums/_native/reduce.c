@@ -381,6 +381,173 @@ done:
 }
 
 
+/* --- every sector of a wedge at once (the joint reduction's sectors) ------------------------ */
+
+/* HeadingWedge._trusted's wrap of an unwrapped centre to (-pi, pi]. */
+static double wrapped_center(double center) {
+    double wrapped = M_PI - floor_mod(M_PI - center, TWO_PI);
+    return wrapped <= -M_PI ? wrapped + TWO_PI : wrapped;
+}
+
+/* _reduce.arc_parts: the unwrapped centre and extents of the wedge of an arc narrower than
+   2 pi, centred on `center` or on the arc's nearer end. */
+static void arc_parts(double lo, double width, double center, double *raw, double *cw, double *ccw) {
+    double offset = floor_mod(center - lo, TWO_PI);
+    if (offset > width) offset = offset - width < TWO_PI - offset ? width : 0.0;
+    *raw = lo + offset;
+    *cw = offset;
+    *ccw = width - offset;
+}
+
+enum { SECTOR_ROW = 12 };
+
+/* reduce_sectors(vertices, center_x, center_y, lo, step, count, half, arguments, max_vertices):
+   see _reduce.reduce_sectors_reference. */
+PyObject *reduce_sectors(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    static const char *const names[] = {"center_x", "center_y", "lo", "step"};
+    static const char *const half_name[] = {"half"};
+    static const char *const cone_names[] = {"kind", "forward", "left", "landmark_x", "landmark_y", "widen",
+                                             "bearing", "bearing_error", "range_min", "range_max", "piece",
+                                             "unused"};
+    static const char *const strip_names[] = {"kind", "forward", "left", "start_x", "start_y", "end_x",
+                                              "end_y", "position_uncertainty", "offset", "offset_error", "angle",
+                                              "angle_error"};
+    if (nargs != 9) {
+        PyErr_Format(PyExc_TypeError, "reduce_sectors: expected 9 arguments, got %zd", nargs);
+        return NULL;
+    }
+    double a[4], half;
+    Py_ssize_t count, max_vertices;
+    if (parse_doubles(args + 1, 4, names, a) < 0 || parse_count(args[5], "count", 1, 1000000, &count) < 0 ||
+        parse_doubles(args + 6, 1, half_name, &half) < 0 || parse_cap(args[8], &max_vertices) < 0)
+        return NULL;
+    PyObject *rows = PySequence_Fast(args[7], "arguments: expected a sequence of numbers");
+    if (!rows) return NULL;
+    Py_ssize_t items = PySequence_Fast_GET_SIZE(rows), pairs = items / SECTOR_ROW;
+    double *values = PyMem_Malloc(sizeof(double) * (size_t)(items > 0 ? items : 1));
+    long long *kept = PyMem_Malloc(sizeof(long long) * (size_t)count);
+    double *outcome = PyMem_Malloc(sizeof(double) * 5 * (size_t)count);
+    long long *counts = PyMem_Malloc(sizeof(long long) * (size_t)count);
+    PyObject *result = NULL;
+    Poly current = {0}, gathered = {0};
+    Py_buffer view;
+    int have_view = 0;
+    Work local_work, *w = NULL;
+    if (!values || !kept || !outcome || !counts) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (items == 0 || items % SECTOR_ROW) {
+        PyErr_Format(PyExc_ValueError, "arguments: expected rows of %d numbers, at least one, got %zd numbers",
+                     (int)SECTOR_ROW, items);
+        goto done;
+    }
+    PyObject **objects = PySequence_Fast_ITEMS(rows);
+    for (Py_ssize_t r = 0; r < pairs; r++) {
+        double kind = PyFloat_AsDouble(objects[r * SECTOR_ROW]);
+        if (kind == -1.0 && PyErr_Occurred()) goto done;
+        if (kind != 0.0 && kind != 1.0) {
+            PyErr_Format(PyExc_ValueError, "arguments: expected kind 0 (cone) or 1 (strip), got %R",
+                         objects[r * SECTOR_ROW]);
+            goto done;
+        }
+        /* A cone row's last number is unused: checked as a strip's would be, both finite. */
+        if (parse_doubles(objects + r * SECTOR_ROW, SECTOR_ROW, kind == 1.0 ? strip_names : cone_names,
+                          values + r * SECTOR_ROW) < 0)
+            goto done;
+        double piece = values[r * SECTOR_ROW + 10];
+        if (kind == 0.0 && (!(piece > 0.0) || TWO_PI / piece > 1e6)) {
+            PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R",
+                         objects[r * SECTOR_ROW + 10]);
+            goto done;
+        }
+    }
+    Py_ssize_t n;
+    if (get_vertices(args[0], &view, &n) < 0) goto done;
+    have_view = 1;
+    const double *prior = (const double *)view.buf;
+    w = work_take(self, &local_work);
+    Py_ssize_t k = 0;
+    for (Py_ssize_t s = 0; s < count; s++) {
+        double raw = (a[2] + (double)s * a[3]) + 0.5 * a[3];
+        double center = wrapped_center(raw), cw = half, ccw = half, x = a[0], y = a[1];
+        if (copy_into(&current, prior, n) < 0) goto done;
+        int alive = 1;
+        for (Py_ssize_t r = 0; r < pairs && alive; r++) {
+            const double *row = values + r * SECTOR_ROW;
+            double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
+            wedge_arc(center, cw, ccw, &heading_lo, &heading_width);
+            int reason = -1;
+            Poly *positions = NULL;
+            if (row[0] == 1.0) {
+                if (strip_reduction(current.v, current.n, heading_lo, heading_width, row[1], row[2], row[3], row[4],
+                                    row[5], row[6], row[7], row[8], row[9], row[10], row[11], &w->positions, w,
+                                    &reason, &arc_lo, &arc_width) < 0)
+                    goto done;
+                positions = &w->positions;
+            } else {
+                double margin = row[7] + TOLERANCE;
+                Cone cone = {row[3], row[4], row[5], heading_lo + row[6] + M_PI - margin,
+                             heading_width + 2.0 * margin, row[8], row[9], row[10]};
+                if (cone_reduction(current.v, current.n, heading_lo, heading_width, row[1], row[2], row[6], row[7],
+                                   &cone, w, &reason, &positions, &arc_lo, &arc_width) < 0)
+                    goto done;
+            }
+            if (reason >= 0) {
+                alive = 0;
+                break;
+            }
+            /* finish's tail, without the areas: the cap, then the centre kept or moved. */
+            if (positions->n > max_vertices) {
+                if (cap_inside(positions, current.v, current.n, max_vertices) < 0) goto done;
+                if (positions->n > max_vertices && positions->n > current.n &&
+                    copy_into(positions, current.v, current.n) < 0)
+                    goto done;
+            }
+            double distance;
+            nearest_on_polygon(positions->v, positions->n, x, y, &distance, &x, &y);
+            if (copy_into(&current, positions->v, positions->n) < 0) goto done;
+            double sum = cw + ccw;
+            if (arc_width < (sum < TWO_PI ? sum : TWO_PI)) {
+                arc_parts(arc_lo, arc_width, center, &raw, &cw, &ccw);
+                center = wrapped_center(raw);
+            }
+        }
+        if (!alive) continue;
+        Py_ssize_t total = checked_add(gathered.n, current.n);
+        if (total < 0 || reserve(&gathered, total) < 0) {
+            if (total < 0) PyErr_NoMemory();
+            goto done;
+        }
+        memcpy(gathered.v + 2 * gathered.n, current.v, 2 * sizeof(double) * (size_t)current.n);
+        gathered.n = total;
+        kept[k] = (long long)s;
+        counts[k] = (long long)current.n;
+        double *o = outcome + 5 * k;
+        o[0] = x;
+        o[1] = y;
+        o[2] = raw;
+        o[3] = cw;
+        o[4] = ccw;
+        k++;
+    }
+    result = Py_BuildValue("(y#y#y#y#)", gathered.v ? (const char *)gathered.v : "", (Py_ssize_t)(2 * sizeof(double) * (size_t)gathered.n),
+                           (const char *)counts, (Py_ssize_t)(sizeof(long long) * (size_t)k), (const char *)kept,
+                           (Py_ssize_t)(sizeof(long long) * (size_t)k), (const char *)outcome,
+                           (Py_ssize_t)(5 * sizeof(double) * (size_t)k));
+done:
+    if (w) work_give(self, w);
+    if (have_view) PyBuffer_Release(&view);
+    Py_DECREF(rows);
+    PyMem_Free(values);
+    PyMem_Free(kept);
+    PyMem_Free(outcome);
+    PyMem_Free(counts);
+    PyMem_Free(current.v);
+    PyMem_Free(gathered.v);
+    return result;
+}
+
 /* --- every slice of a sliced map at once ---------------------------------------------------- */
 
 /* See uncertainty._reduce.narrowed: a slice's interval [lo, hi] narrowed to a kernel's arc. */

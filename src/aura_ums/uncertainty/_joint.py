@@ -22,7 +22,7 @@ reduction's result is: both only add.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, intersect_arcs
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._reduce import Reduction, arc_wedge, check_pair, reduce_checked
+from aura_ums.uncertainty._reduce import Reduction, _kernel_call, arc_wedge, check_pair, reduce_checked
 
 #: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
 DEFAULT_SECTOR = math.radians(5.0)
@@ -140,20 +140,48 @@ def joint_reduced(
     step = width / count
     # Neighbouring sectors overlap by the reductions' tolerance: no heading falls between.
     half = 0.5 * step + TOLERANCE
-    kept: list[_Sector] = []
-    for k in range(count):
-        start = lo + k * step
+
+    def restricted(start: float) -> SpatialUncertaintyMap:
+        """Return the prior restricted to the sector starting at ``start`` (radians)."""
         # start is finite and half > 0: the checks of HeadingWedge() would all pass.
-        restricted = SpatialUncertaintyMap._trusted(
+        return SpatialUncertaintyMap._trusted(
             prior.polygon, prior.center, HeadingWedge._trusted(start + 0.5 * step, half, half)
         )
-        # Centres not held: at most one sector's is read, and that one is reduced again.
-        found = _in_turn(restricted, pairs, cap, held=False)
-        if not isinstance(found, str):
-            kept.append((start, found, restricted))
-    if not kept:
+
+    # Every sector of the prior reduced by each observation in turn, in one kernel call;
+    # centres not held: at most one sector's is read, and that one is reduced again.
+    center_x, center_y = prior.center.tolist()
+    found = _native.reduce_sectors(
+        prior.polygon.vertices, center_x, center_y, lo, step, count, half, _sector_rows(pairs, cap), cap
+    )
+    if not len(found.sectors):
         return JOINT_INCONSISTENT
-    return _combined(prior, kept, wedge.is_full_circle, pairs, cap)
+    kept: list[_Sector] = []
+    map_type, polygon_type = type(prior), type(prior.polygon)
+    stops = np.cumsum(found.counts).tolist()
+    begin = 0
+    for index, sector in enumerate(found.sectors.tolist()):
+        x, y, center, cw, ccw = found.values[index].tolist()
+        result = map_type._trusted(
+            polygon_type._trusted(found.points[begin : stops[index]]),
+            np.array([x, y]),
+            HeadingWedge._trusted(center, cw, ccw),
+        )
+        begin = stops[index]
+        kept.append((lo + sector * step, result))
+    return _combined(prior, kept, wedge.is_full_circle, pairs, cap, restricted)
+
+
+def _sector_rows(pairs: Sequence[tuple[Observation, Landmark]], cap: int) -> list[float]:
+    """Return the observations as :func:`_native.reduce_sectors` takes them: rows of kind and arguments."""
+    rows: list[float] = []
+    for observation, landmark in pairs:
+        kernel, _, arguments = _kernel_call(observation, landmark, cap)
+        # The arguments end with the cap, which the sectors' kernel takes once.
+        numbers = [float(value) for value in arguments[:-1]]
+        rows += [1.0 if kernel is _native.reduce_strip else 0.0, *numbers]
+        rows += [0.0] * (_native.SECTOR_ROW - 1 - len(numbers))
+    return rows
 
 
 def check_sector(value: object, name: str) -> float:
@@ -184,24 +212,19 @@ def _in_turn(
     current: SpatialUncertaintyMap,
     pairs: Sequence[tuple[Observation, Landmark]],
     cap: int,
-    *,
-    held: bool = True,
 ) -> SpatialUncertaintyMap | str:
-    """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is.
-
-    Without ``held``, moved centres are left as the kernel gives them (see ``reduce_checked``).
-    """
+    """Return the map reduced by each (checked) pair in turn, or why the first inconsistent one is."""
     for observation, landmark in pairs:
-        found = reduce_checked(current, observation, landmark, cap, measured=False, held=held)
+        found = reduce_checked(current, observation, landmark, cap, measured=False)
         if isinstance(found, str):
             return found
         current = found[0]
     return current
 
 
-#: A sector the joint reduction kept: where it starts (radians), its result (centre not
-#: held) and the map restricted to it that the observations reduced.
-_Sector = tuple[float, SpatialUncertaintyMap, SpatialUncertaintyMap]
+#: A sector the joint reduction kept: where it starts (radians) and its result (centre not
+#: held).
+_Sector = tuple[float, SpatialUncertaintyMap]
 
 
 def _combined(
@@ -210,13 +233,14 @@ def _combined(
     full_circle: bool,
     pairs: Sequence[tuple[Observation, Landmark]],
     cap: int,
+    restricted: Callable[[float], SpatialUncertaintyMap],
 ) -> SpatialUncertaintyMap:
     """One map holding every sector's result: their hull, and one wedge over their headings.
 
     The results' centres were not held inside their polygons: the one sector whose centre
-    the map takes is reduced again by ``pairs``, held.
+    the map takes is reduced again by ``pairs``, held, from the prior ``restricted`` to it.
     """
-    points = np.concatenate([m.polygon.vertices for _, m, _ in kept])
+    points = np.concatenate([m.polygon.vertices for _, m in kept])
     # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
     outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
     if len(outline) > cap:
@@ -228,7 +252,7 @@ def _combined(
     polygon = ConvexPolygon._trusted(outline)
     # Each result's headings as an interval unwrapped next to its sector, in sector order.
     spans = []
-    for start, result, _ in kept:
+    for start, result in kept:
         result_wedge = result.wedge
         low = start + math.remainder(result_wedge.center - result_wedge.cw - start, _TWO_PI)
         spans.append((low, low + min(result_wedge.width, _TWO_PI)))
@@ -256,8 +280,8 @@ def _combined(
     if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
         return SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
-    restricted = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[2]
-    nearest = _in_turn(restricted, pairs, cap)
+    start = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[0]
+    nearest = _in_turn(restricted(start), pairs, cap)
     # The same polygons and wedges as without held centres: they never depend on the centre.
     assert not isinstance(nearest, str)
     heading = arc_wedge((nearest.wedge.center - nearest.wedge.cw, nearest.wedge.width), target).center

@@ -94,12 +94,8 @@ def arc_wedge(arc: tuple[float, float], center: float) -> HeadingWedge:
     lo, width = arc
     if width >= math.tau:
         return HeadingWedge.full_circle(center)
-    offset = (center - lo) % math.tau
-    if offset > width:
-        # Outside: clamp to whichever end is the shorter way round.
-        offset = width if offset - width < math.tau - offset else 0.0
-    # 0 <= offset <= width, both finite: the checks of HeadingWedge() would all pass.
-    return HeadingWedge._trusted(lo + offset, offset, width - offset)
+    # 0 <= cw, ccw and both finite: the checks of HeadingWedge() would all pass.
+    return HeadingWedge._trusted(*_native.arc_parts(lo, width, center))
 
 
 # --- the map-level entry point ------------------------------------------------------
@@ -168,7 +164,6 @@ def reduce_checked(
     max_vertices: int,
     *,
     measured: bool = True,
-    held: bool = True,
 ) -> Reduced:
     """:func:`reduce_map` for arguments already checked, without its :class:`Reduction` record.
 
@@ -176,11 +171,6 @@ def reduce_checked(
     itself (``max_vertices >= 3``). Without ``measured``, a sliced map's areas are NaN:
     each is a hull of every slice, and the manager keeps the maps, not their areas. A
     product map's come from its kernel at no cost, so they are always given.
-
-    Without ``held``, a product map's moved centre is the kernel's nearest boundary point,
-    not checked against the polygon (:func:`held_centre`): for the joint reduction's
-    sectors, whose centres are read only for the one sector it takes its centre from (it
-    reduces that one again, held). The polygon and the wedge never depend on the centre.
     """
     slices = prior._slices
     if slices is not None:
@@ -195,7 +185,7 @@ def reduce_checked(
     # Bytes are immutable, so the array is read-only as map values must be.
     reduced_vertices = np.frombuffer(raw, _FLOAT64).reshape(-1, 2)
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
-    if held and (x != center_x or y != center_y):
+    if x != center_x or y != center_y:
         x, y = held_centre(reduced_vertices, x, y)
     reduced = type(prior)._trusted(
         type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
