@@ -37,6 +37,7 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from aura_ums import _native
 from aura_ums._native import clamp_into
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs, nearest_on_polygon
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -266,17 +267,26 @@ def _intersections(
     """
     met = shapely.intersection(_geometries(first), _geometries(second))
     result: list[NDArray[np.float64] | None] = []
+    rings: list[NDArray[np.float64]] = []
+    at: list[int] = []
     for geometry in met.tolist():
         if geometry.is_empty:
             result.append(None)
-            continue
-        if geometry.geom_type != "Polygon":
+        elif geometry.geom_type != "Polygon":
             result.append(convex_hull(shapely.get_coordinates(geometry)))
-            continue
-        ring = shapely.get_coordinates(geometry)[:-1]
-        x, y = ring[:, 0], ring[:, 1]
-        twice_area = float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-        result.append(np.ascontiguousarray(ring[::-1] if twice_area < 0.0 else ring))
+        else:
+            at.append(len(result))
+            result.append(None)
+            rings.append(shapely.get_coordinates(geometry)[:-1])
+    if rings:
+        # GEOS may keep two vertices a rounding error apart, an edge whose direction is
+        # noise: a containment test by edge lines would then cut off points far inside
+        # (anchors lost a truth 2 cm inside both maps). The hull kernel (no cap) merges
+        # them and orders the ring counter-clockwise, all rings in one call.
+        widest = max(3, max(len(ring) for ring in rings))
+        hulls = _native.merge_groups(np.concatenate(rings), [len(ring) for ring in rings], widest)
+        for index, hull in zip(at, hulls, strict=True):
+            result[index] = hull
     return result
 
 
