@@ -13,6 +13,10 @@ whose heading may be anything (72 sectors of 5 degrees): with the sectors kernel
 loop run in Python over the compiled single-reduction kernels (one call per sector and
 observation, the joint reduction before the sectors kernel), in the same run.
 
+With ``--replay LOG_DIR ... --terrain T.toml --sensors T.sensors.toml`` it also replays each
+log (``--classes``, ``--profile``) with the sectors kernel and with the loop, alternately,
+``--rounds`` times each in one process, and prints the update's total and median time.
+
 Measured 28 November 2026 on the shared 2-core machine, three runs (its speed drifts):
 two bearings 343-630 µs with the sectors kernel against 751-1,380 µs looped (2.2-2.3x),
 three bearings 274-408 µs against 638-1,258 µs (2.3-3.1x).
@@ -20,10 +24,12 @@ three bearings 274-408 µs against 638-1,258 µs (2.3-3.1x).
 
 from __future__ import annotations
 
+import argparse
 import math
 import statistics
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,6 +39,7 @@ from numpy.typing import NDArray
 from aura_ums import _native
 from aura_ums._native import _reduce as native_reduce
 from aura_ums.geometry import HeadingWedge, regular_polygon
+from aura_ums.manager import MapProfile
 from aura_ums.uncertainty import (
     BearingObservation,
     GroundLineLandmark,
@@ -216,5 +223,53 @@ def main() -> None:
         print(f"{name:<30}{fast:>19.0f}{slow:>11.0f}{slow / fast:>9.1f}x")
 
 
+def replay_side_by_side(args: argparse.Namespace) -> None:
+    """Replay each log with the sectors kernel and with the loop, alternately; print the update times."""
+    from aura_ums.logs import ReplayOptions, load_sensors, open_log, replay_log
+    from aura_ums.manager import MapProfile
+    from aura_ums.uncertainty import LandmarkClass, TerrainTable
+
+    table = TerrainTable.from_toml(args.terrain)
+    motion, working, envelope = load_sensors(args.sensors)
+    kind = LandmarkClass.POINT if args.classes == "II" else LandmarkClass.VERTICAL_LINE
+    options = ReplayOptions(
+        landmark_class=kind,
+        motion=motion,
+        working=working,
+        envelope=envelope,
+        settings=MapProfile(args.profile).settings(),
+    )
+    print(f"{'log':<28}{'reductions':<16}{'update s (each round)':<30}{'median us per frame'}")
+    for folder in args.replay:
+        log = open_log(folder)
+        times: dict[str, list[tuple[float, float]]] = {"sectors kernel": [], "looped": []}
+
+        def replay(log: Any = log) -> object:
+            return replay_log(log, table, options, keep_maps=False)
+
+        for _ in range(args.rounds):
+            for name, run in (("sectors kernel", replay), ("looped", looped_sectors(replay))):
+                result: Any = run()
+                update_us = result.trace.update_us
+                times[name].append((float(update_us.sum()) / 1e6, float(np.median(update_us))))
+        for name, runs in times.items():
+            totals = " / ".join(f"{total:.2f}" for total, _ in runs)
+            medians = " / ".join(f"{median:.0f}" for _, median in runs)
+            print(f"{Path(folder).name:<28}{name:<16}{totals:<30}{medians}")
+
+
 if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--replay", nargs="+", default=[], metavar="LOG_DIR", help="logs to replay both ways")
+    parser.add_argument("--terrain", help="terrain table TOML of the logs")
+    parser.add_argument("--sensors", help="sensors TOML of the logs")
+    parser.add_argument("--classes", choices=["I", "II"], default="I")
+    parser.add_argument("--profile", choices=[p.value for p in MapProfile], default="product")
+    parser.add_argument("--rounds", type=int, default=3)
+    arguments = parser.parse_args()
     main()
+    if arguments.replay:
+        if not (arguments.terrain and arguments.sensors):
+            parser.error("--replay: expected --terrain and --sensors too")
+        print()
+        replay_side_by_side(arguments)
