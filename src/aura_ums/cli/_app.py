@@ -18,9 +18,9 @@ from aura_ums.cli._common import (
     check_seed,
     console,
     fail,
-    file_output,
     folder_argument,
     manager_options,
+    output_file,
     progress_bar,
     refuse_alone,
 )
@@ -144,20 +144,13 @@ def simulate(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the whole Monte Carlo, >= 0.")] = 0,
     metrics_json: Annotated[
         Path | None,
-        typer.Option(
-            "--metrics-json",
-            parser=file_output("--metrics-json"),
-            metavar="<path>",
-            help="Write the metrics as JSON to this file.",
-        ),
+        output_file("--metrics-json", "metrics.json", "Write the metrics as JSON to this file."),
     ] = None,
     prune: Annotated[
         bool,
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
-    mcap: Annotated[
-        Path | None, typer.Option("--mcap", parser=file_output("--mcap"), metavar="<path>", help=MCAP_HELP)
-    ] = None,
+    mcap: Annotated[Path | None, output_file("--mcap", "run.mcap", MCAP_HELP)] = None,
     live: Live = False,
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,

@@ -78,36 +78,25 @@ def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Pa
     return parse
 
 
-def file_output(name: str) -> Callable[[str], Path]:
-    """Return the parser of an output file option: refuses an empty path or a folder's (exit 2).
+def output_file(flag: str, example: str, help: str) -> Any:
+    """Return the ``typer.Option`` of an output file: refuses an empty path or a folder's (exit 2).
 
     A path ending in a separator (``--metrics-json out/``) names a folder; as a ``Path`` it
     would lose the separator and the output would be written to a file ``out`` instead.
+    The refusal suggests ``example`` (a file name) inside that folder.
     """
 
     def parse(text: str) -> Path:
         if not text:
-            raise fail(f"{name}: expected a file name, got an empty path ''")
+            raise fail(f"{flag}: expected a file name, got an empty path ''")
         if text.endswith(("/", os.sep)):
             raise fail(
-                f"{name}: expected a file name, got {text!r}, which names a folder "
-                f"(give the file's name in it, e.g. {text}{_EXAMPLE_NAMES.get(name, 'output')})"
+                f"{flag}: expected a file name, got {text!r}, which names a folder "
+                f"(give the file's name in it, e.g. {text}{example})"
             )
         return Path(text)
 
-    return parse
-
-
-#: The file name each output option's refusal of a folder suggests.
-_EXAMPLE_NAMES = {
-    "--metrics-json": "metrics.json",
-    "--steps-csv": "steps.csv",
-    "--windows-csv": "windows.csv",
-    "--mcap": "run.mcap",
-    "--save-state": "state.json",
-    "--out": "terrain.toml",
-    "--sensors-out": "terrain.sensors.toml",
-}
+    return typer.Option(flag, parser=parse, metavar="<path>", help=help)
 
 
 def _new_log_folder(text: str) -> Path:

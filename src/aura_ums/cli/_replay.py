@@ -31,9 +31,9 @@ from aura_ums.cli._common import (
     console,
     err_console,
     fail,
-    file_output,
     folder_argument,
     manager_options,
+    output_file,
     progress_bar,
     refuse_alone,
 )
@@ -120,11 +120,8 @@ _WindowMargin = Annotated[
 ]
 _WindowsCsv = Annotated[
     Path | None,
-    typer.Option(
-        "--windows-csv",
-        parser=file_output("--windows-csv"),
-        metavar="<path>",
-        help="Write one row per observation and window method (--camera).",
+    output_file(
+        "--windows-csv", "windows.csv", "Write one row per observation and window method (--camera)."
     ),
 ]
 
@@ -223,17 +220,14 @@ def calibrate(
     ],
     out: Annotated[
         Path,
-        typer.Option(
-            "--out", parser=file_output("--out"), metavar="<path>", help="Terrain table TOML to write."
-        ),
+        output_file("--out", "terrain.toml", "Terrain table TOML to write."),
     ],
     sensors_out: Annotated[
         Path | None,
-        typer.Option(
+        output_file(
             "--sensors-out",
-            parser=file_output("--sensors-out"),
-            metavar="<path>",
-            help="Motion and sensor bounds TOML (default: OUT with .sensors.toml).",
+            "terrain.sensors.toml",
+            "Motion and sensor bounds TOML (default: OUT with .sensors.toml).",
         ),
     ] = None,
     quantile: Annotated[float, typer.Option(help="Quantile the motion and working bounds cover.")] = 0.99,
@@ -351,21 +345,11 @@ def replay(
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None,
-        typer.Option(
-            "--metrics-json",
-            parser=file_output("--metrics-json"),
-            metavar="<path>",
-            help="Write the metrics as JSON to this file.",
-        ),
+        output_file("--metrics-json", "metrics.json", "Write the metrics as JSON to this file."),
     ] = None,
     steps_csv: Annotated[
         Path | None,
-        typer.Option(
-            "--steps-csv",
-            parser=file_output("--steps-csv"),
-            metavar="<path>",
-            help="Write one row per time step to this CSV file.",
-        ),
+        output_file("--steps-csv", "steps.csv", "Write one row per time step to this CSV file."),
     ] = None,
     plot: Annotated[
         Path | None,
@@ -378,23 +362,15 @@ def replay(
     ] = None,
     mcap: Annotated[
         Path | None,
-        typer.Option(
-            "--mcap",
-            parser=file_output("--mcap"),
-            metavar="<path>",
-            help="Write the replay as MCAP for Foxglove.",
-        ),
+        output_file("--mcap", "run.mcap", "Write the replay as MCAP for Foxglove."),
     ] = None,
     camera: _Camera = None,
     window_margin: _WindowMargin = 0.0,
     windows_csv: _WindowsCsv = None,
     save_state: Annotated[
         Path | None,
-        typer.Option(
-            "--save-state",
-            parser=file_output("--save-state"),
-            metavar="<path>",
-            help="Write where the replay stopped (versioned JSON), to --resume from.",
+        output_file(
+            "--save-state", "state.json", "Write where the replay stopped (versioned JSON), to --resume from."
         ),
     ] = None,
     resume: Annotated[
@@ -610,12 +586,7 @@ def compare(
     settings: SettingOptions = NO_OPTIONS,
     metrics_json: Annotated[
         Path | None,
-        typer.Option(
-            "--metrics-json",
-            parser=file_output("--metrics-json"),
-            metavar="<path>",
-            help="Write the table as JSON.",
-        ),
+        output_file("--metrics-json", "metrics.json", "Write the table as JSON."),
     ] = None,
     overwrite: Overwrite = False,
     quiet: Quiet = False,
