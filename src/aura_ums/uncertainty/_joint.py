@@ -25,6 +25,7 @@ import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import TOLERANCE, cap_inside
@@ -158,18 +159,18 @@ def joint_reduced(
         return JOINT_INCONSISTENT
     kept: list[_Sector] = []
     map_type, polygon_type = type(prior), type(prior.polygon)
-    stops = np.cumsum(found.counts).tolist()
     begin = 0
-    for index, sector in enumerate(found.sectors.tolist()):
-        x, y, center, cw, ccw = found.values[index].tolist()
+    for sector, stop, (x, y, center, cw, ccw) in zip(
+        found.sectors.tolist(), np.cumsum(found.counts).tolist(), found.values.tolist(), strict=True
+    ):
         result = map_type._trusted(
-            polygon_type._trusted(found.points[begin : stops[index]]),
+            polygon_type._trusted(found.points[begin:stop]),
             np.array([x, y]),
             HeadingWedge._trusted(center, cw, ccw),
         )
-        begin = stops[index]
+        begin = stop
         kept.append((lo + sector * step, result))
-    return _combined(prior, kept, wedge.is_full_circle, pairs, cap, restricted)
+    return _combined(prior, kept, found.points, wedge.is_full_circle, pairs, cap, restricted)
 
 
 def _sector_rows(pairs: Sequence[tuple[Observation, Landmark]], cap: int) -> list[float]:
@@ -230,6 +231,7 @@ _Sector = tuple[float, SpatialUncertaintyMap]
 def _combined(
     prior: SpatialUncertaintyMap,
     kept: Sequence[_Sector],
+    points: NDArray[np.float64],
     full_circle: bool,
     pairs: Sequence[tuple[Observation, Landmark]],
     cap: int,
@@ -237,10 +239,10 @@ def _combined(
 ) -> SpatialUncertaintyMap:
     """One map holding every sector's result: their hull, and one wedge over their headings.
 
-    The results' centres were not held inside their polygons: the one sector whose centre
-    the map takes is reduced again by ``pairs``, held, from the prior ``restricted`` to it.
+    ``points`` are the results' vertices one after the other. The results' centres were not
+    held inside their polygons: the one sector whose centre the map takes is reduced again
+    by ``pairs``, held, from the prior ``restricted`` to it.
     """
-    points = np.concatenate([m.polygon.vertices for _, m in kept])
     # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
     outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
     if len(outline) > cap:
