@@ -141,6 +141,50 @@ def test_without_relaxation_the_same_wrong_sightings_remove_the_truth(seed: int)
     assert all(not step.excluded for step in steps)
 
 
+@pytest.mark.parametrize("slice_width", [None, math.radians(2.0)])
+def test_the_focus_map_lies_in_the_map_and_takes_the_truth_back_once_the_wrong_sighting_leaves(
+    slice_width: float | None,
+) -> None:
+    settings = ManagerSettings(relaxed_q=1, relaxed_window=4, slice_width=slice_width)
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, settings)
+    board = Blackboard()
+    rng = np.random.default_rng(7)
+    truth, lost_at = START_POSE, []
+    for k in range(1, 9):
+        truth = Pose(truth.x + 1.0, truth.y, truth.heading)
+        board.post_report(PositionReport(float(k), STRIDE))
+        before = manager.map
+        moved = SpatialUncertaintyMap.from_polygon(
+            before.polygon.translated(1.0, 0.0), before.center + np.array([1.0, 0.0]), before.wedge
+        )
+        for index, pole in enumerate(POLES):
+            seen = bearing(truth, truth.x, truth.y, pole) + rng.uniform(-0.9, 0.9) * ERROR
+            fake = wrong_bearing(truth, moved, pole) if (k == 5 and index == 0) else None
+            seen = seen if fake is None else fake
+            board.identified.post(BearingObservation(pole.id, float(k), seen, ERROR))
+        step = manager.update(board, now=float(k))
+        assert step.focus_map is manager.focus_map is step.focus
+        # Inside the map: every pose drawn from it is one the map holds.
+        drawn = step.focus.sample_poses(300, np.random.default_rng(k))
+        assert np.all(step.map.contains(drawn[:, 0], drawn[:, 1], drawn[:, 2]))
+        assert step.focus.area <= step.map.area + 1e-9
+        assert step.map.contains(truth)  # the guarantee, for the map
+        if not step.focus.contains(truth):
+            lost_at.append(k)
+    # Step 5's wrong sighting took the truth out of the focus map (it trusts every sighting)
+    # until four more sightings had pushed it out of the window: from step 6 on it is back.
+    assert lost_at == [5], lost_at
+
+
+def test_without_the_relaxed_intersection_the_focus_map_is_the_map() -> None:
+    steps, _, _ = drive(ManagerSettings(), np.random.default_rng(2), 3, 0)
+    for step in steps:
+        assert step.focus_map is None
+        assert step.focus is step.map
+    manager = UncertaintyMapManager(START, WORLD, FLOOR, ManagerSettings())
+    assert manager.focus_map is manager.map
+
+
 def landmarks_at_most(wrong: list[bool], q: int, n: int) -> bool:
     """Whether the wrong ones of any ``n`` consecutive sightings (all poles a step) name <= ``q`` poles."""
     named = [POLES[k % len(POLES)].id if flag else None for k, flag in enumerate(wrong)]

@@ -160,6 +160,10 @@ class ManagerStep:
         where that first holds (it may have arrived in an earlier one); one excluded on
         arrival also has the outcome :attr:`RejectReason.EXCLUDED`. Always empty with
         ``relaxed_q = 0``.
+    focus_map : SpatialUncertaintyMap or None
+        The map after the update of the relaxed intersection's primary branch (see
+        :attr:`UncertaintyMapManager.focus_map`); None with ``relaxed_q = 0``, where it is
+        ``map`` itself (read :attr:`focus`).
     """
 
     time: float
@@ -171,6 +175,12 @@ class ManagerStep:
     relocalized: bool = False
     envelope_map: SpatialUncertaintyMap | None = None
     excluded: tuple[Observation, ...] = ()
+    focus_map: SpatialUncertaintyMap | None = None
+
+    @property
+    def focus(self) -> SpatialUncertaintyMap:
+        """The map to search first: :attr:`focus_map`, or :attr:`map` without the relaxed intersection."""
+        return self.map if self.focus_map is None else self.focus_map
 
     @property
     def accepted(self) -> tuple[ObservationOutcome, ...]:
@@ -419,6 +429,22 @@ class UncertaintyMapManager:
         return self._map
 
     @property
+    def focus_map(self) -> SpatialUncertaintyMap:
+        """The map of the poses that agree with every recent sighting: where to search first.
+
+        With the relaxed intersection (``relaxed_q > 0``), :attr:`map` is the outer bound of
+        its branches, each of which excludes up to ``q`` of the latest sightings; this is
+        the map of its primary branch, the one that excludes the fewest (the most recent
+        first among equals). It lies inside :attr:`map`, and holds the truth whenever the
+        sightings that branch trusts are right. A sighting that leaves the window merges the
+        branch that excluded it back into this one, so a wrong sighting narrows it for at
+        most ``relaxed_window`` sightings. A window from it is narrower than one from
+        :attr:`map`, whose window is the one guaranteed: search this one first, and the
+        other when the landmark is not in it. Without the relaxed intersection, :attr:`map`.
+        """
+        return self._map if self._relaxed is None else self._relaxed.primary
+
+    @property
     def state(self) -> ManagerState:
         """NOMINAL, or LOST (see the class notes)."""
         return self._state
@@ -611,6 +637,7 @@ class UncertaintyMapManager:
             relocalized,
             None if outer is None else outer._map,
             tuple(excluded),
+            None if self._relaxed is None else self._relaxed.primary,
         )
 
     def _advance(
