@@ -89,9 +89,11 @@ BEST_SLICE_WIDTH = float(MapProfile.SLICED.settings().slice_width or math.nan)
 PRODUCT = "product map"
 SLICED = "sliced map"
 FILTERPY = "filterpy EKF"
-OURS, EKF_BOX, DISK_MODEL = WindowReport.methods
+OURS, FOCUS, EKF_BOX, DISK_MODEL = WindowReport.methods
 #: How the replays' methods are named in the rows of compare_on_log.
 COMPARE_OURS, COMPARE_EKF = "aura-ums", "EKF"
+# The focus map's window figures (the map's own with relaxed_q = 0), kept in each map's row.
+FOCUS_KEYS = ("focus_window_containment", "median_focus_window_width_frac", "median_searched_width_frac")
 
 #: (dataset folder, robot number), as ``mrclam7:1`` on the command line.
 LogId = tuple[str, int]
@@ -197,6 +199,7 @@ def measure(
         )  # fmt: skip
         # The EKF's box and the disk model do not depend on the map's settings: one report serves.
         box = windows if box is None else box
+        figures = windows.metrics()
         rows.append(
             Metrics(
                 {
@@ -206,6 +209,7 @@ def measure(
                     "median_area_m2": plain.median_area_m2,
                     "median_wedge_width_rad": plain.median_wedge_width_rad,
                     **windows.figures(OURS),
+                    **{key: figures[key] for key in FOCUS_KEYS},
                     "median_update_us": plain.median_update_us,
                     "inconsistent_observations": plain.inconsistent_observations,
                     "excluded_observations": int(plain.trace.excluded.sum()),

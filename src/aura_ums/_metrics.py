@@ -161,7 +161,7 @@ _TABLE: tuple[MetricKey, ...] = (
         _K.TEXT,
         (COMPARE_ROW, CAMERA_ROW, WINDOWS_CSV),
         "aura-ums, EKF, PF (particles), codac, or a method of yours; for windows: aura-ums, "
-        "EKF 3-sigma box or disk model.",
+        "aura-ums focus, EKF 3-sigma box or disk model.",
     ),
     _key("frames", "count", _K.COUNT, (SIMULATE,), "Frames of all runs (one command and one image each)."),
     _key(
@@ -340,6 +340,39 @@ _TABLE: tuple[MetricKey, ...] = (
         _K.FRACTION,
         (CAMERA, CAMERA_ROW),
         "Median over the judged observations of the window's area over the image's; null: none judged.",
+    ),
+    _key(
+        "focus_window_containment",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA,),
+        "window_containment of the windows from the focus map (UncertaintyMapManager.focus_map: "
+        "with the relaxed intersection, the poses that agree with every recent sighting; "
+        "without it, the map itself, so the same figure).",
+    ),
+    _key(
+        "focus_window_truth_containment",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA,),
+        "window_truth_containment of the windows from the focus map (not guaranteed: the focus map "
+        "may leave the truth out while a wrong sighting is in the relaxed window).",
+    ),
+    _key(
+        "median_focus_window_width_frac",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA,),
+        "median_window_width_frac of the windows from the focus map.",
+    ),
+    _key(
+        "median_searched_width_frac",
+        "fraction",
+        _K.FRACTION,
+        (CAMERA,),
+        "Median over the judged observations of the width a focus-first search scans, over the "
+        "image's: the focus window's when the measured pixel is in it, else the (guaranteed) "
+        "window's; null: none judged.",
     ),
     _key(
         "window_baselines",
@@ -671,8 +704,9 @@ class Metrics(Mapping[str, "MetricValue"]):
         containment_rate             n/a
         """
         out: list[str] = []
+        width = max([28, *(len(name) for name in self._values)])
         for name, value in self._values.items():
-            out.append(f"{name:28s} {_shown(value)}")
+            out.append(f"{name:{width}s} {_shown(value)}")
             if isinstance(value, tuple):
                 for row in value:
                     out.extend(f"  {line}" for line in row.lines())

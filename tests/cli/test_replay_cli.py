@@ -190,7 +190,9 @@ def test_replay_with_a_camera_writes_the_window_figures_and_rows(log_folder: Pat
     assert 0.0 < metrics["median_window_width_frac"] <= 1.0
     header, *lines = rows.read_text().splitlines()
     assert set(header.split(",")) == set(written_by("replay --windows-csv"))
-    assert len(lines) == 3 * sum(1 for line in lines if ",aura-ums," in line)
+    # One row per observation and method: ours, the focus map's, the EKF box's, the disk's.
+    assert len(lines) == 4 * sum(1 for line in lines if ",aura-ums," in line)
+    assert sum(1 for line in lines if ",aura-ums focus," in line) == len(lines) // 4
     # Without --camera the replay is the same and writes no window keys.
     plain_out = tmp_path / "plain.json"
     result = runner.invoke(app, ["replay", *base, "--metrics-json", str(plain_out)])

@@ -116,7 +116,7 @@ def test_reversing_odometry_a_truth_gap_and_the_frame_hook_stream_as_the_whole_l
     seen: dict[str, list[tuple[float, float, list[int]]]] = {"whole": [], "stream": []}
 
     def hook(name: str):  # type: ignore[no-untyped-def]
-        return lambda time, grown, rows: seen[name].append((time, grown.area, [r.line for r in rows]))
+        return lambda time, grown, rows, focus: seen[name].append((time, grown.area, [r.line for r in rows]))
 
     whole = replay_log(load_log(folder), FLOOR, options, before_frame=hook("whole"))
     stream = replay_log(open_log(folder, block_bytes=200), FLOOR, options, before_frame=hook("stream"))

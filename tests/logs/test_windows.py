@@ -125,8 +125,18 @@ def test_csv_rows_match_the_metrics(clean_log: RobotLog) -> None:
     assert tuple(rows[0]) == WindowReport.csv_columns
     assert len(rows) == len(report.rows)
     metrics = strict_json(report.metrics().to_json())
-    per_method = {"aura-ums": metrics, **{row["method"]: row for row in metrics["window_baselines"]}}
+    focus = strict_json(report.figures("aura-ums focus").to_json())
+    per_method = {
+        "aura-ums": metrics,
+        "aura-ums focus": focus,
+        **{row["method"]: row for row in metrics["window_baselines"]},
+    }
     assert list(per_method) == list(WindowReport.methods)
+    assert (
+        metrics["focus_window_containment"],
+        metrics["focus_window_truth_containment"],
+        metrics["median_focus_window_width_frac"],
+    ) == (focus["window_containment"], focus["window_truth_containment"], focus["median_window_width_frac"])
     for method, figures in per_method.items():
         judged = [row for row in rows if row["method"] == method and row["in_window"] != ""]
         assert all(row["in_view"] == "1" for row in judged)
@@ -152,6 +162,74 @@ def test_csv_rows_match_the_metrics(clean_log: RobotLog) -> None:
     assert metrics["window_observations"] == len(
         [row for row in rows if row["method"] == "aura-ums" and row["in_view"] == "1"]
     )
+
+
+def misread(log: RobotLog, every: int) -> tuple[RobotLog, int]:
+    """The log with every ``every``-th observation's landmark id swapped for the next landmark's.
+
+    A misread barcode: the bearing and range are right, for the wrong landmark. Returns the
+    log and how many were swapped.
+    """
+    ids = [lm.id for lm in log.landmarks]
+    rows = list(log.observations)
+    for k in range(every - 1, len(rows), every):
+        wrong = ids[(ids.index(rows[k].landmark_id) + 1) % len(ids)]
+        rows[k] = dataclasses.replace(rows[k], landmark_id=wrong)
+    return dataclasses.replace(log, observations=tuple(rows)), len(range(every - 1, len(rows), every))
+
+
+def test_without_the_relaxed_intersection_the_focus_window_is_ours(clean_log: RobotLog) -> None:
+    _, report = replay_windows(clean_log, FLOOR, CAMERA, ReplayOptions(landmark_class=LandmarkClass.POINT))
+    ours, focus = report.judged("aura-ums"), report.judged("aura-ums focus")
+    assert len(ours) > 100
+    for mine, first in zip(ours, focus, strict=True):
+        assert (first.time, first.landmark_id, first.window, first.inside) == (
+            mine.time,
+            mine.landmark_id,
+            mine.window,
+            mine.inside,
+        )
+    metrics = report.metrics()
+    assert metrics.number("focus_window_containment") == metrics.number("window_containment")
+    for key in ("median_focus_window_width_frac", "median_searched_width_frac"):
+        assert metrics.number(key) == metrics.number("median_window_width_frac")
+
+
+def test_the_focus_window_lies_in_ours_and_a_focus_first_search_scans_less(clean_log: RobotLog) -> None:
+    # Misread landmarks, one sighting in 11: at most one in any 5, as relaxed_q = 1,
+    # relaxed_window = 5 assume. The map keeps the truth; its windows are the guaranteed ones.
+    log, swapped = misread(clean_log, 11)
+    assert swapped > 10
+    settings = dataclasses.replace(ReplayOptions().settings, relaxed_q=1, relaxed_window=5)
+    options = ReplayOptions(landmark_class=LandmarkClass.POINT, settings=settings)
+    result, report = replay_windows(log, FLOOR, CAMERA, options)
+    assert result.containment_rate == 1.0
+    ours, focus = report.judged("aura-ums"), report.judged("aura-ums focus")
+    assert len(ours) == len(focus) > 100
+    searched = []
+    for mine, first in zip(ours, focus, strict=True):
+        assert (first.time, first.landmark_id) == (mine.time, mine.landmark_id)
+        if first.window is not None:
+            assert mine.window is not None
+            tolerance = 1e-6  # pixels
+            assert mine.window.u_min - tolerance <= first.window.u_min
+            assert first.window.u_max <= mine.window.u_max + tolerance
+            assert mine.window.v_min - tolerance <= first.window.v_min
+            assert first.window.v_max <= mine.window.v_max + tolerance
+        searched.append(first.width_frac if first.inside else mine.width_frac)
+    metrics = report.metrics()
+    focus_width, searched_width, width = (
+        metrics.number(key)
+        for key in (
+            "median_focus_window_width_frac",
+            "median_searched_width_frac",
+            "median_window_width_frac",
+        )
+    )
+    assert searched_width == np.median(searched)
+    assert focus_width <= searched_width <= width
+    assert focus_width < width
+    assert metrics.number("focus_window_containment") <= metrics.number("window_containment")
 
 
 def tiny_log(landmarks: tuple[LogLandmark, ...], observations: tuple[LogObservation, ...]) -> RobotLog:
@@ -273,7 +351,12 @@ def test_real_log_windows_on_mrclam6(mrclam6_robot1_calibration: Calibration) ->
     assert truth is not None
     holds: dict[float, bool] = {}
 
-    def record(time: float, grown: SpatialUncertaintyMap, rows: Sequence[LogObservation]) -> None:
+    def record(
+        time: float,
+        grown: SpatialUncertaintyMap,
+        rows: Sequence[LogObservation],
+        focus: SpatialUncertaintyMap,
+    ) -> None:
         x, y, heading = truth.at([time])[0]
         holds[time] = not math.isnan(x) and bool(grown.contains(float(x), float(y), float(heading)))
 

@@ -90,7 +90,9 @@ _MIN_POLE = 0.1
 _MIN_SPHERE = 0.2
 _ANNOTATION_FONT = 12.0
 #: RGBA of the windows of the baselines beside ours (replay with a camera), by method.
-_BASELINE_COLORS: Mapping[str, _RGBA] = {
+# The windows drawn thin and unlabelled beside ours: the focus map's, and the baselines'.
+_SECONDARY_COLORS: Mapping[str, _RGBA] = {
+    "aura-ums focus": (0.10, 0.80, 0.80, 0.9),
     "EKF 3-sigma box": (1.00, 0.65, 0.10, 0.9),
     "disk model": (0.75, 0.45, 1.00, 0.9),
 }
@@ -502,17 +504,18 @@ def window_annotations(
     """Return a replay frame's windows (labelled rectangles) and measured pixels (cyan marks).
 
     Our window (method ``"aura-ums"``) is green when the measured pixel lies in it, red
-    when not, grey when not judged, labelled with the landmark id; the baselines' windows
-    (EKF 3-sigma box, disk model) are orange and violet. The measured pixels of our rows in
+    when not, grey when not judged, labelled with the landmark id; the focus map's window
+    (``"aura-ums focus"``) is teal, the baselines' windows (EKF 3-sigma box, disk model) are
+    orange and violet. The measured pixels of our rows in
     view are one ``LINE_LIST``: a full-height column for a Class I (bearing-only) row, a
     cross for a Class II point.
     """
     rectangles, texts, marks = [], [], []
     for row in rows:
-        ours = row.method not in _BASELINE_COLORS
+        ours = row.method not in _SECONDARY_COLORS
         if row.window is not None:
             if not ours:
-                rgba = _BASELINE_COLORS[row.method]
+                rgba = _SECONDARY_COLORS[row.method]
             elif row.inside is None:
                 rgba = _NOT_JUDGED_COLOR
             else:

@@ -55,8 +55,9 @@ LogT = TypeVar("LogT", RobotLog, LogStream)
 _REPLAY_CLASSES = (LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT)
 
 #: :func:`replay_log`'s ``before_frame``: called with a frame's time (s), the working map grown
-#: to it (before the frame's observations reduce it) and the frame's log rows.
-FrameHook = Callable[[float, SpatialUncertaintyMap, Sequence[LogObservation]], None]
+#: to it (before the frame's observations reduce it), the frame's log rows, and the focus map
+#: grown to it (:attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`).
+FrameHook = Callable[[float, SpatialUncertaintyMap, Sequence[LogObservation], SpatialUncertaintyMap], None]
 
 # Header of the per-step CSV (``replay --steps-csv``): the metrics table's columns of that file.
 STEPS_CSV_HEADER = ",".join(key.name for key in Metrics.table() if STEPS_CSV in key.written_by)
@@ -678,9 +679,12 @@ def replay_log(
     options : ReplayOptions or None
         How; default :class:`ReplayOptions`.
     before_frame : callable or None
-        Called once per frame, in time order, as ``before_frame(time, grown_map, rows)``:
-        seconds, the working map grown to ``time``, the frame's :class:`LogObservation` s.
-        :func:`~aura_ums.logs.replay_windows` asks the Expecter there.
+        Called once per frame, in time order, as ``before_frame(time, grown_map, rows,
+        focus_map)``: seconds, the working map grown to ``time``, the frame's
+        :class:`LogObservation` s, and the manager's focus map grown to ``time``
+        (:attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`: ``grown_map`` itself
+        without the relaxed intersection). :func:`~aura_ums.logs.replay_windows` asks the
+        Expecter there.
     keep_maps : bool
         Keep the working map of every step (:attr:`ReplayResult.maps`, and
         :attr:`ReplayResult.steps`, which needs them). A long log's replay that only wants
@@ -831,10 +835,11 @@ def replay_log(
                 for report in due:
                     board.post_report(report)
                 if before_frame is not None:
-                    grown = manager.update(board, now=frame_time).map
+                    grown = manager.update(board, now=frame_time)
                     paused = _time.perf_counter()
                     assert chunk.logged is not None
-                    before_frame(frame_time, grown, chunk.logged[offsets[index] : offsets[index + 1]])
+                    logged = chunk.logged[offsets[index] : offsets[index + 1]]
+                    before_frame(frame_time, grown.map, logged, grown.focus)
                     began += _time.perf_counter() - paused
                 for observation in working:
                     board.identified.post(observation)

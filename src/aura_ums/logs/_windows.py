@@ -3,7 +3,9 @@
 A log from a robot without a camera model (or with one) is replayed through a camera of
 the user's choosing. Before each frame's observations reduce the map, the Expecter is
 asked for each observed landmark's window from the map of that moment (grown to the
-frame's time, not yet reduced); the EKF, run alongside on the same position reports and
+frame's time, not yet reduced), and from the focus map of that moment (with the relaxed
+intersection, the poses that agree with every recent sighting: the window to search
+first, the map's being the one guaranteed); the EKF, run alongside on the same position reports and
 observations, gives its 3-sigma box's window, and the disk model the window of the circle
 around the same map. Each real observation is then judged: does its measured pixel lie
 inside each window? A window is judged as a set of whole pixels, as a perception module
@@ -66,9 +68,11 @@ from aura_ums.world import PerceptualStrategy
 
 #: The methods whose windows are judged, in the order of the rows and of the CSV.
 OURS = "aura-ums"
+#: The Expecter's window from the focus map (:attr:`UncertaintyMapManager.focus_map`).
+FOCUS = "aura-ums focus"
 EKF_BOX = "EKF 3-sigma box"
 DISK_MODEL = "disk model"
-WINDOW_METHODS: tuple[str, ...] = (OURS, EKF_BOX, DISK_MODEL)
+WINDOW_METHODS: tuple[str, ...] = (OURS, FOCUS, EKF_BOX, DISK_MODEL)
 
 #: Columns of :meth:`WindowReport.to_csv`, each a key of the metrics table.
 CSV_COLUMNS: tuple[str, ...] = (
@@ -154,7 +158,8 @@ class WindowReport:
     rows : tuple of WindowRow
         One per observation and method, in time order, the methods in :attr:`methods` order.
     methods : tuple of str
-        Class attribute: the methods judged, ``("aura-ums", "EKF 3-sigma box", "disk model")``.
+        Class attribute: the methods judged, ``("aura-ums", "aura-ums focus", "EKF 3-sigma box",
+        "disk model")``.
     csv_columns : tuple of str
         Class attribute: the columns of :meth:`to_csv`, each a key of the metrics table.
 
@@ -198,19 +203,34 @@ class WindowReport:
         )
 
     def metrics(self) -> Metrics:
-        """Return the window metrics (keys: ``docs/metrics.md``): ours, then the baselines as rows."""
+        """Return the window metrics (keys: ``docs/metrics.md``): ours, the focus map's, the baselines'."""
         ours = self.figures(OURS)
+        focus = self.figures(FOCUS)
         baselines = tuple(
-            Metrics({"method": method, **self.figures(method)}) for method in WINDOW_METHODS if method != OURS
+            Metrics({"method": method, **self.figures(method)})
+            for method in WINDOW_METHODS
+            if method not in (OURS, FOCUS)
         )
         return Metrics(
             {
                 "window_margin_px": self.margin,
                 "window_observations": len(self.judged(OURS)),
                 **ours,
+                "focus_window_containment": focus["window_containment"],
+                "focus_window_truth_containment": focus["window_truth_containment"],
+                "median_focus_window_width_frac": focus["median_window_width_frac"],
+                "median_searched_width_frac": self._searched_width(),
                 "window_baselines": baselines,
             }
         )
+
+    def _searched_width(self) -> float | None:
+        """Median width searched focus first: the focus window's if the observation is in it, else ours."""
+        searched = [
+            focus.width_frac if focus.inside else ours.width_frac
+            for ours, focus in zip(self.judged(OURS), self.judged(FOCUS), strict=True)
+        ]
+        return float(np.median(searched)) if searched else None
 
     def to_csv(self) -> str:
         """Return the rows as CSV text: :attr:`csv_columns`, one line per observation and method.
@@ -281,11 +301,13 @@ def replay_windows(
     save_state: bool = False,
     after_step: Callable[[ReplayStep, tuple[WindowRow, ...]], None] | None = None,
 ) -> tuple[ReplayResult, WindowReport]:
-    """Replay a log and judge, for each real observation, the image windows of three methods.
+    """Replay a log and judge, for each real observation, the image windows of four methods.
 
     :func:`replay_log` runs as usual; before each frame's observations reduce the map, the
     :class:`~aura_ums.expecter.Expecter` gives each observed landmark's window from the map
-    grown to that time (``aura-ums``); an :class:`~aura_ums.baselines.ExtendedKalmanFilter`,
+    grown to that time (``aura-ums``) and from the focus map grown to that time
+    (``aura-ums focus``: :attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`, the
+    same window without the relaxed intersection); an :class:`~aura_ums.baselines.ExtendedKalmanFilter`,
     predicted by the same position reports up to that time, gives its ``sigmas`` box's
     window (:func:`~aura_ums.expecter.gaussian_window`); and the disk model gives the window
     of the circle around the same map (:func:`~aura_ums.expecter.disk_model_window`). The
@@ -392,7 +414,7 @@ def _with_rows(
 
 
 class _Judge:
-    """The replay's ``before_frame``: steps the EKF and judges the three windows of each row."""
+    """The replay's ``before_frame``: steps the EKF and judges the four windows of each row."""
 
     def __init__(
         self,
@@ -426,7 +448,13 @@ class _Judge:
         self._sigmas = sigmas
         self.rows: list[WindowRow] = []
 
-    def __call__(self, time: float, grown: SpatialUncertaintyMap, rows: Sequence[LogObservation]) -> None:
+    def __call__(
+        self,
+        time: float,
+        grown: SpatialUncertaintyMap,
+        rows: Sequence[LogObservation],
+        focus: SpatialUncertaintyMap,
+    ) -> None:
         ekf, reports = self._ekf, self._reports
         while self._next < len(reports) and reports[self._next].time <= time:
             ekf.predict(reports[self._next].command, self._terrain)
@@ -438,8 +466,10 @@ class _Judge:
             landmark = self._landmarks[row.landmark_id]
             measured = self._measured(row, landmark, grown)
             true_pixel = None if truth is None else self._projected(truth, landmark)
+            ours = expecter.window(grown, landmark, margin=margin)
             windows = (
-                expecter.window(grown, landmark, margin=margin),
+                ours,
+                ours if focus is grown else expecter.window(focus, landmark, margin=margin),
                 gaussian_window(expecter, mean, covariance, landmark, self._sigmas, margin=margin),
                 disk_model_window(expecter, grown, landmark, margin=margin),
             )
