@@ -299,6 +299,10 @@ def test_a_saved_relaxed_manager_goes_on_exactly_as_the_original() -> None:
     assert copy is not None
     assert copy.to_json() == manager.to_json()
     assert copy.map.polygon.vertices.tobytes() == manager.map.polygon.vertices.tobytes()
+    # The focus map is one of the saved branches: it comes back too.
+    assert copy.focus_map is not copy.map
+    assert copy.focus_map.polygon.vertices.tobytes() == manager.focus_map.polygon.vertices.tobytes()
+    assert copy.focus_map.wedge == manager.focus_map.wedge
 
 
 def test_a_saved_document_must_match_its_settings() -> None:
