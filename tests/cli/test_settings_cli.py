@@ -180,7 +180,7 @@ def test_a_profile_is_the_base_of_the_options_given_one_by_one() -> None:
 def test_the_profile_help_names_the_options_it_sets() -> None:
     group = typer.main.get_command(app)
     option = next(p for p in group.commands["replay"].params if "--profile" in p.opts)  # type: ignore[attr-defined]
-    assert "relaxed = --slice-width 2deg --relaxed-q 1 --relaxed-window 5," in option.help
+    assert "relaxed = --slice-width 2deg --max-slices 180 --relaxed-q 1 --relaxed-window 5," in option.help
     assert "sliced = --slice-width 2deg," in option.help
     assert "product = the defaults," in option.help
 

@@ -163,6 +163,10 @@ def test_the_profiles_are_the_product_map_the_sliced_map_and_the_relaxed_interse
     # The width the map's own with_slices takes by default: one width measured best.
     assert relaxed.slice_width == sliced.slice_width == DEFAULT_SLICE_WIDTH
     assert relaxed.relaxed_window == 5 < ManagerSettings().relaxed_window
+    # The relaxed map keeps every cell (merged neighbours widened its windows); the sliced map
+    # keeps the default cap.
+    assert relaxed.max_slices == cell_count(relaxed.slice_width) == 180
+    assert sliced.max_slices == ManagerSettings().max_slices < 180
     assert MapProfile("relaxed") is MapProfile.RELAXED
 
 

@@ -527,16 +527,18 @@ class MapProfile(enum.Enum):
       of the area, at about 0.3-0.9 ms a frame; a misread landmark or an observation beyond its
       calibrated bounds cuts deeper (the truth stayed inside 0.89 to 1.00 of the time).
     - ``RELAXED``: ``SLICED`` with the q-relaxed intersection (``relaxed_q = 1`` over
-      ``relaxed_window = 5`` observations): the truth stays inside whenever at most one
-      landmark among any 5 consecutive observations is wrong (it stayed inside 0.998 to
-      1.000 of the time), for windows of 0.34-0.40 of the frame with range and
-      bearing and 0.44-0.83 with bearings only, at about 6-11 ms a frame.
+      ``relaxed_window = 5`` observations) and no slice cap (``max_slices`` 180, every cell):
+      the truth stays inside whenever at most one landmark among any 5 consecutive
+      observations is wrong (it stayed inside 0.998 to 1.000 of the time), for guaranteed
+      windows of 0.34-0.40 of the frame with range and bearing and 0.43-0.60 with bearings
+      only, and focus windows (searched first: :attr:`UncertaintyMapManager.focus_map`) of
+      0.26 and 0.27-0.31, at about 6-11 ms a frame.
 
     Examples
     --------
     >>> settings = MapProfile.RELAXED.settings(ManagerSettings(area_limit=25.0))
-    >>> settings.relaxed_q, settings.relaxed_window, settings.area_limit
-    (1, 5, 25.0)
+    >>> settings.relaxed_q, settings.relaxed_window, settings.max_slices, settings.area_limit
+    (1, 5, 180, 25.0)
     >>> round(math.degrees(settings.slice_width), 6)
     2.0
     >>> MapProfile.PRODUCT.settings(settings) == ManagerSettings(area_limit=25.0)   # back to the paper's
@@ -568,14 +570,36 @@ _RELAXED_WINDOW = 5
 # Without the relaxed intersection its window is unused: the field's default, so that a
 # profile leaves the settings as ManagerSettings() has them.
 _UNUSED_WINDOW: int = ManagerSettings().relaxed_window
+#: The PRODUCT and SLICED profiles' slice cap: the field's default.
+_DEFAULT_MAX_SLICES: int = ManagerSettings().max_slices
+#: The RELAXED profile's slice cap: every cell of its grid, so neighbours never merge. With
+#: bearings only, the cap of 48 merged the wide branches' slices and widened the focus
+#: windows to 0.28-0.40 of the frame; without it they are 0.27-0.31, the guaranteed ones
+#: 0.43-0.60 instead of 0.44-0.83, at about the same time (docs/real-logs.md, "The focus window").
+_RELAXED_MAX_SLICES = round(2.0 * math.pi / _PROFILE_SLICE_WIDTH)
 _PROFILE_FIELDS = {
     MapProfile.PRODUCT: MappingProxyType(
-        {"slice_width": None, "relaxed_q": 0, "relaxed_window": _UNUSED_WINDOW}
+        {
+            "slice_width": None,
+            "max_slices": _DEFAULT_MAX_SLICES,
+            "relaxed_q": 0,
+            "relaxed_window": _UNUSED_WINDOW,
+        }
     ),
     MapProfile.SLICED: MappingProxyType(
-        {"slice_width": _PROFILE_SLICE_WIDTH, "relaxed_q": 0, "relaxed_window": _UNUSED_WINDOW}
+        {
+            "slice_width": _PROFILE_SLICE_WIDTH,
+            "max_slices": _DEFAULT_MAX_SLICES,
+            "relaxed_q": 0,
+            "relaxed_window": _UNUSED_WINDOW,
+        }
     ),
     MapProfile.RELAXED: MappingProxyType(
-        {"slice_width": _PROFILE_SLICE_WIDTH, "relaxed_q": 1, "relaxed_window": _RELAXED_WINDOW}
+        {
+            "slice_width": _PROFILE_SLICE_WIDTH,
+            "max_slices": _RELAXED_MAX_SLICES,
+            "relaxed_q": 1,
+            "relaxed_window": _RELAXED_WINDOW,
+        }
     ),
 }
