@@ -530,9 +530,9 @@ class MapProfile(enum.Enum):
       ``relaxed_window = 5`` observations) and no slice cap (``max_slices`` 180, every cell):
       the truth stays inside whenever at most one landmark among any 5 consecutive
       observations is wrong (it stayed inside 0.998 to 1.000 of the time), for guaranteed
-      windows of 0.34-0.40 of the frame with range and bearing and 0.43-0.60 with bearings
+      windows of 0.33-0.40 of the frame with range and bearing and 0.43-0.60 with bearings
       only, and focus windows (searched first: :attr:`UncertaintyMapManager.focus_map`) of
-      0.26 and 0.27-0.31, at about 6-11 ms a frame.
+      0.26 and 0.27-0.31, at about 5-11 ms a frame.
 
     Examples
     --------
