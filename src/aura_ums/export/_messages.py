@@ -511,7 +511,8 @@ def window_annotations(
     cross for a Class II point.
     """
     rectangles, texts, marks = [], [], []
-    for row in rows:
+    # Ours last, on top: without the relaxed intersection the focus window is the same rectangle.
+    for row in sorted(rows, key=lambda row: row.method not in _SECONDARY_COLORS):
         ours = row.method not in _SECONDARY_COLORS
         if row.window is not None:
             if not ours:

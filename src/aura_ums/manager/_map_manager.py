@@ -437,10 +437,11 @@ class UncertaintyMapManager:
         the map of its primary branch, the one that excludes the fewest (the most recent
         first among equals). It lies inside :attr:`map`, and holds the truth whenever the
         sightings that branch trusts are right. A sighting that leaves the window merges the
-        branch that excluded it back into this one, so a wrong sighting narrows it for at
-        most ``relaxed_window`` sightings. A window from it is narrower than one from
-        :attr:`map`, whose window is the one guaranteed: search this one first, and the
-        other when the landmark is not in it. Without the relaxed intersection, :attr:`map`.
+        branch that excluded it back into this one: when the guarantee's assumption holds
+        (see :class:`ManagerSettings`), the truth is back in it once every wrong sighting has
+        left the window. A window from it is no wider than one from :attr:`map`, whose
+        window is the one guaranteed: search this one first, and the other when the
+        landmark is not in it. Without the relaxed intersection, :attr:`map`.
         """
         return self._map if self._relaxed is None else self._relaxed.primary
 
