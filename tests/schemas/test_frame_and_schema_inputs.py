@@ -58,6 +58,10 @@ def test_frame_validates_its_inputs() -> None:
         Frame(0.0, np.zeros((0, 4)), SNAPSHOT)
     with pytest.raises(InputError, match="map: expected a SpatialUncertaintyMap, got Pose"):
         Frame(0.0, np.zeros((4, 4)), Pose(0, 0, 0))  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="focus: expected a SpatialUncertaintyMap or None, got Pose"):
+        Frame(0.0, np.zeros((4, 4)), SNAPSHOT, focus=Pose(0, 0, 0))  # type: ignore[arg-type]
+    # The map itself as its focus: nothing to search first.
+    assert Frame(0.0, np.zeros((4, 4)), SNAPSHOT, focus=SNAPSHOT).focus is None
 
 
 def test_line_finder_is_tuned_from_the_record() -> None:

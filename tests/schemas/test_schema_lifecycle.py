@@ -88,6 +88,43 @@ def test_discovery_is_posted_on_the_nth_consecutive_hit(rng: np.random.Generator
     assert confirming.window.u_min <= pole_column(TRUTH, POLE) <= confirming.window.u_max
 
 
+def test_a_focus_window_is_searched_first_and_the_guaranteed_one_where_it_misses(
+    rng: np.random.Generator,
+) -> None:
+    schema = FindLandmarkSchema(pole_record(POLE, confirm=1), EXPECTER)
+    snapshot = map_around(TRUTH, radius=0.4, halfwidth=math.radians(10.0))
+    guaranteed = EXPECTER.window(snapshot, POLE, margin=PerceptualStrategy.LINE_FINDER)
+    assert guaranteed is not None
+    image = pole_image(rng, TRUTH, [POLE])
+    column = pole_column(TRUTH, POLE)
+    # A focus map about the truth: the pole is in its narrower window, found there.
+    near = map_around(TRUTH, offset=(0.02, 0.0, 0.002), radius=0.1, halfwidth=math.radians(1.0))
+    found = schema.step(Frame(0.0, image, snapshot, focus=near))
+    assert found.hit
+    assert found.focus_window is not None
+    assert found.window == found.focus_window
+    assert guaranteed.u_min <= found.window.u_min <= column <= found.window.u_max <= guaranteed.u_max
+    assert found.window.width < 0.5 * guaranteed.width
+    # A focus map turned 6 degrees away (a wrong sighting trusted): nothing there, so the
+    # guaranteed window is searched and the pole is found all the same.
+    away = SpatialUncertaintyMap.from_pose(
+        Pose(TRUTH.x, TRUTH.y, TRUTH.heading + math.radians(6.0)), 0.05, math.radians(1.0)
+    )
+    missed = schema.step(Frame(0.1, image, snapshot, focus=away))
+    assert missed.focus_window is not None
+    assert not missed.focus_window.u_min <= column <= missed.focus_window.u_max
+    assert missed.hit
+    assert missed.window == guaranteed
+    # While lost (windows widened) no focus window is searched.
+    lost = schema.step(Frame(0.2, image, snapshot, focus=near, window_scale=2.0))
+    assert lost.focus_window is None
+    assert lost.hit
+    # Without a focus map, only the guaranteed window.
+    plain = schema.step(Frame(0.3, image, snapshot))
+    assert plain.focus_window is None
+    assert plain.window == guaranteed
+
+
 def test_discovery_of_a_class_ii_corner(rng: np.random.Generator) -> None:
     corner = PointLandmark("corner", 12.0, 2.0, 3.0, symbol="building corner", position_uncertainty=0.1)
     record = LandmarkRecord(

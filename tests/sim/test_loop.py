@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from aura_ums.errors import InputError
-from aura_ums.manager import ManagerState
+from aura_ums.manager import ManagerState, MapProfile
 from aura_ums.sim import (
     FrameRecord,
     PerceptionMode,
+    RunResult,
     Scenario,
     check_render_consistency,
     run_scenario,
@@ -150,6 +151,28 @@ def test_full_frame_perception_searches_the_whole_image(paper: Scenario) -> None
     areas = [w.area for r in result.records for _, w in r.windows]
     assert areas
     assert all(a == pytest.approx(width * height) for a in areas)
+
+
+def test_focus_first_perception_keeps_the_truth_and_searches_narrower_windows() -> None:
+    # The relaxed profile's focus map, the branch that trusts every recent sighting, is
+    # narrower than the map: discovering schemas search its window first.
+    corridor = Scenario.from_toml(SCENARIOS / "indoor_corridor.toml")
+    relaxed = dataclasses.replace(corridor, settings=MapProfile.RELAXED.settings(corridor.settings))
+    seeds = range(3)
+    focused = [
+        run_scenario(relaxed, np.random.default_rng(s), perception=PerceptionMode.FOCUS_FIRST) for s in seeds
+    ]
+    plain = [run_scenario(relaxed, np.random.default_rng(s)) for s in seeds]
+    assert summarize_runs(focused).number("containment_rate") >= 0.99
+    assert summarize_runs(focused).number("accepted_observations") > 0
+
+    def widths(results: list[RunResult]) -> list[float]:
+        return [w.u_max - w.u_min for r in results for record in r.records for _, w in record.windows]
+
+    first, guaranteed = widths(focused), widths(plain)
+    assert first
+    assert guaranteed
+    assert np.median(first) < np.median(guaranteed)
 
 
 def test_render_consistency_rule(paper: Scenario) -> None:

@@ -33,6 +33,11 @@ class Frame:
         centres (the map manager's :attr:`~aura_ums.manager.UncertaintyMapManager.window_scale`
         while lost); ``inf`` searches the whole image, tracking included (the full-frame
         baseline). Default 1: the Expecter's windows as they are.
+    focus : SpatialUncertaintyMap or None
+        A map inside ``map`` whose windows a discovering schema searches first, falling
+        back on ``map``'s (the guaranteed ones) where the landmark is not found: the
+        manager's :attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`. None (the
+        default), or ``map`` itself: the guaranteed windows only.
 
     Notes
     -----
@@ -63,10 +68,17 @@ class Frame:
     image: NDArray[np.generic]
     map: SpatialUncertaintyMap
     window_scale: float
+    focus: SpatialUncertaintyMap | None
     _lines: dict[tuple[FastLineFinder, ImageWindow], LineSegments] = field(repr=False)
 
     def __init__(
-        self, time: float, image: ArrayLike, map: SpatialUncertaintyMap, *, window_scale: float = 1.0
+        self,
+        time: float,
+        image: ArrayLike,
+        map: SpatialUncertaintyMap,
+        *,
+        window_scale: float = 1.0,
+        focus: SpatialUncertaintyMap | None = None,
     ) -> None:
         when = finite_float(time, "time")
         scale = float(window_scale) if isinstance(window_scale, (int, float)) else math.nan
@@ -88,10 +100,13 @@ class Frame:
             array.setflags(write=False)
         if not isinstance(map, SpatialUncertaintyMap):
             raise InputError(f"map: expected a SpatialUncertaintyMap, got {type(map).__name__}")
+        if focus is not None and not isinstance(focus, SpatialUncertaintyMap):
+            raise InputError(f"focus: expected a SpatialUncertaintyMap or None, got {type(focus).__name__}")
         object.__setattr__(self, "time", when)
         object.__setattr__(self, "image", array)
         object.__setattr__(self, "map", map)
         object.__setattr__(self, "window_scale", scale)
+        object.__setattr__(self, "focus", None if focus is map else focus)
         object.__setattr__(self, "_lines", {})
 
     def lines(self, finder: FastLineFinder, window: ImageWindow) -> LineSegments:

@@ -289,17 +289,45 @@ class FindLandmarkSchema:
             search = self.tracking_window(frame, status.detection, guaranteed)
         if search is None:  # it would have left the view: discovery starts again
             status, search = SchemaStatus(SchemaState.DISCOVERING), guaranteed
-        value, detection, observation = self._look(frame, search)
+        first = self._focus_window(frame, guaranteed) if search is guaranteed else None
+        value, detection, observation = (None, None, None) if first is None else self._look(frame, first)
+        if first is not None and detection is not None and observation is not None:
+            search = first
+        else:  # no focus window, or nothing in it: the guaranteed (or following) window
+            value, detection, observation = self._look(frame, search)
         if detection is None or observation is None:
             return SchemaReport(
-                ident, SchemaStatus(SchemaState.DISCOVERING), search, value, False, None, None, bounds
+                ident, SchemaStatus(SchemaState.DISCOVERING), search, value, False, None, None, bounds, first
             )
         hits = status.hits + 1 if status.state is SchemaState.DISCOVERING else 1
         if hits >= self.record.confirm_frames:
             confirmed = SchemaStatus(SchemaState.TRACKING, hits, 0, detection)
-            return SchemaReport(ident, confirmed, search, value, True, observation, detection, bounds)
+            return SchemaReport(ident, confirmed, search, value, True, observation, detection, bounds, first)
         pending = SchemaStatus(SchemaState.DISCOVERING, hits, 0, detection)
-        return SchemaReport(ident, pending, search, value, True, None, detection, bounds)
+        return SchemaReport(ident, pending, search, value, True, None, detection, bounds, first)
+
+    def _focus_window(self, frame: Frame, guaranteed: ImageWindow) -> ImageWindow | None:
+        """Return the focus map's window, inside ``guaranteed``; None without one or when it is all of it.
+
+        Not while the windows are widened (lost): the focus map then says little.
+        """
+        if frame.focus is None or frame.window_scale != 1.0:
+            return None
+        bounds = self.expecter.bounds(frame.focus, self.record.landmark)
+        if bounds is None:
+            return None
+        k = self.expecter.camera.intrinsics
+        grown = _grown_clipped(bounds, self.margin, k.width, k.height)
+        if grown is None:
+            return None
+        # The focus map lies inside the map, so its window inside the guaranteed one: the cut
+        # only keeps rounding from reaching outside.
+        u0, v0 = max(grown.u_min, guaranteed.u_min), max(grown.v_min, guaranteed.v_min)
+        u1, v1 = min(grown.u_max, guaranteed.u_max), min(grown.v_max, guaranteed.v_max)
+        if u0 > u1 or v0 > v1:
+            return None
+        first = ImageWindow._trusted(u0, v0, u1, v1)
+        return None if first == guaranteed else first
 
     # -- internals ---------------------------------------------------------------------
 

@@ -112,6 +112,10 @@ class SchemaReport:
         The Expecter's guaranteed bounds of the landmark's projection this frame (before
         margin and clipping); None when the schema hibernates or the landmark cannot be
         in view.
+    focus_window : ImageWindow or None
+        The focus map's window (:attr:`Frame.focus`), searched before the guaranteed one
+        while discovering; :attr:`window` is then this window when it held the match, the
+        guaranteed one when not. None when no focus window was searched.
     """
 
     landmark_id: str
@@ -122,6 +126,7 @@ class SchemaReport:
     observation: Observation | None
     detection: Detection | None
     bounds: ImageWindow | None = None
+    focus_window: ImageWindow | None = None
 
     @property
     def state(self) -> SchemaState:

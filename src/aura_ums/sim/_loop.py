@@ -75,8 +75,14 @@ _WRONG_TURN = 3.0
 class PerceptionMode(enum.Enum):
     """Where perception runs: in the Expecter's windows, or on the whole image (the baseline)."""
 
+    #: In the Expecter's windows from the map (the guaranteed ones).
     WINDOWS = "windows"
+    #: On the whole image, tracking included: the baseline.
     FULL_FRAME = "full_frame"
+    #: A discovering schema searches the focus map's window first
+    #: (:attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`, narrower with the relaxed
+    #: intersection), the guaranteed window where the landmark is not found there.
+    FOCUS_FIRST = "focus_first"
 
 
 @dataclass(frozen=True, slots=True)
@@ -452,7 +458,8 @@ class _Loop:
             scale = math.inf
         else:
             scale = self.manager.window_scale if self.prune else 1.0
-        report = self.schemas.step(Frame(now, image, grown.map, window_scale=scale))
+        focus = grown.focus if self.perception is PerceptionMode.FOCUS_FIRST else None
+        report = self.schemas.step(Frame(now, image, grown.map, window_scale=scale, focus=focus))
         injected = 0
         if not self.prune:
             self.board.identified.drain(until=now)
@@ -585,7 +592,8 @@ def run_scenario(
     prune : bool
         Reduce the map by the identified landmarks (False: growth only, no lost response).
     perception : PerceptionMode
-        Run perception in the Expecter's windows, or on the full frame (the baseline).
+        Run perception in the Expecter's windows, on the full frame (the baseline), or in
+        the focus map's windows first (the guaranteed ones where the landmark is not there).
     stop_after : int or None
         Stop after this many frames in all (the start frame included) and return the
         state to resume from in :attr:`RunResult.saved`.
