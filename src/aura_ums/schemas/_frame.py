@@ -37,7 +37,8 @@ class Frame:
         A map inside ``map`` whose windows a discovering schema searches first, falling
         back on ``map``'s (the guaranteed ones) where the landmark is not found: the
         manager's :attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`. None (the
-        default), or ``map`` itself: the guaranteed windows only.
+        default), or ``map`` itself: the guaranteed windows only. A match in the focus
+        window is taken without looking for rivals in the rest of the guaranteed one.
 
     Notes
     -----

@@ -81,7 +81,9 @@ class PerceptionMode(enum.Enum):
     FULL_FRAME = "full_frame"
     #: A discovering schema searches the focus map's window first
     #: (:attr:`~aura_ums.manager.UncertaintyMapManager.focus_map`, narrower with the relaxed
-    #: intersection), the guaranteed window where the landmark is not found there.
+    #: intersection), the guaranteed window where the landmark is not found there. A
+    #: look-alike outside the focus window is then not seen to rival a match inside it: a
+    #: wrong match this makes is one of the wrong sightings the relaxed intersection bounds.
     FOCUS_FIRST = "focus_first"
 
 
