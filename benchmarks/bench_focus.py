@@ -34,10 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from aura_ums.manager import MapProfile
-from aura_ums.perception import FastLineFinder
-from aura_ums.schemas import SchemaManager
 from aura_ums.sim import PerceptionMode, Scenario, run_scenario
-from bench_loop import _framed, _per_frame, _timed
+from bench_loop import finder_timed
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 DEFAULTS = (SCENARIOS / "indoor_corridor.toml", SCENARIOS / "four_terrains.toml")
@@ -59,17 +57,10 @@ def measure(scenario: Scenario, runs: int) -> dict[PerceptionMode, Tally]:
     tallies = {mode: Tally() for mode in MODES}
     for seed in range(runs):
         for mode in MODES:
-            find, step = FastLineFinder.find_detailed, SchemaManager.step
-            FastLineFinder.find_detailed = _timed(find)  # type: ignore[method-assign]
-            SchemaManager.step = _framed(step)  # type: ignore[method-assign]
-            try:
-                _per_frame.clear()
+            with finder_timed() as per_frame:
                 result = run_scenario(scenario, np.random.default_rng(seed), perception=mode)
-            finally:
-                FastLineFinder.find_detailed = find  # type: ignore[method-assign]
-                SchemaManager.step = step  # type: ignore[method-assign]
             tally = tallies[mode]
-            for record, finder in zip(result.records, _per_frame, strict=True):
+            for record, finder in zip(result.records, per_frame, strict=True):
                 tally.frame_ms.append(record.frame_ms)
                 tally.finder_ms.append(finder)
                 tally.widths += [window.width for _, window in record.windows]

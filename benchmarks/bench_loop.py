@@ -28,7 +28,8 @@ from __future__ import annotations
 import statistics
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -70,21 +71,28 @@ def _framed(step: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
+@contextmanager
+def finder_timed() -> Iterator[list[float]]:
+    """Time the line finder while inside: yields each stepped frame's line-finder milliseconds."""
+    find, step = FastLineFinder.find_detailed, SchemaManager.step
+    FastLineFinder.find_detailed = _timed(find)  # type: ignore[method-assign]
+    SchemaManager.step = _framed(step)  # type: ignore[method-assign]
+    _per_frame.clear()
+    try:
+        yield _per_frame
+    finally:
+        FastLineFinder.find_detailed = find  # type: ignore[method-assign]
+        SchemaManager.step = step  # type: ignore[method-assign]
+
+
 def frame_times(scenario: Scenario, runs: int) -> dict[PerceptionMode, list[tuple[float, float]]]:
     """(frame ms, line-finder ms) of the frames with three landmarks searched, per mode."""
     times: dict[PerceptionMode, list[tuple[float, float]]] = {mode: [] for mode in MODES}
     for seed in range(runs):
         for mode in MODES:
-            find, step = FastLineFinder.find_detailed, SchemaManager.step
-            FastLineFinder.find_detailed = _timed(find)  # type: ignore[method-assign]
-            SchemaManager.step = _framed(step)  # type: ignore[method-assign]
-            try:
-                _per_frame.clear()
+            with finder_timed() as per_frame:
                 result = run_scenario(scenario, np.random.default_rng(seed), perception=mode)
-            finally:
-                FastLineFinder.find_detailed = find  # type: ignore[method-assign]
-                SchemaManager.step = step  # type: ignore[method-assign]
-            frames = zip(result.records, _per_frame, strict=True)
+            frames = zip(result.records, per_frame, strict=True)
             times[mode].extend((r.frame_ms, p) for r, p in frames if len(r.windows) >= 3)
     return times
 
