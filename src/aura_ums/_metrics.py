@@ -95,6 +95,13 @@ _TABLE: tuple[MetricKey, ...] = (
     _key("seed", "", _K.INTEGER, (SIMULATE,), "Seed of the whole Monte Carlo."),
     _key("prune", "", _K.FLAG, (SIMULATE,), "Whether landmarks reduced the map (false: growth only)."),
     _key(
+        "perception",
+        "",
+        _K.TEXT,
+        (SIMULATE,),
+        "Where the find-landmark schemas looked: windows, full_frame or focus_first (simulate --perception).",
+    ),
+    _key(
         "replays",
         "",
         _K.ROWS,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import sys
 import time
 from collections.abc import Iterator
@@ -24,8 +25,10 @@ from aura_ums.campaign import (
     simulate_campaign,
 )
 from aura_ums.errors import InputError, MissingDependencyError, RunLostError
+from aura_ums.geometry import ImageWindow
 from aura_ums.logs import ReplayOptions, calibrate_logs, synthetic_log, write_log
-from aura_ums.sim import Scenario, summarize_runs
+from aura_ums.manager import MapProfile
+from aura_ums.sim import PerceptionMode, RunResult, Scenario, run_scenario, summarize_runs
 from tests.campaign.campaign_helpers import FailOn, HangOnce, KillAlways, KillOnce, run_figures
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
@@ -94,6 +97,23 @@ def test_a_run_called_twice_with_one_seed_draws_the_same(scenario: Scenario) -> 
     (seed,) = run_seeds(3, 1)
     run = SimulationRun(scenario)
     assert run_figures(run(seed)) == run_figures(run(seed))
+
+
+def test_a_run_searches_where_its_perception_says() -> None:
+    corridor = Scenario.from_toml(SCENARIO.with_name("indoor_corridor.toml"))
+    relaxed = dataclasses.replace(corridor, settings=MapProfile.RELAXED.settings(corridor.settings))
+    (seed,) = run_seeds(2, 1)
+
+    def windows(result: RunResult) -> list[tuple[str, ImageWindow]]:
+        return [pair for record in result.records for pair in record.windows]
+
+    focus = windows(SimulationRun(relaxed, perception=PerceptionMode.FOCUS_FIRST)(seed))
+    fresh = np.random.SeedSequence(seed.entropy, spawn_key=seed.spawn_key, pool_size=seed.pool_size)
+    alone = run_scenario(relaxed, np.random.default_rng(fresh), perception=PerceptionMode.FOCUS_FIRST)
+    assert focus == windows(alone)
+    assert focus != windows(SimulationRun(relaxed)(seed))  # some landmark was found in a focus window
+    with pytest.raises(InputError, match="perception: expected a PerceptionMode, got 'windows'"):
+        simulate_campaign(relaxed, 1, 0, perception="windows")  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(

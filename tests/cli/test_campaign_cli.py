@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -127,3 +128,38 @@ def test_replay_of_several_logs_refuses_the_outputs_of_one(log_folders: list[Pat
     result = runner.invoke(app, [*args, "--steps-csv", str(tmp_path / "s.csv")])
     assert result.exit_code == 2
     assert "--steps-csv: expected one LOG_DIR, got 2" in result.output
+
+
+@pytest.mark.parametrize("mode", ["full_frame", "focus_first"])
+def test_simulate_perception_runs_the_campaign_in_that_mode(tmp_path: Path, mode: str) -> None:
+    from aura_ums.campaign import simulate_campaign
+    from aura_ums.manager import MapProfile
+    from aura_ums.sim import PerceptionMode, Scenario, summarize_runs
+
+    corridor = Path(SCENARIO).with_name("indoor_corridor.toml")
+    out = tmp_path / "m.json"
+    args = ["simulate", str(corridor), "--runs", "2", "--seed", "5", "--profile", "relaxed", "--quiet"]
+    result = runner.invoke(app, [*args, "--perception", mode, "--metrics-json", str(out)])
+    assert result.exit_code == 0, result.output
+    written = strict_json(out.read_text())
+    assert written["perception"] == mode
+    # The same as the library's campaign in that mode, and not the windows' campaign.
+    loaded = Scenario.from_toml(corridor)
+    relaxed = dataclasses.replace(loaded, settings=MapProfile.RELAXED.settings(loaded.settings))
+    figures = {
+        chosen: json.loads(
+            summarize_runs(simulate_campaign(relaxed, 2, 5, perception=chosen).values).to_json()
+        )
+        for chosen in (PerceptionMode(mode), PerceptionMode.WINDOWS)
+    }
+    assert all(written[key] == value for key, value in untimed(figures[PerceptionMode(mode)]).items())
+    # Focus-first finds what the windows find here (tests/campaign checks its windows).
+    if mode == "full_frame":
+        assert untimed(figures[PerceptionMode(mode)]) != untimed(figures[PerceptionMode.WINDOWS])
+
+
+def test_simulate_refuses_an_unknown_perception() -> None:
+    result = runner.invoke(app, ["simulate", SCENARIO, "--runs", "1", "--perception", "everywhere"])
+    assert result.exit_code == 2
+    assert "--perception" in result.output
+    assert "everywhere" in result.output

@@ -16,7 +16,7 @@ from aura_ums.cli._interop import MCAP_HELP, rosbag_command, write_simulation_mc
 from aura_ums.cli._outputs import Target
 from aura_ums.export import mcap_channels
 from aura_ums.logs import load_log
-from aura_ums.sim import Scenario
+from aura_ums.sim import PerceptionMode, Scenario
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -35,7 +35,12 @@ def make_app() -> typer.Typer:
     ) -> None:
         if mcap is not None:
             write_simulation_mcap_option(
-                Target("--mcap", mcap), Scenario.from_toml(scenario), seed, prune=True, quiet=True
+                Target("--mcap", mcap),
+                Scenario.from_toml(scenario),
+                seed,
+                prune=True,
+                perception=PerceptionMode.WINDOWS,
+                quiet=True,
             )
 
     return app

@@ -23,7 +23,7 @@ from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
 from aura_ums.errors import InputError
 from aura_ums.logs import ReplayOptions, RobotLog, load_log, replay_log, replay_windows
-from aura_ums.sim import RunResult, Scenario, run_scenario
+from aura_ums.sim import PerceptionMode, RunResult, Scenario, run_scenario
 from aura_ums.uncertainty import TerrainTable
 
 _Item = TypeVar("_Item")
@@ -72,10 +72,13 @@ class SimulationRun:
         The scenario, settings included.
     prune : bool
         Reduce the map by landmarks (False: growth only).
+    perception : PerceptionMode
+        Where perception runs (:func:`~aura_ums.sim.run_scenario`'s ``perception``).
     """
 
     scenario: Scenario
     prune: bool = True
+    perception: PerceptionMode = PerceptionMode.WINDOWS
 
     def __call__(self, seed: np.random.SeedSequence) -> RunResult:
         """Run the scenario once with the generator of ``seed``.
@@ -87,7 +90,9 @@ class SimulationRun:
         if not isinstance(seed, np.random.SeedSequence):
             raise InputError(f"seed: expected a numpy.random.SeedSequence, got {type(seed).__name__}")
         fresh = np.random.SeedSequence(seed.entropy, spawn_key=seed.spawn_key, pool_size=seed.pool_size)
-        return run_scenario(self.scenario, np.random.default_rng(fresh), prune=self.prune)
+        return run_scenario(
+            self.scenario, np.random.default_rng(fresh), prune=self.prune, perception=self.perception
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,6 +135,7 @@ def simulate_campaign(
     seed: int,
     *,
     prune: bool = True,
+    perception: PerceptionMode = PerceptionMode.WINDOWS,
     settings: CampaignSettings | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Campaign[RunResult]:
@@ -147,6 +153,9 @@ def simulate_campaign(
         >= 0.
     prune : bool
         Reduce the map by landmarks (False: growth only).
+    perception : PerceptionMode
+        Where perception runs: the Expecter's windows (the default), the full frame, or the
+        focus map's windows first (:class:`~aura_ums.sim.PerceptionMode`).
     settings : CampaignSettings or None
         Where to run (default: serially, in this process).
     progress : callable or None
@@ -168,7 +177,9 @@ def simulate_campaign(
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
     count = scenario.check_runs(runs)  # before a seed is spawned per run
-    run, seeds = SimulationRun(scenario, prune), run_seeds(seed, count)
+    if not isinstance(perception, PerceptionMode):
+        raise InputError(f"perception: expected a PerceptionMode, got {perception!r}")
+    run, seeds = SimulationRun(scenario, prune, perception), run_seeds(seed, count)
     chosen = settings_or_serial(settings)
     if not chosen.distributed:
         return run_campaign(run, seeds, chosen, progress=progress)

@@ -39,6 +39,7 @@ from aura_ums.cli._interop import (
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, staged, write_text
 from aura_ums.cli._replay import calibrate, compare, replay
+from aura_ums.sim import PerceptionMode
 
 app = typer.Typer(
     name="aura-ums",
@@ -150,6 +151,17 @@ def simulate(
         bool,
         typer.Option("--prune/--no-prune", help="Reduce the map by landmarks (default) or only grow it."),
     ] = True,
+    perception: Annotated[
+        PerceptionMode,
+        typer.Option(
+            "--perception",
+            help=(
+                "Where the find-landmark schemas look: windows = the Expecter's (guaranteed) windows; "
+                "full_frame = the whole image (the baseline); focus_first = the focus map's window first, "
+                "the guaranteed one where the landmark is not there (with --relaxed-q, or --profile relaxed)."
+            ),
+        ),
+    ] = PerceptionMode.WINDOWS,
     mcap: Annotated[Path | None, output_file("--mcap", "run.mcap", MCAP_HELP)] = None,
     live: Live = False,
     live_host: LiveHost = LIVE_DEFAULTS.host,
@@ -207,7 +219,13 @@ def simulate(
         with watch as view, progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
             if view is None:
                 campaign = simulate_campaign(
-                    loaded, runs, seed, prune=prune, settings=campaign_options, progress=advance
+                    loaded,
+                    runs,
+                    seed,
+                    prune=prune,
+                    perception=perception,
+                    settings=campaign_options,
+                    progress=advance,
                 )
                 values = list(campaign.values)
                 retried = campaign.retried
@@ -216,7 +234,7 @@ def simulate(
 
                 def watched(run_seed: np.random.SeedSequence) -> RunResult:
                     rng = np.random.default_rng(run_seed)
-                    return run_scenario(loaded, rng, prune=prune, after_frame=frame)
+                    return run_scenario(loaded, rng, prune=prune, perception=perception, after_frame=frame)
 
                 values = list(run_campaign(watched, run_seeds(seed, runs), progress=advance).values)
                 retried = 0
@@ -228,6 +246,7 @@ def simulate(
             "runs": runs,
             "seed": seed,
             "prune": prune,
+            "perception": perception.value,
             "slice_width_rad": loaded.settings.slice_width,
             "relaxed_q": loaded.settings.relaxed_q,
             "relaxed_window": loaded.settings.relaxed_window,
@@ -240,7 +259,9 @@ def simulate(
     if json_target is not None:
         write_text(json_target, metrics.to_json())
     if mcap_target is not None:
-        write_simulation_mcap_option(mcap_target, loaded, seed, prune=prune, quiet=quiet)
+        write_simulation_mcap_option(
+            mcap_target, loaded, seed, prune=prune, perception=perception, quiet=quiet
+        )
 
 
 # Commands on recorded logs, and the dataset importers (``aura-ums import ...``).

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from aura_ums.camera import Camera
     from aura_ums.export import LiveReplay, LiveSimulation
     from aura_ums.logs import ReplayOptions, ReplayResult, RobotLog, WindowReport
-    from aura_ums.sim import Scenario
+    from aura_ums.sim import PerceptionMode, Scenario
 
 
 def rosbag_command(
@@ -110,7 +110,7 @@ MCAP_HELP = "Also write an MCAP file to open in Foxglove (needs aura-ums[foxglov
 
 
 def write_simulation_mcap_option(
-    target: Target, scenario: Scenario, seed: int, *, prune: bool, quiet: bool
+    target: Target, scenario: Scenario, seed: int, *, prune: bool, perception: PerceptionMode, quiet: bool
 ) -> Path:
     """Run the first Monte Carlo run of ``seed`` again, with its images, and write it as MCAP.
 
@@ -126,7 +126,7 @@ def write_simulation_mcap_option(
 
     (rng,) = np.random.default_rng(seed).spawn(1)
     try:
-        result = run_scenario(scenario, rng, prune=prune, keep_images=True)
+        result = run_scenario(scenario, rng, prune=prune, perception=perception, keep_images=True)
         with progress_bar(f"{target.path.name}: frames", quiet=quiet) as advance:
             write_simulation_mcap(resolved(target.path), scenario, result, progress=advance)
     except AuraUmsError as exc:
