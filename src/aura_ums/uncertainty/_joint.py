@@ -157,19 +157,11 @@ def joint_reduced(
     )
     if not len(found.sectors):
         return JOINT_INCONSISTENT
-    kept: list[_Sector] = []
-    map_type, polygon_type = type(prior), type(prior.polygon)
-    begin = 0
-    for sector, stop, (x, y, center, cw, ccw) in zip(
-        found.sectors.tolist(), np.cumsum(found.counts).tolist(), found.values.tolist(), strict=True
-    ):
-        result = map_type._trusted(
-            polygon_type._trusted(found.points[begin:stop]),
-            np.array([x, y]),
-            HeadingWedge._trusted(center, cw, ccw),
-        )
-        begin = stop
-        kept.append((lo + sector * step, result))
+    # The combination reads only the results' vertices (all together) and wedges.
+    kept: list[_Sector] = [
+        (lo + sector * step, HeadingWedge._trusted(center, cw, ccw))
+        for sector, (_, _, center, cw, ccw) in zip(found.sectors.tolist(), found.values.tolist(), strict=True)
+    ]
     return _combined(prior, kept, found.points, wedge.is_full_circle, pairs, cap, restricted)
 
 
@@ -223,9 +215,8 @@ def _in_turn(
     return current
 
 
-#: A sector the joint reduction kept: where it starts (radians) and its result (centre not
-#: held).
-_Sector = tuple[float, SpatialUncertaintyMap]
+#: A sector the joint reduction kept: where it starts (radians) and its result's wedge.
+_Sector = tuple[float, HeadingWedge]
 
 
 def _combined(
@@ -239,9 +230,10 @@ def _combined(
 ) -> SpatialUncertaintyMap:
     """One map holding every sector's result: their hull, and one wedge over their headings.
 
-    ``points`` are the results' vertices one after the other. The results' centres were not
-    held inside their polygons: the one sector whose centre the map takes is reduced again
-    by ``pairs``, held, from the prior ``restricted`` to it.
+    ``kept`` holds each kept sector's start and result wedge, ``points`` the results'
+    vertices one after the other. The kernel did not hold the results' centres inside their
+    polygons: the one sector whose centre the map takes is reduced again by ``pairs``, held,
+    from the prior ``restricted`` to it.
     """
     # The hull kernel: no cap (at least as many vertices as the points), the hull alone.
     outline = _native.merge_groups(points, [len(points)], max(len(points), 3))[0]
@@ -254,8 +246,7 @@ def _combined(
     polygon = ConvexPolygon._trusted(outline)
     # Each result's headings as an interval unwrapped next to its sector, in sector order.
     spans = []
-    for start, result in kept:
-        result_wedge = result.wedge
+    for start, result_wedge in kept:
         low = start + math.remainder(result_wedge.center - result_wedge.cw - start, _TWO_PI)
         spans.append((low, low + min(result_wedge.width, _TWO_PI)))
     first, last = spans[0][0], max(high for _, high in spans)
@@ -282,7 +273,7 @@ def _combined(
     if not full_circle and heading_kept and polygon.contains(prior.center[None, :])[0]:
         return SpatialUncertaintyMap(polygon, prior.center, arc_wedge(arc, prior.wedge.center))
     target = prior.wedge.center if not full_circle else arc[0] + 0.5 * arc[1]
-    start = min(kept, key=lambda item: _angular_gap(target, item[1].wedge))[0]
+    start = min(kept, key=lambda item: _angular_gap(target, item[1]))[0]
     nearest = _in_turn(restricted(start), pairs, cap)
     # The same polygons and wedges as without held centres: they never depend on the centre.
     assert not isinstance(nearest, str)
