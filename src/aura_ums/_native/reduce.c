@@ -262,16 +262,25 @@ static int strip_reduction(const double *prior, Py_ssize_t n, double heading_lo,
 /* The tail of _reduce.reduce_cone_reference and reduce_strip_reference: the vertex cap, the
    centre update and both areas; returns
    (vertex bytes, arc lo, arc width, centre x, centre y, area before, area after). */
-static PyObject *finish(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices,
-                        double center_x, double center_y, double arc_lo, double arc_width) {
+/* A reduction's tail: the positions capped to max_vertices inside the prior (n vertices), and
+   the centre (x, y) moved to the nearest point of them. -1 with an exception set. */
+static int capped(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices, double center_x,
+                  double center_y, double *x, double *y) {
     if (positions->n > max_vertices) {
-        if (cap_inside(positions, prior, n, max_vertices) < 0) return NULL;
+        if (cap_inside(positions, prior, n, max_vertices) < 0) return -1;
         /* Merging stopped above max(max_vertices, n) (rounding can block the undoing of a
            cut): the prior, which holds the positions, is the outer bound with few enough. */
-        if (positions->n > max_vertices && positions->n > n && copy_into(positions, prior, n) < 0) return NULL;
+        if (positions->n > max_vertices && positions->n > n && copy_into(positions, prior, n) < 0) return -1;
     }
-    double distance, x, y;
-    nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, &x, &y);
+    double distance;
+    nearest_on_polygon(positions->v, positions->n, center_x, center_y, &distance, x, y);
+    return 0;
+}
+
+static PyObject *finish(Poly *positions, const double *prior, Py_ssize_t n, Py_ssize_t max_vertices,
+                        double center_x, double center_y, double arc_lo, double arc_width) {
+    double x, y;
+    if (capped(positions, prior, n, max_vertices, center_x, center_y, &x, &y) < 0) return NULL;
     double values[6] = {arc_lo, arc_width, x, y, polygon_area(prior, n), polygon_area(positions->v, positions->n)};
     PyObject *result = PyTuple_New(7);
     if (!result) return NULL;
@@ -300,6 +309,29 @@ static void wedge_arc(double center, double cw, double ccw, double *lo, double *
     *width = TWO_PI < sum ? TWO_PI : sum;
 }
 
+/* A cone's piece angle, `given` for the message: positive, at most a million pieces (each
+   costs a clip). -1 with ValueError set. */
+static int check_piece(double piece, PyObject *given) {
+    if (!(piece > 0.0) || TWO_PI / piece > 1e6) {
+        PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R", given);
+        return -1;
+    }
+    return 0;
+}
+
+/* cone_reduction of the prior over the heading arc by one observation: c holds forward, left,
+   landmark x and y, widen, bearing, bearing error, range min and max, and piece. */
+static int cone_step(const double *prior, Py_ssize_t n, double heading_lo, double heading_width, const double *c,
+                     Work *w, int *reason, Poly **positions, double *arc_lo, double *arc_width) {
+    /* The landmark is seen towards h + bearing, so the sensor lies from the landmark
+       towards h + bearing + pi, for some heading h of the wedge and bearing error. */
+    double margin = c[6] + TOLERANCE;
+    Cone cone = {c[2], c[3], c[4], heading_lo + c[5] + M_PI - margin, heading_width + 2.0 * margin,
+                 c[7], c[8], c[9]};
+    return cone_reduction(prior, n, heading_lo, heading_width, c[0], c[1], c[5], c[6], &cone, w, reason, positions,
+                          arc_lo, arc_width);
+}
+
 PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
     static const char *const names[] = {"center_x", "center_y",   "wedge_center", "wedge_cw", "wedge_ccw",
                                         "forward",  "left",       "landmark_x",   "landmark_y", "widen",
@@ -313,11 +345,7 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
     Py_ssize_t max_vertices, n;
     if (parse_doubles(args + 1, DOUBLES, names, a) < 0 || parse_cap(args[DOUBLES + 1], &max_vertices) < 0)
         return NULL;
-    /* At most a million pieces: each costs a clip. */
-    if (!(a[14] > 0.0) || TWO_PI / a[14] > 1e6) {
-        PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R", args[15]);
-        return NULL;
-    }
+    if (check_piece(a[14], args[15]) < 0) return NULL;
     Py_buffer view;
     if (get_vertices(args[0], &view, &n) < 0) return NULL;
     const double *prior = (const double *)view.buf;
@@ -325,15 +353,9 @@ PyObject *reduce_cone(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
     PyObject *result = NULL;
     double heading_lo, heading_width, arc_lo = 0.0, arc_width = 0.0;
     wedge_arc(a[2], a[3], a[4], &heading_lo, &heading_width);
-    /* The landmark is seen towards h + bearing, so the sensor lies from the landmark
-       towards h + bearing + pi, for some heading h of the wedge and bearing error. */
-    double margin = a[11] + TOLERANCE;
-    Cone cone = {a[7], a[8], a[9], heading_lo + a[10] + M_PI - margin, heading_width + 2.0 * margin,
-                 a[12], a[13], a[14]};
     int reason = -1;
     Poly *positions = NULL;
-    if (cone_reduction(prior, n, heading_lo, heading_width, a[5], a[6], a[10], a[11], &cone, w, &reason,
-                       &positions, &arc_lo, &arc_width) < 0)
+    if (cone_step(prior, n, heading_lo, heading_width, a + 5, w, &reason, &positions, &arc_lo, &arc_width) < 0)
         goto done;
     if (reason >= 0)
         result = PyLong_FromLong(reason);
@@ -455,12 +477,7 @@ PyObject *reduce_sectors(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         if (parse_doubles(objects + r * SECTOR_ROW, SECTOR_ROW, kind == 1.0 ? strip_names : cone_names,
                           values + r * SECTOR_ROW) < 0)
             goto done;
-        double piece = values[r * SECTOR_ROW + 10];
-        if (kind == 0.0 && (!(piece > 0.0) || TWO_PI / piece > 1e6)) {
-            PyErr_Format(PyExc_ValueError, "piece: expected a positive angle of at least 2 pi / 1e6, got %R",
-                         objects[r * SECTOR_ROW + 10]);
-            goto done;
-        }
+        if (kind == 0.0 && check_piece(values[r * SECTOR_ROW + 10], objects[r * SECTOR_ROW + 10]) < 0) goto done;
     }
     Py_ssize_t n;
     if (get_vertices(args[0], &view, &n) < 0) goto done;
@@ -485,27 +502,16 @@ PyObject *reduce_sectors(PyObject *self, PyObject *const *args, Py_ssize_t nargs
                                     &reason, &arc_lo, &arc_width) < 0)
                     goto done;
                 positions = &w->positions;
-            } else {
-                double margin = row[7] + TOLERANCE;
-                Cone cone = {row[3], row[4], row[5], heading_lo + row[6] + M_PI - margin,
-                             heading_width + 2.0 * margin, row[8], row[9], row[10]};
-                if (cone_reduction(current.v, current.n, heading_lo, heading_width, row[1], row[2], row[6], row[7],
-                                   &cone, w, &reason, &positions, &arc_lo, &arc_width) < 0)
-                    goto done;
+            } else if (cone_step(current.v, current.n, heading_lo, heading_width, row + 1, w, &reason, &positions,
+                                 &arc_lo, &arc_width) < 0) {
+                goto done;
             }
             if (reason >= 0) {
                 alive = 0;
                 break;
             }
             /* finish's tail, without the areas: the cap, then the centre kept or moved. */
-            if (positions->n > max_vertices) {
-                if (cap_inside(positions, current.v, current.n, max_vertices) < 0) goto done;
-                if (positions->n > max_vertices && positions->n > current.n &&
-                    copy_into(positions, current.v, current.n) < 0)
-                    goto done;
-            }
-            double distance;
-            nearest_on_polygon(positions->v, positions->n, x, y, &distance, &x, &y);
+            if (capped(positions, current.v, current.n, max_vertices, x, y, &x, &y) < 0) goto done;
             if (copy_into(&current, positions->v, positions->n) < 0) goto done;
             double sum = cw + ccw;
             if (arc_width < (sum < TWO_PI ? sum : TWO_PI)) {
