@@ -41,6 +41,14 @@ def test_help_shows_flags_and_brackets_as_written(command: str) -> None:
     assert result.exit_code == 0, result.output
     assert "<bool>" not in result.stdout
     assert "--overwrite" in result.stdout
+    # Positional arguments named as click names them and typed as the options are.
+    assert "Path]" not in result.stdout
+    assert "<Path>" not in result.stdout
+    assert "{log_dir" not in result.stdout
+    assert "{dataset_dir}" not in result.stdout
+    if command in ("replay", "calibrate"):
+        assert "{LOG_DIRS}..." in result.stdout
+        assert "<path>..." in result.stdout
     if command == "simulate":
         assert "aura-ums[foxglove]" in result.stdout
         assert "[manager]" in result.stdout

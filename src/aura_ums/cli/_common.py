@@ -373,6 +373,10 @@ def _angle_option(flag: str, info: SettingInfo) -> Callable[[str], float]:
     return parse
 
 
+# Positional arguments' types as the help shows them (typer's own: <Path>, <list[Path]>).
+_ARGUMENT_TYPES = {str(Path): "<path>", str(list[Path]): "<path>..."}
+
+
 def _plain_help(params: list[Any]) -> list[Any]:
     """Show flags as ``--flag/--no-flag`` without a ``<bool>`` type, and help text as written.
 
@@ -383,6 +387,12 @@ def _plain_help(params: list[Any]) -> list[Any]:
         # typer's options are not click.Option subclasses: duck-typed on what they have
         if getattr(param, "is_flag", False):
             param.metavar = ""
+        if getattr(param, "param_type_name", None) == "argument" and param.metavar is None:
+            # As click names them (LOG_DIRS), typed as the options are (<path>, not <list[Path]>).
+            param.metavar = str(param.name).upper()
+            shown = _ARGUMENT_TYPES.get(str(param.type_descriptor.annotation))
+            if shown is not None:
+                param.display_type_rich = lambda ctx, shown=shown: shown
         text = getattr(param, "help", None)
         if text and not getattr(param, "_escaped", False):
             setattr(param, "help", escape(text))  # noqa: B010 - an attribute of typer's options only
