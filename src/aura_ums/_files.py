@@ -1162,6 +1162,8 @@ _EXPECTED: dict[type, str] = {
 
 #: Ending of the scratch names beside a target being written (``.<name>.<random>.tmp``).
 SCRATCH_SUFFIX = ".tmp"
+#: The longest file name, bytes, on the file systems we write to (Linux, macOS, Windows).
+NAME_MAX = 255
 
 
 def scratch_path(target: Path) -> Path:
@@ -1175,18 +1177,25 @@ def scratch_path(target: Path) -> Path:
     >>> name = scratch_path(Path("out/metrics.json"))
     >>> name.parent.as_posix(), name.name.startswith(".metrics.json."), name.suffix
     ('out', True, '.tmp')
+    >>> len(scratch_path(Path("a" * 300 + ".json")).name)   # a name too long for a scratch name: cut
+    255
     """
-    return target.with_name(f".{target.name}.{secrets.token_hex(8)}{SCRATCH_SUFFIX}")
+    # The two dots and the random part add 18 bytes, the suffix 4: a long target name is cut
+    # (at a whole character) so that the scratch name stays within a file name's 255 bytes.
+    kept = os.fsencode(target.name)[: NAME_MAX - 18 - len(SCRATCH_SUFFIX)].decode("utf-8", "ignore")
+    return target.with_name(f".{kept}.{secrets.token_hex(8)}{SCRATCH_SUFFIX}")
 
 
 @contextmanager
-def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
+def atomic_path(target: str | os.PathLike[str], *, replace: bool = True) -> Iterator[Path]:
     """Yield a scratch path beside ``target`` to write; when the block ends, it replaces ``target``.
 
     The folder of ``target`` is created when missing. When the block raises (a
     ``KeyboardInterrupt`` too) the scratch file is removed and ``target`` is left as it
     was. A process killed outright (``SIGKILL``) leaves at most the hidden scratch file:
-    never a partial file under the target's name.
+    never a partial file under the target's name. Without ``replace``, a ``target`` that
+    exists when the block ends (made by someone else meanwhile) is kept and
+    :class:`FileExistsError` raised: the check and the rename are one step (a hard link).
 
     Examples
     --------
@@ -1204,20 +1213,61 @@ def atomic_path(target: str | os.PathLike[str]) -> Iterator[Path]:
     OSError: disk full
     >>> (folder / "a.txt").read_text(), len(list(folder.iterdir()))
     ('whole', 1)
+    >>> with atomic_path(folder / "a.txt", replace=False) as scratch:   # it exists: kept
+    ...     _ = scratch.write_text("new")
+    Traceback (most recent call last):
+    ...
+    FileExistsError: ...
+    >>> (folder / "a.txt").read_text(), len(list(folder.iterdir()))
+    ('whole', 1)
     """
     final = Path(target)
     final.parent.mkdir(parents=True, exist_ok=True)
     scratch = scratch_path(final)
     try:
         yield scratch
-        os.replace(scratch, final)
+        if replace:
+            os.replace(scratch, final)
+        else:
+            place_new(scratch, final)
     except BaseException:
         scratch.unlink(missing_ok=True)
         raise
 
 
-def write_text_atomic(target: str | os.PathLike[str], text: str) -> Path:
+def place_new(scratch: Path, final: Path) -> None:
+    """Move the file ``scratch`` to ``final``, which must not exist (:class:`FileExistsError` if it does).
+
+    A hard link refuses an existing name in the same step as it makes the new one; on a
+    file system without hard links, the check comes just before the rename.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = (folder / "a").write_text("a")
+    >>> place_new(folder / "a", folder / "b")
+    >>> sorted(path.name for path in folder.iterdir())
+    ['b']
+    """
+    try:
+        os.link(scratch, final)
+    except FileExistsError:
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(final)) from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
+            raise
+        if os.path.lexists(final):
+            raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(final)) from None
+        os.replace(scratch, final)
+        return
+    scratch.unlink()
+
+
+def write_text_atomic(target: str | os.PathLike[str], text: str, *, replace: bool = True) -> Path:
     """Write ``text`` (UTF-8) to ``target`` through :func:`atomic_path` and return the path.
+
+    Without ``replace``, an existing ``target`` is kept and :class:`FileExistsError` raised.
 
     Examples
     --------
@@ -1228,6 +1278,9 @@ def write_text_atomic(target: str | os.PathLike[str], text: str) -> Path:
     """
     final = Path(target)
     # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay on the result)
-    with atomic_path(final) as scratch, scratch.open("x", encoding="utf-8", newline="") as stream:
+    with (
+        atomic_path(final, replace=replace) as scratch,
+        scratch.open("x", encoding="utf-8", newline="") as stream,
+    ):
         stream.write(text)
     return final

@@ -7,6 +7,7 @@ traceback, and leave every input byte-identical.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import hashlib
 import os
@@ -521,3 +522,96 @@ def test_no_path_is_checked_by_the_parser_before_our_readers() -> None:
             checked.append(name)
             assert info.parser is not None or info.readable is False, f"{callback.__name__}: {name}"
     assert len(checked) >= 20
+
+
+def test_the_sensors_file_read_by_default_is_an_input(inputs: Path, tmp_path: Path) -> None:
+    """replay and compare read TERRAIN.sensors.toml without --sensors: never an output."""
+    terrain = tmp_path / "terrain.toml"
+    shutil.copy(inputs / "terrain.toml", terrain)
+    calibrated = invoke("calibrate", inputs / "log", "--out", terrain, "--overwrite", "--quiet")
+    assert calibrated.exit_code == 0, calibrated.output
+    sensors = tmp_path / "terrain.sensors.toml"
+    before = sensors.read_bytes()
+    for command in ("replay", "compare"):
+        result = invoke(
+            command, inputs / "log", "--terrain", terrain, "--metrics-json", sensors, "--overwrite"
+        )
+        refused(result, "--metrics-json", "--sensors (by default, beside --terrain)", str(sensors))
+    assert sensors.read_bytes() == before
+
+
+@pytest.mark.parametrize(("key", "name"), [("camera", "paper_camera.toml"), ("map", "four_terrains.geojson")])
+def test_the_files_a_scenario_names_are_inputs(key: str, name: str, tmp_path: Path) -> None:
+    for file in ("four_terrains.toml", "four_terrains.geojson", "paper_camera.toml"):
+        shutil.copy(SCENARIO.with_name(file), tmp_path / file)
+    named = tmp_path / name
+    before = named.read_bytes()
+    for option in ("--metrics-json", "--mcap"):
+        scenario = tmp_path / "four_terrains.toml"
+        result = invoke("simulate", scenario, "--runs", "1", option, named, "--overwrite")
+        refused(result, option, f"SCENARIO's {key}", str(named))
+    assert named.read_bytes() == before
+
+
+def test_a_name_too_long_for_the_file_system_is_refused_before_the_computation(
+    inputs: Path, tmp_path: Path
+) -> None:
+    common = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--quiet")
+    too_long = tmp_path / ("m" * 256 + ".json")
+    result = invoke(*common, "--metrics-json", tmp_path / "ok.json", "--steps-csv", too_long)
+    refused(result, "--steps-csv", "261 bytes")
+    assert list(tmp_path.iterdir()) == []
+    # A name that fits, but not with the 22 bytes of its scratch name's dots and suffix.
+    longest = tmp_path / ("m" * 250 + ".csv")
+    result = invoke(*common, "--steps-csv", longest)
+    assert result.exit_code == 0, result.output
+    assert [p.name for p in tmp_path.iterdir()] == [longest.name]
+    assert longest.read_text().startswith("time,")
+
+
+@pytest.mark.parametrize("kind", ["text", "placed", "staged"])
+def test_an_output_that_appears_during_the_run_is_kept_without_overwrite(kind: str, tmp_path: Path) -> None:
+    """The existence check before the work and the final rename are both no-clobber."""
+    from aura_ums.cli import _outputs
+
+    out = tmp_path / ("figures" if kind == "staged" else "out.txt")
+    target = _outputs.Target("--out", out, folder=kind == "staged")
+    precious = (out / "a.txt") if kind == "staged" else out
+    for overwrite in (False, True):
+        shutil.rmtree(tmp_path)
+        tmp_path.mkdir()
+        _outputs.check_outputs([target], [], overwrite=overwrite)
+        precious.parent.mkdir(exist_ok=True)
+        precious.write_text("precious")  # made by someone else while the command computes
+        with pytest.raises(typer.Exit) if not overwrite else _nothing():
+            if kind == "text":
+                _outputs.write_text(target, "new")
+            elif kind == "placed":
+                with _outputs.placed(target) as scratch:
+                    scratch.write_text("new")
+            else:
+                with _outputs.staged(target) as stage:
+                    (stage / "a.txt").write_text("new")
+        assert precious.read_text() == ("new" if overwrite else "precious")
+        leftovers = [p.name for p in precious.parent.iterdir() if p.name.startswith(".")]
+        assert leftovers == []
+
+
+@contextlib.contextmanager
+def _nothing() -> Iterator[None]:
+    yield
+
+
+def test_import_into_a_symlinked_out_dir_writes_where_it_leads(tmp_path: Path) -> None:
+    real = tmp_path / "real"
+    real.mkdir()
+    link = tmp_path / "link"
+    link.symlink_to(real, target_is_directory=True)
+    written = write_log(synthetic_log(np.random.default_rng(5), duration=5.0), link)
+    assert written == real
+    assert link.is_symlink()
+    assert (real / "meta.toml").is_file()
+    dangling = tmp_path / "dangling"
+    dangling.symlink_to(tmp_path / "missing", target_is_directory=True)
+    write_log(synthetic_log(np.random.default_rng(5), duration=5.0), dangling)
+    assert (tmp_path / "missing" / "meta.toml").is_file()

@@ -203,6 +203,9 @@ def simulate(
         loaded = Scenario.from_toml(scenario)
     except AuraUmsError as exc:
         raise fail(str(exc)) from None
+    # The files the scenario names (its map, camera, terrain table) are inputs too.
+    named = [Source(f"SCENARIO's {key}", path) for key, path in loaded.files]
+    check_outputs([json_target, mcap_target], [Source("SCENARIO", scenario), *named], overwrite=overwrite)
     loaded = dataclasses.replace(loaded, settings=settings.over(loaded.settings))
     try:
         loaded.check_runs(runs)  # before spawning a generator per run

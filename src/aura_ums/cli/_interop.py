@@ -23,7 +23,7 @@ from aura_ums.cli._common import (
     print_log_summary,
     progress_bar,
 )
-from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, resolved, wrote
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, placed, wrote
 from aura_ums.export import LiveOptions
 
 if TYPE_CHECKING:
@@ -127,8 +127,8 @@ def write_simulation_mcap_option(
     (rng,) = np.random.default_rng(seed).spawn(1)
     try:
         result = run_scenario(scenario, rng, prune=prune, perception=perception, keep_images=True)
-        with progress_bar(f"{target.path.name}: frames", quiet=quiet) as advance:
-            write_simulation_mcap(resolved(target.path), scenario, result, progress=advance)
+        with placed(target) as scratch, progress_bar(f"{target.path.name}: frames", quiet=quiet) as advance:
+            write_simulation_mcap(scratch, scenario, result, progress=advance)
     except AuraUmsError as exc:
         raise fail(f"{target.option}: {exc}") from None
     wrote(target.path, f" (run 1 of seed {seed}; open it in Foxglove)")
@@ -143,8 +143,8 @@ def write_replay_mcap_option(
     from aura_ums.export import write_replay_mcap
 
     try:
-        with progress_bar(f"{target.path.name}: steps", quiet=quiet) as advance:
-            write_replay_mcap(resolved(target.path), replay, windows=windows, progress=advance)
+        with placed(target) as scratch, progress_bar(f"{target.path.name}: steps", quiet=quiet) as advance:
+            write_replay_mcap(scratch, replay, windows=windows, progress=advance)
     except AuraUmsError as exc:
         raise fail(f"{target.option}: {exc}") from None
     wrote(target.path, " (open it in Foxglove)")

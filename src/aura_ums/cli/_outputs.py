@@ -16,6 +16,7 @@ Ctrl-C into exit code 130 and says what was (not) written.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import re
@@ -29,7 +30,7 @@ from typing import Annotated, Any
 
 import typer
 
-from aura_ums._files import scratch_path, write_text_atomic
+from aura_ums._files import NAME_MAX, place_new, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
 
 #: The option every command that writes takes, with the same help everywhere.
@@ -45,6 +46,9 @@ INTERRUPTED = 130
 
 # What the running command has written so far, for the message after a Ctrl-C.
 _written: list[Path] = []
+# Whether the running command was given --overwrite (set by check_outputs): without it, an
+# output that appears while the command computes is not replaced either.
+_replacing: list[bool] = [False]
 
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 _SAFE_NAME_LENGTH = 100
@@ -117,9 +121,11 @@ def check_outputs(
     Called before any computation, so a refusal costs nothing. ``None`` entries (options
     not given) are skipped.
     """
+    _replacing[0] = overwrite
     inputs = [(source, resolved(source.path)) for source in sources if source is not None]
     seen: list[tuple[Target, Path]] = []
     for target in (t for t in targets if t is not None):
+        _named(target)
         where = resolved(target.path)
         for source, origin in inputs:
             _apart(target, where, source, origin)
@@ -140,8 +146,22 @@ def check_outputs(
                     f"the output file of {other.option} ({other.path})"
                 )
         seen.append((target, where))
-        _replaceable(target, where, overwrite)
-        _writable(target, where)
+        try:
+            _replaceable(target, where, overwrite)
+            _writable(target, where)
+        except OSError as exc:  # e.g. a folder of the path that cannot be looked into
+            raise _unwritable(target, target.path, exc) from None
+
+
+def _named(target: Target) -> None:
+    """Refuse a path with a name longer than a file system takes: it would fail after the work."""
+    for part in target.path.parts:
+        size = len(os.fsencode(part))
+        if size > NAME_MAX:
+            raise fail(
+                f"{target.option}: expected names of at most {NAME_MAX} bytes in the path, got one of "
+                f"{size} bytes ({part[:24]}...)"
+            )
 
 
 def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
@@ -219,11 +239,45 @@ def write_text(target: Target, text: str) -> Path:
     """Write ``text`` to the target file atomically; a system error exits 2 naming the option."""
     try:
         # through a symlink to its file (the link stays), as the checks resolved it
-        write_text_atomic(resolved(target.path), text)
+        write_text_atomic(resolved(target.path), text, replace=_replacing[0])
+    except FileExistsError:
+        raise appeared(target, target.path) from None
     except OSError as exc:
         raise _unwritable(target, target.path, exc) from None
     wrote(target.path)
     return target.path
+
+
+def appeared(target: Target, path: Path) -> typer.Exit:
+    """Return the refusal of an output that appeared while the command computed (no --overwrite)."""
+    return fail(
+        f"{target.option}: expected a new file, got {path}, which appeared while this command ran "
+        "(kept; pass --overwrite to replace it)"
+    )
+
+
+@contextmanager
+def placed(target: Target) -> Iterator[Path]:
+    """Yield a scratch path for the target file; when the block ends, move it onto the target.
+
+    For outputs a library function writes itself (an MCAP file, the per-step CSV): the
+    final move keeps an output that appeared meanwhile unless ``--overwrite`` was given.
+    """
+    final = resolved(target.path)
+    scratch = scratch_path(final)
+    try:
+        yield scratch
+        if _replacing[0]:
+            os.replace(scratch, final)
+        else:
+            place_new(scratch, final)
+    except FileExistsError:
+        raise appeared(target, target.path) from None
+    except OSError as exc:
+        raise _unwritable(target, target.path, exc) from None
+    finally:
+        with contextlib.suppress(OSError):  # gone, or its folder never was
+            scratch.unlink()
 
 
 @contextmanager
@@ -246,8 +300,13 @@ def staged(target: Target) -> Iterator[Path]:
         for path in sorted(p for p in stage.rglob("*") if p.is_file()):
             place = final / path.relative_to(stage)
             place.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(path, place)
+            if _replacing[0]:
+                os.replace(path, place)
+            else:
+                place_new(path, place)
             wrote(target.path / path.relative_to(stage))
+    except FileExistsError as exc:
+        raise appeared(target, Path(exc.filename or final)) from None
     except OSError as exc:
         raise _unwritable(target, final, exc) from None
     finally:
@@ -260,6 +319,7 @@ def interruptible(command: Callable[..., None]) -> Callable[..., None]:
     @functools.wraps(command)
     def run(*args: Any, **kwargs: Any) -> None:
         _written.clear()
+        _replacing[0] = False
         try:
             command(*args, **kwargs)
         except KeyboardInterrupt:

@@ -43,7 +43,7 @@ from aura_ums.cli._outputs import (
     Source,
     Target,
     check_outputs,
-    resolved,
+    placed,
     safe_name,
     staged,
     write_text,
@@ -155,6 +155,16 @@ def _terrain_table(terrain: Path, name: str, log_dir: Path) -> TerrainTable:
     except InputError as exc:
         raise fail(str(exc)) from None
     return table
+
+
+def _sensors_source(sensors: Path | None, terrain: Path) -> Source | None:
+    """Return the sensors file as an input: the one given, else the one :func:`_sensors_file` reads."""
+    from aura_ums.logs import sensors_path
+
+    if sensors is not None:
+        return Source("--sensors", sensors)
+    beside = sensors_path(terrain)
+    return Source("--sensors (by default, beside --terrain)", beside) if beside.is_file() else None
 
 
 def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
@@ -442,7 +452,7 @@ def replay(
             raise fail(f"{given[0]}: expected one LOG_DIR, got {len(log_dirs)}")
         json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
         sources: list[Source | None] = [Source("LOG_DIR", folder, folder=True) for folder in log_dirs]
-        sources += [Source("--terrain", terrain), None if sensors is None else Source("--sensors", sensors),
+        sources += [Source("--terrain", terrain), _sensors_source(sensors, terrain),
                     None if camera is None else Source("--camera", camera)]  # fmt: skip
         check_outputs([json_target], sources, overwrite=overwrite)
         try:
@@ -459,7 +469,7 @@ def replay(
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
         Source("--terrain", terrain),
-        None if sensors is None else Source("--sensors", sensors),
+        _sensors_source(sensors, terrain),
         None if resume is None else Source("--resume", resume),
         None if camera is None else Source("--camera", camera),
     ]
@@ -491,15 +501,19 @@ def replay(
             options = dataclasses.replace(options, settings=kept)
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
-        # The per-step CSV is streamed, through a scratch file renamed onto it whole.
-        steps_path = None if csv_target is None else resolved(csv_target.path)
         lens = None if camera is None else load_camera(camera)
         watch = (
             live_replay(log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate)
             if isinstance(log, RobotLog)
             else contextlib.nullcontext(None)
         )
-        with watch as view, progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance:
+        # The per-step CSV is streamed into a scratch file, moved onto its name once whole.
+        steps = contextlib.nullcontext(None) if csv_target is None else placed(csv_target)
+        with (
+            steps as steps_path,
+            watch as view,
+            progress_bar(f"{safe_name(log.meta.name)}: frames", quiet=quiet) as advance,
+        ):
             if lens is None:
                 result = replay_log(
                     log, table, options, keep_maps=keep_maps, steps_csv=steps_path, progress=advance,
@@ -612,7 +626,7 @@ def compare(
     sources = [
         Source("LOG_DIR", log_dir, folder=True),
         Source("--terrain", terrain),
-        None if sensors is None else Source("--sensors", sensors),
+        _sensors_source(sensors, terrain),
         *(Source("--noise-from", p, folder=True) for p in calibration_logs or ()),
     ]
     check_outputs([json_target], sources, overwrite=overwrite)

@@ -971,6 +971,10 @@ def write_log(
     if not isinstance(log, RobotLog):
         raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
     base = Path(folder)
+    if base.is_symlink():
+        # Into the folder it leads to (made when missing): the scratch folder is renamed onto
+        # a folder, and a rename onto the link would fail after all the work.
+        base = Path(os.path.realpath(base))
     if base.name in ("", ".."):
         # The log is written under a scratch name beside the folder, then renamed onto it.
         raise InputError(f"folder: expected a path ending in the log folder's name, got {str(folder)!r}")

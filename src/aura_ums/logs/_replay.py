@@ -6,7 +6,6 @@ import dataclasses
 import hashlib
 import math
 import os
-import secrets
 import time as _time
 import types
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -17,6 +16,7 @@ from typing import TextIO, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._files import scratch_path
 from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
@@ -1334,7 +1334,7 @@ class _StepsCsv:
     def __enter__(self) -> _StepsCsv:
         if self.target is not None:
             target = self.target
-            self.scratch = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
+            self.scratch = scratch_path(target)
             try:
                 target.parent.mkdir(parents=True, exist_ok=True)
                 # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay).

@@ -260,6 +260,7 @@ class _Reader:
     def __init__(self, source: str) -> None:
         self.source = source
         self.fields = Fields(source)
+        self.files: list[tuple[str, Path]] = []  # the files the document names, by key
 
     def fail(self, where: str, message: str) -> FileFormatError:
         return self.fields.error(where, message)
@@ -318,7 +319,9 @@ class _Reader:
     def path(self, value: object, where: str, base: Path) -> Path:
         text = self.string(value, where)
         path = Path(text)
-        return path if path.is_absolute() else base / path
+        found = path if path.is_absolute() else base / path
+        self.files.append((where, found))
+        return found
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -362,6 +365,9 @@ class Scenario:
         for testing outlier handling (:attr:`ManagerSettings.relaxed_q`). 0: none.
     source : str
         The file it was read from (``""`` when built in code).
+    files : tuple of (str, Path)
+        The files that file names, each with its key (``("camera", Path(...))``, as read:
+        relative to the scenario's folder); empty when built in code.
 
     Examples
     --------
@@ -375,6 +381,8 @@ class Scenario:
     ...     "[start]\nx = 0.0\ny = 0.0\nheading_deg = 0.0\nposition_radius = 0.3\n"
     ...     "heading_halfwidth_deg = 2.0\n[route]\ncommands = [{turn_deg = 0.0, run = 5.0}]\n")
     >>> scenario = Scenario.from_toml(folder / "walk.toml")
+    >>> [(key, path.name) for key, path in scenario.files]     # the files it names
+    [('camera', 'cam.toml')]
     >>> [command.run for command in scenario.legs()]       # a frame every 2 m, and at the stop
     [2.0, 2.0, 1.0]
     >>> frames = list(scenario.simulate(np.random.default_rng(0)))
@@ -400,6 +408,7 @@ class Scenario:
     render: RenderSettings = RenderSettings()
     source: str = ""
     inject_wrong_rate: float = 0.0
+    files: tuple[tuple[str, Path], ...] = ()
 
     def __post_init__(self) -> None:
         for name, kind in (
@@ -600,6 +609,7 @@ class Scenario:
                 render,
                 reader.source,
                 rate,
+                tuple(reader.files),
             )
         except InputError as exc:
             field_name, _, message = str(exc).partition(": ")
