@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import ast
 import importlib
+import json
 import pkgutil
+import subprocess
+import sys
+from pathlib import Path
 from types import ModuleType
 
 import pytest
@@ -62,3 +67,37 @@ def test_few_constants_are_public_and_foot_is_one() -> None:
     assert ("aura_ums", "FOOT") in shown
     assert ("aura_ums.uncertainty", "FOOT") in shown
     assert count <= CONSTANT_LIMIT, f"expected at most {CONSTANT_LIMIT} constants, got {count}: {shown}"
+
+
+def test_the_lazy_top_level_takes_each_name_from_where_the_type_checkers_see_it() -> None:
+    """``aura_ums._HOMES`` (imported on first use) matches the imports under ``TYPE_CHECKING``."""
+    tree = ast.parse(Path(aura_ums.__file__).read_text(encoding="utf-8"))
+    (guard,) = [
+        node
+        for node in tree.body
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+    ]
+    seen = {
+        alias.name: node.module
+        for node in guard.body
+        if isinstance(node, ast.ImportFrom)
+        for alias in node.names
+    }
+    assert seen == aura_ums._HOMES
+    assert set(seen) == set(public_all("aura_ums")) - {"__version__"}
+    assert {"numpy", "aura_ums.uncertainty"} & set(
+        json.loads(
+            subprocess.run(
+                [sys.executable, "-c", "import json, sys, aura_ums; print(json.dumps(sorted(sys.modules)))"],
+                capture_output=True,
+                text=True,
+                check=True,
+            ).stdout
+        )
+    ) == set()
+
+
+def test_a_subpackage_is_an_attribute_of_the_top_level_and_an_unknown_name_is_not() -> None:
+    assert aura_ums.geometry is importlib.import_module("aura_ums.geometry")
+    with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
+        _ = aura_ums.no_such_name  # type: ignore[attr-defined]

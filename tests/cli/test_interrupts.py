@@ -6,6 +6,10 @@ where a user's Ctrl-C would land.
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -110,3 +114,48 @@ def test_ctrl_c_during_import_leaves_no_log_folder(tmp_path: Path, monkeypatch: 
     result = runner.invoke(app, ["import", "mrclam", str(dataset), str(out), "--robot", "1"])
     assert "interrupted: nothing was written" in interrupted(result)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dataset"]
+
+
+# A finder that raises a Ctrl-C when the command line's code is imported (where numpy and
+# the kernels load): the moment before any command runs, made deterministic.
+_INTERRUPT_WHILE_LOADING = """
+import sys
+
+class Interrupt:
+    @staticmethod
+    def find_spec(name, path=None, target=None):
+        if name == "aura_ums.cli._app":
+            raise KeyboardInterrupt
+        return None
+
+sys.meta_path.insert(0, Interrupt)
+sys.argv = ["aura-ums", "--version"]
+from aura_ums.cli import main
+main()
+"""
+
+
+def test_ctrl_c_while_the_command_line_loads_exits_130_without_a_traceback() -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", _INTERRUPT_WHILE_LOADING], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 130, done.stderr
+    assert done.stderr == "error: interrupted: nothing was written\n"
+    assert done.stdout == ""
+
+
+def test_a_real_ctrl_c_early_in_a_command_exits_130_without_a_traceback(tmp_path: Path) -> None:
+    """Sent 0.3 s in: while the libraries load, or once the command runs; either way a clean 130."""
+    cli = Path(sys.executable).with_name("aura-ums")
+    out = tmp_path / "metrics.json"
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+    command = [str(cli), "simulate", str(scenario), "--runs", "50", "--metrics-json", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.3)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr
+    assert "interrupted: nothing was written" in stderr
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []

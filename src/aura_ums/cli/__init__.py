@@ -1,5 +1,41 @@
-"""The ``aura-ums`` command line."""
+"""The ``aura-ums`` command line.
 
-from aura_ums.cli._app import app, main
+Importing this package loads nothing else (``app`` is imported on first use): the console
+script's :func:`main` answers a Ctrl-C from its first moment, while numpy, the kernels and
+the command line itself are still loading.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING, Any
+
+from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN
+
+if TYPE_CHECKING:
+    from aura_ums.cli._app import app
 
 __all__ = ["app", "main"]
+
+
+def main() -> None:
+    """Run the ``aura-ums`` command line (the console script's entry point).
+
+    A Ctrl-C before a command starts (while the libraries load) exits with code 130 and
+    says so on stderr, as one during a command does, instead of a traceback.
+    """
+    try:
+        from aura_ums.cli._app import main as run
+
+        run()
+    except KeyboardInterrupt:
+        sys.stderr.write(f"error: {NOTHING_WRITTEN}\n")
+        raise SystemExit(INTERRUPTED) from None
+
+
+def __getattr__(name: str) -> Any:
+    if name == "app":
+        from aura_ums.cli._app import app
+
+        return app
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

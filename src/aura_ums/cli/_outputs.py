@@ -32,6 +32,7 @@ import typer
 
 from aura_ums._files import NAME_MAX, place_new, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
+from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN
 
 #: The option every command that writes takes, with the same help everywhere.
 Overwrite = Annotated[
@@ -41,8 +42,6 @@ Overwrite = Annotated[
     ),
 ]
 
-#: Exit code after a Ctrl-C (128 + SIGINT), as shells report it.
-INTERRUPTED = 130
 
 # What the running command has written so far, for the message after a Ctrl-C.
 _written: list[Path] = []
@@ -327,7 +326,7 @@ def interruptible(command: Callable[..., None]) -> Callable[..., None]:
                 done = ", ".join(str(path) for path in _written)
                 message = f"interrupted: only {done} written whole; nothing else was written"
             else:
-                message = "interrupted: nothing was written"
+                message = NOTHING_WRITTEN
             err_console.print(f"[red]error:[/red] {_escape(message)}", highlight=False)
             raise typer.Exit(code=INTERRUPTED) from None
 
