@@ -691,6 +691,17 @@ def _is_row(line: str) -> bool:
     return bool(stripped) and not stripped.startswith("#")
 
 
+def _regular_file(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` is a regular file: opening a named pipe would wait for a writer.
+
+    The fast readers then leave the file to :func:`read_bytes`, whose message names it.
+    """
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
 class CsvFallbackError(Exception):
     """Raised by :func:`csv_blocks` for a file it cannot read block by block exactly.
 
@@ -768,6 +779,8 @@ def csv_blocks(
     source = str(path)
     limit = _limit(max_bytes, MAX_BYTES)
     most = _limit(max_rows, MAX_ROWS)
+    if not _regular_file(path):
+        raise CsvFallbackError
     try:
         handle = open(path, "rb")  # noqa: SIM115 - closed below, on every path
     except (OSError, ValueError):
@@ -906,6 +919,8 @@ def read_csv_floats(
     >>> read_csv_floats(path, columns=("time", "v")) is None   # an empty cell: parse_csv says more
     True
     """
+    if not _regular_file(path):
+        return None
     try:
         with open(path, "rb") as handle:
             # Rows are at most the line breaks plus one: the values are written in place, never

@@ -27,6 +27,7 @@ from aura_ums.cli import app
 from aura_ums.cli._outputs import safe_name
 from aura_ums.logs import synthetic_log, write_log
 from aura_ums.uncertainty import TerrainTable
+from tests.logs.log_helpers import long_odometry_log
 
 runner = CliRunner()
 REPOSITORY = Path(__file__).resolve().parents[2]
@@ -615,3 +616,24 @@ def test_import_into_a_symlinked_out_dir_writes_where_it_leads(tmp_path: Path) -
     dangling.symlink_to(tmp_path / "missing", target_is_directory=True)
     write_log(synthetic_log(np.random.default_rng(5), duration=5.0), dangling)
     assert (tmp_path / "missing" / "meta.toml").is_file()
+
+
+@pytest.mark.parametrize(
+    "name", ["meta.toml", "landmarks.csv", "observations.csv", "odometry.csv", "groundtruth.csv"]
+)
+@pytest.mark.parametrize("command", ["replay", "calibrate"])
+def test_a_log_file_that_is_a_named_pipe_is_refused_not_waited_on(
+    name: str, command: str, tmp_path: Path
+) -> None:
+    """The streamed readers open the big files block by block: a pipe would block the open."""
+    log = tmp_path / "log"
+    write_log(long_odometry_log(600), log)
+    (log / name).unlink()
+    os.mkfifo(log / name)
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    if command == "replay":
+        result = invoke("replay", log, "--terrain", terrain, "--quiet")
+    else:
+        result = invoke("calibrate", log, "--out", tmp_path / "out.toml", "--quiet")
+    refused(result, str(log / name), "named pipe")

@@ -195,7 +195,9 @@ def simulate(
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
     check_seed(seed)
     if not scenario.is_file():
-        raise fail(f"{scenario}: expected a scenario TOML file, got no such file")
+        got = "a folder" if scenario.is_dir() else "no such file"
+        got = "a named pipe or socket" if scenario.exists() and not scenario.is_dir() else got
+        raise fail(f"{scenario}: expected a scenario TOML file, got {got}")
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     mcap_target = None if mcap is None else Target("--mcap", mcap)
     check_outputs([json_target, mcap_target], [Source("SCENARIO", scenario)], overwrite=overwrite)
