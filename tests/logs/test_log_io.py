@@ -239,6 +239,11 @@ BAD_CSV_CASES = [
     ),
     (
         "odometry.csv",
+        "time,v,omega\n0,1,0\n1,0_5,0\n",  # float() would read 5.0 (Python's digit grouping)
+        "odometry.csv:3: expected a number in column 'v', got '0_5'",
+    ),
+    (
+        "odometry.csv",
         "time,v,omega\n0,1,nan\n",
         "odometry.csv:2: expected a finite number in column 'omega', got 'nan'",
     ),

@@ -311,6 +311,11 @@ class _CsvFile:
             result: NDArray[np.float64] = values if factor == 1.0 else values * factor
         else:
             cells = self.cells[column]
+            # float() reads "0_03" as 3.0 (Python's digit grouping): no CSV writer means that.
+            grouped = next((row for row, cell in enumerate(cells) if "_" in cell), None)
+            if grouped is not None:
+                got = describe(cells[grouped])
+                self.fail_at(grouped, f"expected a number in column {column!r}, got {got}")
             try:
                 values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
             except ValueError:
