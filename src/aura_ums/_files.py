@@ -33,11 +33,11 @@ import re
 import secrets
 import stat
 import tomllib
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal, NoReturn, TypeVar, cast
+from typing import Literal, NoReturn, TypeAlias, TypeVar, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,11 +48,13 @@ from aura_ums.errors import FileFormatError
 __all__ = [
     "MAX_BYTES",
     "MAX_ROWS",
+    "NAME_MAX",
     "SCRATCH_SUFFIX",
     "CsvFallbackError",
     "CsvFloats",
     "CsvTable",
     "Fields",
+    "RowsParser",
     "atomic_path",
     "csv_blocks",
     "decode",
@@ -63,8 +65,10 @@ __all__ = [
     "load_toml",
     "parse_csv",
     "parse_csv_floats",
+    "parse_float_rows",
     "parse_json",
     "parse_toml",
+    "place_new",
     "read_bytes",
     "read_csv_floats",
     "read_folder",
@@ -568,6 +572,11 @@ _FORBIDDEN[ord('"')] = True
 _MOST_INDENTED = 10_000
 
 
+#: Reads the data rows of a numeric CSV block: ``(data, rows, columns)`` to a
+#: ``(rows, columns)`` array, or None when it cannot (see :func:`parse_float_rows`).
+RowsParser: TypeAlias = Callable[[bytes, int, int], NDArray[np.float64] | None]
+
+
 def parse_csv_floats(
     text: str,
     source: str,
@@ -576,6 +585,7 @@ def parse_csv_floats(
     required: Sequence[str] = (),
     max_rows: int | None = None,
     max_bytes: int | None = None,
+    parse_rows: RowsParser | None = None,
 ) -> CsvFloats | None:
     r"""Parse a CSV file of numbers only, without a Python object per cell; None when it cannot.
 
@@ -595,6 +605,8 @@ def parse_csv_floats(
         The file, for messages.
     columns, required, max_rows, max_bytes
         As for :func:`parse_csv`.
+    parse_rows : callable or None
+        Reads the data rows (:data:`RowsParser`); None: :func:`parse_float_rows`.
 
     Returns
     -------
@@ -668,21 +680,49 @@ def parse_csv_floats(
     else:
         data[head] = False
         rows_bytes = raw[np.repeat(data, np.diff(np.concatenate((starts, [raw.size]))))]
+    values = (parse_rows or parse_float_rows)(rows_bytes.tobytes(), rows, len(header))
+    if values is None:
+        return None
+    return CsvFloats(source, header, head + 1, values, lines, body)
+
+
+def parse_float_rows(data: bytes, rows: int, columns: int) -> NDArray[np.float64] | None:
+    r"""Return ``rows`` lines of ``columns`` comma-separated numbers as an array, or None.
+
+    The reader of :func:`parse_csv_floats` by default, :func:`numpy.loadtxt`; and the
+    reference of the compiled one the log readers pass (``aura_ums._native.parse_float_rows``).
+
+    Parameters
+    ----------
+    data : bytes
+        ASCII lines ending in ``"\n"`` (the last one may not), each a data row: no header,
+        comment, blank line, quote or ``"\r"``.
+    rows, columns : int
+        The shape expected, ``rows >= 0``, ``columns >= 1``.
+
+    Returns
+    -------
+    ndarray of shape (rows, columns), or None
+        Each cell's number (as ``float(cell)``); None when a cell is not a number or the
+        shape differs.
+
+    Examples
+    --------
+    >>> parse_float_rows(b"0.5, 1\n-2e-1,3.\n", 2, 2).tolist()
+    [[0.5, 1.0], [-0.2, 3.0]]
+    >>> parse_float_rows(b"0.5,\n", 1, 2) is None   # an empty cell
+    True
+    """
+    if rows == 0 or not data:  # loadtxt would warn of no data
+        return np.empty((0, columns)) if rows == 0 and not data else None
     try:
         # From bytes: numpy reads them in blocks (a str would be copied as 4 bytes a character).
         values = np.loadtxt(
-            io.BytesIO(rows_bytes.tobytes()),
-            delimiter=",",
-            comments=None,
-            quotechar=None,
-            dtype=np.float64,
-            ndmin=2,
+            io.BytesIO(data), delimiter=",", comments=None, quotechar=None, dtype=np.float64, ndmin=2
         )
     except ValueError:
         return None
-    if values.shape != (rows, len(header)):
-        return None
-    return CsvFloats(source, header, head + 1, values, lines, body)
+    return values if values.shape == (rows, columns) else None
 
 
 def _is_row(line: str) -> bool:
@@ -724,6 +764,7 @@ def csv_blocks(
     max_rows: int | None = None,
     max_bytes: int | None = None,
     block_bytes: int = CSV_BLOCK_BYTES,
+    parse_rows: RowsParser | None = None,
 ) -> Iterator[CsvFloats | CsvTable]:
     r"""Read a CSV file ``block_bytes`` at a time and yield each block's rows as they are read.
 
@@ -745,6 +786,8 @@ def csv_blocks(
         Yield :class:`CsvFloats` (every cell a number) rather than :class:`CsvTable`.
     block_bytes : int
         Bytes read at a time, >= 1.
+    parse_rows : callable or None
+        Reads each block's data rows (:data:`RowsParser`); None: :func:`parse_float_rows`.
 
     Yields
     ------
@@ -826,7 +869,7 @@ def csv_blocks(
                 if chunk and not any(_is_row(line) for line in text.splitlines()):
                     carry = block + carry  # comments and blank lines only: the header is further on
                     continue
-                found = _parse_block(text, source, columns, required, numeric, most, limit)
+                found = _parse_block(text, source, columns, required, numeric, most, limit, parse_rows)
                 if found is None:
                     raise CsvFallbackError
                 header_text = text.splitlines()[found.header_line - 1]
@@ -835,7 +878,14 @@ def csv_blocks(
             else:
                 # The header again before the block: the block's rows read as they would below it.
                 found = _parse_block(
-                    f"{header_text}\n{text}", source, columns, required, numeric, most - rows, limit
+                    f"{header_text}\n{text}",
+                    source,
+                    columns,
+                    required,
+                    numeric,
+                    most - rows,
+                    limit,
+                    parse_rows,
                 )
                 if found is None or found.header_line != 1:
                     raise CsvFallbackError
@@ -861,12 +911,14 @@ def _parse_block(
     numeric: bool,
     most: int,
     limit: int,
+    parse_rows: RowsParser | None,
 ) -> CsvFloats | CsvTable | None:
     """One block of :func:`csv_blocks`: its rows, or None when it cannot be read exactly."""
     if numeric:
         return parse_csv_floats(
-            text, source, columns=columns, required=required, max_rows=most, max_bytes=limit
-        )
+            text, source, columns=columns, required=required, max_rows=most, max_bytes=limit,
+            parse_rows=parse_rows,
+        )  # fmt: skip
     try:
         return parse_csv(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
     except FileFormatError:
@@ -881,6 +933,7 @@ def read_csv_floats(
     max_rows: int | None = None,
     max_bytes: int | None = None,
     block_bytes: int = CSV_BLOCK_BYTES,
+    parse_rows: RowsParser | None = None,
 ) -> CsvFloats | None:
     r"""Read a CSV file of numbers only block by block (:func:`csv_blocks`); None when it cannot.
 
@@ -901,6 +954,8 @@ def read_csv_floats(
         As for :func:`parse_csv`.
     block_bytes : int
         Bytes read at a time, >= 1.
+    parse_rows : callable or None
+        Reads each block's data rows (:data:`RowsParser`); None: :func:`parse_float_rows`.
 
     Returns
     -------
@@ -941,6 +996,7 @@ def read_csv_floats(
             max_rows=max_rows,
             max_bytes=max_bytes,
             block_bytes=block_bytes,
+            parse_rows=parse_rows,
         ):
             assert isinstance(block, CsvFloats)
             if header is None:

@@ -8,12 +8,13 @@ sets ``AURA_UMS_NATIVE=0``; the numpy reference otherwise (:data:`NATIVE`).
 
 Only the layer that owns a kernel calls it, as ``_native.<kernel>``: ``uncertainty`` the
 growth, the reductions and the slices' kernels, ``expecter`` its points, ``schemas`` the
-polygon distance. This package imports nothing of aura-ums but ``geometry``.
+polygon distance, ``logs`` the numeric CSV rows. This package imports nothing of aura-ums
+but ``geometry`` (and ``_files``, whose CSV reader is a kernel's reference).
 """
 
 import os
 
-from aura_ums._native import _distance, _expecter, _growth, _reduce, _slices
+from aura_ums._native import _csv, _distance, _expecter, _growth, _reduce, _slices
 from aura_ums._native._expecter import ExpectedPoints
 from aura_ums._native._extension import BUILT
 from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bounds
@@ -61,6 +62,7 @@ reduce_cone_slices = _slices.reduce_cone_slices_compiled if NATIVE else _slices.
 reduce_strip_slices = (
     _slices.reduce_strip_slices_compiled if NATIVE else _slices.reduce_strip_slices_reference
 )
+parse_float_rows = _csv.parse_float_rows_compiled if NATIVE else _csv.parse_float_rows_reference
 
 __all__ = [
     "ANGLE_SLACK",
@@ -91,6 +93,7 @@ __all__ = [
     "merge_groups",
     "motion_bounds",
     "narrowed",
+    "parse_float_rows",
     "point_in_solid_convex",
     "polygon_distance",
     "reduce_cone",

@@ -242,5 +242,6 @@ PyObject *distribute_slices(PyObject *self, PyObject *const *args, Py_ssize_t na
 PyObject *grow_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_cone_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 PyObject *reduce_strip_slices(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
 
 #endif

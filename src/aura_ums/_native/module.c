@@ -1,6 +1,6 @@
 /*
  * The extension module aura_ums._native._kernels: the kernels of growth.c, reduce.c,
- * expecter.c, distance.c and slices.c, and the constants of kernels.h, exported so that a test can
+ * expecter.c, distance.c, slices.c and csv.c, and the constants of kernels.h, exported so that a test can
  * check them against their Python twins.
  */
 #include "kernels.h"
@@ -52,6 +52,9 @@ static PyMethodDef methods[] = {
      "reduce_strip_slices(points, counts, lo, hi, center_x, center_y, heading, forward, left, start_x, start_y, "
      "end_x, end_y, position_uncertainty, offset, offset_error, angle, angle_error, max_vertices) -> (points, "
      "counts, lo, hi bytes, center_x, center_y, wedge_center, wedge_cw, wedge_ccw), or an int reason code"},
+    {"parse_float_rows", (PyCFunction)(void (*)(void))parse_float_rows, METH_FASTCALL,
+     "parse_float_rows(data, rows, columns) -> bytearray of rows x columns float64 (row-major), or None "
+     "when a cell is not a plain decimal number or the rows are not rows lines of columns cells"},
     {NULL, NULL, 0, NULL},
 };
 

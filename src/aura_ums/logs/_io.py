@@ -23,6 +23,7 @@ from typing import Any, NoReturn, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums import _native
 from aura_ums._files import (
     CsvFallbackError,
     CsvFloats,
@@ -225,7 +226,11 @@ class _CsvFile:
             self.fast = block
         elif block is None and all(unit != "text" for unit in columns.values()):
             self.fast = read_csv_floats(
-                path, columns=tuple(columns), required=required, max_bytes=LOG_CSV_MAX_BYTES
+                path,
+                columns=tuple(columns),
+                required=required,
+                max_bytes=LOG_CSV_MAX_BYTES,
+                parse_rows=_native.parse_float_rows,
             )
         if self.fast is not None:
             self.lines: NDArray[np.int64] | tuple[int, ...] = self.fast.lines
@@ -263,6 +268,7 @@ class _CsvFile:
                 max_rows=STREAM_MAX_ROWS,
                 max_bytes=LOG_CSV_MAX_BYTES,
                 block_bytes=block_bytes,
+                parse_rows=_native.parse_float_rows,
             ):
                 table = cls(path, columns, required, block)
                 if len(table):

@@ -1,0 +1,98 @@
+/*
+ * Compiled kernel of the numeric CSV reader: the data rows of a block of a large log file
+ * (odometry, ground truth), every cell a plain decimal number. Its reference is numpy's
+ * loadtxt (_csv.parse_float_rows_reference beside this file). Both give the correctly rounded
+ * double of each cell; this one reads only the plain form (sign, digits, point, exponent,
+ * blanks around) and gives None for anything else (nan, inf, hex, a cell too long), which the
+ * caller then reads the slow, exact way.
+ */
+#include <stdlib.h>
+
+#include "kernels.h"
+
+/* Longest cell read here, bytes: a longer one (thousands of digits) goes the slow way. */
+#define LONGEST_CELL 400
+
+static int is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static int is_blank(char c) { return c == ' ' || c == '\t'; }
+
+/* The end of the plain decimal number at p (before `end`), or NULL when there is none. */
+static const char *plain_number(const char *p, const char *end) {
+    if (p < end && (*p == '+' || *p == '-')) p++;
+    Py_ssize_t digits = 0;
+    while (p < end && is_digit(*p)) p++, digits++;
+    if (p < end && *p == '.') {
+        p++;
+        while (p < end && is_digit(*p)) p++, digits++;
+    }
+    if (digits == 0) return NULL;
+    if (p < end && (*p == 'e' || *p == 'E')) {
+        p++;
+        if (p < end && (*p == '+' || *p == '-')) p++;
+        Py_ssize_t exponent = 0;
+        while (p < end && is_digit(*p)) p++, exponent++;
+        if (exponent == 0) return NULL;
+    }
+    return p;
+}
+
+PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    (void)self;
+    if (nargs != 3) {
+        PyErr_Format(PyExc_TypeError, "parse_float_rows expects 3 arguments, got %zd", nargs);
+        return NULL;
+    }
+    Py_ssize_t rows, columns;
+    if (parse_count(args[1], "rows", 0, PY_SSIZE_T_MAX / 8, &rows) < 0) return NULL;
+    if (parse_count(args[2], "columns", 1, PY_SSIZE_T_MAX / 8, &columns) < 0) return NULL;
+    Py_ssize_t cells = checked_multiply(rows, columns);
+    Py_ssize_t size = cells < 0 ? -1 : checked_multiply(cells, (Py_ssize_t)sizeof(double));
+    if (size < 0) return PyErr_NoMemory();
+    Py_buffer view;
+    if (PyObject_GetBuffer(args[0], &view, PyBUF_SIMPLE) < 0) return NULL;
+    PyObject *result = PyByteArray_FromStringAndSize(NULL, size);
+    if (!result) {
+        PyBuffer_Release(&view);
+        return NULL;
+    }
+    double *out = (double *)(void *)PyByteArray_AS_STRING(result);
+    const char *p = (const char *)view.buf, *end = p + view.len;
+    char cell[LONGEST_CELL + 1];
+    int plain = 1;
+    for (Py_ssize_t row = 0; row < rows && plain; row++) {
+        for (Py_ssize_t column = 0; column < columns; column++) {
+            while (p < end && is_blank(*p)) p++;
+            const char *stop = plain_number(p, end);
+            if (!stop || stop - p > LONGEST_CELL) {
+                plain = 0;
+                break;
+            }
+            /* strtod on a copy: the block is not NUL-terminated, and the copy's end is known. */
+            Py_ssize_t length = stop - p;
+            memcpy(cell, p, (size_t)length);
+            cell[length] = '\0';
+            char *parsed;
+            out[row * columns + column] = strtod(cell, &parsed);
+            if (parsed != cell + length) { /* a locale whose decimal point is not "." */
+                plain = 0;
+                break;
+            }
+            p = stop;
+            while (p < end && is_blank(*p)) p++;
+            char expected = column + 1 < columns ? ',' : '\n';
+            if (p < end && *p == expected) {
+                p++;
+            } else if (!(p == end && column + 1 == columns)) {
+                plain = 0;
+                break;
+            }
+        }
+    }
+    PyBuffer_Release(&view);
+    if (!plain || p != end) {
+        Py_DECREF(result);
+        Py_RETURN_NONE;
+    }
+    return result;
+}
