@@ -92,6 +92,27 @@ CLI's default), the steps CSV and metrics JSON written (``/usr/bin/time``, 28 No
 01:50 UTC, load average 2): f47bbb6 61.75 s and 811 MB peak, this tree 24.40 s and 106 MB
 peak, 2.5x. The issue's tenfold gain is not reached in any of these runs.
 
+With the numeric rows read by a compiled kernel (``csv.c``, ``parse_float_rows``; numpy's
+``loadtxt`` is its reference), 28 November 2026 about 21:10 UTC, idle machine, this tree
+then f47bbb6 (``--src``) one after the other:
+
+===============================  ========  =====================  =====================  =====
+10^6 rows                        steps     this tree: load,       f47bbb6: load,         gain
+                                           update, total s; peak  update, total s; peak
+===============================  ========  =====================  =====================  =====
+a frame every 100 rows           9,335     0.81, 0.71, 2.69; 80   8.78, 0.85, 11.53; 754 4.3x
+a frame every 10 rows            93,359    0.57, 4.94, 10.38; 87  9.34, 5.30, 28.93; 781 2.8x
+===============================  ========  =====================  =====================  =====
+
+The command line as a user runs it (``/usr/bin/time``, ``replay LOG --terrain ... --steps-csv
+... --metrics-json ...``, Class I), alternating the trees twice: a frame every 100 rows 3.41 and
+2.61 s against 13.60 and 11.14 s (4.0x, 4.3x), every 10 rows 11.25 and 11.90 s against 33.76
+and 29.74 s (3.0x, 2.5x); peak 99-107 MB against 770-812 MB. Where a frame every 10 rows
+spends its time now (py-spy): the manager's update 47% (its compiled kernels about a third
+of that), the judge 21% (the area of each step's two maps, ``polygon_area``, 10%), reading the
+files 16%. Tenfold needs the update's Python (about 50 us a step around 15 us of kernels)
+compiled too.
+
 (``--rows 1000000 --frame-every 100`` and ``--rows 100000 --frame-every 1``, each then with
 ``--src`` of f47bbb6.) The manager's update, about 100 us a step on an idle machine, two
 maps a step, is most of the time once frames are frequent; its compiled kernels take
