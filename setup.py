@@ -9,7 +9,17 @@ from pathlib import Path
 from setuptools import Extension, setup
 
 NATIVE = Path("src/aura_ums/_native")
-SOURCES = ["args.c", "polygon.c", "growth.c", "reduce.c", "expecter.c", "distance.c", "slices.c", "csv.c", "module.c"]
+SOURCES = [
+    "args.c",
+    "polygon.c",
+    "growth.c",
+    "reduce.c",
+    "expecter.c",
+    "distance.c",
+    "slices.c",
+    "csv.c",
+    "module.c",
+]
 
 setup(
     ext_modules=[
