@@ -9,6 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
@@ -131,3 +133,31 @@ def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
     assert not grown.contains(x, y, heading)
     poses = np.array([[x, y, heading]] * 2)
     assert _contains([grown, grown.without_slices()], poses).tolist() == [0, 1]
+
+
+@given(
+    st.integers(3, 16),
+    st.floats(-8.0, 3.0),
+    st.floats(-1e4, 1e4),
+    st.floats(-1e4, 1e4),
+    st.floats(-18.0, 0.0),
+    st.integers(0, 2**32 - 1),
+)
+def test_the_envelope_gate_calls_an_area_positive_only_when_polygon_area_does(
+    count: int, log_scale: float, x: float, y: float, log_squash: float, seed: int
+) -> None:
+    """The judge's batched area sign never admits a polygon polygon_area calls flat or worse."""
+    from aura_ums.geometry import polygon_area
+    from aura_ums.logs._replay import _surely_positive
+
+    rng = np.random.default_rng(seed)
+    angles = np.sort(rng.uniform(0.0, 2.0 * math.pi, count))
+    vertices = np.column_stack((np.cos(angles), np.sin(angles) * 10.0**log_squash)) * 10.0**log_scale
+    origin = np.array([x, y])
+    vertices += origin
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) + origin
+    line = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]) + origin
+    gate = _surely_positive([vertices, square, line])
+    if gate[0] == 1.0:
+        assert polygon_area(vertices) > 0.0
+    assert gate[1:].tolist() == [1.0, 0.0]

@@ -1261,8 +1261,9 @@ class _Judge:
             at = np.array([i for i, _ in with_envelope])
             maps = [m for _, m in with_envelope]
             vertices = [m.polygon.vertices for m in maps]
+            # The envelope's areas are not reported: only whether each is surely positive.
             trace.envelope_inside[at] = _contains(
-                maps, trace.truth[at], vertices, _areas(vertices), _wedges(maps)
+                maps, trace.truth[at], vertices, _surely_positive(vertices), _wedges(maps)
             )
         self.working, self.envelope = [], []
 
@@ -1278,6 +1279,33 @@ def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
     return np.array([polygon_area(v) for v in vertices], dtype=np.float64)
 
 
+def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
+    """1.0 where a polygon's area is surely above 0, else 0.0: the shoelace of all at once.
+
+    Summed otherwise than :func:`~aura_ums.geometry.polygon_area` (whose two dot products
+    give the reported areas), so a value is trusted only beyond a bound on its rounding; a
+    polygon within it (a degenerate one, or nearly) is then judged by ``contains`` itself.
+    """
+    counts = np.array([len(v) for v in vertices], dtype=np.int64)
+    result = np.zeros(len(vertices))
+    if not len(vertices) or counts.min() < 3:
+        return np.array([polygon_area(v) > 0.0 for v in vertices], dtype=np.float64)
+    every = np.concatenate(vertices)
+    first = np.cumsum(counts) - counts
+    following = np.arange(1, len(every) + 1)
+    following[first + counts - 1] = first
+    origin = np.repeat(every[first], counts, axis=0)  # each polygon's first vertex, as polygon_area
+    relative = every - origin
+    ahead = relative[following]
+    forward, backward = relative[:, 0] * ahead[:, 1], relative[:, 1] * ahead[:, 0]
+    total = np.add.reduceat(forward - backward, first)
+    size = np.add.reduceat(np.abs(forward) + np.abs(backward), first)
+    # Either sum's error, whatever its order (and fused or not), is below (n + 2) units in the
+    # last place of the sum of the products' sizes: beyond twice that, both are above 0.
+    result[total > 4.0 * np.finfo(np.float64).eps * (counts + 2) * size] = 1.0
+    return result
+
+
 def _contains(
     maps: Sequence[SpatialUncertaintyMap],
     poses: NDArray[np.float64],
@@ -1288,7 +1316,8 @@ def _contains(
     """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``).
 
     ``vertices``, ``areas`` and ``wedges`` are those of each map's polygon and wedge, when
-    the caller has them already.
+    the caller has them already; only whether each area is above 0 counts (a polygon
+    without one is judged by ``contains`` itself).
     """
     if vertices is None:
         vertices = [step_map.polygon.vertices for step_map in maps]
