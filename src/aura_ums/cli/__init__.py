@@ -7,10 +7,9 @@ the command line itself are still loading.
 
 from __future__ import annotations
 
-import sys
 from typing import TYPE_CHECKING, Any
 
-from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN
+from aura_ums.cli._interrupt import INTERRUPTED, say_interrupted
 
 if TYPE_CHECKING:
     from aura_ums.cli._app import app
@@ -21,16 +20,21 @@ __all__ = ["app", "main"]
 def main() -> None:
     """Run the ``aura-ums`` command line (the console script's entry point).
 
-    A Ctrl-C before a command starts (while the libraries load) exits with code 130 and
-    says so on stderr, as one during a command does, instead of a traceback.
+    A Ctrl-C before a command starts (while the libraries load, or while the arguments
+    are read) exits with code 130 and says so on stderr, as one during a command does,
+    instead of a traceback or nothing.
     """
     try:
         from aura_ums.cli._app import main as run
 
         run()
     except KeyboardInterrupt:
-        sys.stderr.write(f"error: {NOTHING_WRITTEN}\n")
+        say_interrupted()
         raise SystemExit(INTERRUPTED) from None
+    except SystemExit as exc:
+        if exc.code == INTERRUPTED:  # typer's own answer to a Ctrl-C while it reads the arguments
+            say_interrupted()
+        raise
 
 
 def __getattr__(name: str) -> Any:

@@ -32,7 +32,7 @@ import typer
 
 from aura_ums._files import NAME_MAX, place_new, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
-from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN
+from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN, announce
 
 #: The option every command that writes takes, with the same help everywhere.
 Overwrite = Annotated[
@@ -328,6 +328,7 @@ def interruptible(command: Callable[..., None]) -> Callable[..., None]:
             else:
                 message = NOTHING_WRITTEN
             err_console.print(f"[red]error:[/red] {_escape(message)}", highlight=False)
+            announce()
             raise typer.Exit(code=INTERRUPTED) from None
 
     return run
