@@ -52,10 +52,14 @@ def _import_sources(module: ModuleType) -> dict[str, str]:
         return {}
     tree = ast.parse(Path(path).read_text(encoding="utf-8"))
     sources: dict[str, str] = {}
-    for node in tree.body:
-        if isinstance(node, ast.ImportFrom) and node.module is not None and node.level == 0:
-            for alias in node.names:
-                sources[alias.asname or alias.name] = node.module
+    for statement in tree.body:
+        # The top level imports its names on first use: the imports type checkers see are
+        # under ``if TYPE_CHECKING:``.
+        guarded = isinstance(statement, ast.If) and ast.unparse(statement.test) == "TYPE_CHECKING"
+        for node in statement.body if guarded else [statement]:
+            if isinstance(node, ast.ImportFrom) and node.module is not None and node.level == 0:
+                for alias in node.names:
+                    sources[alias.asname or alias.name] = node.module
     return sources
 
 
