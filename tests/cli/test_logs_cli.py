@@ -74,7 +74,7 @@ def test_missing_dataset_folder_is_named(app: typer.Typer, tmp_path: Path) -> No
     ("robot", "message"),
     [
         ("2", "Robot2_Measurement.dat: expected robot 2's measurements"),
-        ("9", "robot: expected a robot number"),
+        ("9", "--robot: expected a robot number"),
     ],
 )
 def test_bad_robot_is_an_error(

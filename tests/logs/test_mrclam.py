@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -181,3 +182,17 @@ def test_robot1_import_round_trip(robot1: RobotLog, tmp_path: Path) -> None:
     imported = import_mrclam(MRCLAM6, 1, tmp_path / "robot1")
     assert_same_log(imported, robot1)
     assert_same_log(load_log(tmp_path / "robot1"), imported, lines=True)
+
+
+@pytest.mark.parametrize(("kind", "said"), [("pipe", "a named pipe or socket"), ("folder", "a folder")])
+@pytest.mark.parametrize("name", ["Robot1_Odometry.dat", "Robot1_Measurement.dat", "Barcodes.dat"])
+def test_a_data_file_that_is_a_pipe_or_folder_is_named_as_such(
+    tmp_path: Path, name: str, kind: str, said: str
+) -> None:
+    folder = tiny_dataset(tmp_path, **{name: None})
+    if kind == "pipe":
+        os.mkfifo(folder / name)  # opened, it would wait for a writer
+    else:
+        (folder / name).mkdir()
+    with pytest.raises(FileFormatError, match=rf"{name}: expected a MRCLAM data file, got {said}$"):
+        read_mrclam(folder, 1)

@@ -66,6 +66,8 @@ def mrclam(
         with progress_bar(f"{out_dir}: files", quiet=quiet) as advance:
             folder = write_log(log, out_dir, overwrite=overwrite, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        message = str(exc)
+        # the library names its argument; the user gave the option
+        raise fail(f"--{message}" if message.startswith("robot: ") else message) from None
     wrote(folder)
     print_log_summary(dataclasses.replace(log, path=folder))

@@ -63,7 +63,7 @@ class _DatFile:
 
     def __init__(self, path: Path, columns: tuple[str, ...]) -> None:
         self.source = str(path)
-        if not path.is_file():
+        if not path.exists():  # a folder or a pipe: read_text names what it is
             self.fail("", f"expected an MRCLAM data file ({', '.join(columns)}), got no such file")
         # The same reader as every other file: size limit, UTF-8 with an optional BOM.
         text = read_text(path, kind="MRCLAM data")
@@ -209,7 +209,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     robot = int(robot)
     folder = read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder")
     prefix = f"Robot{robot}_"
-    if not (folder / f"{prefix}Measurement.dat").is_file():
+    if not (folder / f"{prefix}Measurement.dat").exists():
         present = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})
         raise FileFormatError(
             str(folder / f"{prefix}Measurement.dat"),
