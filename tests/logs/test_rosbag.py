@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -392,3 +393,19 @@ def test_bad_arguments(bag: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatc
         monkeypatch.setitem(sys.modules, name, None)
     with pytest.raises(MissingDependencyError, match=r"install aura-ums\[ros\]"):
         read(bag)
+
+
+def test_a_bag_that_is_or_holds_a_named_pipe_is_refused_not_waited_on(bag: Path, tmp_path: Path) -> None:
+    pipe = tmp_path / "walk.bag"
+    os.mkfifo(pipe)
+    with pytest.raises(FileFormatError, match=r"walk\.bag: expected a ROS bag file, got a named pipe"):
+        read(pipe)
+    folder = tmp_path / "walk"
+    folder.mkdir()
+    os.mkfifo(folder / "metadata.yaml")
+    with pytest.raises(FileFormatError, match=r"metadata\.yaml: expected a ROS bag file, got a named pipe"):
+        read(folder)
+    landmarks = tmp_path / "landmarks.csv"
+    os.mkfifo(landmarks)
+    with pytest.raises(FileFormatError, match=r"landmarks\.csv: expected a CSV file, got a named pipe"):
+        read(bag, landmarks=landmarks)

@@ -42,6 +42,7 @@ import importlib
 import itertools
 import math
 import os
+import stat
 import struct
 from collections.abc import Iterator, Sequence
 from dataclasses import replace
@@ -83,10 +84,22 @@ def _topic(value: object, name: str) -> str:
     return value
 
 
+def _no_pipes(path: Path) -> None:
+    """Refuse a bag that is, or holds, a named pipe or socket: rosbags would wait on it for a writer."""
+    try:
+        items = [path, *(path.iterdir() if path.is_dir() else ())]
+        modes = [(item, item.stat().st_mode) for item in items]
+    except OSError:
+        return  # unreadable: the reader says so, naming the bag
+    for item, mode in modes:
+        if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
+            raise FileFormatError(str(item), "", "expected a ROS bag file, got a named pipe or socket")
+
+
 def _landmarks(value: object) -> tuple[LogLandmark, ...]:
     if isinstance(value, (str, os.PathLike)):
         path = Path(value)
-        if not path.is_file():
+        if not path.exists():  # a folder or a pipe: the reader names what it is
             raise FileFormatError(str(path), "", "expected a landmarks CSV file, got no such file")
         return _read_landmarks(path, Units())
     if not isinstance(value, Sequence):
@@ -310,6 +323,7 @@ def read_rosbag(
             "",
             "expected a ROS bag (a rosbag2 folder or a ROS 1 .bag file), got no such file or folder",
         )
+    _no_pipes(path)
     listed = _landmarks(landmarks)
     _require_rosbags()
     from rosbags.highlevel import AnyReader, AnyReaderError
