@@ -116,9 +116,11 @@ def test_ctrl_c_during_import_leaves_no_log_folder(tmp_path: Path, monkeypatch: 
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dataset"]
 
 
-# A finder that raises a Ctrl-C when the command line's code is imported (where numpy and
-# the kernels load): the moment before any command runs, made deterministic.
-_INTERRUPT_WHILE_LOADING = """
+# A Ctrl-C at two moments before any command runs, made deterministic: while the command
+# line's code is imported (numpy and the kernels load then), and while typer reads the
+# arguments (typer answers it with a bare exit code 130 of its own).
+_INTERRUPTED_BEFORE_THE_COMMAND = {
+    "loading": """
 import sys
 
 class Interrupt:
@@ -129,16 +131,24 @@ class Interrupt:
         return None
 
 sys.meta_path.insert(0, Interrupt)
-sys.argv = ["aura-ums", "--version"]
-from aura_ums.cli import main
-main()
-"""
+""",
+    "reading the arguments": """
+import typer.core
+
+def interrupted(*args, **kwargs):
+    raise KeyboardInterrupt
+
+typer.core.TyperGroup.make_context = interrupted
+""",
+}
 
 
-def test_ctrl_c_while_the_command_line_loads_exits_130_without_a_traceback() -> None:
-    done = subprocess.run(
-        [sys.executable, "-c", _INTERRUPT_WHILE_LOADING], capture_output=True, text=True, check=False
+@pytest.mark.parametrize("moment", sorted(_INTERRUPTED_BEFORE_THE_COMMAND))
+def test_ctrl_c_before_the_command_runs_exits_130_and_says_so(moment: str) -> None:
+    script = _INTERRUPTED_BEFORE_THE_COMMAND[moment] + (
+        "import sys\nsys.argv = ['aura-ums', '--version']\nfrom aura_ums.cli import main\nmain()\n"
     )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=False)
     assert done.returncode == 130, done.stderr
     assert done.stderr == "error: interrupted: nothing was written\n"
     assert done.stdout == ""
@@ -163,26 +173,3 @@ def test_a_real_ctrl_c_early_in_a_command_exits_130_without_a_traceback(tmp_path
     assert "interrupted: nothing was written" in stderr
     assert not out.exists()
     assert list(tmp_path.iterdir()) == []
-
-
-_INTERRUPT_WHILE_PARSING = """
-import sys
-import typer.core
-
-def interrupted(*args, **kwargs):
-    raise KeyboardInterrupt
-
-typer.core.TyperGroup.make_context = interrupted
-sys.argv = ["aura-ums", "--version"]
-from aura_ums.cli import main
-main()
-"""
-
-
-def test_ctrl_c_while_the_arguments_are_read_says_so_too() -> None:
-    """typer answers a Ctrl-C before the command with a bare 130: the entry point says why."""
-    done = subprocess.run(
-        [sys.executable, "-c", _INTERRUPT_WHILE_PARSING], capture_output=True, text=True, check=False
-    )
-    assert done.returncode == 130, done.stderr
-    assert done.stderr == "error: interrupted: nothing was written\n"
