@@ -90,6 +90,14 @@ def test_tiny_dataset(tmp_path: Path) -> None:
         ),
         ({"Barcodes.dat": None}, r"Barcodes\.dat: expected an MRCLAM data file"),
         (
+            {"Robot1_Measurement.dat": HEADER + "10.0 63.9 2.0 0.5\n"},  # int() would read 63
+            r"Robot1_Measurement\.dat:5: expected a whole number as barcode, got '63\.9'",
+        ),
+        (
+            {"Robot1_Measurement.dat": HEADER + "10.0 99 2.0 0.5\n11.0 98 2.0 0.5\n"},
+            r"Robot1_Measurement\.dat: expected measurements of the landmarks .*none: 2 of unknown",
+        ),
+        (
             {"Landmark_Groundtruth.dat": HEADER + "6 0.5 -4.0 -1e400 0.1\n"},
             r"Landmark_Groundtruth\.dat:5: expected finite numbers",
         ),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -409,3 +410,28 @@ def test_a_bag_that_is_or_holds_a_named_pipe_is_refused_not_waited_on(bag: Path,
     os.mkfifo(landmarks)
     with pytest.raises(FileFormatError, match=r"landmarks\.csv: expected a CSV file, got a named pipe"):
         read(bag, landmarks=landmarks)
+
+
+def test_a_damaged_or_endless_bag_is_refused_naming_it(bag: Path, tmp_path: Path) -> None:
+    """Damaged bytes fail inside rosbags' parsers with their own errors: each is named, no traceback."""
+    magic_only = tmp_path / "m.mcap"
+    magic_only.write_bytes(b"\x89MCAP0\r\n")
+    with pytest.raises(FileFormatError, match=r"m\.mcap: expected a readable ROS bag, got "):
+        read(magic_only)
+    damaged = tmp_path / "damaged"
+    shutil.copytree(bag, damaged)
+    for storage in damaged.glob("*.db3"):
+        data = bytearray(storage.read_bytes())
+        middle = len(data) // 2
+        data[middle : middle + 2000] = b"\xff" * 2000
+        storage.write_bytes(bytes(data))
+    try:  # what the damage hits decides whether a message still reads: either is sound
+        read(damaged)
+        said = str(damaged)
+    except FileFormatError as exc:  # any other exception fails the test
+        said = str(exc)
+    assert said.startswith(str(damaged))
+    endless = tmp_path / "zero.bag"
+    endless.symlink_to("/dev/zero")
+    with pytest.raises(FileFormatError, match=r"zero\.bag: expected a ROS bag file, got a device"):
+        read(endless)

@@ -40,6 +40,7 @@ CITATION = "Leung et al., IJRR 2011"
 LANDMARK_SYMBOL = "cylinder"
 #: Subjects and barcodes are small whole numbers.
 _NUMBER = Range(0, 1e6)
+_WHOLE = frozenset({"subject", "barcode"})
 #: The physical range of each column of the ``.dat`` files (docs/formats.md lists them).
 COLUMN_RANGES: dict[str, Range] = {
     "subject": _NUMBER,
@@ -90,6 +91,8 @@ class _DatFile:
                 bounds = COLUMN_RANGES[name]
                 if not bounds.contains(value):
                     self.fail_at(number, f"expected {name} {bounds.text()}, got {_shown(cell)}")
+                if name in _WHOLE and value != int(value):  # 14.9 would be read as barcode 14
+                    self.fail_at(number, f"expected a whole number as {name}, got {_shown(cell)}")
             lines.append(number)
             rows.append(values)
         self.lines = np.array(lines, dtype=np.int64)
@@ -256,6 +259,13 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
             measurements.fail_at(number, f"expected a range >= 0, got {distance!r}")
         else:
             observations.append(LogObservation(time, str(subject), bearing, range=distance, line=int(number)))
+    if unknown and not observations:
+        # Every landmark measurement dropped: a log that would replay on odometry alone, in silence.
+        measurements.fail(
+            "",
+            f"expected measurements of the landmarks of Landmark_Groundtruth.dat (by Barcodes.dat), "
+            f"got none: {unknown} of unknown barcodes, {robots} of robots",
+        )
     observations.sort(key=lambda item: item.time)  # stable: frames keep their order
 
     odometry_file = _DatFile(folder / f"{prefix}Odometry.dat", ("time", "v", "omega"))

@@ -85,7 +85,10 @@ def _topic(value: object, name: str) -> str:
 
 
 def _no_pipes(path: Path) -> None:
-    """Refuse a bag that is, or holds, a named pipe or socket: rosbags would wait on it for a writer."""
+    """Refuse a bag that is, or holds, a pipe, socket or device: rosbags would wait on it or read forever.
+
+    (``/dev/zero`` as a bag grew to 24 GB before it was killed.)
+    """
     try:
         items = [path, *(path.iterdir() if path.is_dir() else ())]
         modes = [(item, item.stat().st_mode) for item in items]
@@ -94,6 +97,8 @@ def _no_pipes(path: Path) -> None:
     for item, mode in modes:
         if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
             raise FileFormatError(str(item), "", "expected a ROS bag file, got a named pipe or socket")
+        if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+            raise FileFormatError(str(item), "", "expected a ROS bag file, got a device")
 
 
 def _landmarks(value: object) -> tuple[LogLandmark, ...]:
@@ -327,6 +332,8 @@ def read_rosbag(
     listed = _landmarks(landmarks)
     _require_rosbags()
     from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.rosbag1 import ReaderError as Bag1Error
+    from rosbags.rosbag2 import ReaderError as Bag2Error
     from rosbags.typesys import Stores, get_typestore
 
     try:
@@ -341,11 +348,12 @@ def read_rosbag(
             groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
     except AuraUmsError:
         raise
-    except (AnyReaderError, OSError) as exc:  # no metadata.yaml, unreadable storage, bad definitions
+    except (AnyReaderError, Bag1Error, Bag2Error, OSError) as exc:  # no metadata.yaml, unreadable, damaged
         raise FileFormatError(str(path), "", f"expected a readable ROS bag, got {exc}") from exc
-    except (ValueError, LookupError, EOFError, struct.error) as exc:
-        # Bytes that are no bag at all: rosbags' parsers fail as they meet them (a UnicodeDecodeError
-        # on a header, a short read), not with AnyReaderError.
+    except (ValueError, LookupError, EOFError, struct.error, TypeError, ArithmeticError, MemoryError) as exc:
+        # Bytes that are no bag at all, or a damaged one: rosbags' parsers fail as they meet them
+        # (a UnicodeDecodeError on a header, a short read, an ord() of nothing, a length beyond
+        # any size), not with AnyReaderError.
         raise FileFormatError(
             str(path), "", f"expected a readable ROS bag, got {type(exc).__name__}: {exc}"
         ) from exc
