@@ -124,7 +124,7 @@ def test_simulate_options_override_the_scenarios_manager_table(ran: list[Scenari
     assert ran[-1].settings.area_limit == file.area_limit == 25.0
     bad = runner.invoke(app, ["simulate", path, "--runs", "1", "--envelope-factor", "0.5"])
     assert bad.exit_code == 2
-    assert "--envelope-factor: expected a number >= 1, got 0.5" in bad.output
+    assert "--envelope-factor: expected a number in [1, 100], got 0.5" in bad.output
 
 
 @pytest.mark.parametrize(
@@ -195,3 +195,53 @@ def test_simulate_profile_overrides_the_scenarios_map_keeps_the_rest(ran: list[S
     assert ran[-1].settings.area_limit == file.area_limit == 25.0
     shown = next(line for line in result.stdout.splitlines() if line.startswith("slice_width_rad"))
     assert float(shown.split()[1]) == pytest.approx(math.radians(2.0))
+
+
+@pytest.mark.parametrize(
+    "flag", ["--area-limit", "--envelope-max-vertices", "--slice-width", "--joint-above"]
+)
+def test_a_nullable_setting_takes_none_as_its_message_says(flag: str) -> None:
+    # "expected ... or none" refused 'none' (typer's own parse, or the angle parser)
+    tool, seen = recorder()
+    base = {"area_limit": 4.0, "envelope_max_vertices": 20, "slice_width": 0.1, "joint_above": 1.0}
+    start = ManagerSettings.from_dict(base)
+    given = ["x", "--area-limit", "4", "--envelope-max-vertices", "20", "--slice-width", "0.1"]
+    given += ["--joint-above", "1.0"]
+    index = given.index(flag)
+    given[index + 1] = "None"
+    result = runner.invoke(tool, given)
+    assert result.exit_code == 0, result.output
+    name = flag.removeprefix("--").replace("-", "_")
+    assert seen[-1] == ManagerSettings.from_dict({name: None}, base=start)
+    # over a profile that sets it, too
+    assert runner.invoke(tool, ["x", "--profile", "sliced", "--slice-width", "none"]).exit_code == 0
+    assert seen[-1] == ManagerSettings()
+
+
+@pytest.mark.parametrize(
+    ("given", "message"),
+    [
+        (["--area-limit", "abc"], "--area-limit: expected a positive number or none, got 'abc'"),
+        (["--area-limit", "1_0"], "--area-limit: expected a positive number or none, got '1_0'"),
+        (
+            ["--envelope-max-vertices", "1.5"],
+            "--envelope-max-vertices: expected an integer >= 3 or none, got '1.5'",
+        ),
+        (["--slice-width", "1e-6"], "--slice-width: expected at least 0.00174533 rad (0.1 degree, 3600"),
+        (["--sigmas", "1e300"], "--sigmas: expected a number in [0.1, 100], got 1e+300"),
+        (
+            ["--relaxed-q", "3", "--relaxed-window", "100"],
+            "--relaxed-q: expected at most 2000 branches of the relaxed intersection",
+        ),
+        (
+            ["--relaxed-window", "100000", "--profile", "relaxed"],
+            "--relaxed-window: expected at most 2000 branches of the relaxed intersection",
+        ),
+    ],
+)
+def test_a_bad_nullable_or_costly_setting_is_named_with_its_option(given: list[str], message: str) -> None:
+    tool, seen = recorder()
+    result = runner.invoke(tool, ["x", *given])
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"error: {message}"), result.stderr
+    assert not seen

@@ -46,14 +46,28 @@ def test_the_defaults_are_the_library_defaults() -> None:
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        ({"sigmas": 0.0}, "sigmas: expected a positive number, got 0.0"),
-        ({"sigmas": "3"}, "sigmas: expected a positive number, got '3'"),
-        ({"sigmas": None}, "sigmas: expected a positive number, got None"),
+        ({"sigmas": 0.0}, r"sigmas: expected a number in \[0\.1, 100\], got 0\.0"),
+        ({"sigmas": "3"}, r"sigmas: expected a number in \[0\.1, 100\], got '3'"),
+        ({"sigmas": None}, r"sigmas: expected a number in \[0\.1, 100\], got None"),
+        # 1e300 overflowed the polygon's coordinates; 1e-300 bounded nothing
+        ({"sigmas": 1e300}, r"sigmas: expected a number in \[0\.1, 100\], got 1e\+300"),
+        ({"sigmas": 1e-300}, r"sigmas: expected a number in \[0\.1, 100\], got 1e-300"),
+        ({"envelope_factor": 1e300}, r"envelope_factor: expected a number in \[1, 100\], got 1e\+300"),
+        # 166,751 branches of the relaxed intersection: 2 GB and no end in 100 s
+        (
+            {"relaxed_q": 3, "relaxed_window": 100},
+            r"relaxed_q: expected at most 2000 branches of the relaxed intersection \(the sum of "
+            r"C\(relaxed_window, k\) for k <= relaxed_q\), got 166751 \(relaxed_q 3, relaxed_window 100\)",
+        ),
+        (
+            {"relaxed_q": 99_999, "relaxed_window": 100_000},
+            r"relaxed_q: expected at most 2000 branches .* got more than 1000000000000000 .*",
+        ),
         ({"area_limit": -1.0}, "area_limit: expected a positive number or none, got -1.0"),
         ({"area_limit": math.inf}, "area_limit: expected a finite positive number or none, got inf"),
         ({"missed_limit": 0}, "missed_limit: expected an integer >= 1, got 0"),
         ({"missed_limit": True}, "missed_limit: expected an integer >= 1, got True"),
-        ({"lost_window_scale": 0.5}, "lost_window_scale: expected a number >= 1, got 0.5"),
+        ({"lost_window_scale": 0.5}, r"lost_window_scale: expected a number in \[1, 100\], got 0\.5"),
         ({"joint_above": -0.1}, "joint_above: expected a number >= 0 or none, got -0.1"),
         ({"joint_above": math.nan}, "joint_above: expected a finite number >= 0 or none, got nan"),
         ({"joint_sector": 0.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 0.0"),
@@ -69,10 +83,11 @@ def test_the_defaults_are_the_library_defaults() -> None:
         # 2 pi / 1e-12 heading cells: a ValueError traceback from the kernel before
         (
             {"slice_width": 1e-12},
-            r"slice_width: expected at least 3\.74507e-07 rad \(16777216 heading cells\), got 1e-12",
+            r"slice_width: expected at least 0\.00174533 rad \(0\.1 degree, 3600 heading cells; a step costs "
+            r"in proportion to the cells\), got 1e-12",
         ),
         ({"robust": 1}, "robust: expected true or false, got 1"),
-        ({"envelope_factor": 0.9}, "envelope_factor: expected a number >= 1, got 0.9"),
+        ({"envelope_factor": 0.9}, r"envelope_factor: expected a number in \[1, 100\], got 0\.9"),
         ({"envelope_max_vertices": 1.5}, "envelope_max_vertices: expected an integer >= 3 or none, got 1.5"),
         ({"relocalize_after": 0}, "relocalize_after: expected an integer >= 1, got 0"),
         (

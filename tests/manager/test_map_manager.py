@@ -626,7 +626,7 @@ def edited(path: str, value: object) -> str:
             r"counters\.rejected\['unknown landmark id'\]",
         ),
         (edited("counters/accepted", None), r"counters\.accepted: expected an integer >= 0, got null"),
-        (edited("settings/sigmas", -3.0), r"settings\.sigmas: expected a positive number, got -3\.0"),
+        (edited("settings/sigmas", -3.0), r"settings\.sigmas: expected a number in \[0\.1, 100\], got -3\.0"),
         (edited("settings/missed_limit", 0), r"settings\.missed_limit: expected an integer >= 1, got 0"),
         (
             edited("settings/area_limit", "big"),

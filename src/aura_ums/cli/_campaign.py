@@ -40,11 +40,27 @@ Retries = Annotated[
     int,
     typer.Option("--retries", help="Times a run is submitted again after its worker died or it timed out."),
 ]
+
+
+def _timeout(text: str) -> float | None:
+    """Read ``--run-timeout``: seconds, or ``none`` (the default: no timeout)."""
+    if text.strip().lower() == "none":
+        return None
+    try:
+        if "_" in text:
+            raise ValueError(text)
+        return float(text)
+    except ValueError:
+        raise fail(f"--run-timeout: expected a positive number of seconds or none, got {text!r}") from None
+
+
 RunTimeout = Annotated[
     float | None,
     typer.Option(
         "--run-timeout",
-        help="Seconds a run may take on a worker before it is retried (its worker restarted); default none.",
+        help="Seconds a run may take on a worker before it is retried (its worker restarted), or none.",
+        parser=_timeout,
+        metavar="<seconds>",
     ),
 ]
 

@@ -212,8 +212,18 @@ class SettingOptions:
         return f"{flag}/{_off_flag(name)}" if _INFOS[name].kind is bool else flag
 
     def over(self, base: ManagerSettings | None = None) -> ManagerSettings:
-        """Return ``base`` (default: the defaults) with the options given; a bad value exits, named."""
-        return ManagerSettings.from_dict(self.given, base=base, fail=_fail_setting)
+        """Return ``base`` (default: the defaults) with the options given; a bad value exits, named.
+
+        The profile's fields go first, then the options typed: two that conflict are
+        blamed on the one typed (``--profile relaxed --relaxed-window 100000`` names
+        ``--relaxed-window``, not the ``relaxed_q`` the profile set).
+        """
+        profiled = {
+            name: value for name, value in self.given.items() if self.option_of(name).startswith("--profile ")
+        }
+        typed = {name: value for name, value in self.given.items() if name not in profiled}
+        start = ManagerSettings.from_dict(profiled, base=base, fail=_fail_setting) if profiled else base
+        return ManagerSettings.from_dict(typed, base=start, fail=_fail_setting)
 
 
 #: The ``settings`` parameter's placeholder default in a command's definition (see :func:`manager_options`).
@@ -254,6 +264,8 @@ def manager_options(default_from: str = "") -> Callable[[Callable[..., None]], C
                 if kwargs.pop(_OFF.format(name), False):
                     if value is not None:
                         raise fail(f"{setting_flag(name)}: expected it or {_off_flag(name)}, got both")
+                    given[name] = None
+                elif value is _NONE_TYPED:
                     given[name] = None
                 elif value is not None:
                     given[name] = value
@@ -333,12 +345,12 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
     angle = info.unit == "rad"
     if angle:
         unit += " (or in degrees: 2deg)"
-    help_text = f"{info.help}{unit}; {info.expected.removesuffix(' or none')}."
+    help_text = f"{info.help}{unit}; {info.expected}."
     option = typer.Option(
         flag,
         help=help_text,
         show_default=default,
-        parser=_angle_option(flag, info) if angle else None,
+        parser=_setting_option(flag, info) if angle or info.nullable else None,
         metavar="<angle>" if angle else None,
     )
     parameters = [
@@ -354,21 +366,34 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
     return parameters
 
 
-def _angle_option(flag: str, info: SettingInfo) -> Callable[[str], float]:
-    """Return the parser of an angle option: radians, or degrees with a suffix (``2deg``, ``2°``)."""
+# What the parser of a nullable setting's option returns for ``none``: apart from the None
+# of an option not given, so that ``--profile sliced --area-limit none`` overrides the profile.
+_NONE_TYPED: Any = object()
 
-    def parse(text: str) -> float:
-        value = info.read(text)
+
+def _setting_option(flag: str, info: SettingInfo) -> Callable[[str], object]:
+    """Return the parser of an angle option or a nullable setting's option.
+
+    An angle is radians, or degrees with a suffix (``2deg``, ``2°``); a nullable setting
+    also takes ``none``, as its help says.
+    """
+    angle = info.unit == "rad"
+    also = " (radians, or degrees as 2deg)" if angle else ""
+
+    def parse(text: str) -> object:
+        if info.nullable and text.strip().lower() == "none":
+            return _NONE_TYPED
+        if "_" in text:  # float() reads 1_000 as 1000: a typo, not a number
+            raise fail(f"{flag}: expected {info.expected}{also}, got {text!r}")
+        value = info.read(text) if angle else text
         if isinstance(value, float):
             if info.problem(value) is not None:  # named as typed, not as the radians it became
                 raise fail(f"{flag}: expected {info.expected}, got {text!r} ({value:.6g} rad)")
             return value
         try:
-            return float(text)
+            return int(text) if info.kind is int else float(text)
         except ValueError:
-            raise fail(
-                f"{flag}: expected {info.expected} (radians, or degrees as 2deg), got {text!r}"
-            ) from None
+            raise fail(f"{flag}: expected {info.expected}{also}, got {text!r}") from None
 
     return parse
 

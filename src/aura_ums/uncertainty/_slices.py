@@ -106,8 +106,12 @@ class HeadingSlice(NamedTuple):
         return HeadingWedge._trusted(self.lo + half, half, half)
 
 
-#: Most heading cells round the circle (the C kernel's limit), so the narrowest slice width.
-MAX_CELLS = 1 << 24
+#: Most heading cells round the circle, so the narrowest slice width (0.1 degree). Growth
+#: spreads a slice over every cell its headings cover, so a step costs in proportion to the
+#: cells: four_terrains.toml (one run, ``--profile relaxed --max-slices 100000``) took 1.4,
+#: 5.3 and 15.9 s at 720, 3600 and 7200 cells, and 1e-6 rad (6.3 million cells) ran out of
+#: memory. No odometry resolves a heading finer than a tenth of a degree.
+MAX_CELLS = 3600
 MIN_SLICE_WIDTH = _TWO_PI / MAX_CELLS
 
 
@@ -115,7 +119,7 @@ def cell_count(width: float) -> int:
     """Return the number of heading cells of a sliced map's grid for a cell width (radians, in (0, 2 pi]).
 
     The grid has a whole number of cells round the circle, each at most ``width`` wide
-    (``ManagerSettings.slice_width``); a width under ``2 pi / 2**24`` is refused.
+    (``ManagerSettings.slice_width``); a width under ``2 pi / 3600`` (0.1 degree) is refused.
 
     Examples
     --------
@@ -124,11 +128,12 @@ def cell_count(width: float) -> int:
     >>> cell_count(1e-12)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: slice_width: expected at least 3.74507e-07 rad (...), got 1e-12
+    aura_ums.errors.InputError: slice_width: expected at least 0.00174533 rad (...), got 1e-12
     """
     if width < MIN_SLICE_WIDTH:
         raise InputError(
-            f"slice_width: expected at least {MIN_SLICE_WIDTH:g} rad ({MAX_CELLS} heading cells), "
+            f"slice_width: expected at least {MIN_SLICE_WIDTH:g} rad (0.1 degree, {MAX_CELLS} heading "
+            f"cells; a step costs in proportion to the cells), "
             f"got {width!r}"
         )
     return max(1, math.ceil(_TWO_PI / width - 1e-9))
