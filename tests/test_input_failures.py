@@ -8,6 +8,7 @@ estimate. The CLI turns these errors into exit 2 (tests/cli); here the readers a
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -442,7 +443,12 @@ def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path)
     ("parameters", "message"),
     [
         ({"bogus": 1}, r"pole_a\.parameters: expected names among orientation, .*, got 'bogus'"),
-        ({"min_length": -5}, r"min_length: expected a non-negative number, got -5\.0"),
+        ({"min_length": -5}, r"pole_a\.parameters\.min_length: expected a non-negative number, got -5\.0"),
+        # a Gaussian of 1e9 px asked scipy for 59.6 GiB (a MemoryError traceback)
+        (
+            {"smoothing": 1e9},
+            r"pole_a\.parameters\.smoothing: expected a number in \[0, 100\] px, got 1000000000\.0",
+        ),
     ],
 )
 def test_a_strategy_parameter_perception_refuses_names_the_scenarios_map(
@@ -564,3 +570,140 @@ def test_monte_carlo_runs_are_limited_with_the_estimate() -> None:
     seconds, memory = scenario.estimate()
     assert 0.0 < seconds < 1.0
     assert math.isclose(memory, 512 * 480 * 200 + 40 * 400)
+
+
+# --- found by the TOML and log fuzz passes after the first round ------------------------------
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # the robot was simulated into the gap and stopped with "start: expected a point inside
+        # a meadow for a zero-length run", naming neither the file nor the command
+        (
+            "{ turn_deg = 0.0, run = 6.096 },   # to 40 ft",
+            "{ turn_deg = 0.0, run = 9000.0 },",
+            r"walk\.toml: \[route\] commands\[2\]: expected a route inside the map's meadows, got a leg "
+            r"from \(6\.096, 0\) to \(9006\.1, 0\) that leaves them",
+        ),
+        # 100,000 short commands are 100,001 frames: the estimate blamed the camera
+        (
+            "commands = [\n",
+            "commands = [\n" + "{ turn_deg = 0.0, run = 0.0001 },\n" * 100_000,
+            r"walk\.toml: \[route\]: expected at most 600 s and 4 GB a run, got 100004 frames",
+        ),
+    ],
+    ids=["a-run-off-the-map", "too-many-commands"],
+)
+def test_a_route_is_checked_where_the_scenario_names_it(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    with pytest.raises(FileFormatError, match=message):
+        Scenario.from_toml(scenario_file(tmp_path, old, new))
+
+
+def test_a_waypoint_across_a_gap_between_meadows_is_refused(tmp_path: Path) -> None:
+    # was simulated: the robot crossed ground no meadow covers and the run was lost
+    for name in ("four_terrains.toml", "paper_camera.toml"):
+        shutil.copy(REPOSITORY / "scenarios" / name, tmp_path / name)
+    document = json.loads((REPOSITORY / "scenarios" / "four_terrains.geojson").read_text())
+    del document["features"][1]
+    (tmp_path / "four_terrains.geojson").write_text(json.dumps(document))
+    with pytest.raises(
+        FileFormatError,
+        match=r"four_terrains\.toml: \[route\] waypoints\[\d\]: expected a route inside the map's meadows",
+    ):
+        Scenario.from_toml(tmp_path / "four_terrains.toml")
+
+
+def test_a_maps_terrain_table_reference_is_checked_when_another_table_is_given(tmp_path: Path) -> None:
+    # ignored when the caller gave a table: a broken reference loaded in silence
+    document = json.loads((REPOSITORY / "scenarios" / "four_terrains.geojson").read_text())
+    document["terrain_table"] = "gone.toml"
+    path = tmp_path / "map.geojson"
+    path.write_text(json.dumps(document))
+    table = TerrainTable.default()
+    with pytest.raises(FileFormatError, match=r"map\.geojson: terrain_table: expected a terrain table file"):
+        MeadowMap.from_geojson(path, terrain_table=table)
+
+
+def test_a_camera_below_the_ground_is_refused(tmp_path: Path) -> None:
+    # -5 m gave every window zero width, and containment 0, with exit 0
+    text = (REPOSITORY / "scenarios" / "paper_camera.toml").read_text()
+    height = re.search(r"\[mount\]\nheight = [^\n]+", text)
+    assert height is not None
+    path = tmp_path / "camera.toml"
+    path.write_text(text.replace(height.group(0), "[mount]\nheight = -5.0"))
+    with pytest.raises(
+        FileFormatError, match=r"camera\.toml: \[mount\] height: expected a number in \[0, 100\] m"
+    ):
+        load_camera(path)
+    with pytest.raises(InputError, match=r"CameraMount\.height: expected a height >= 0 m above the ground"):
+        CameraMount(-5.0)
+    assert CameraMount(0.0).height == 0.0
+
+
+@pytest.mark.parametrize("cell", ["\uff11.5", "\u0661.5"], ids=["full-width", "arabic-indic"])
+def test_digits_other_than_ascii_are_refused_in_a_log(tmp_path: Path, cell: str) -> None:
+    # float() reads them as digits: a full-width 1 before "0.5" was the time 10.5
+    observations = LOG["observations.csv"].replace("1.0,B", f"{cell},B")
+    with pytest.raises(
+        FileFormatError, match=rf"observations\.csv:3: expected a number in column 'time', got '{cell}'"
+    ):
+        load_log(log_folder(tmp_path, observations_csv=observations))
+
+
+def test_a_broken_ground_truth_link_is_named_not_taken_for_no_ground_truth(tmp_path: Path) -> None:
+    folder = log_folder(tmp_path)
+    (folder / "groundtruth.csv").symlink_to(tmp_path / "gone.csv")
+    with pytest.raises(
+        FileFormatError, match=r"groundtruth\.csv: expected an existing CSV file, got no such file"
+    ):
+        load_log(folder)
+
+
+@pytest.mark.parametrize("name", ["robot\\u001b[2J", "a\\u0007bell"])
+def test_a_log_name_with_control_characters_is_refused(tmp_path: Path, name: str) -> None:
+    # the name is printed: an escape sequence reached the terminal
+    meta = f'name = "{name}"\n' + LOG["meta.toml"].split("\n", 1)[1]
+    with pytest.raises(FileFormatError, match=r"meta\.toml: .*expected printable characters"):
+        load_log(log_folder(tmp_path, meta_toml=meta))
+
+
+def test_a_range_of_1e_300_does_not_overflow_the_calibration() -> None:
+    # its relative error overflowed (numpy warnings, then FilterNoise named in the error)
+    log = synthetic_log(np.random.default_rng(3), duration=60.0)
+    first = log.observations[0]
+    assert first.range is not None
+    rest = log.observations[1:]
+    tiny = calibrate_logs(
+        [dataclasses.replace(log, observations=(dataclasses.replace(first, range=1e-300), *rest))]
+    )
+    none = calibrate_logs(
+        [dataclasses.replace(log, observations=(dataclasses.replace(first, range=None), *rest))]
+    )
+    assert (tiny.noise, tiny.working, tiny.envelope) == (none.noise, none.working, none.envelope)
+
+
+def test_a_delay_that_moves_the_start_past_the_ground_truth_is_named() -> None:
+    # blamed groundtruth.csv alone: "the start lies between two rows more than 0.5 s apart"
+    from aura_ums.logs import replay_log
+
+    log = synthetic_log(np.random.default_rng(4), duration=10.0)
+    late = dataclasses.replace(log, meta=dataclasses.replace(log.meta, start=None, delay_s=3600.0))
+    with pytest.raises(
+        InputError, match=r"or after the last row; the motion's delay_s \(3600 s, of the sensors"
+    ):
+        replay_log(late, TerrainTable({"floor": TerrainTable.default()["tile"]}))
+
+
+def test_files_of_one_log_whose_clocks_disagree_are_refused(tmp_path: Path) -> None:
+    # each file continuous, the observations 30 days after the motion: loaded, and replayed
+    # as a run that never sees a landmark
+    observations = LOG["observations.csv"].replace("0.5,A", "2592000.5,A").replace("1.0,B", "2592001.0,B")
+    with pytest.raises(
+        FileFormatError,
+        match=r"log: expected the times of odometry\.csv and observations\.csv to overlap \(at most 86400 s "
+        r"apart\), got 0 to 2 s and 2592000\.5 to 2592001 s",
+    ):
+        load_log(log_folder(tmp_path, observations_csv=observations))

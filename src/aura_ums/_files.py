@@ -174,6 +174,23 @@ def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None
     return data
 
 
+def present(path: str | os.PathLike[str]) -> bool:
+    """Whether an optional file is there: a link that leads nowhere (or round in a loop) is.
+
+    ``Path.exists`` calls such a link absent, so a log whose ``groundtruth.csv`` was a
+    broken link replayed without ground truth in silence; present, its reader names it.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> (folder / "link").symlink_to(folder / "gone")
+    >>> present(folder / "link"), (folder / "link").exists(), present(folder / "other")
+    (True, False, False)
+    """
+    return os.path.lexists(path)
+
+
 def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
     """Return ``path`` as a folder whose files can be read, or refuse it naming why.
 

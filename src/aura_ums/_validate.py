@@ -124,9 +124,10 @@ LENGTH = Range(0.0, 1e4, "m")
 HEIGHT = Range(-1e4, 1e4, "m")
 #: An angle as given (bearing, heading, turn), radians; wrapped where it is used.
 ANGLE = Range(-1e3, 1e3, "rad")
-#: A bound on an angle's error, radians, > 0 (from pi on it says nothing; a widened
-#: envelope may pass it, so only absurd magnitudes are refused).
-ANGLE_ERROR = Range(0.0, 1e3, "rad", low_open=True)
+#: A bound on an angle's error, radians, from a microradian (no robot's sensor bounds a
+#: bearing closer; 1e-300 rad passed and bounded the map to nothing) to absurd magnitudes
+#: (from pi on it says nothing, but a widened envelope may pass it).
+ANGLE_ERROR = Range(1e-6, 1e3, "rad")
 #: A time stamp, seconds (Unix times run to 1e10 s in the year 2286).
 TIME = Range(-1e10, 1e10, "s")
 #: Forward velocity of a ground robot, m/s (100 m/s is 360 km/h).
@@ -135,6 +136,10 @@ SPEED = Range(-100.0, 100.0, "m/s")
 ANGULAR_SPEED = Range(-100.0, 100.0, "rad/s")
 #: A dimensionless factor (scales, fractions of a range), > 0.
 FACTOR = Range(0.0, 100.0, "", low_open=True)
+#: A scale on recorded odometry (``run_scale``, ``turn_scale``): near 1 when calibrated, 1e-3
+#: or 1e3 for odometry in other units (millimetres, milliradians); 1e-300 passed and stopped
+#: the map growing.
+ODOMETRY_SCALE = Range(1e-3, 1e3, "")
 #: Delay of recorded motion behind the true motion, seconds (an hour).
 DELAY = Range(0.0, 3600.0, "s")
 #: Seconds between two motion rows of a log: a longer gap is a clock jump, not a held velocity.
@@ -148,6 +153,9 @@ DISTORTION = Range(-1000.0, 1000.0)
 FOCAL_LENGTH = Range(0.0, 1e6, "px", low_open=True)
 #: A principal point or pixel coordinate, pixels.
 PIXEL = Range(-1e5, 1e5, "px")
+#: Standard deviation of a Gaussian blur of an image, pixels: beyond 100 px it blurs a frame
+#: to one grey, and its kernel grows with it (a sigma of 1e9 px asked for 59.6 GiB).
+BLUR = Range(0.0, 100.0, "px")
 
 
 def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:

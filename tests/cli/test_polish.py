@@ -281,3 +281,20 @@ def test_an_option_that_would_have_no_effect_is_refused(walk: tuple[Path, Path],
     assert not (tmp_path / "never.toml").exists()
     # The same options with what they need, or left out, run.
     assert "containment_rate" in invoke(*replay).stdout
+
+
+def test_until_before_the_start_and_a_run_timeout_of_none(tmp_path: Path) -> None:
+    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+    # --until -1 replayed no frame and exited 0 with figures of none
+    result = runner.invoke(app, [*replay, "--until", "-1"])
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error: --until: expected a time at or after the replay's start (")
+    # "default none" in the help, and 'none' was refused by typer
+    result = runner.invoke(app, [*replay, "--run-timeout", "none"])
+    assert result.stderr.startswith("error: --run-timeout: expected --workers above 1 or --scheduler too")
+    bad = runner.invoke(app, [*replay, "--run-timeout", "soon"])
+    assert bad.exit_code == 2
+    assert bad.stderr == "error: --run-timeout: expected a positive number of seconds or none, got 'soon'\n"

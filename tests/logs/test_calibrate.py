@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import Path
 
 import numpy as np
@@ -95,9 +96,36 @@ def test_out_of_range_sensor_value_is_named(tmp_path: Path) -> None:
         .replace("[working]\nbearing_error = ", "[working]\nbearing_error = -")
     )
     with pytest.raises(
-        FileFormatError, match=r"neg\.toml: \[working\] bearing_error: expected a number in \(0, 1000\] rad"
+        FileFormatError,
+        match=r"neg\.toml: \[working\] bearing_error: expected a number in \[1e-06, 1000\] rad",
     ):
         load_sensors(_write(tmp_path / "neg.toml", text))
+
+
+def test_an_envelope_narrower_than_the_working_bounds_is_refused(tmp_path: Path) -> None:
+    calibration = calibrate_logs([synthetic_log(np.random.default_rng(1), duration=60.0)])
+    narrow = calibration.working.bearing_error / 2.0
+    text = re.sub(
+        r"(\[envelope\]\nbearing_error = )[^\n]+",
+        lambda m: f"{m.group(1)}{narrow!r}",
+        calibration.sensors_toml(),
+    )
+    with pytest.raises(
+        FileFormatError,
+        match=r"narrow\.toml: \[envelope\] bearing_error: expected at least \[working\] bearing_error",
+    ):
+        load_sensors(_write(tmp_path / "narrow.toml", text))
+
+
+@pytest.mark.parametrize(("key", "value"), [("run_scale", "1e-300"), ("turn_scale", "1e4")])
+def test_an_odometry_scale_beyond_any_units_is_refused(tmp_path: Path, key: str, value: str) -> None:
+    text = re.sub(
+        rf"(\n{key} = )[^\n]+",
+        lambda m: f"{m.group(1)}{value}",
+        calibrate_logs([synthetic_log(np.random.default_rng(1), duration=60.0)]).sensors_toml(),
+    )
+    with pytest.raises(FileFormatError, match=rf"\[motion\] {key}: expected a number in \[0\.001, 1000\]"):
+        load_sensors(_write(tmp_path / "scale.toml", text))
 
 
 def test_calibration_input_errors() -> None:

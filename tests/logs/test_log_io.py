@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from aura_ums._files import MAX_BYTES
-from aura_ums._validate import ANGULAR_SPEED, COORDINATE, DELAY, ROW_GAP, SPEED, TIME, Range
+from aura_ums._validate import ANGLE_ERROR, ANGULAR_SPEED, COORDINATE, DELAY, ROW_GAP, SPEED, TIME, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
     LogLandmark,
@@ -61,7 +61,7 @@ def within(bounds: Range) -> st.SearchStrategy[float]:
         exclude_min=bounds.low_open,
         exclude_max=bounds.high_open,
         allow_nan=False,
-        allow_subnormal=True,
+        allow_subnormal=bounds.low <= 0.0,
     )
 
 
@@ -84,7 +84,7 @@ def random_logs(draw: st.DrawFn) -> RobotLog:
     )
     # Observations at most a day apart too (half a day: rounding the sums keeps them within).
     steps = draw(st.lists(st.floats(0.0, ROW_GAP.high / 2.0), min_size=0, max_size=5))
-    first = draw(st.floats(TIME.low, TIME.high - 3.0 * ROW_GAP.high))
+    first = draw(st.floats(TIME.low, TIME.high - 6.0 * ROW_GAP.high))
     times = list(itertools.accumulate(steps, initial=first))[: draw(st.integers(0, 6))]
     observations = tuple(
         LogObservation(
@@ -92,17 +92,20 @@ def random_logs(draw: st.DrawFn) -> RobotLog:
             draw(st.sampled_from(ids)),
             draw(st.floats(-math.pi, math.pi, exclude_min=True)),
             range=draw(st.none() | positive),
-            bearing_error=draw(st.none() | positive),
+            bearing_error=draw(st.none() | within(ANGLE_ERROR)),
         )
         for time in times
     )
     # Rows at most a day apart: a longer gap is a clock jump (refused on reading).
     gaps = draw(st.lists(st.floats(1e-3, ROW_GAP.high), min_size=0, max_size=5))
-    motion = list(itertools.accumulate(gaps, initial=draw(st.floats(-1e9, 1e9))))
+    # The files share a clock: the motion starts within half a day of the first observation.
+    start = first + draw(st.floats(0.0, ROW_GAP.high / 2.0)) if times else draw(st.floats(-1e9, 1e9))
+    motion = list(itertools.accumulate(gaps, initial=start))
     odometry = Odometry(
         motion, [draw(within(SPEED)) for _ in motion], [draw(within(ANGULAR_SPEED)) for _ in motion]
     )
-    meta = LogMeta(draw(st.text(max_size=12)), bearing_error=draw(positive), delay_s=draw(within(DELAY)))
+    name = draw(st.text(max_size=12).filter(str.isprintable))
+    meta = LogMeta(name, bearing_error=draw(within(ANGLE_ERROR)), delay_s=draw(within(DELAY)))
     return RobotLog(meta, landmarks, observations, odometry=odometry)
 
 
@@ -297,7 +300,7 @@ BAD_CSV_CASES = [
     (
         "observations.csv",
         "time,landmark_id,bearing,bearing_error\n0,A,0,0\n",
-        r"observations.csv:2: expected a number in \(0, 1000\] rad in column 'bearing_error', got '0'",
+        r"observations.csv:2: expected a number in \[1e-06, 1000\] rad in column 'bearing_error', got '0'",
     ),
     (
         "observations.csv",
@@ -394,7 +397,7 @@ BAD_META_CASES = [
     ),
     (
         "[sensor]\nbearing_error = 0\n",
-        r"meta\.toml: \[sensor\] bearing_error: expected a number in \(0, 1000\] rad, got 0",
+        r"meta\.toml: \[sensor\] bearing_error: expected a number in \[1e-06, 1000\] rad, got 0",
     ),
     (
         "[sensor]\nrange_error = -0.1\n",
@@ -402,7 +405,7 @@ BAD_META_CASES = [
     ),
     (
         "[motion]\nrun_scale = -1\n",
-        r"meta\.toml: \[motion\] run_scale: expected a number in \(0, 100\], got -1",
+        r"meta\.toml: \[motion\] run_scale: expected a number in \[0\.001, 1000\], got -1",
     ),
     ("[motion]\ndelay_s = -0.5\n", r"meta\.toml: \[motion\] delay_s: expected a number in \[0, 3600\] s"),
     (

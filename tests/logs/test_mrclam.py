@@ -101,6 +101,27 @@ def test_tiny_dataset(tmp_path: Path) -> None:
             {"Landmark_Groundtruth.dat": HEADER + "6 0.5 -4.0 -1e400 0.1\n"},
             r"Landmark_Groundtruth\.dat:5: expected finite numbers",
         ),
+        # float() reads 0_1 as 1 and full-width digits as digits
+        (
+            {"Robot1_Measurement.dat": HEADER + "10.0 63 2_0 0.5\n"},
+            r"Robot1_Measurement\.dat:5: expected numbers \(time, barcode, range, bearing\), "
+            r"got '10\.0 63 2_0",
+        ),
+        (
+            {"Robot1_Measurement.dat": HEADER + "10.0 63 \uff12.0 0.5\n"},
+            r"Robot1_Measurement\.dat:5: expected numbers \(time, barcode, range, bearing\)",
+        ),
+        # a form feed (or U+2028, NEL) in a comment counted as a line break: every later
+        # line number was one too many
+        (
+            {"Robot1_Measurement.dat": HEADER + "# page\x0cbreak\u2028here\n10.0 63 -2.0 0.5\n"},
+            r"Robot1_Measurement\.dat:6: expected range a number in \[0, 10000\] m",
+        ),
+        # each file continuous, the measurements 30 days after the rest
+        (
+            {"Robot1_Measurement.dat": HEADER + "2592010.0 63 2.0 0.5\n2592011.0 81 4.0 -0.1\n"},
+            r"expected the times of Robot1_Odometry\.dat and Robot1_Measurement\.dat to overlap",
+        ),
     ],
 )
 def test_malformed_files_are_named_with_their_line(

@@ -81,6 +81,11 @@ def test_a_state_before_any_frame_and_bad_states() -> None:
     log = synthetic_log(np.random.default_rng(12), duration=10.0)
     empty = replay_log(log, TABLE, until=-1.0, save_state=True)
     assert empty.steps == ()
+    # without a state to save, a replay of no frame is refused (it exited 0 with no figures)
+    with pytest.raises(
+        InputError, match=r"^until: expected a time at or after the replay's start \(.* s\), got -1\.0$"
+    ):
+        replay_log(log, TABLE, until=-1.0)
     assert empty.state is not None
     assert math.isnan(empty.state.last_time)
     assert math.isnan(ReplayState.from_json(empty.state.to_json()).last_time)

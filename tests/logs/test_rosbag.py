@@ -435,3 +435,95 @@ def test_a_damaged_or_endless_bag_is_refused_naming_it(bag: Path, tmp_path: Path
     endless.symlink_to("/dev/zero")
     with pytest.raises(FileFormatError, match=r"zero\.bag: expected a ROS bag file, got a device"):
         read(endless)
+
+
+def _set(messages: list[Message], index: int, part: str, **values: float) -> list[Message]:
+    """The messages with fields of one message's ``part`` (a dotted path) set to ``values``."""
+    target = messages[index][1]
+    for name in part.split("."):
+        target = getattr(target, name)
+    for name, value in values.items():
+        setattr(target, name, value)
+    return messages
+
+
+def _shifted(store: Typestore, messages: Sequence[Message], seconds: float, first: int = 0) -> list[Message]:
+    """The messages from ``first`` on stamped ``seconds`` later (header and receive time)."""
+    moved: list[Message] = []
+    for index, (received, message) in enumerate(messages):
+        if index >= first:
+            time = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9 + seconds
+            message.header.stamp = stamp(store, time)
+            received += ns(seconds)
+        moved.append((received, message))
+    return moved
+
+
+@pytest.mark.parametrize(
+    ("topic", "change", "match"),
+    [
+        # accepted on import, refused on replay: the import wrote a log nothing could read
+        (
+            "/landmarks",
+            lambda store, ms: _set(ms, 0, "point", y=1e300),
+            r"topic /landmarks, message 0: expected bearing to be a number in \[-1000, 1000\] rad, "
+            r"got 1e\+300",
+        ),
+        (
+            "/landmarks",
+            lambda store, ms: _set(ms, 1, "point", x=1e308),
+            r"topic /landmarks, message 1: expected range to be a number in \[0, 10000\] m, got 1e\+308",
+        ),
+        (
+            "/odom",
+            lambda store, ms: _set(ms, 0, "twist.twist.linear", x=1e308),
+            r"topic /odom, message 0: expected v to be a number in \[-100, 100\] m/s, got 1e\+308",
+        ),
+        (
+            "/odom",
+            lambda store, ms: _shifted(store, ms, 30 * 86400.0, first=10),
+            r"topic /odom, message 10: expected motion messages at most 86400 s apart, got 2\.592e\+06 s",
+        ),
+        # a zero quaternion became heading 0 in silence
+        (
+            "/truth",
+            lambda store, ms: _set(ms, 3, "pose.orientation", w=0.0, z=0.0),
+            r"topic /truth, message 3: expected a finite pose and a unit orientation quaternion, got .*"
+            r"orientation \(0\.0, 0\.0, 0\.0, 0\.0\)",
+        ),
+        # each topic continuous, the observations 30 days after the motion
+        (
+            "/landmarks",
+            lambda store, ms: _shifted(store, ms, 30 * 86400.0),
+            r"expected the times of topic /odom and topic /landmarks to overlap \(at most 86400 s apart\)",
+        ),
+    ],
+    ids=["bearing-1e300", "range-1e308", "speed-1e308", "clock-jump", "zero-quaternion", "clock-offset"],
+)
+def test_what_a_log_may_not_hold_is_refused_on_import(
+    run: Run, tmp_path: Path, topic: str, change: Callable[[Typestore, Sequence[Message]], Any], match: str
+) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    topics = standard_topics(run, store)
+    kind, messages = topics[topic]
+    topics[topic] = (kind, change(store, list(messages)))
+    path = write_bag(tmp_path / "bad", topics)
+    with pytest.raises(FileFormatError, match=match):
+        read(path)
+
+
+def test_a_topic_the_bags_index_counts_as_empty_is_read_when_it_has_messages(
+    run: Run, tmp_path: Path
+) -> None:
+    # called "expected at least one observation message, got none" on the index's word alone
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    path = write_bag(tmp_path / "miscounted", standard_topics(run, store), StoragePlugin.SQLITE3)
+    metadata = path / "metadata.yaml"
+    text = metadata.read_text()
+    miscounted = text.replace(
+        "- message_count: 30\n    topic_metadata:\n      name: /landmarks",
+        "- message_count: 0\n    topic_metadata:\n      name: /landmarks",
+    )
+    assert miscounted != text
+    metadata.write_text(miscounted)
+    assert len(read(path).observations) == len(run.observations)

@@ -132,7 +132,7 @@ def test_interest_operator_and_region_segmenter_are_parameterized() -> None:
         ),
         (
             LandmarkRecord(CORNER, PerceptualStrategy.INTEREST_OPERATOR, {"window": 4.0}, 30.0, 1.0),
-            "size: expected an odd integer, got 4",
+            r"\.parameters\.window: expected an odd integer, got 4",
         ),
         (
             LandmarkRecord(POLE, PerceptualStrategy.REGION_SEGMENTER, {"min_aspect": 0.0}, 30.0, 1.0),

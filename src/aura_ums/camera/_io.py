@@ -66,7 +66,7 @@ KEY_RANGES: dict[str, dict[str, Range]] = {
         "distortion": DISTORTION,  # each coefficient (OpenCV files too)
     },
     "mount": {
-        "height": MOUNT_OFFSET,
+        "height": Range(0.0, MOUNT_OFFSET.high, "m"),  # above the ground
         "forward": MOUNT_OFFSET,
         "left": MOUNT_OFFSET,
         "pan": ANGLE,

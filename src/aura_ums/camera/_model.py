@@ -114,7 +114,7 @@ class CameraMount:
     Parameters
     ----------
     height : float
-        Optical centre above the ground plane, metres.
+        Optical centre above the ground plane, metres, >= 0.
     forward, left : float
         Optical centre's offset from the robot's reference point, metres (robot frame).
     pan : float
@@ -132,6 +132,11 @@ class CameraMount:
     def __post_init__(self) -> None:
         for name in ("height", "forward", "left", "pan", "tilt"):
             object.__setattr__(self, name, finite_float(getattr(self, name), f"CameraMount.{name}"))
+        if self.height < 0.0:
+            # below the ground plane every landmark's foot is above the camera: all windows were empty
+            raise InputError(
+                f"CameraMount.height: expected a height >= 0 m above the ground, got {self.height}"
+            )
         if abs(self.tilt) >= math.pi / 2:
             raise InputError(f"CameraMount.tilt: expected |tilt| < pi/2, got {self.tilt}")
 

@@ -532,7 +532,7 @@ def replay(
         if resume is not None and message.startswith("resume: "):
             # the library names its argument; the user gave a file
             message = f"{resume}: --{message}"
-        elif resume is not None and message.startswith("until: "):
+        elif message.startswith("until: "):
             message = f"--{message.replace('the resumed state', f'the state in {resume}', 1)}"
         raise fail(message) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import ANGLE_ERROR, DELAY, FACTOR, LENGTH, Range, finite_float, positive_float
+from aura_ums._validate import ANGLE_ERROR, DELAY, LENGTH, ODOMETRY_SCALE, Range, finite_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import (
@@ -44,8 +44,8 @@ _NOISE_KEYS = ("bearing_sd", "range_sd_fraction")
 #: The physical range of every number of a sensor calibration file (docs/formats.md lists them).
 KEY_RANGES: dict[str, Range] = {
     "delay_s": DELAY,
-    "run_scale": FACTOR,
-    "turn_scale": FACTOR,
+    "run_scale": ODOMETRY_SCALE,
+    "turn_scale": ODOMETRY_SCALE,
     "bearing_error": ANGLE_ERROR,
     "range_error": LENGTH,
     "range_fraction_low": Range(0.0, 1.0, high_open=True),
@@ -339,7 +339,16 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
         _build(reader, document, "noise", _NOISE_KEYS, FilterNoise)
     motion = _build(reader, document, "motion", _MOTION_KEYS, MotionCalibration)
     working = _build(reader, document, "working", _SENSOR_KEYS, SensorBounds)
-    return motion, working, _build(reader, document, "envelope", _SENSOR_KEYS, SensorBounds)
+    envelope = _build(reader, document, "envelope", _SENSOR_KEYS, SensorBounds)
+    for key in _SENSOR_KEYS:
+        # The envelope is the worst case the working bounds may be wrong within: a narrower
+        # one re-localized into a map that excluded the truth.
+        wide, narrow = getattr(envelope, key), getattr(working, key)
+        if wide < narrow:
+            raise reader.error(
+                key_path("[envelope]", key), f"expected at least [working] {key} ({narrow!r}), got {wide!r}"
+            )
+    return motion, working, envelope
 
 
 def load_noise(path: str | Path) -> FilterNoise | None:
@@ -1068,6 +1077,11 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
     return bearing, error / measured
 
 
+#: Shortest measured range whose error calibrates the range bounds, metres: the relative
+#: error of a range of 1e-300 m overflowed, and no range sensor measures under a millimetre.
+_SHORTEST_RANGE = 1e-3
+
+
 def _observation_errors(
     logs: Sequence[RobotLog],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -1092,7 +1106,7 @@ def _observation_errors(
         error = np.angle(np.exp(1j * (measured - true_bearing)))
         bearing.append(error[keep])
         measured_range = np.array([np.nan if o.range is None else o.range for o in log.observations])
-        with_range = keep & ~np.isnan(measured_range) & (measured_range > 0.0)
+        with_range = keep & ~np.isnan(measured_range) & (measured_range >= _SHORTEST_RANGE)
         errors.append(measured_range[with_range] - np.hypot(dx, dy)[with_range])
         measured_ranges.append(measured_range[with_range])
     empty = np.empty(0, dtype=np.float64)

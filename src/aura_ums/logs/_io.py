@@ -35,6 +35,7 @@ from aura_ums._files import (
     key_path,
     load_toml,
     parse_csv,
+    present,
     read_csv_floats,
     read_folder,
     read_text,
@@ -46,9 +47,9 @@ from aura_ums._validate import (
     ANGULAR_SPEED,
     COORDINATE,
     DELAY,
-    FACTOR,
     HEIGHT,
     LENGTH,
+    ODOMETRY_SCALE,
     POSITION_UNCERTAINTY,
     ROW_GAP,
     SENSOR_OFFSET,
@@ -58,7 +59,15 @@ from aura_ums._validate import (
     Range,
 )
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.logs._log import (
+    GroundTruth,
+    LogLandmark,
+    LogMeta,
+    LogObservation,
+    Odometry,
+    RobotLog,
+    printable,
+)
 from aura_ums.logs._odometry import DEFAULT_MAX_INTERVAL, NO_REVERSE, ReversingError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TurnAndRun
@@ -128,14 +137,14 @@ _META_KEYS: dict[str, dict[str, tuple[str, str, Range | None]]] = {
     "sensor": {
         "bearing_error": ("bearing_error", "angle", ANGLE_ERROR),
         "range_error": ("range_error", "length", LENGTH),
-        "range_error_fraction": ("range_error_fraction", "", Range(0.0, 10.0)),
+        "range_error_fraction": ("range_error_fraction", "", Range(0.0, 1.0, high_open=True)),
         "forward": ("sensor_forward", "length", SENSOR_OFFSET),
         "left": ("sensor_left", "length", SENSOR_OFFSET),
     },
     "motion": {
         "delay_s": ("delay_s", "", DELAY),
-        "run_scale": ("run_scale", "", FACTOR),
-        "turn_scale": ("turn_scale", "", FACTOR),
+        "run_scale": ("run_scale", "", ODOMETRY_SCALE),
+        "turn_scale": ("turn_scale", "", ODOMETRY_SCALE),
     },
     "start": {
         "x": ("start.x", "length", COORDINATE),
@@ -317,8 +326,9 @@ class _CsvFile:
             result: NDArray[np.float64] = values if factor == 1.0 else values * factor
         else:
             cells = self.cells[column]
-            # float() reads "0_03" as 3.0 (Python's digit grouping): no CSV writer means that.
-            grouped = next((row for row, cell in enumerate(cells) if "_" in cell), None)
+            # float() reads "0_03" as 3.0 (Python's digit grouping) and full-width or Arabic-Indic
+            # digits as digits: no CSV writer means either.
+            grouped = next((row for row, cell in enumerate(cells) if "_" in cell or not cell.isascii()), None)
             if grouped is not None:
                 got = describe(cells[grouped])
                 self.fail_at(grouped, f"expected a number in column {column!r}, got {got}")
@@ -503,7 +513,7 @@ class _MetaReader:
             self.fail("[start]", f"expected x, y and heading together (or none of them), got only {given}")
         if pose:
             values["start"] = Pose(pose["x"], pose["y"], pose["heading"])  # type: ignore[arg-type]
-        values.setdefault("name", default_name)
+        values.setdefault("name", printable(default_name))  # a folder name may hold a line break
         try:
             meta = LogMeta(**values)  # type: ignore[arg-type]
         except InputError as exc:
@@ -566,14 +576,19 @@ def load_log(folder: str | os.PathLike[str]) -> RobotLog:
     meta, units = _MetaReader(base / META).read(base.name)
     landmarks = _read_landmarks(base / LANDMARKS, units)
     observations = _read_observations(base / OBSERVATIONS, units, {item.id for item in landmarks})
-    has_odometry, has_commands = (base / ODOMETRY).exists(), (base / COMMANDS).exists()
+    has_odometry, has_commands = present(base / ODOMETRY), present(base / COMMANDS)
     if has_odometry == has_commands:
         got = "both" if has_odometry else "neither"
         raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
     odometry = _read_odometry(base / ODOMETRY, units) if has_odometry else None
     commands = None if has_odometry else _read_commands(base / COMMANDS, units)
-    groundtruth = _read_groundtruth(base / GROUNDTRUTH, units) if (base / GROUNDTRUTH).exists() else None
-    return RobotLog(meta, landmarks, observations, odometry, commands, groundtruth, base)
+    groundtruth = _read_groundtruth(base / GROUNDTRUTH, units) if present(base / GROUNDTRUTH) else None
+    log = RobotLog(meta, landmarks, observations, odometry, commands, groundtruth, base)
+    names = {"motion": ODOMETRY if has_odometry else COMMANDS, "observations": OBSERVATIONS}
+    problem = log.unaligned_clocks({**names, "ground truth": GROUNDTRUTH})
+    if problem is not None:
+        raise FileFormatError(str(base), "", problem)
+    return log
 
 
 def _read_landmarks(path: Path, units: Units) -> tuple[LogLandmark, ...]:
@@ -921,7 +936,7 @@ def log_files_in(folder: str | os.PathLike[str]) -> tuple[str, ...]:
     ('meta.toml', 'landmarks.csv')
     """
     base = Path(folder)
-    return tuple(name for name in LOG_FILES if (base / name).exists())
+    return tuple(name for name in LOG_FILES if present(base / name))
 
 
 def write_log(

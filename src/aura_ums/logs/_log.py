@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import enum
+import itertools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import cast
@@ -12,7 +13,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, float_array, integer_at_least, read_only
+from aura_ums._validate import ROW_GAP, finite_float, float_array, integer_at_least, read_only
 from aura_ums.errors import InputError, UnknownLandmarkError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, reports_of
@@ -43,9 +44,22 @@ def _text(value: object, name: str, *, empty: bool = False) -> str:
         raise InputError(f"{name}: expected a string, got {value!r}")
     if not empty and (not value or value != value.strip()):
         raise InputError(f"{name}: expected a non-empty string without surrounding spaces, got {value!r}")
-    if not empty and not value.isprintable():
+    if not value.isprintable():  # a name is printed: control characters would reach the terminal
         raise InputError(f"{name}: expected printable characters (no line breaks or tabs), got {value!r}")
     return value
+
+
+def printable(text: str) -> str:
+    r"""Return ``text`` with each character that is not printable (a line break, an escape) as ``_``.
+
+    For names made from file names, which may hold what a log's name may not.
+
+    Examples
+    --------
+    >>> printable("run\n2"), printable("hall")
+    ('run_2', 'hall')
+    """
+    return "".join(c if c.isprintable() else "_" for c in text)
 
 
 def _bounded(value: object, name: str, *, positive: bool = False) -> float:
@@ -660,6 +674,35 @@ class RobotLog:
         if not self.commands:
             return math.nan, math.nan
         return self.commands[0].time, self.commands[-1].time
+
+    def unaligned_clocks(self, names: Mapping[str, str]) -> str | None:
+        """Return why the record's clocks disagree, or None when they agree.
+
+        Motion, observations and ground truth are of one run: a record that starts more
+        than a day (``ROW_GAP``) after another ends is a clock offset between the files
+        (a whole file shifted 30 days was imported and replayed as a run without sightings).
+        ``names`` names each record in the message: ``"motion"``, ``"observations"`` and
+        ``"ground truth"`` to a file or topic.
+        """
+        spans: list[tuple[str, float, float]] = []
+        first, last = self.motion_span
+        if not math.isnan(first):
+            spans.append((names["motion"], first, last))
+        if self.observations:
+            spans.append((names["observations"], self.observations[0].time, self.observations[-1].time))
+        if self.groundtruth is not None:
+            truth = self.groundtruth.time
+            spans.append((names["ground truth"], float(truth[0]), float(truth[-1])))
+        for (name, start, end), (other, other_start, other_end) in itertools.combinations(spans, 2):
+            gap = max(start - other_end, other_start - end)
+            if gap > ROW_GAP.high:
+                return (
+                    f"expected the times of {name} and {other} to overlap (at most "
+                    f"{ROW_GAP.high:g} s apart), "
+                    f"got {start:.17g} to {end:.17g} s and {other_start:.17g} to {other_end:.17g} s, "
+                    f"{gap:.6g} s apart: a clock offset between them"
+                )
+        return None
 
     def position_reports(
         self,

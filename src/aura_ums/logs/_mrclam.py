@@ -32,7 +32,15 @@ from aura_ums._validate import (
 )
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs._io import clock_jump, renumbered, write_log
-from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.logs._log import (
+    GroundTruth,
+    LogLandmark,
+    LogMeta,
+    LogObservation,
+    Odometry,
+    RobotLog,
+    printable,
+)
 
 #: Subjects 1-5 are the robots; 6-20 the landmarks.
 ROBOT_SUBJECTS = range(1, 6)
@@ -59,6 +67,9 @@ COLUMN_RANGES: dict[str, Range] = {
 }
 
 
+_LINE_BREAK = re.compile(r"\r\n|\r|\n")
+
+
 class _DatFile:
     """A whitespace-separated ``.dat`` file of numbers, rows kept with their line numbers."""
 
@@ -70,7 +81,9 @@ class _DatFile:
         text = read_text(path, kind="MRCLAM data")
         lines: list[int] = []
         rows: list[list[float]] = []
-        for number, line in enumerate(text.splitlines(), start=1):
+        # Lines end at a newline as an editor counts them: splitlines() also broke at form
+        # feeds, U+2028 and NEL, and every later line number was off.
+        for number, line in enumerate(_LINE_BREAK.split(text), start=1):
             cells = line.split()
             if not cells or cells[0].startswith("#"):
                 continue
@@ -82,6 +95,8 @@ class _DatFile:
                     f"expected {len(columns)} numbers ({', '.join(columns)}), got {len(cells)}",
                 )
             try:
+                if any("_" in cell or not cell.isascii() for cell in cells):
+                    raise ValueError(line)  # float() reads 0_1 as 1 and full-width digits as digits
                 values = [float(cell) for cell in cells]
             except ValueError:
                 self.fail_at(number, f"expected numbers ({', '.join(columns)}), got {_shown(line)}")
@@ -285,14 +300,20 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     if truth_repeats:
         notes.append(f"dropped {_plural(truth_repeats, 'repeated ground-truth time')} (kept the last row)")
     source = f"{_dataset_label(folder)} robot {robot} ({CITATION}); {'; '.join(notes)}"
-    meta = LogMeta(name=f"{folder.name}-robot{robot}", terrain="floor", source=source)
-    return RobotLog(
+    name = printable(f"{folder.name}-robot{robot}").strip()
+    meta = LogMeta(name=name, terrain="floor", source=printable(source))
+    log = RobotLog(
         meta,
         tuple(landmarks),
         tuple(observations),
         odometry=Odometry(odometry_rows[:, 0], odometry_rows[:, 1], odometry_rows[:, 2]),
         groundtruth=GroundTruth(truth_rows[:, 0], truth_rows[:, 1], truth_rows[:, 2], truth_rows[:, 3]),
     )
+    names = {"motion": "Odometry", "observations": "Measurement", "ground truth": "Groundtruth"}
+    problem = log.unaligned_clocks({key: f"{prefix}{name}.dat" for key, name in names.items()})
+    if problem is not None:
+        raise FileFormatError(str(folder), "", problem)
+    return log
 
 
 def import_mrclam(

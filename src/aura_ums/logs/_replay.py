@@ -504,21 +504,29 @@ def replay_start(log: RobotLog) -> tuple[float, Pose]:
             f"log {log.meta.name!r}: expected a [start] pose in meta.toml or a groundtruth.csv, got neither"
         )
     start = max(first_motion, float(log.groundtruth.time[0]))
-    return start, _truth_start(log.meta.name, start, log.groundtruth.at([start])[0], log.groundtruth.max_gap)
+    pose = log.groundtruth.at([start])[0]
+    return start, _truth_start(log.meta, start, pose, log.groundtruth.max_gap)
 
 
-def _truth_start(name: str, start: float, pose: NDArray[np.float64], max_gap: float) -> Pose:
+def _truth_start(meta: LogMeta, start: float, pose: NDArray[np.float64], max_gap: float) -> Pose:
     """Return the start pose taken from the ground truth at ``start``; refuse one in a gap of it.
 
-    The truth is NaN strictly inside two rows more than ``max_gap`` apart (a lost track):
-    the log then has no start pose, and the message says where the start fell.
+    The truth is NaN strictly inside two rows more than ``max_gap`` apart (a lost track)
+    and after its last row: the log then has no start pose, and the message says where the
+    start fell, and that a motion delay moved it there.
     """
     x, y, heading = (float(value) for value in pose)
     if math.isnan(x):
+        delayed = (
+            f"; the motion's delay_s ({meta.delay_s:g} s, of the sensors file or meta.toml) "
+            "moved the start there"
+            if meta.delay_s > 0.0
+            else ""
+        )
         raise InputError(
-            f"log {name!r}: groundtruth.csv: expected a ground-truth pose at the replay's start, "
+            f"log {meta.name!r}: groundtruth.csv: expected a ground-truth pose at the replay's start, "
             f"{start:g} s (meta.toml gives no [start] pose), got none: the start lies between two "
-            f"rows more than {max_gap:g} s apart (--max-truth-gap)"
+            f"rows more than {max_gap:g} s apart (--max-truth-gap) or after the last row{delayed}"
         )
     return Pose(x, y, heading)
 
@@ -779,6 +787,12 @@ def replay_log(
         if isinstance(log, LogStream)
         else _whole_source(log, opts, stop, resume)
     )
+    if stop < source.start_time and not save_state:
+        # Nothing would be replayed: metrics of no frame are no answer (a state saved before
+        # any frame is one: the start map, resumable).
+        raise InputError(
+            f"until: expected a time at or after the replay's start ({source.start_time!r} s), got {stop!r}"
+        )
     initial = SpatialUncertaintyMap.from_pose(
         source.start_pose, log.meta.start_radius, log.meta.start_heading_halfwidth
     )
@@ -1079,7 +1093,7 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
         )
     else:
         start_time = max(first_motion, truth.first)
-        start_pose = _truth_start(meta.name, start_time, truth.at(np.array([start_time]))[0], truth.max_gap)
+        start_pose = _truth_start(meta, start_time, truth.at(np.array([start_time]))[0], truth.max_gap)
     meadow_map = _meadow_map(meta, stream.landmarks, stream.truth_box, opts.landmark_class, opts.arena_margin)
     reports: _WholeReports | _StreamReports
     if odometry is not None:

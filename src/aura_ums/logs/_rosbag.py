@@ -51,9 +51,18 @@ from typing import Any
 
 import numpy as np
 
+from aura_ums._validate import ROW_GAP
 from aura_ums.errors import AuraUmsError, FileFormatError, InputError, MissingDependencyError
-from aura_ums.logs._io import Units, _read_landmarks, renumbered, write_log
-from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
+from aura_ums.logs._io import COLUMN_RANGES, Units, _read_landmarks, renumbered, write_log
+from aura_ums.logs._log import (
+    GroundTruth,
+    LogLandmark,
+    LogMeta,
+    LogObservation,
+    Odometry,
+    RobotLog,
+    printable,
+)
 
 #: Message types read as motion (velocities).
 MOTION_TYPES = ("nav_msgs/msg/Odometry", "geometry_msgs/msg/TwistStamped", "geometry_msgs/msg/Twist")
@@ -119,8 +128,22 @@ def _landmarks(value: object) -> tuple[LogLandmark, ...]:
 
 
 def _yaw(q: Any) -> float:
-    """Heading (rad) of a quaternion ``(x, y, z, w)``: the rotation about +z."""
+    """Heading (rad) of a quaternion ``(x, y, z, w)``: the rotation about +z; NaN for no rotation.
+
+    A quaternion of (near) zero norm is no orientation: atan2 gave it heading 0.
+    """
+    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    if not norm > 1e-6:
+        return math.nan
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def _in_range(bag: _Bag, where: str, values: dict[str, float]) -> None:
+    """Refuse a value a log file could not hold (``COLUMN_RANGES``): the import would be refused on replay."""
+    for column, value in values.items():
+        bounds = COLUMN_RANGES[column]
+        if math.isfinite(value) and not bounds.contains(value):
+            raise bag.fail(where, f"expected {column} to be {bounds.text()}, got {value!r}")
 
 
 class _Bag:
@@ -150,7 +173,9 @@ class _Bag:
                 f"topic {topic}",
                 f"expected {role} messages of type {' or '.join(allowed)}, got {kind or 'several types'}",
             )
-        if self.counts[topic] == 0:
+        # The count is the bag's index (metadata.yaml); a damaged one says 0 of a topic that
+        # has messages: look before calling it empty.
+        if self.counts[topic] == 0 and next(self.messages(topic), None) is None:
             raise self.fail(f"topic {topic}", f"expected at least one {role} message, got none")
         return kind
 
@@ -185,7 +210,21 @@ def _sorted_rows(
                 f"topic {topic}, message {i1}",
                 f"expected {role} messages at distinct times, got time {t1!r} s again (message {i0})",
             )
+    _no_clock_jump(bag, topic, [(time, index) for time, index, _ in rows], role)
     return np.array([(t, *values) for t, _, values in rows], dtype=np.float64)
+
+
+def _no_clock_jump(bag: _Bag, topic: str, times: list[tuple[float, int]], role: str) -> None:
+    """Refuse a time out of range or two messages more than a day apart (as a log's reader does)."""
+    for time, index in times:
+        _in_range(bag, f"topic {topic}, message {index}", {"time": time})
+    for (t0, i0), (t1, i1) in itertools.pairwise(times):
+        if t1 - t0 > ROW_GAP.high:
+            raise bag.fail(
+                f"topic {topic}, message {i1}",
+                f"expected {role} messages at most {ROW_GAP.high:g} s apart, got {t1 - t0:.6g} s after "
+                f"message {i0}: a clock jump",
+            )
 
 
 def _motion(bag: _Bag, topic: str, kind: str) -> Odometry:
@@ -203,9 +242,14 @@ def _motion(bag: _Bag, topic: str, kind: str) -> Odometry:
                 f"topic {topic}, message {index}",
                 f"expected finite velocities, got linear.x {v!r} and angular.z {omega!r}",
             )
+        _in_range(bag, f"topic {topic}, message {index}", {"v": v, "omega": omega})
         rows.append((time, index, (v, omega)))
     table = _sorted_rows(bag, topic, rows, "motion")
     return Odometry(table[:, 0], table[:, 1], table[:, 2])
+
+
+def _quaternion(q: Any) -> str:
+    return f"({float(q.x)!r}, {float(q.y)!r}, {float(q.z)!r}, {float(q.w)!r})"
 
 
 def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
@@ -217,8 +261,10 @@ def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
         if not all(math.isfinite(value) for value in (x, y, heading)):
             raise bag.fail(
                 f"topic {topic}, message {index}",
-                f"expected a finite pose, got x {x!r}, y {y!r}, heading {heading!r}",
+                f"expected a finite pose and a unit orientation quaternion, got x {x!r}, y {y!r}, "
+                f"orientation {_quaternion(pose.orientation)}",
             )
+        _in_range(bag, f"topic {topic}, message {index}", {"x": x, "y": y})
         rows.append((_time(message.header, received), index, (x, y, heading)))
     table = _sorted_rows(bag, topic, rows, "ground truth")
     return GroundTruth(table[:, 0], table[:, 1], table[:, 2], table[:, 3])
@@ -244,6 +290,8 @@ def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple
                 where,
                 f"expected point.z to be a bearing error bound > 0 rad (0 or NaN: the log's), got {z!r}",
             )
+        values = {"bearing": y, "range": x if x > 0.0 else math.nan}
+        _in_range(bag, where, {**values, "bearing_error": z if z > 0.0 else math.nan})
         time = _time(message.header, received)
         observation = LogObservation(
             time,
@@ -255,6 +303,7 @@ def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple
         )
         found.append((time, index, observation))
     found.sort(key=lambda item: (item[0], item[1]))
+    _no_clock_jump(bag, topic, [(time, index) for time, index, _ in found], "observation")
     return tuple(observation for _, _, observation in found)
 
 
@@ -359,11 +408,18 @@ def read_rosbag(
         ) from exc
     if meta is None:
         topics = f"motion {odom}, observations {observed}" + (f", ground truth {truth}" if truth else "")
-        meta = LogMeta(path.stem or path.name, source=f"ROS bag {path.name} ({topics})")
+        # A file name may hold what a log name may not (a line break): kept readable, as printed.
+        name = printable(path.stem or path.name).strip() or "bag"
+        meta = LogMeta(name, source=printable(f"ROS bag {path.name} ({topics})"))
     try:
-        return RobotLog(meta, listed, observations, odometry=odometry, groundtruth=groundtruth)
+        log = RobotLog(meta, listed, observations, odometry=odometry, groundtruth=groundtruth)
     except InputError as exc:  # e.g. duplicate landmark ids in the list
         raise InputError(f"{path}: {exc}") from exc
+    names = {"motion": f"topic {odom}", "observations": f"topic {observed}", "ground truth": f"topic {truth}"}
+    problem = log.unaligned_clocks(names)
+    if problem is not None:
+        raise FileFormatError(str(path), "", problem)
+    return log
 
 
 def import_rosbag(

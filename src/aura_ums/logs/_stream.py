@@ -26,7 +26,7 @@ from typing import BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import read_folder
+from aura_ums._files import present, read_folder
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -204,13 +204,13 @@ def open_log(
         raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
     meta, units = _MetaReader(base / META).read(base.name)
     landmarks = _read_landmarks(base / LANDMARKS, units)
-    has_odometry, has_commands = (base / ODOMETRY).exists(), (base / COMMANDS).exists()
+    has_odometry, has_commands = present(base / ODOMETRY), present(base / COMMANDS)
     if has_odometry == has_commands:
         got = "both" if has_odometry else "neither"
         raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
     commands = None if has_odometry else _read_commands(base / COMMANDS, units)
     box, scratch = None, None
-    if (base / GROUNDTRUTH).exists():
+    if present(base / GROUNDTRUTH):
         box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
     return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch)
 

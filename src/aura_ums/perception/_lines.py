@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, positive_float
+from aura_ums._validate import BLUR, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
@@ -97,7 +97,8 @@ class FastLineFinder:
         Untuned only: also build the partition offset by half a bucket, so that lines whose
         gradient falls on a bucket border are not split (Burns' voting).
     smoothing : float
-        Standard deviation of a Gaussian applied before the gradient, pixels (0 = none).
+        Standard deviation of a Gaussian applied before the gradient, pixels, in [0, 100]
+        (0 = none).
     backend : LineBackend
         Library for gradients and connected components.
 
@@ -142,7 +143,7 @@ class FastLineFinder:
         object.__setattr__(self, "buckets", int_at_least(self.buckets, "buckets", 4))
         if not isinstance(self.overlap, bool):
             raise InputError(f"overlap: expected a bool, got {self.overlap!r}")
-        object.__setattr__(self, "smoothing", nonnegative_float(self.smoothing, "smoothing"))
+        object.__setattr__(self, "smoothing", BLUR.check(self.smoothing, "smoothing"))
         if not isinstance(self.backend, LineBackend):
             raise InputError(f"backend: expected a LineBackend, got {self.backend!r}")
         if self.backend is LineBackend.OPENCV:

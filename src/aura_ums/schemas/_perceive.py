@@ -96,7 +96,26 @@ def _integer(name: str, value: float) -> int:
 
 
 def build_detector(record: LandmarkRecord) -> Detector:
-    """Return the record's perceptual strategy, parameterized from its ``parameters``."""
+    """Return the record's perceptual strategy, parameterized from its ``parameters``.
+
+    A parameter out of its strategy's range is named as the map names it
+    (``pole_a.parameters.smoothing``), not by the detector's own field.
+    """
+    try:
+        return _build_detector(record)
+    except InputError as exc:
+        field, sep, message = str(exc).partition(": ")
+        if not sep or "." in field:
+            raise
+        renamed = _MORAVEC_PARAMETERS if record.strategy is PerceptualStrategy.INTEREST_OPERATOR else {}
+        raise InputError(f"{record.id}.parameters.{renamed.get(field, field)}: {message}") from None
+
+
+# MoravecOperator's fields as a map's parameters name them.
+_MORAVEC_PARAMETERS = {"size": "window", "threshold": "min_interest"}
+
+
+def _build_detector(record: LandmarkRecord) -> Detector:
     cls, strategy, params = record.landmark_class, record.strategy, record.parameters
     name = f"{record.id}.parameters"
     if strategy not in _SUPPORTED[cls]:

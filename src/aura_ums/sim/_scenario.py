@@ -166,6 +166,8 @@ MAX_RUN_BYTES = 4e9
 #: Most Monte Carlo runs of one call: each run's result stays in memory (about 20 kB).
 MAX_RUNS = 100_000
 _RUN_RESULT_BYTES = 20_000
+#: Frames a run's camera could afford: past the limits with more, the count is to blame.
+_FEW_FRAMES = 1000
 _SAMPLE_PREFIX = "sample:"
 _START_DRAWS = 100
 
@@ -428,12 +430,14 @@ class Scenario:
                 raise InputError(f"Scenario.commands[{index}]: expected a TurnAndRun, got {command!r}")
         object.__setattr__(self, "commands", commands)
         ids = tuple(self.landmark_ids)
+        seen: set[str] = set()
         for index, ident in enumerate(ids):
             self.meadow_map.landmark(ident)  # raises, naming the id, when unknown
-            if ident in ids[:index]:
+            if ident in seen:
                 raise InputError(
                     f"Scenario.landmark_ids[{index}]: expected each id once, got {ident!r} again"
                 )
+            seen.add(ident)
         object.__setattr__(self, "landmark_ids", ids)
         if self.frame_spacing is not None:
             spacing = finite_float(self.frame_spacing, "Scenario.frame_spacing")
@@ -505,6 +509,8 @@ class Scenario:
             name = "Scenario.render.clutter" if clutter else "Scenario.camera"
         elif self.frame_spacing is not None and per_frame * (len(self.commands) + 1) <= MAX_RUN_SECONDS:
             name = "Scenario.frame_spacing"
+        elif self.frame_spacing is None and per_frame * _FEW_FRAMES <= MAX_RUN_SECONDS < seconds:
+            name = "Scenario.commands"  # a frame after each command: too many commands
         elif frames * self.render.clutter * _SECONDS_PER_STRIP > seconds / 2:
             name = "Scenario.render.clutter"
         elif frames * self.render.clutter_lines * _SECONDS_PER_LINE > seconds / 2:
@@ -617,6 +623,7 @@ class Scenario:
                 "Scenario.render.clutter": "[render] clutter",
                 "Scenario.render.clutter_lines": "[render] clutter_lines",
                 "Scenario.frame_spacing": "frame_spacing" if "frame_spacing" in document else "frame_rate",
+                "Scenario.commands": "[route]",
             }.get(field_name, field_name.removeprefix("Scenario."))
             raise reader.fail(where, message) from None
 
@@ -817,13 +824,15 @@ def _landmark_ids(document: Mapping[str, object], reader: _Reader, meadow_map: M
     if not isinstance(value, list):
         raise reader.fail("landmarks", f"expected a list of landmark ids, got {describe(value)}")
     known = {record.id for record in meadow_map.landmarks}
+    seen: set[str] = set()
     for index, item in enumerate(value):
         where = f"landmarks[{index}]"
         ident = reader.string(item, where)
         if ident not in known:
             raise reader.fail(where, f"expected the id of a landmark of the map, got {describe(ident)}")
-        if ident in value[:index]:
+        if ident in seen:
             raise reader.fail(where, f"expected each id once, got {describe(ident)} again")
+        seen.add(ident)
     chosen = set(value)
     return tuple(record.id for record in meadow_map.landmarks if record.id in chosen)
 
@@ -871,6 +880,45 @@ def _commands_through(
 def _route(
     table: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap, pose: Pose
 ) -> tuple[TurnAndRun, ...]:
+    commands, where = _route_commands(table, reader, meadow_map, pose)
+    _check_inside(commands, pose, meadow_map, reader, where)
+    return commands
+
+
+def _check_inside(
+    commands: tuple[TurnAndRun, ...], pose: Pose, meadow_map: MeadowMap, reader: _Reader, where: str
+) -> None:
+    """Refuse a route whose commanded legs leave the meadows, naming the first such leg.
+
+    The simulation found it only when the robot got there, with a message that named
+    neither the file nor the leg (a run across a gap between meadows was simulated on).
+    """
+    import shapely  # deferred: only a scenario's route needs it here
+
+    turns = np.array([command.turn for command in commands])
+    runs = np.array([command.run for command in commands])
+    headings = pose.heading + np.cumsum(turns)
+    ends = np.array([pose.x, pose.y]) + np.cumsum(
+        runs[:, None] * np.stack([np.cos(headings), np.sin(headings)], 1), 0
+    )
+    starts = np.vstack([[pose.x, pose.y], ends[:-1]])
+    area = shapely.union_all([shapely.Polygon(meadow.polygon.vertices) for meadow in meadow_map.meadows])
+    legs = shapely.linestrings(np.stack([starts, ends], 1))
+    inside = shapely.covers(area.buffer(1e-6), legs)
+    if not inside.all():
+        index = int(np.argmin(inside))
+        place = where if where.endswith("goal") else f"{where}[{index}]"
+        (x0, y0), (x1, y1) = starts[index], ends[index]
+        raise reader.fail(
+            place,
+            f"expected a route inside the map's meadows, got a leg from ({x0:.6g}, {y0:.6g}) to "
+            f"({x1:.6g}, {y1:.6g}) that leaves them",
+        )
+
+
+def _route_commands(
+    table: Mapping[str, object], reader: _Reader, meadow_map: MeadowMap, pose: Pose
+) -> tuple[tuple[TurnAndRun, ...], str]:
     reader.keys(table, ("commands", "waypoints", "goal"), "[route]")
     given = [key for key in ("commands", "waypoints", "goal") if key in table]
     if len(given) != 1:
@@ -887,12 +935,12 @@ def _route(
             raise reader.fail(where, f"expected a goal reachable from the start, got: {exc}") from None
         if len(route.waypoints) < 2:
             raise reader.fail(where, f"expected a goal away from the start, got {list(goal)}")
-        return tuple(_commands_through(route.waypoints[1:], pose, reader, where))
+        return tuple(_commands_through(route.waypoints[1:], pose, reader, where)), where
     if not isinstance(value, list) or not value:
         raise reader.fail(where, f"expected a non-empty list, got {describe(value)}")
     if key == "waypoints":
         points = np.array([reader.point(item, f"{where}[{i}]") for i, item in enumerate(value)])
-        return tuple(_commands_through(points, pose, reader, where))
+        return tuple(_commands_through(points, pose, reader, where)), where
     commands: list[TurnAndRun] = []
     for index, item in enumerate(value):
         place = f"{where}[{index}]"
@@ -903,7 +951,7 @@ def _route(
         if "run" not in item:
             raise reader.fail(f"{place}.run", "expected the run in metres, got none")
         commands.append(TurnAndRun(turn, reader.ranged(item["run"], f"{place}.run", "run")))
-    return tuple(commands)
+    return tuple(commands), where
 
 
 def _frame_spacing(document: Mapping[str, object], reader: _Reader) -> float | None:

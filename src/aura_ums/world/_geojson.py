@@ -81,10 +81,12 @@ class _Reader:
         if table_file is not None:
             if not isinstance(table_file, str) or not table_file:
                 self.fail("terrain_table", f"expected the name of a TOML file, got {_kind(table_file)}")
+            path = self.base / table_file
+            # Checked though a table given by the caller overrides it: a broken reference is
+            # a broken file, not a silent fallback.
+            if not path.is_file():
+                self.fail("terrain_table", f"expected a terrain table file, got no file at {path}")
             if table is None:
-                path = self.base / table_file
-                if not path.is_file():
-                    self.fail("terrain_table", f"expected a terrain table file, got no file at {path}")
                 table = TerrainTable.from_toml(path)
         self.table = table
 
