@@ -103,6 +103,18 @@ def test_symlinks_are_resolved_before_comparing(inputs: Path, tmp_path: Path, un
     refused(result, "--steps-csv", str(out))
 
 
+def test_a_hard_link_to_an_input_is_refused_as_output(
+    inputs: Path, tmp_path: Path, untouched: object
+) -> None:
+    # written atomically the input survived, but the name given was the input's other name
+    link = tmp_path / "hard.json"
+    os.link(inputs / "terrain.toml", link)
+    result = invoke(
+        "replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", link, "--overwrite"
+    )
+    refused(result, "--metrics-json", "a hard link to the input --terrain", str(link.name))
+
+
 def test_two_outputs_may_not_share_a_path(inputs: Path, tmp_path: Path, untouched: object) -> None:
     same = tmp_path / "same.toml"
     refused(

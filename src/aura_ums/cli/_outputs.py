@@ -168,12 +168,26 @@ def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
     given, option = _shown(target.path, where), target.option
     if where == origin:
         raise fail(f"{option}: expected an output apart from the inputs, got {given}, which is {what}")
+    if _same_file(where, origin):
+        # a hard link: another name of the input's bytes (replaced atomically, the input would
+        # survive, but the name given is the input)
+        raise fail(
+            f"{option}: expected an output apart from the inputs, got {given}, a hard link to {what}"
+        )
     if source.folder and where.is_relative_to(origin):
         raise fail(f"{option}: expected an output outside the input folders, got {given}, inside {what}")
     if target.folder and origin.is_relative_to(where):
         raise fail(
             f"{option}: expected an output folder apart from the inputs, got {given}, which holds {what}"
         )
+
+
+def _same_file(one: Path, other: Path) -> bool:
+    """Whether two existing paths are one file (a hard link); False when either is missing."""
+    try:
+        return one.is_file() and other.is_file() and one.samefile(other)
+    except OSError:
+        return False
 
 
 def _shown(path: Path, where: Path) -> str:
