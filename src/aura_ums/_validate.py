@@ -149,8 +149,9 @@ IMAGE_SIDE = Range(1, 20_000, "px")
 #: One coefficient of a lens's OpenCV distortion (k1, k2, p1, p2 or k3), dimensionless: real
 #: lenses fit within a few units, strong wide-angle fits reach tens; beyond 1000 is no lens.
 DISTORTION = Range(-1000.0, 1000.0)
-#: A focal length, pixels (1e6 px is a field of view of 1 mrad on a 1000 px image).
-FOCAL_LENGTH = Range(0.0, 1e6, "px", low_open=True)
+#: A focal length, pixels: from 1 px (a field of view of over 179 degrees on any image; 1e-300
+#: gave windows of a nanopixel) to 1e6 px (1 mrad on a 1000 px image).
+FOCAL_LENGTH = Range(1.0, 1e6, "px")
 #: A principal point or pixel coordinate, pixels.
 PIXEL = Range(-1e5, 1e5, "px")
 #: Standard deviation of a Gaussian blur of an image, pixels: beyond 100 px it blurs a frame

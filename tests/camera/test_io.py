@@ -112,7 +112,13 @@ def edit(old: str, new: str) -> str:
         (
             edit("fx = 500.0", "fx = -500.0"),
             "fx",
-            r"\[intrinsics\] fx: expected a number in \(0, 1e\+06\] px",
+            r"\[intrinsics\] fx: expected a number in \[1, 1e\+06\] px",
+        ),
+        # a field of view of nearly 180 degrees squeezed every window to a nanopixel
+        (
+            edit("fx = 500.0", "fx = 1e-300"),
+            "fx",
+            r"\[intrinsics\] fx: expected a number in \[1, 1e\+06\] px, got 1e-300",
         ),
         (edit("-0.002]", "-0.002, 0.0, 0.0]"), "distortion", "expected 4, 5, 8, 12 or 14 distortion"),
         (edit("-0.002]", "-0.002, 0.0, 0.1, 0.0, 0.0]"), "distortion", "beyond k3 .* to be zero"),
@@ -369,7 +375,7 @@ def test_opencv_json_with_bare_trailing_dots(tmp_path: Path) -> None:
         (
             json.dumps({**GOOD_JSON, "camera_matrix": opencv_matrix(3, 3, [-5.0, 0, 1, 0, 5, 1, 0, 0, 1])}),
             "camera_matrix fx",
-            r"expected a number in \(0, 1e\+06\] px",
+            r"expected a number in \[1, 1e\+06\] px",
         ),
     ],
 )

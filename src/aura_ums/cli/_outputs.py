@@ -171,9 +171,7 @@ def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
     if _same_file(where, origin):
         # a hard link: another name of the input's bytes (replaced atomically, the input would
         # survive, but the name given is the input)
-        raise fail(
-            f"{option}: expected an output apart from the inputs, got {given}, a hard link to {what}"
-        )
+        raise fail(f"{option}: expected an output apart from the inputs, got {given}, a hard link to {what}")
     if source.folder and where.is_relative_to(origin):
         raise fail(f"{option}: expected an output outside the input folders, got {given}, inside {what}")
     if target.folder and origin.is_relative_to(where):
