@@ -121,3 +121,27 @@ def test_the_arguments_are_checked() -> None:
         parse_float_rows(b"1\n", 1, 0)
     with pytest.raises(TypeError, match="bytes-like"):
         parse_float_rows("1\n", 1, 1)  # type: ignore[arg-type]
+
+
+@built
+def test_short_decimals_and_their_exponent_edges_read_as_float_does() -> None:
+    # The fast path (Clinger: <= 15 significant digits times an exact power of ten within
+    # 1e22) against float(), bit for bit, at and beyond its edges: 15/16 digits, 1e22/1e23,
+    # leading and trailing zeros, signs, exponents written both ways.
+    rng = np.random.default_rng(20261129)
+    cells = []
+    for _ in range(40_000):
+        digits = int(rng.integers(1, 18))
+        mantissa = "".join(str(d) for d in rng.integers(0, 10, digits))
+        point = int(rng.integers(0, digits + 1))
+        text = (mantissa[:point] or "0") + "." + mantissa[point:] if rng.random() < 0.8 else mantissa
+        text = "0" * int(rng.integers(0, 3)) + text + "0" * int(rng.integers(0, 3) if "." in text else 0)
+        if rng.random() < 0.5:
+            text += "eE"[int(rng.integers(2))] + str(int(rng.integers(-30, 31)))
+        if rng.random() < 0.3:
+            text = "-+"[int(rng.integers(2))] + text
+        cells.append(text)
+    data = ("\n".join(",".join(cells[i : i + 4]) for i in range(0, len(cells), 4)) + "\n").encode()
+    ours = parse_float_rows_compiled(data, len(cells) // 4, 4)
+    assert ours is not None
+    assert bits(ours) == bits(np.array([float(cell) for cell in cells]))

@@ -6,6 +6,7 @@
  * blanks around) and gives None for anything else (nan, inf, hex, a cell too long), which the
  * caller then reads the slow, exact way.
  */
+#include <float.h>
 #include <stdlib.h>
 
 #include "kernels.h"
@@ -35,6 +36,62 @@ static const char *plain_number(const char *p, const char *end) {
         if (exponent == 0) return NULL;
     }
     return p;
+}
+
+/* Powers of ten that are exact doubles (10^22 < 2^53 * 2^22 is the last). */
+static const double EXACT_TENS[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                    1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/*
+ * The plain number from p to stop as the correctly rounded double, when Clinger's fast path
+ * applies: at most 15 significant digits (an integer below 2^53, exact as a double) and a
+ * power of ten within 1e22 (exact too), so one multiplication or division, itself correctly
+ * rounded, gives the correctly rounded result. Returns 0 when it does not apply (strtod then
+ * reads the cell). Logs' cells (0.785398163, 1234.56) take this path: about a tenth of strtod's
+ * time.
+ */
+static int fast_number(const char *p, const char *stop, double *value) {
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+    /* Arithmetic in a wider type (x87) would round twice: strtod alone is exact there. */
+    (void)p, (void)stop, (void)value;
+    return 0;
+#endif
+    int negative = 0;
+    if (*p == '+' || *p == '-') negative = *p++ == '-';
+    unsigned long long mantissa = 0;
+    int significant = 0, exponent = 0, seen_point = 0;
+    for (; p < stop && *p != 'e' && *p != 'E'; p++) {
+        if (*p == '.') {
+            seen_point = 1;
+            continue;
+        }
+        if (mantissa == 0 && *p == '0') {
+            if (seen_point) exponent--;
+            continue;
+        }
+        if (++significant > 15) return 0;
+        mantissa = mantissa * 10 + (unsigned long long)(*p - '0');
+        if (seen_point) exponent--;
+    }
+    if (p < stop) { /* an exponent: at most a few digits, or the slow way */
+        p++;
+        int negative_exponent = 0;
+        if (*p == '+' || *p == '-') negative_exponent = *p++ == '-';
+        int written = 0;
+        for (; p < stop; p++) {
+            if (written > 1000) return 0;
+            written = written * 10 + (*p - '0');
+        }
+        exponent += negative_exponent ? -written : written;
+    }
+    double result = (double)mantissa;
+    if (mantissa != 0) {
+        if (exponent < -22 || exponent > 22) return 0;
+        result = exponent < 0 ? result / EXACT_TENS[-exponent] : result * EXACT_TENS[exponent];
+    }
+    *value = negative ? -result : result;
+    return 1;
 }
 
 PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -68,15 +125,17 @@ PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nar
                 plain = 0;
                 break;
             }
-            /* strtod on a copy: the block is not NUL-terminated, and the copy's end is known. */
-            Py_ssize_t length = stop - p;
-            memcpy(cell, p, (size_t)length);
-            cell[length] = '\0';
-            char *parsed;
-            out[row * columns + column] = strtod(cell, &parsed);
-            if (parsed != cell + length) { /* a locale whose decimal point is not "." */
-                plain = 0;
-                break;
+            if (!fast_number(p, stop, &out[row * columns + column])) {
+                /* strtod on a copy: the block is not NUL-terminated, and the copy's end is known. */
+                Py_ssize_t length = stop - p;
+                memcpy(cell, p, (size_t)length);
+                cell[length] = '\0';
+                char *parsed;
+                out[row * columns + column] = strtod(cell, &parsed);
+                if (parsed != cell + length) { /* a locale whose decimal point is not "." */
+                    plain = 0;
+                    break;
+                }
             }
             p = stop;
             while (p < end && is_blank(*p)) p++;
