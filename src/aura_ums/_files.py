@@ -595,7 +595,7 @@ RowsParser: TypeAlias = Callable[[bytes, int, int], NDArray[np.float64] | None]
 
 
 def parse_csv_floats(
-    text: str,
+    text: str | bytes,
     source: str,
     *,
     columns: Sequence[str],
@@ -616,8 +616,9 @@ def parse_csv_floats(
 
     Parameters
     ----------
-    text : str
-        The CSV text.
+    text : str or bytes
+        The CSV text, or its bytes when they are ASCII (a block of a file: not decoded and
+        encoded again; the result then keeps no text, and :meth:`CsvFloats.cell` reads the file).
     source : str
         The file, for messages.
     columns, required, max_rows, max_bytes
@@ -643,11 +644,17 @@ def parse_csv_floats(
     >>> parse_csv_floats("time,v\n0.5,\n", "o.csv", columns=("time", "v")) is None   # an empty cell
     True
     """
-    body = _text(text, source, max_bytes)
     most = _limit(max_rows, MAX_ROWS)
-    if not body.isascii():
-        return None
-    raw = np.frombuffer(body.encode("ascii"), dtype=np.uint8)
+    body: str | None
+    if isinstance(text, bytes):
+        if len(text) > _limit(max_bytes, MAX_BYTES) or not text.isascii():
+            return None  # parse_csv says what is wrong
+        body, raw = None, np.frombuffer(text, dtype=np.uint8)
+    else:
+        body = _text(text, source, max_bytes)
+        if not body.isascii():
+            return None
+        raw = np.frombuffer(body.encode("ascii"), dtype=np.uint8)
     if np.any(_FORBIDDEN[raw]):
         return None
     returns = np.flatnonzero(raw == _CR)
@@ -875,10 +882,8 @@ def csv_blocks(
                 first = False
             if numeric and not block.isascii():
                 raise CsvFallbackError
-            try:
-                text = block.decode("utf-8")
-            except UnicodeDecodeError:
-                raise CsvFallbackError from None
+            # A numeric block is parsed as its bytes (ASCII): decoded only to find the header.
+            text = "" if numeric and header_text is not None else _decoded(block)
             if not numeric and _OTHER_BREAKS.search(text):
                 raise CsvFallbackError
             found: CsvFloats | CsvTable | None
@@ -895,7 +900,7 @@ def csv_blocks(
             else:
                 # The header again before the block: the block's rows read as they would below it.
                 found = _parse_block(
-                    f"{header_text}\n{text}",
+                    header_text.encode("ascii") + b"\n" + block if numeric else f"{header_text}\n{text}",
                     source,
                     columns,
                     required,
@@ -920,8 +925,15 @@ def csv_blocks(
                 return
 
 
+def _decoded(block: bytes) -> str:
+    try:
+        return block.decode("utf-8")
+    except UnicodeDecodeError:
+        raise CsvFallbackError from None
+
+
 def _parse_block(
-    text: str,
+    text: str | bytes,
     source: str,
     columns: Sequence[str],
     required: Sequence[str],
@@ -936,6 +948,8 @@ def _parse_block(
             text, source, columns=columns, required=required, max_rows=most, max_bytes=limit,
             parse_rows=parse_rows,
         )  # fmt: skip
+    if isinstance(text, bytes):  # only numeric blocks come as bytes: not met
+        text = text.decode("utf-8")
     try:
         return parse_csv(text, source, columns=columns, required=required, max_rows=most, max_bytes=limit)
     except FileFormatError:
