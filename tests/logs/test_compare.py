@@ -110,3 +110,26 @@ class _NotAnEstimator:
 def test_bad_others_are_named(log: RobotLog, others: object, match: str) -> None:
     with pytest.raises(InputError, match=match):
         compare(log, particles=10, others=others)
+
+
+def test_a_particle_filter_too_costly_is_refused_with_the_estimate_before_any_work() -> None:
+    # a million particles ran past a minute on the sample log; on a real log, hours
+    long_log = synthetic_log(np.random.default_rng(5), duration=600.0)
+    with pytest.raises(
+        InputError,
+        match=r"^particles: expected a particle filter of at most 600 s \(at most \d+ particles over this "
+        r"log's \d+ reports and \d+ updates\), got 1000000: about [\d.e+]+ s$",
+    ):
+        compare_on_log(
+            long_log, FLOOR, bearing_sd=0.01, range_sd_fraction=0.01, rng=np.random.default_rng(0),
+            particles=1_000_000,
+        )  # fmt: skip
+    with pytest.raises(InputError, match=r"^particles: expected an integer >= 1, got 0$"):
+        compare_on_log(
+            long_log,
+            FLOOR,
+            bearing_sd=0.01,
+            range_sd_fraction=0.01,
+            rng=np.random.default_rng(0),
+            particles=0,
+        )

@@ -617,6 +617,7 @@ def edited(path: str, value: object) -> str:
         (edited("map/wedge/cw", -0.1), r"map\.wedge: HeadingWedge\.cw: expected a non-negative number"),
         (edited("map/wedge/center", 4.0), r"map\.wedge\.center: expected a heading in \(-pi, pi\], got 4\.0"),
         (edited("map/wedge/spin", 0.0), r"map\.wedge: expected only the keys"),
+        (edited("version", True), r"version: expected 1, got true"),  # JSON true == 1 in Python
         (edited("state", "confused"), r"state: expected one of \['nominal', 'lost'\], got 'confused'"),
         (edited("consumed_reports", -1), r"consumed_reports: expected an integer >= 0, got -1"),
         (edited("consumed_reports", 1.5), r"consumed_reports: expected an integer >= 0, got 1\.5"),

@@ -679,7 +679,8 @@ def compare(
                 progress=advance,
             )
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        message = str(exc)
+        raise fail(f"--{message}" if message.startswith("particles: ") else message) from None
     boxes = ", the Codac box" if with_codac else ""
     grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters{boxes}")
     for column in (

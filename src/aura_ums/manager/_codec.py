@@ -72,7 +72,7 @@ class Reader:
         if found != kind:
             self.fail("format", f"expected {kind!r}, got {_found(top, 'format')}")
         version = top.get("version")
-        if version != FORMAT_VERSION:
+        if isinstance(version, bool) or version != FORMAT_VERSION:  # JSON true == 1 in Python
             self.fail("version", f"expected {FORMAT_VERSION}, got {_found(top, 'version')}")
         return top
 
