@@ -298,3 +298,22 @@ def test_until_before_the_start_and_a_run_timeout_of_none(tmp_path: Path) -> Non
     bad = runner.invoke(app, [*replay, "--run-timeout", "soon"])
     assert bad.exit_code == 2
     assert bad.stderr == "error: --run-timeout: expected a positive number of seconds or none, got 'soon'\n"
+
+
+def test_a_resumed_state_whose_parts_disagree_names_the_file(tmp_path: Path) -> None:
+    # "blackboard: expected the one this manager reads, ..." named no file
+    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+    state = tmp_path / "state.json"
+    invoke(*replay, "--until", "20", "--save-state", state)
+    document = json.loads(state.read_text())
+    document["manager"]["map_time"] = 1e9
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(document))
+    result = runner.invoke(app, [*replay, "--resume", str(edited)])
+    assert result.exit_code == 2
+    assert result.stderr.startswith(
+        f"error: {edited}: --resume: blackboard: expected the one this manager reads"
+    )

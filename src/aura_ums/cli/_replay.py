@@ -126,6 +126,8 @@ _WindowsCsv = Annotated[
 ]
 
 
+# How the library names the parts of a saved state in its messages (--resume names the file).
+_STATE_PARTS = ("blackboard: ", "<manager JSON>", "<blackboard JSON>")
 #: Most particles of compare's particle filter (about 100 bytes each, several arrays).
 _MOST_PARTICLES = 1_000_000
 
@@ -532,6 +534,9 @@ def replay(
         if resume is not None and message.startswith("resume: "):
             # the library names its argument; the user gave a file
             message = f"{resume}: --{message}"
+        elif resume is not None and message.startswith(_STATE_PARTS):
+            # the saved manager and blackboard disagree (an edited state): the file is at fault
+            message = f"{resume}: --resume: {message}"
         elif message.startswith("until: "):
             message = f"--{message.replace('the resumed state', f'the state in {resume}', 1)}"
         raise fail(message) from None
