@@ -113,6 +113,23 @@ of that), the judge 21% (the area of each step's two maps, ``polygon_area``, 10%
 files 16%. Tenfold needs the update's Python (about 50 us a step around 15 us of kernels)
 compiled too.
 
+With the CSV kernel's exact fast path (Clinger: 742a91e; the ground truth's 4e6 cells in 0.14
+instead of 0.48 s) and numeric blocks parsed as bytes (b1c7186), 29 November 2026 about 00:45
+UTC, idle machine (load average below 1), this tree then f47bbb6 (``--src``):
+
+===============================  ========  =====================  =====================  =====
+10^6 rows                        steps     this tree: load,       f47bbb6: load,         gain
+                                           update, total s; peak  update, total s; peak
+===============================  ========  =====================  =====================  =====
+a frame every 100 rows           9,335     0.31, 0.60, 1.62; 81   8.77, 0.63, 10.86; 755 6.7x
+a frame every 10 rows            93,359    0.29, 5.00, 9.62; 88   9.63, 5.95, 31.75; 781 3.3x
+===============================  ========  =====================  =====================  =====
+
+At a frame every 10 rows the manager's update alone (5.0 s, 54 us a step) is half of this
+tree's time, and is as long as the older tree's: tenfold (3.2 s) cannot be reached without
+compiling the update's Python. Runs beside a fuzzing helper (load 1 to 4) gave 1.74 to 2.34 s
+for a frame every 100 rows and 9.70 to 11.21 s for every 10.
+
 (``--rows 1000000 --frame-every 100`` and ``--rows 100000 --frame-every 1``, each then with
 ``--src`` of f47bbb6.) The manager's update, about 100 us a step on an idle machine, two
 maps a step, is most of the time once frames are frequent; its compiled kernels take
