@@ -189,3 +189,29 @@ def test_a_profiles_fields_cannot_be_changed() -> None:
     with pytest.raises(TypeError, match="does not support item assignment"):
         MapProfile.SLICED.fields["relaxed_q"] = 3  # type: ignore[index]
     assert MapProfile.SLICED.fields["relaxed_q"] == 0
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        # the relaxed profile at a cap of 100,000 vertices passed 4 GB and ignored Ctrl-C
+        (
+            {"slice_width": math.radians(2.0), "max_slices": 180, "relaxed_q": 1, "relaxed_window": 5,
+             "max_vertices": 10_000},
+            r"max_vertices: expected at most 4000000 vertices at the caps \(the vertex cap 10000 times 180 "
+            r"slices times 6 branches of the relaxed intersection\), got 10800000",
+        ),
+        (
+            {"slice_width": math.radians(2.0), "envelope_max_vertices": 100_000},
+            r"envelope_max_vertices: expected at most 4000000 vertices at the caps .* got 4800000",
+        ),
+    ],
+)  # fmt: skip
+def test_caps_whose_worst_case_holds_too_many_vertices_are_refused(
+    changes: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(InputError, match=f"^ManagerSettings.{message}$"):
+        ManagerSettings(**changes)
+    # the profiles and a product map at the largest cap stay allowed
+    assert ManagerSettings(max_vertices=100_000).max_vertices == 100_000
+    assert MapProfile.RELAXED.settings().max_vertices == 64

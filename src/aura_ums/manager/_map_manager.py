@@ -1341,7 +1341,9 @@ class UncertaintyMapManager:
         window = self._settings.relocalize_window
         if len(recent) > window or not all(isinstance(item, bool) for item in recent):
             reader.fail(
-                "envelope.recent", f"expected at most {window} booleans (relocalize_window), got {recent!r}"
+                "envelope.recent",
+                f"expected at most {window} booleans (relocalize_window), got {len(recent)} items"
+                + ("" if all(isinstance(item, bool) for item in recent) else ", not all booleans"),
             )
         self._recent.extend(recent)
 
