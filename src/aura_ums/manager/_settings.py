@@ -483,11 +483,11 @@ def _checked(
         if problem is not None:
             raise fail(name, problem)
         checked[name] = info.normalize(value)
-    width = checked["slice_width"]
+    width, cells = checked["slice_width"], 1
     if isinstance(width, float):
         # 2 pi / 1e-12 heading cells failed deep in the kernel, as a traceback
         try:
-            cell_count(width)
+            cells = cell_count(width)
         except InputError as exc:
             raise fail("slice_width", str(exc).partition(": ")[2]) from None
     after, window = checked["relocalize_after"], checked["relocalize_window"]
@@ -502,7 +502,7 @@ def _checked(
         if _blames_count("relaxed_q", "relaxed_window", given):
             raise fail("relaxed_q", f"expected an integer < relaxed_window ({span}), got {allowed}")
         raise fail("relaxed_window", f"expected an integer > relaxed_q ({allowed}), got {span}")
-    _refuse_too_many_vertices(checked, fail, given)
+    branches = 1
     if isinstance(allowed, int) and isinstance(span, int) and allowed > 0:
         branches = branch_bound(allowed, span)
         if branches > MAX_BRANCHES:
@@ -513,6 +513,7 @@ def _checked(
                 f"C(relaxed_window, k) for k <= relaxed_q), got {'more than ' if branches > 10**15 else ''}"
                 f"{min(branches, 10**15)} (relaxed_q {allowed}, relaxed_window {span})",
             )
+    _refuse_too_many_vertices(checked, cells, branches, fail, given)
     return checked
 
 
@@ -524,19 +525,23 @@ MAX_VERTEX_SLOTS = 4_000_000
 
 
 def _refuse_too_many_vertices(
-    checked: Mapping[str, SettingValue], fail: Callable[[str, str], Exception], given: Collection[str]
+    checked: Mapping[str, SettingValue],
+    cells: int,
+    branches: int,
+    fail: Callable[[str, str], Exception],
+    given: Collection[str],
 ) -> None:
-    """Refuse caps whose worst case holds more than :data:`MAX_VERTEX_SLOTS` vertices, with the count."""
+    """Refuse caps whose worst case holds more than :data:`MAX_VERTEX_SLOTS` vertices, with the count.
+
+    ``cells`` is the heading grid's (1 for a product map), ``branches`` the relaxed
+    intersection's most (1 without it).
+    """
     vertices, envelope = checked["max_vertices"], checked["envelope_max_vertices"]
-    width, slices = checked["slice_width"], checked["max_slices"]
-    allowed, span = checked["relaxed_q"], checked["relaxed_window"]
-    if not (isinstance(vertices, int) and isinstance(slices, int) and isinstance(span, int)):
+    slices = checked["max_slices"]
+    if not (isinstance(vertices, int) and isinstance(slices, int)):
         return
     cap = max(vertices, envelope if isinstance(envelope, int) else 0)
-    polygons = min(cell_count(width), slices) if isinstance(width, float) else 1
-    branches = branch_bound(allowed, span) if isinstance(allowed, int) and allowed > 0 else 1
-    if branches > MAX_BRANCHES:
-        return  # refused below, for its own reason
+    polygons = min(cells, slices)
     slots = cap * polygons * branches
     if slots > MAX_VERTEX_SLOTS:
         wider = isinstance(envelope, int) and envelope > vertices
