@@ -18,80 +18,70 @@ static int is_digit(char c) { return c >= '0' && c <= '9'; }
 
 static int is_blank(char c) { return c == ' ' || c == '\t'; }
 
-/* The end of the plain decimal number at p (before `end`), or NULL when there is none. */
-static const char *plain_number(const char *p, const char *end) {
-    if (p < end && (*p == '+' || *p == '-')) p++;
-    Py_ssize_t digits = 0;
-    while (p < end && is_digit(*p)) p++, digits++;
-    if (p < end && *p == '.') {
-        p++;
-        while (p < end && is_digit(*p)) p++, digits++;
-    }
-    if (digits == 0) return NULL;
-    if (p < end && (*p == 'e' || *p == 'E')) {
-        p++;
-        if (p < end && (*p == '+' || *p == '-')) p++;
-        Py_ssize_t exponent = 0;
-        while (p < end && is_digit(*p)) p++, exponent++;
-        if (exponent == 0) return NULL;
-    }
-    return p;
-}
-
 /* Powers of ten that are exact doubles (10^22 < 2^53 * 2^22 is the last). */
 static const double EXACT_TENS[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 /*
- * The plain number from p to stop as the correctly rounded double, when Clinger's fast path
- * applies: at most 15 significant digits (an integer below 2^53, exact as a double) and a
- * power of ten within 1e22 (exact too), so one multiplication or division, itself correctly
- * rounded, gives the correctly rounded result. Returns 0 when it does not apply (strtod then
- * reads the cell). Logs' cells (0.785398163, 1234.56) take this path: about a tenth of strtod's
- * time.
+ * The end of the plain decimal number at p (before `end`), or NULL when there is none. In
+ * the same pass, *exact tells whether Clinger's fast path gives its correctly rounded double
+ * (then in *value): at most 15 significant digits (an integer below 2^53, exact as a double)
+ * and a power of ten within 1e22 (exact too), so one multiplication or division, itself
+ * correctly rounded, gives the correctly rounded result. Otherwise strtod reads the cell. Logs'
+ * cells (0.785398163, 1234.56) take the fast path: about a tenth of strtod's time.
  */
-static int fast_number(const char *p, const char *stop, double *value) {
-#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
-    /* Arithmetic in a wider type (x87) would round twice: strtod alone is exact there. */
-    (void)p, (void)stop, (void)value;
-    return 0;
-#endif
+static const char *plain_number(const char *p, const char *end, double *value, int *exact) {
     int negative = 0;
-    if (*p == '+' || *p == '-') negative = *p++ == '-';
-    unsigned long long mantissa = 0;
-    int significant = 0, exponent = 0, seen_point = 0;
-    for (; p < stop && *p != 'e' && *p != 'E'; p++) {
-        if (*p == '.') {
-            seen_point = 1;
-            continue;
-        }
-        if (mantissa == 0 && *p == '0') {
-            if (seen_point) exponent--;
-            continue;
-        }
-        if (++significant > 15) return 0;
-        mantissa = mantissa * 10 + (unsigned long long)(*p - '0');
-        if (seen_point) exponent--;
+    if (p < end && (*p == '+' || *p == '-')) negative = *p++ == '-';
+    unsigned long long mantissa = 0; /* the first 15 significant digits */
+    int significant = 0, scale = 0;  /* the number is mantissa * 10^scale */
+    Py_ssize_t digits = 0;
+    for (; p < end && is_digit(*p); p++, digits++) {
+        if (significant == 0 && *p == '0') continue;
+        if (significant++ < 15) mantissa = mantissa * 10 + (unsigned long long)(*p - '0');
     }
-    if (p < stop) { /* an exponent: at most a few digits, or the slow way */
+    if (p < end && *p == '.') {
+        p++;
+        for (; p < end && is_digit(*p); p++, digits++) {
+            if (significant == 0 && *p == '0') {
+                scale--;
+                continue;
+            }
+            if (significant++ < 15) {
+                mantissa = mantissa * 10 + (unsigned long long)(*p - '0');
+                scale--;
+            }
+        }
+    }
+    if (digits == 0) return NULL;
+    int small_exponent = 1;
+    if (p < end && (*p == 'e' || *p == 'E')) {
         p++;
         int negative_exponent = 0;
-        if (*p == '+' || *p == '-') negative_exponent = *p++ == '-';
+        if (p < end && (*p == '+' || *p == '-')) negative_exponent = *p++ == '-';
+        Py_ssize_t exponent_digits = 0;
         int written = 0;
-        for (; p < stop; p++) {
-            if (written > 1000) return 0;
+        for (; p < end && is_digit(*p); p++, exponent_digits++) {
+            if (written > 1000) {
+                small_exponent = 0; /* thousands of digits or a huge power: the slow way */
+                continue;
+            }
             written = written * 10 + (*p - '0');
         }
-        exponent += negative_exponent ? -written : written;
+        if (exponent_digits == 0) return NULL;
+        scale += negative_exponent ? -written : written;
     }
-    double result = (double)mantissa;
-    if (mantissa != 0) {
-        if (exponent < -22 || exponent > 22) return 0;
-        result = exponent < 0 ? result / EXACT_TENS[-exponent] : result * EXACT_TENS[exponent];
+    *exact = significant <= 15 && small_exponent && (mantissa == 0 || (scale >= -22 && scale <= 22));
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+    *exact = 0; /* arithmetic in a wider type (x87) would round twice: strtod alone is exact there */
+#endif
+    if (*exact) {
+        double result = (double)mantissa;
+        if (mantissa != 0) result = scale < 0 ? result / EXACT_TENS[-scale] : result * EXACT_TENS[scale];
+        *value = negative ? -result : result;
     }
-    *value = negative ? -result : result;
-    return 1;
+    return p;
 }
 
 PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
@@ -120,12 +110,16 @@ PyObject *parse_float_rows(PyObject *self, PyObject *const *args, Py_ssize_t nar
     for (Py_ssize_t row = 0; row < rows && plain; row++) {
         for (Py_ssize_t column = 0; column < columns; column++) {
             while (p < end && is_blank(*p)) p++;
-            const char *stop = plain_number(p, end);
+            double fast;
+            int exact;
+            const char *stop = plain_number(p, end, &fast, &exact);
             if (!stop || stop - p > LONGEST_CELL) {
                 plain = 0;
                 break;
             }
-            if (!fast_number(p, stop, &out[row * columns + column])) {
+            if (exact) {
+                out[row * columns + column] = fast;
+            } else {
                 /* strtod on a copy: the block is not NUL-terminated, and the copy's end is known. */
                 Py_ssize_t length = stop - p;
                 memcpy(cell, p, (size_t)length);
