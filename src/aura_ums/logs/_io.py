@@ -584,8 +584,10 @@ def load_log(folder: str | os.PathLike[str]) -> RobotLog:
     commands = None if has_odometry else _read_commands(base / COMMANDS, units)
     groundtruth = _read_groundtruth(base / GROUNDTRUTH, units) if present(base / GROUNDTRUTH) else None
     log = RobotLog(meta, landmarks, observations, odometry, commands, groundtruth, base)
-    names = {"motion": ODOMETRY if has_odometry else COMMANDS, "observations": OBSERVATIONS}
-    problem = log.unaligned_clocks({**names, "ground truth": GROUNDTRUTH})
+    motion = ODOMETRY if has_odometry else COMMANDS
+    problem = log.unaligned_clocks(
+        {"motion": motion, "observations": OBSERVATIONS, "ground truth": GROUNDTRUTH}
+    )
     if problem is not None:
         raise FileFormatError(str(base), "", problem)
     return log
