@@ -340,3 +340,17 @@ def test_a_sliver_whose_triangles_round_below_zero_is_still_sampled() -> None:
     points = sliver.sample(50, np.random.default_rng(0))
     assert points.shape == (50, 2)
     assert np.all(sliver.contains(points, tolerance=1e-9))
+
+
+def test_a_repeated_vertex_constrains_nothing_in_the_point_test() -> None:
+    # The library's own kernels may repeat a vertex (60 repeated sightings did): its edge
+    # of no length gave 0 / 0 = NaN, a RuntimeWarning, and every point "outside".
+    from aura_ums.geometry._convex import points_in_convex
+
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    assert points_in_convex(square, np.array([[1.0, 1.0], [3.0, 1.0]]), 0.0).tolist() == [True, False]
+    points = np.random.default_rng(5).uniform(-1.0, 3.0, (2000, 2))  # past the dense limit
+    expected = np.all((points >= 0.0) & (points <= 2.0), axis=1)
+    assert np.array_equal(points_in_convex(square, points, 0.0), expected)
+    assert expected.any()
+    assert not expected.all()

@@ -161,3 +161,16 @@ def test_the_envelope_gate_calls_an_area_positive_only_when_polygon_area_does(
     if gate[0] == 1.0:
         assert polygon_area(vertices) > 0.0
     assert gate[1:].tolist() == [1.0, 0.0]
+
+
+def test_the_batched_truth_check_takes_a_repeated_vertex_as_no_edge() -> None:
+    # 0 / 0 on the repeated vertex's edge: a RuntimeWarning and the truth judged outside
+    from aura_ums.geometry import ConvexPolygon, HeadingWedge
+    from aura_ums.logs._replay import _contains
+    from aura_ums.uncertainty import SpatialUncertaintyMap
+
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    polygon = ConvexPolygon._trusted(square)
+    repeated = SpatialUncertaintyMap._trusted(polygon, np.array([1.0, 1.0]), HeadingWedge(0.0, 0.5, 0.5))
+    poses = np.array([[1.0, 1.0, 0.0], [2.5, 1.0, 0.0], [1.0, 1.0, 1.0]])
+    assert _contains([repeated] * 3, poses).tolist() == [1, 0, 0]

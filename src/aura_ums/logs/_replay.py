@@ -1360,7 +1360,13 @@ def _contains(
     pose = poses[batched]
     relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]
     relative_y = np.repeat(pose[:, 1], chosen) - every[:, 1]
-    signed = (edge[:, 0] * relative_y - edge[:, 1] * relative_x) / length
+    # A zero-length edge (a repeated vertex) constrains nothing: +inf, not 0 / 0 = NaN (outside).
+    signed = np.divide(
+        edge[:, 0] * relative_y - edge[:, 1] * relative_x,
+        length,
+        out=np.full(length.shape, np.inf),
+        where=length > 0.0,
+    )
     in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
     result[batched] = in_polygon & wedges_contain(wedges[batched], pose[:, 2])
     return result
