@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import itertools
 import json
+import shutil
 from importlib.metadata import version
 from pathlib import Path
 
@@ -317,3 +318,59 @@ def test_a_resumed_state_whose_parts_disagree_names_the_file(tmp_path: Path) -> 
     assert result.stderr.startswith(
         f"error: {edited}: --resume: blackboard: expected the one this manager reads"
     )
+
+
+def test_a_replay_of_no_frame_is_refused_and_leaves_no_output(tmp_path: Path) -> None:
+    # a ground truth 10,000 s after the motion (the clocks check allows a day): 0 steps,
+    # every figure n/a, exit 0; and --until before the first frame did the same
+    sample = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
+    late = tmp_path / "late"
+    shutil.copytree(sample, late)
+    truth = late / "groundtruth.csv"
+    lines = truth.read_text().splitlines()
+    shifted = [
+        f"{float(time) + 10000.0!r},{rest}" for time, rest in (line.split(",", 1) for line in lines[2:])
+    ]
+    truth.write_text("\n".join([*lines[:2], *shifted]) + "\n")
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    steps = tmp_path / "steps.csv"
+    result = runner.invoke(
+        app, ["replay", str(late), "-q", "--terrain", str(terrain), "--steps-csv", str(steps)]
+    )
+    assert result.exit_code == 2
+    assert result.stdout == ""
+    assert result.stderr.startswith(
+        "error: log 'sample-r1': expected a frame (an observation time) after the replay's start, "
+        "10000 s, got none"
+    )
+    assert not steps.exists()
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["late", "terrain.toml"]
+    # among many logs, the folder is named
+    many = runner.invoke(app, ["replay", str(sample), str(late), "-q", "--terrain", str(terrain)])
+    assert many.exit_code == 2
+    assert many.stderr.startswith(f"error: {late}: log 'sample-r1': expected a frame")
+    early = runner.invoke(app, ["replay", str(sample), "-q", "--terrain", str(terrain), "--until", "0.05"])
+    assert early.exit_code == 2
+    assert early.stderr == (
+        "error: --until: expected a frame (an observation time) between the replay's start (0 s) and 0.05 s, "
+        "got none\n"
+    )
+
+
+def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path) -> None:
+    # a camera turned backwards reported 0 window observations and n/a, on stdout alone
+    root = Path(__file__).resolve().parents[2] / "examples"
+    camera = tmp_path / "back.toml"
+    text = (root / "virtual_camera_60deg.toml").read_text()
+    camera.write_text(text.replace("pan_deg = 0.0 ", "pan_deg = 180.0", 1))
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    replay = ["replay", str(root / "logs" / "r1"), "-q", "--terrain", str(terrain), "--until", "10"]
+    result = invoke(*replay, "--camera", camera)
+    assert "window_observations            0\n" in result.stdout
+    assert result.stderr.startswith(
+        f"warning: --camera: expected some of the 33 observations to fall in the image of {camera}, got none"
+    )
+    seen = invoke(*replay, "--camera", root / "virtual_camera_60deg.toml")
+    assert "warning" not in seen.stderr

@@ -382,8 +382,20 @@ def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: 
     result = runner.invoke(app, ["calibrate", str(folder), "--out", str(tmp_path / "t.toml")])
     assert result.exit_code == 2
     assert f"error: LOG_DIRS ({folder}): calibrating from their contents: " in result.stderr
-    assert "expected at least 10 1.0-second windows of motion, got 0" in result.stderr
+    assert (
+        "default horizons: expected a horizon of which the logs hold at least 10 windows of motion, "
+        "got 1 s (0 windows in their " in result.stderr
+    )
     assert not (tmp_path / "t.toml").exists()
+    # a --horizon too long for the logs is named as the option (it named neither)
+    longer = runner.invoke(
+        app, ["calibrate", str(log_folder), "--out", str(tmp_path / "t.toml"), "--horizon", "1000"]
+    )
+    assert longer.exit_code == 2
+    assert longer.stderr.startswith(
+        "error: --horizon: expected a horizon of which the logs hold at least 10 windows of motion, "
+        "got 1000 s (0 windows in their "
+    )
 
 
 def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, tmp_path: Path) -> None:

@@ -53,6 +53,11 @@ def test_clean_synthetic_log_keeps_the_truth_at_every_step(
         dataclasses.replace(clean_log, observations=()), FLOOR, ReplayOptions(landmark_class=landmark_class)
     )
     assert grown_only.steps == ()
+    with pytest.raises(
+        InputError, match=r"^log 'synthetic': expected a frame \(an observation time\) after the"
+    ):
+        grown_only.require_steps()
+    result.require_steps()
     assert result.median_area_m2 < 2.0
     metrics = result.metrics()
     for key in (
@@ -112,6 +117,11 @@ def test_zero_length_log_gives_no_steps() -> None:
     result = replay_log(dataclasses.replace(log, observations=()), FLOOR)
     assert result.steps == ()
     assert np.isnan(result.containment_rate)
+    assert result.start_time == pytest.approx(0.0, abs=0.1)
+    with pytest.raises(
+        InputError, match=r"^until: expected a frame \(an observation time\) between the replay's start"
+    ):
+        result.require_steps(until=0.05)
 
 
 @pytest.fixture(scope="module")

@@ -22,7 +22,7 @@ from aura_ums.camera import Camera
 from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
 from aura_ums.errors import InputError
-from aura_ums.logs import ReplayOptions, RobotLog, load_log, replay_log, replay_windows
+from aura_ums.logs import ReplayOptions, ReplayResult, RobotLog, load_log, replay_log, replay_windows
 from aura_ums.sim import PerceptionMode, RunResult, Scenario, run_scenario
 from aura_ums.uncertainty import TerrainTable
 
@@ -270,7 +270,8 @@ class LogReplay:
     def __call__(self, folder: str | os.PathLike[str]) -> Metrics:
         """Replay the log in ``folder`` and return its metrics (with the windows', given a camera).
 
-        The metrics are :meth:`ReplayResult.metrics <aura_ums.logs.ReplayResult.metrics>`.
+        The metrics are :meth:`ReplayResult.metrics <aura_ums.logs.ReplayResult.metrics>`. A log
+        that replays no step (:meth:`~aura_ums.logs.ReplayResult.require_steps`) is refused.
         """
         log = self.load(folder)
         # Checked here, where the log's terrain is first known: the replay's own check
@@ -279,7 +280,9 @@ class LogReplay:
             log.meta.terrain, where=str(self.table_file), whose=f"the log in {folder} (its meta.toml)"
         )
         if self.camera is None:
-            return replay_log(log, self.table, self.options, keep_maps=False, until=self.until).metrics()
+            result = replay_log(log, self.table, self.options, keep_maps=False, until=self.until)
+            _require_steps(result, self.until, folder)
+            return result.metrics()
         result, windows = replay_windows(
             log,
             self.table,
@@ -289,4 +292,13 @@ class LogReplay:
             keep_maps=False,
             until=self.until,
         )
+        _require_steps(result, self.until, folder)
         return Metrics({**result.metrics(), **windows.metrics()})
+
+
+def _require_steps(result: ReplayResult, until: float | None, folder: str | os.PathLike[str]) -> None:
+    """Refuse a log of the campaign that replayed no step, naming its folder among the many."""
+    try:
+        result.require_steps(until)
+    except InputError as exc:
+        raise InputError(f"{os.fspath(folder)}: {exc}") from None

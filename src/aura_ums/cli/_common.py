@@ -49,6 +49,11 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def warn(message: str) -> None:
+    """Print ``warning: <message>`` (markup-safe) on stderr: the command goes on."""
+    err_console.print(f"[yellow]warning:[/yellow] {escape(message)}", highlight=False)
+
+
 def refuse_alone(context: typer.Context, rules: Sequence[tuple[str, str, str, bool]]) -> None:
     """Refuse (exit 2) an option typed on the command line that would have no effect.
 

@@ -36,6 +36,7 @@ from aura_ums.cli._common import (
     output_file,
     progress_bar,
     refuse_alone,
+    warn,
 )
 from aura_ums.cli._interop import LIVE_DEFAULTS, Live, LiveHost, LivePort, LiveRate, live_replay, live_rules
 from aura_ums.cli._outputs import (
@@ -51,7 +52,7 @@ from aura_ums.cli._outputs import (
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import LogStream, ReplayOptions, ReplayResult
+    from aura_ums.logs import LogStream, ReplayOptions, ReplayResult, WindowReport
     from aura_ums.manager import ManagerSettings
     from aura_ums.uncertainty import TerrainTable
 
@@ -307,6 +308,10 @@ def calibrate(
     except AuraUmsError as exc:
         message = str(exc)
         name, _, rest = message.partition(": ")
+        if name == "horizons" and not horizons and "windows of motion" in rest:
+            # no --horizon given: the logs are too short for the default horizons
+            folders = ", ".join(str(folder) for folder in log_dirs)
+            raise fail(f"LOG_DIRS ({folders}): calibrating from their contents: default {message}") from None
         if name == "horizons" and not horizons:
             # no --horizon given: the defaults are too short for the --move given, the option at fault
             defaults = inspect.signature(calibrate_logs).parameters["horizons"].default
@@ -529,6 +534,9 @@ def replay(
                     steps_csv=steps_path, progress=advance, until=until, resume=saved,
                     save_state=save_state is not None, after_step=None if view is None else view.step,
                 )  # fmt: skip
+            if resume is None and save_state is None:
+                # Inside the outputs' block, so no empty steps CSV is left under its name.
+                result.require_steps(until)
     except AuraUmsError as exc:
         message = str(exc)
         if resume is not None and message.startswith("resume: "):
@@ -541,6 +549,8 @@ def replay(
             message = f"--{message.replace('the resumed state', f'the state in {resume}', 1)}"
         raise fail(message) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
+    if windows is not None and camera is not None:
+        _warn_unseen(windows, camera)
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if json_target is not None:
@@ -557,6 +567,18 @@ def replay(
         from aura_ums.cli._interop import write_replay_mcap_option
 
         write_replay_mcap_option(mcap_target, result, quiet=quiet, windows=windows)
+
+
+def _warn_unseen(windows: WindowReport, camera: Path) -> None:
+    """Say so when the camera saw none of the observations: its window figures are all n/a."""
+    ours = windows.methods[0]
+    asked = sum(row.method == ours for row in windows.rows)
+    if asked and not windows.judged(ours):
+        warn(
+            f"--camera: expected some of the {asked} observations to fall in the image of {camera}, "
+            "got none (a measured pixel outside the image, or behind the camera): the window figures "
+            "are n/a; check its [mount] and [intrinsics]"
+        )
 
 
 def _open(folder: Path, max_truth_gap: float | None) -> LogStream:

@@ -997,8 +997,11 @@ def calibrate_logs(
     ]
     counted = sum(int(w.run.size) for w in windows)
     if windows[0].run.size < 10:
+        # The logs are too short (or too still) for the first horizon: named as the
+        # horizon, which the caller may shorten; the CLI blames the logs when it is a default.
         raise InputError(
-            f"logs: expected at least 10 {spans[0]!r}-second windows of motion, got {windows[0].run.size}"
+            f"horizons: expected a horizon of which the logs hold at least 10 windows of motion, "
+            f"got {spans[0]:g} s ({windows[0].run.size} windows in their {seconds:g} s with ground truth)"
         )
     valid = np.concatenate([m.valid for m in moves])
     run_gain = _gain(

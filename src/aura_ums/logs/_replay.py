@@ -363,6 +363,10 @@ class ReplayResult:
     state : ReplayState or None
         Where the replay stopped (the manager and blackboard after its last frame), to
         save and resume from; None when not recorded.
+    start_time : float
+        The replay's start, s: the motion's first time, or the ground truth's first row
+        when that is later (NaN when not known). A replay whose frames all come before it
+        has no step.
     """
 
     log: RobotLog | LogStream
@@ -419,6 +423,45 @@ class ReplayResult:
         )
 
     state: ReplayState | None = None
+    start_time: float = math.nan
+
+    def require_steps(self, until: float | None = None) -> None:
+        """Refuse a replay that made no step: its figures would all be undefined.
+
+        A log's frames may all come before the replay's start (a ground truth that begins
+        after the last observation) or after ``until`` (the replay's own argument, named in
+        the message); a command that reports figures calls this first.
+
+        Raises
+        ------
+        InputError
+            When :attr:`trace` holds no step.
+
+        Examples
+        --------
+        >>> import dataclasses, numpy as np
+        >>> from aura_ums.logs import synthetic_log
+        >>> from aura_ums.uncertainty import TerrainTable
+        >>> log = synthetic_log(np.random.default_rng(0), duration=2.0)
+        >>> table = TerrainTable({"floor": TerrainTable.default()["tile"]})
+        >>> replay_log(log, table).require_steps()  # frames after the start: nothing raised
+        >>> replay_log(dataclasses.replace(log, observations=()), table).require_steps()  # the edge
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: log 'synthetic': expected a frame (an observation time) after the ...
+        """
+        if self.trace.time.size:
+            return
+        if until is not None:
+            raise InputError(
+                f"until: expected a frame (an observation time) between the replay's start "
+                f"({self.start_time:g} s) and {until:g} s, got none"
+            )
+        raise InputError(
+            f"log {self.log.meta.name!r}: expected a frame (an observation time) after the replay's start, "
+            f"{self.start_time:g} s, got none: the log has no observation after it (the start is the "
+            "motion's first time, or the ground truth's first row when that is later)"
+        )
 
     @property
     def containment_rate(self) -> float:
@@ -905,6 +948,7 @@ def replay_log(
         manager.relocalizations,
         tuple(maps) if keep_maps else None,
         state,
+        source.start_time,
     )
 
 
