@@ -161,6 +161,32 @@ def test_a_pipe_or_device_is_never_replaced_by_an_output(inputs: Path, tmp_path:
     assert stat.S_ISFIFO(pipe.lstat().st_mode)
 
 
+def test_the_commands_own_stdout_is_refused_as_an_output(inputs: Path, tmp_path: Path) -> None:
+    # --metrics-json /dev/stdout on a pipe: "expected a writable place, got /proc/<pid>/fd";
+    # redirected to a file, the rename would have replaced the printed results
+    import subprocess
+    import sys
+
+    aura = Path(sys.executable).with_name("aura-ums")
+    command: list[str | Path] = [
+        aura, "replay", inputs / "log", "--terrain", inputs / "terrain.toml", "-q", "--metrics-json"
+    ]  # fmt: skip
+    piped = subprocess.run([*command, "/dev/stdout"], capture_output=True, text=True, check=False)
+    assert piped.returncode == 2
+    assert piped.stderr == (
+        "error: --metrics-json: expected a file apart from the command's own stdout, got /dev/stdout "
+        "(results are printed on stdout, errors on stderr, anyway)\n"
+    )
+    printed = tmp_path / "printed.txt"
+    with printed.open("w") as out:
+        done = subprocess.run(
+            [*command, printed, "--overwrite"], stdout=out, stderr=subprocess.PIPE, check=False
+        )
+    assert done.returncode == 2
+    assert b"expected a file apart from the command's own stdout, got " in done.stderr
+    assert printed.read_text() == ""
+
+
 def test_an_unwritable_output_is_refused_before_the_computation(
     inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -21,6 +21,7 @@ import functools
 import os
 import re
 import shutil
+import stat
 import unicodedata
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -206,7 +207,14 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
         return
     if where.is_dir():
         raise fail(f"{target.option}: expected a file, got {target.path}, which is a folder")
-    if where.exists() and not where.is_file():
+    stream = _stream_of(target.path)
+    if stream:
+        raise fail(
+            f"{target.option}: expected a file apart from the command's own {stream}, got {target.path} "
+            "(results are printed on stdout, errors on stderr, anyway)"
+        )
+    # Also the path as given: /dev/stdout on a pipe resolves to a /proc name that is no file.
+    if (where.exists() and not where.is_file()) or _special(target.path):
         # The atomic rename would put a regular file in its place (as root, /dev/null's).
         raise fail(
             f"{target.option}: expected a regular file, got {target.path}, which is a device, pipe or "
@@ -217,6 +225,33 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
             f"{target.option}: expected a new file, got {target.path}, which exists "
             "(pass --overwrite to replace it)"
         )
+
+
+def _stream_of(path: Path) -> str:
+    """Name the stream of this process that ``path`` is, ``"stdout"`` or ``"stderr"``, else ``""``.
+
+    ``/dev/stdout``, or the file the stream is redirected to.
+    """
+    try:
+        given = os.stat(path)
+    except (OSError, ValueError):
+        return ""
+    for name, descriptor in (("stdout", 1), ("stderr", 2)):
+        try:
+            stream = os.fstat(descriptor)
+        except OSError:  # closed
+            continue
+        if (given.st_dev, given.st_ino) == (stream.st_dev, stream.st_ino):
+            return name
+    return ""
+
+
+def _special(path: Path) -> bool:
+    """Whether ``path``, followed through its links, is a device, pipe or socket."""
+    try:
+        return not stat.S_ISREG(os.stat(path).st_mode) and not stat.S_ISDIR(os.stat(path).st_mode)
+    except (OSError, ValueError):  # no such file (the usual case), or a name the system refuses
+        return False
 
 
 def _writable(target: Target, where: Path) -> None:
