@@ -163,3 +163,21 @@ def test_simulate_refuses_an_unknown_perception() -> None:
     assert result.exit_code == 2
     assert "--perception" in result.output
     assert "everywhere" in result.output
+
+
+def test_a_log_lost_to_the_run_timeout_is_named_with_the_option(
+    log_folders: list[Path], tmp_path: Path
+) -> None:
+    # "run 0: ... (last: no result within 1e-09 s)" named neither the log nor --run-timeout
+    pytest.importorskip("distributed", reason="the dask extra is not installed")
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    options = ["--terrain", str(terrain), "-q", "--workers", "2", "--retries", "0", "--run-timeout", "1e-9"]
+    result = runner.invoke(app, ["replay", *map(str, log_folders), *options])
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error: run ")
+    assert f" ({log_folders[0]}): " in result.stderr or f" ({log_folders[1]}): " in result.stderr
+    assert result.stderr.endswith(
+        ": expected it to finish within 0 retries, got it lost 1 times "
+        "(last: no result within --run-timeout 1e-09 s)\n"
+    )

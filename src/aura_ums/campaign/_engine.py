@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib
 import logging
+import os
 import queue
 import time
 import uuid
@@ -216,8 +217,11 @@ class _Runs(Generic[_T, _R]):
     def lost(self, index: int, why: str) -> None:
         self.attempts[index] += 1
         if self.attempts[index] > self.settings.retries:
+            # A folder (a log replayed) is named: "run 3" alone left the user counting.
+            item: object = self.items[index]
+            named = f" ({os.fspath(item)})" if isinstance(item, str | os.PathLike) else ""
             raise RunLostError(
-                f"run {index}: expected it to finish within {self.settings.retries} retries, "
+                f"run {index}{named}: expected it to finish within {self.settings.retries} retries, "
                 f"got it lost {self.attempts[index]} times (last: {why})"
             )
         self.retried.add(index)
@@ -279,7 +283,7 @@ def _time_out(client: Client, runs: _Runs[_T, _R], timeout_s: float) -> None:
     for future in late:
         index, _ = runs.in_flight.pop(future)
         future.cancel()
-        runs.lost(index, f"no result within {timeout_s:g} s")
+        runs.lost(index, f"no result within timeout_s = {timeout_s:g} s")
     if stuck:
         # A thread cannot be stopped: the worker's process is, by its nanny. Not waiting for
         # the restarted workers to return: a nanny whose worker was lost before may never

@@ -8,7 +8,15 @@ from typing import Annotated
 
 import typer
 
-from aura_ums.cli._campaign import DEFAULTS, Retries, RunTimeout, Scheduler, Workers, campaign_settings
+from aura_ums.cli._campaign import (
+    DEFAULTS,
+    Retries,
+    RunTimeout,
+    Scheduler,
+    Workers,
+    campaign_failure,
+    campaign_settings,
+)
 from aura_ums.cli._common import (
     NO_OPTIONS,
     PlainCommand,
@@ -244,7 +252,7 @@ def simulate(
                 values = list(run_campaign(watched, run_seeds(seed, runs), progress=advance).values)
                 retried = 0
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        raise fail(campaign_failure(exc)) from None
     metrics = Metrics(
         {
             "scenario": loaded.name,

@@ -76,6 +76,18 @@ _FLAGS = {
 }
 
 
+def campaign_failure(exc: Exception) -> str:
+    """Return a campaign's error message with its settings named as the options are spelled.
+
+    A run lost to its timeout says ``no result within timeout_s = 1e-09 s``: the user typed
+    ``--run-timeout``.
+    """
+    message = str(exc)
+    for name, flag in _FLAGS.items():
+        message = message.replace(f"{name} = ", f"{flag} ")
+    return message
+
+
 def campaign_settings(
     context: typer.Context, workers: int, scheduler: str | None, retries: int, run_timeout: float | None
 ) -> CampaignSettings:
@@ -125,7 +137,7 @@ def replay_logs(
         with progress_bar("replay: logs", quiet=quiet, total=len(log_dirs)) as advance:
             campaign = run_campaign(job, log_dirs, settings, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        raise fail(campaign_failure(exc)) from None
     metrics = Metrics({"replays": campaign.values, "runs_retried": campaign.retried})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)

@@ -20,6 +20,7 @@ from aura_ums.cli._campaign import (
     RunTimeout,
     Scheduler,
     Workers,
+    campaign_failure,
     campaign_settings,
     replay_logs,
 )
@@ -296,7 +297,7 @@ def calibrate(
         with progress_bar("calibrate: logs", quiet=quiet, total=len(log_dirs)) as advance:
             loaded = run_campaign(LoadLog(max_truth_gap), log_dirs, campaign_options, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        raise fail(campaign_failure(exc)) from None
     logs = list(loaded.values)
     try:
         if horizons:
