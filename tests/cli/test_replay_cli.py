@@ -398,6 +398,29 @@ def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: 
     )
 
 
+def test_a_calibration_no_sighting_agrees_with_is_warned_about(log_folder: Path, tmp_path: Path) -> None:
+    # every bearing wrong: bearing_error 3.11 rad written without a word, a map nothing shrinks
+    folder = tmp_path / "wrong"
+    shutil.copytree(log_folder, folder)
+    observations = folder / "observations.csv"
+    lines = observations.read_text().splitlines()
+    header = [line for line in lines if line.startswith(("#", "time,"))]
+    rows = [line.split(",") for line in lines[len(header) :]]
+    rng = np.random.default_rng(3)
+    for row in rows:
+        row[2] = repr(float(rng.uniform(-3.1, 3.1)))
+    observations.write_text("\n".join([*header, *(",".join(row) for row in rows)]) + "\n")
+    result = runner.invoke(app, ["calibrate", str(folder), "--out", str(tmp_path / "t.toml"), "-q"])
+    assert result.exit_code == 0, result.output
+    assert (
+        "warning: working bearing bound: expected the observations to agree with the ground truth within "
+        in (result.stderr)
+    )
+    clean = runner.invoke(app, ["calibrate", str(log_folder), "--out", str(tmp_path / "c.toml"), "-q"])
+    assert clean.exit_code == 0
+    assert "warning" not in clean.stderr
+
+
 def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, tmp_path: Path) -> None:
     terrain = tmp_path / "cal" / "terrain.toml"
     assert runner.invoke(app, ["calibrate", str(log_folder), "--out", str(terrain)]).exit_code == 0

@@ -58,6 +58,9 @@ if TYPE_CHECKING:
     from aura_ums.uncertainty import TerrainTable
 
 
+# A calibrated bearing bound wider than this (29 degrees) is warned about: a misread log.
+_LOOSE_BEARING_RAD = 0.5
+
 # draw_replay's file name after the log's name
 _FIGURE = "_replay.png"
 
@@ -338,6 +341,13 @@ def calibrate(
             f"-{bounds.range_fraction_high:.3f}/+{bounds.range_fraction_low:.3f} of measured "
             f"+-{bounds.range_error:.3f} m "
             f"({calibration.observations} observations)"
+        )
+    if working.bearing_error > _LOOSE_BEARING_RAD:
+        # Sound, but a map no sighting can shrink: most likely the logs, not the sensor.
+        warn(
+            f"working bearing bound: expected the observations to agree with the ground truth within "
+            f"{_LOOSE_BEARING_RAD:g} rad, got +-{working.bearing_error:.4f} rad: no sighting will shrink the "
+            "map much; check the logs' landmark ids, and their bearings' sign and units"
         )
     if campaign_options.distributed:
         console.print(f"logs read on Dask workers: {len(logs)} ({loaded.retried} retried)", highlight=False)
