@@ -610,8 +610,19 @@ def test_a_file_output_given_as_a_folder_is_refused(
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("whole", [False, True], ids=["streamed", "whole (--plot)"])
-def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(tmp_path: Path, whole: bool) -> None:
+@pytest.mark.parametrize(
+    "how",
+    [
+        ["replay"],
+        ["replay", "--plot", "plot"],
+        ["replay", "--camera", "camera"],
+        ["compare", "--particles", "50", "--noise-from", "sample"],
+    ],
+    ids=["streamed", "whole (--plot)", "windows (--camera)", "compare"],
+)
+def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(
+    tmp_path: Path, how: list[str]
+) -> None:
     folder = write_log(long_odometry_log(200, rate=50.0, frame_every=5), tmp_path / "log")
     lines = (folder / "odometry.csv").read_text().splitlines()
     row = next(number for number, text in enumerate(lines) if text[:1].isdigit()) + 2  # a later data row
@@ -622,10 +633,13 @@ def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(tmp_path:
     terrain.write_text(
         TerrainTable({"tile": TerrainTable.default()["tile"]}).to_toml().replace("tile", "floor")
     )
-    plot = ["--plot", str(tmp_path / "plot")] if whole else []
-    result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "-q", *plot])
+    sample = VIRTUAL_CAMERA.parent / "logs" / "r1"
+    places = {"plot": str(tmp_path / "plot"), "camera": str(VIRTUAL_CAMERA), "sample": str(sample)}
+    command, *options = (places.get(word, word) for word in how)
+    result = runner.invoke(app, [command, str(folder), "--terrain", str(terrain), "-q", *options])
     assert result.exit_code == 2
     # was "v: expected forward velocities >= 0 (...), got -1.0 at row 2": an argument's name
+    # (compare and replay --camera said so until 29 November)
     assert result.stderr.startswith(
         f"error: {folder / 'odometry.csv'}:{row + 1}: expected forward velocities >= 0 in column 'v' "
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import math
@@ -1071,14 +1072,10 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
     frames = frames_after(log, start_time)
     frame_times = np.array(sorted(frames), dtype=np.float64)
     end = float(frame_times[-1]) if frame_times.size else start_time
-    try:
+    with _reversal_named(log):
         report_arrays = log.position_report_arrays(
             frame_times, max_interval=opts.max_interval, start=start_time, end=end, reverse=opts.reverse
         )
-    except ReversingError as refused:
-        if log.path is None or log.odometry is None:
-            raise
-        raise reversed_at(log.path / ODOMETRY, refused) from None
     first, posted = 0, 0
     if resume is not None:
         first, posted = _resumed_at(resume, log, frames, frame_times, int(report_arrays[0].size))
@@ -1528,6 +1525,18 @@ def position_reports_for(log: RobotLog, options: ReplayOptions) -> tuple[Positio
     start_time, _ = replay_start(log)
     times = np.array(sorted(frames_after(log, start_time)), dtype=np.float64)
     end = float(times[-1]) if times.size else start_time
-    return log.position_reports(
-        times, max_interval=options.max_interval, start=start_time, end=end, reverse=options.reverse
-    )
+    with _reversal_named(log):
+        return log.position_reports(
+            times, max_interval=options.max_interval, start=start_time, end=end, reverse=options.reverse
+        )
+
+
+@contextlib.contextmanager
+def _reversal_named(log: RobotLog) -> Iterator[None]:
+    """Name the odometry file and line of a refused reverse (the motion knows only its row)."""
+    try:
+        yield
+    except ReversingError as refused:
+        if log.path is None or log.odometry is None:
+            raise
+        raise reversed_at(log.path / ODOMETRY, refused) from None
