@@ -818,9 +818,11 @@ def replay_log(
     done = source.first
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
-            report_times, report_turns, report_runs = (
-                values.tolist() for values in reports.until(chunk.times)
-            )
+            due_arrays = reports.until(chunk.times)
+            # Checked once for the chunk (finite, runs >= 0), the reports are made without
+            # checking each again; else each is made checked, and a bad one refused as it was.
+            checked = _reports_valid(*due_arrays)
+            report_times, report_turns, report_runs = (values.tolist() for values in due_arrays)
             due_count = len(report_times)
             next_report = 0
             count = len(chunk.times)
@@ -839,7 +841,11 @@ def replay_log(
                 due = []
                 while next_report < due_count and report_times[next_report] <= frame_time:
                     due.append(
-                        PositionReport(
+                        PositionReport._trusted(
+                            report_times[next_report], report_turns[next_report], report_runs[next_report]
+                        )
+                        if checked
+                        else PositionReport(
                             report_times[next_report],
                             TurnAndRun(report_turns[next_report], report_runs[next_report]),
                         )
@@ -905,6 +911,16 @@ def replay_log(
         manager.relocalizations,
         tuple(maps) if keep_maps else None,
         state,
+    )
+
+
+def _reports_valid(times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64]) -> bool:
+    """Whether every report's time and turn is finite and its run finite and >= 0 (what they check)."""
+    return bool(
+        np.isfinite(times).all()
+        and np.isfinite(turns).all()
+        and np.isfinite(runs).all()
+        and (runs >= 0.0).all()
     )
 
 

@@ -111,6 +111,10 @@ or GroundLineObservation, got str
         del self._items[:stop]
         return taken
 
+    def _drop_first(self, count: int) -> None:
+        """Remove the ``count`` oldest observations: :meth:`drain` of what :meth:`peek` just returned."""
+        del self._items[:count]
+
     def peek(self, until: float | None = None) -> tuple[Observation, ...]:
         """Return what :meth:`drain` would, without removing anything."""
         return tuple(self._items[: self._stop(until)])

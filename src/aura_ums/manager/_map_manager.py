@@ -331,6 +331,7 @@ class UncertaintyMapManager:
         "_grown",
         "_joint_above",
         "_joint_sector",
+        "_landmarks",
         "_latest",
         "_latest_committed",
         "_lineages",
@@ -373,6 +374,7 @@ class UncertaintyMapManager:
         self._meadow_map = meadow_map
         self._table = table
         self._only_terrain: TerrainStats | None = None
+        self._landmarks: dict[str, Landmark] = {}  # by id, as found in the meadow map
         self._settings = settings
         # The settings the hot paths read, as plain attributes.
         self._sigmas = settings.sigmas
@@ -596,6 +598,7 @@ class UncertaintyMapManager:
 
         identified = blackboard.identified
         pending = identified.peek(time)
+        # Single-threaded by contract: the commit below drains exactly these.
         # The reports this update consumes (the envelope map has consumed as many).
         reports = blackboard.reports_until(time, start=self._consumed)
         index = self._consumed + len(reports)
@@ -610,7 +613,7 @@ class UncertaintyMapManager:
             wide, wide_time, wide_branches = outer._advance(reports, twins, None, None)
 
         # Commit: nothing above changed the manager or the blackboard.
-        identified.drain(time)  # exactly ``pending``: single-threaded by contract
+        identified._drop_first(len(pending))  # identified.drain(time): exactly ``pending``
         grown = len(reports)
         found = self._commit(current, index, map_time, outcomes, branches, len(excluded))
         relocalized = False
@@ -952,7 +955,8 @@ class UncertaintyMapManager:
                     f"blackboard: expected the one this manager reads, keeping its last consumed report "
                     f"{self._consumed - 1}, got one that forgot the reports before {released}"
                 )
-            last = blackboard.report(self._consumed - 1).time
+            # blackboard.report(self._consumed - 1), whose index the checks above bound.
+            last = blackboard._reports[self._consumed - 1 - released].time
             if last != self._map_time:
                 raise InputError(
                     f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
@@ -977,7 +981,7 @@ class UncertaintyMapManager:
             # the terrain up once (here, so that a missing one fails where it always did).
             terrain = self._only_terrain = self._table[self._meadow_map.meadows[0].terrain]
         if terrain is not None:
-            commands = [reports[index].command for index in range(start, stop)]
+            commands = [report.command for report in reports[start:stop]]
             if self._anchor_growth:
                 since = reports[start].time if map_time is None else map_time
                 now = reports[stop - 1].time
@@ -1097,10 +1101,14 @@ class UncertaintyMapManager:
         """Return the landmark an observation names, or why it is rejected before any reduction."""
         if map_time is not None and observation.time < map_time:
             return RejectReason.STALE
-        try:
-            landmark = self._meadow_map.landmark(observation.landmark_id).landmark
-        except UnknownLandmarkError:
-            return RejectReason.UNKNOWN_LANDMARK
+        # The meadow map is immutable: each landmark is looked up once.
+        landmark = self._landmarks.get(observation.landmark_id)
+        if landmark is None:
+            try:
+                landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+            except UnknownLandmarkError:
+                return RejectReason.UNKNOWN_LANDMARK
+            self._landmarks[observation.landmark_id] = landmark
         if observation.landmark_class is not landmark.landmark_class:
             return RejectReason.CLASS_MISMATCH
         return landmark

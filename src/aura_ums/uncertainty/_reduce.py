@@ -187,9 +187,7 @@ def reduce_checked(
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
     if x != center_x or y != center_y:
         x, y = held_centre(reduced_vertices, x, y)
-    reduced = type(prior)._trusted(
-        type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
-    )
+    reduced = type(prior)._at(type(prior.polygon)._read_only(reduced_vertices), x, y, reduced_wedge)
     return reduced, area_before, area_after
 
 
