@@ -72,7 +72,8 @@ class ConvexPolygon:
         """Wrap vertices that the library itself computed (already convex, CCW, finite)."""
         # The slots' own setters: the library builds a polygon for every growth and reduction.
         polygon = object.__new__(cls)
-        vertices.setflags(write=False)
+        if vertices.flags.writeable:  # a kernel's bytes are read-only already
+            vertices.setflags(write=False)
         _set_vertices(polygon, vertices)
         _set_area(polygon, math.nan)
         return polygon

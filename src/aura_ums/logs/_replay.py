@@ -816,6 +816,8 @@ def replay_log(
     bearing_only = opts.landmark_class is LandmarkClass.VERTICAL_LINE
     reports = source.reports
     done = source.first
+    identified = board.identified
+    nominal = _STATES[0]
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
             due_arrays = reports.until(chunk.times)
@@ -862,12 +864,18 @@ def replay_log(
                     before_frame(frame_time, grown.map, logged, grown.focus)
                     began += _time.perf_counter() - paused
                 for observation in working:
-                    board.identified.post(observation)
+                    identified.post(observation)
                 step = manager.update(board, now=frame_time, envelope=envelope)
                 update_us.append((_time.perf_counter() - began) * 1e6)
-                accepted.append(len(step.accepted))
-                rejected.append(len(step.rejected))
-                states.append(_STATE_INDEX[step.state])
+                # len(step.accepted) and len(step.rejected), without building either tuple.
+                taken = 0
+                for outcome in step.outcomes:
+                    if outcome.accepted:
+                        taken += 1
+                accepted.append(taken)
+                rejected.append(len(step.outcomes) - taken)
+                # An enum's hash is computed in Python: the usual state is told by identity.
+                states.append(0 if step.state is nominal else _STATE_INDEX[step.state])
                 relocalized.append(step.relocalized)
                 excluded.append(len(step.excluded))
                 judge.add(index, step.map, step.envelope_map)
@@ -1250,9 +1258,9 @@ class _Judge:
 
     Gives exactly :attr:`SpatialUncertaintyMap.area`, ``wedge.width`` and
     :meth:`SpatialUncertaintyMap.contains`: the same arithmetic, element by element (and
-    the area's two dot products polygon by polygon), over the vertices of many polygons
-    together instead of a few calls per map (which cost more than the map's update on a
-    long log).
+    the area's two dot products by the same BLAS dot, polygon by polygon, see ``_areas``),
+    over the vertices of many polygons together instead of a few calls per map (which cost
+    more than the map's update on a long log).
     """
 
     def __init__(self, trace: ReplayTrace) -> None:
@@ -1305,8 +1313,26 @@ def _wedges(maps: Sequence[SpatialUncertaintyMap]) -> NDArray[np.float64]:
 
 
 def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
-    """Each polygon's area, m^2 (:func:`aura_ums.geometry.polygon_area` of each)."""
-    return np.array([polygon_area(v) for v in vertices], dtype=np.float64)
+    """Each polygon's area, m^2: :func:`aura_ums.geometry.polygon_area` of each, bit for bit.
+
+    The polygons of each vertex count are measured together: their coordinates relative to
+    their first vertex (the same subtractions), in rows, and the two dot products of each
+    row by one ``matmul`` of a row by a column, which numpy computes by the very BLAS dot
+    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers.
+    """
+    counts = np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
+    areas = np.zeros(len(vertices), dtype=np.float64)  # a point or a segment: 0.0, as polygon_area
+    for count in np.unique(counts[counts >= 3]).tolist():
+        chosen = np.flatnonzero(counts == count)
+        stack = np.stack([vertices[index] for index in chosen.tolist()])
+        relative = stack - stack[:, :1, :]
+        x, y = np.ascontiguousarray(relative[:, :, 0]), np.ascontiguousarray(relative[:, :, 1])
+        x_ahead = np.concatenate((x[:, 1:], x[:, :1]), axis=1)
+        y_ahead = np.concatenate((y[:, 1:], y[:, :1]), axis=1)
+        forward = np.matmul(x[:, None, :], y_ahead[:, :, None])[:, 0, 0]
+        backward = np.matmul(y[:, None, :], x_ahead[:, :, None])[:, 0, 0]
+        areas[chosen] = 0.5 * (forward - backward)
+    return areas
 
 
 def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:

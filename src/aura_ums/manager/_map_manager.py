@@ -671,7 +671,8 @@ class UncertaintyMapManager:
                 )
             else:
                 current = self._reduce_instant(current, instant, map_time, outcomes)
-        current, map_time = self._grow(current, reports, index, len(reports), map_time)
+        if index < len(reports):
+            current, map_time = self._grow(current, reports, index, len(reports), map_time)
         return current, map_time, None
 
     def _advance_relaxed(
@@ -850,7 +851,12 @@ class UncertaintyMapManager:
         if envelope is None:
             factor = self._envelope_factor
             return [_widened(observation, factor) for observation in pending]
-        if isinstance(envelope, (str, bytes)) or not isinstance(envelope, Sequence):
+        # A list or a tuple is told first: the check against the Sequence ABC costs more.
+        if (
+            type(envelope) is not list
+            and type(envelope) is not tuple
+            and (isinstance(envelope, (str, bytes)) or not isinstance(envelope, Sequence))
+        ):
             raise InputError(
                 f"envelope: expected a sequence of observations or None, got {type(envelope).__name__}"
             )
