@@ -1285,7 +1285,11 @@ class _Judge:
             trace.area_m2[:count] = _areas(vertices)
             trace.wedge_width_rad[:count] = np.minimum(wedges[:, 1] + wedges[:, 2], _FULL_CIRCLE)
             known = np.flatnonzero(~np.isnan(trace.truth[:count, 0]))
-            if known.size:
+            if known.size == count:  # the truth at every step: no lists to gather
+                trace.inside[:count] = _contains(
+                    self.working, trace.truth[:count], vertices, trace.area_m2[:count], wedges
+                )
+            elif known.size:
                 chosen = known.tolist()
                 trace.inside[known] = _contains(
                     [self.working[i] for i in chosen],
@@ -1348,11 +1352,9 @@ def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.floa
         return np.array([polygon_area(v) > 0.0 for v in vertices], dtype=np.float64)
     every = np.concatenate(vertices)
     first = np.cumsum(counts) - counts
-    following = np.arange(1, len(every) + 1)
-    following[first + counts - 1] = first
     origin = np.repeat(every[first], counts, axis=0)  # each polygon's first vertex, as polygon_area
     relative = every - origin
-    ahead = relative[following]
+    ahead = _ahead(relative, first, first + counts - 1)
     forward, backward = relative[:, 0] * ahead[:, 1], relative[:, 1] * ahead[:, 0]
     total = np.add.reduceat(forward - backward, first)
     size = np.add.reduceat(np.abs(forward) + np.abs(backward), first)
@@ -1360,6 +1362,20 @@ def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.floa
     # last place of the sum of the products' sizes: beyond twice that, both are above 0.
     result[total > 4.0 * np.finfo(np.float64).eps * (counts + 2) * size] = 1.0
     return result
+
+
+def _ahead(
+    rows: NDArray[np.float64], first: NDArray[np.int64], last: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """Rows of polygons one after another, each moved to its predecessor's place (cyclically per polygon).
+
+    Row ``i`` of the result is row ``i + 1``, but at a polygon's ``last`` row, which gets its
+    ``first``: indexing by each row's follower, in two copies instead of a gather.
+    """
+    ahead = np.empty_like(rows)
+    ahead[:-1] = rows[1:]
+    ahead[last] = rows[first]
+    return ahead
 
 
 def _contains(
@@ -1395,9 +1411,7 @@ def _contains(
     chosen = counts[batched]
     every = np.concatenate([vertices[index] for index in batched.tolist()])
     first = np.cumsum(chosen) - chosen
-    following = np.arange(1, len(every) + 1)
-    following[first + chosen - 1] = first
-    edge = every[following] - every
+    edge = _ahead(every, first, first + chosen - 1) - every
     length = np.hypot(edge[:, 0], edge[:, 1])
     pose = poses[batched]
     relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]
