@@ -91,7 +91,11 @@ or GroundLineObservation, got str
                 "observation: expected a BearingObservation, RangeBearingObservation or "
                 f"GroundLineObservation, got {type(observation).__name__}"
             )
-        bisect.insort_right(self._items, observation, key=_time)
+        items = self._items
+        if not items or items[-1].time <= observation.time:
+            items.append(observation)  # in time order, the usual case: where insort_right puts it
+        else:
+            bisect.insort_right(items, observation, key=_time)
 
     def drain(self, until: float | None = None) -> tuple[Observation, ...]:
         """Remove and return the observations with ``time <= until``, in time order.
