@@ -70,6 +70,7 @@ _CHUNK = 1024
 _BATCHED_VERTICES = 1024
 _STATES = tuple(ManagerState)
 _STATE_INDEX = {state: index for index, state in enumerate(_STATES)}
+_STATE_VALUES = tuple(state.value for state in _STATES)  # an enum's value is a property: read once
 # HeadingWedge.width caps a wedge at the full circle.
 _FULL_CIRCLE = 2.0 * math.pi
 
@@ -336,7 +337,7 @@ class ReplayTrace:
             judged = "" if inside < 0 else str(inside)
             lines.append(
                 f"{time!r},{judged},{area!r},{width!r},{accepted},{rejected},"
-                f"{update_us:.3f},{_STATES[state].value},{int(relocalized)}"
+                f"{update_us:.3f},{_STATE_VALUES[state]},{int(relocalized)}"
             )
         return lines
 
