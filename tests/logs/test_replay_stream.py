@@ -136,6 +136,30 @@ def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
 
 
 @given(
+    st.lists(st.integers(1, 40), min_size=1, max_size=12),
+    st.floats(-8.0, 3.0),
+    st.floats(-1e4, 1e4),
+    st.floats(-18.0, 0.0),
+    st.integers(0, 2**32 - 1),
+)
+def test_the_judges_batched_areas_are_polygon_area_bit_for_bit(
+    counts: list[int], log_scale: float, offset: float, log_squash: float, seed: int
+) -> None:
+    """Polygons of every vertex count (BLAS's unrolled dot from 16 on), far from the origin, thin."""
+    from aura_ums.geometry import polygon_area
+    from aura_ums.logs._replay import _areas
+
+    rng = np.random.default_rng(seed)
+    polygons = []
+    for count in counts:
+        angles = np.sort(rng.uniform(0.0, 2.0 * math.pi, count))
+        ring = np.column_stack((np.cos(angles), np.sin(angles) * 10.0**log_squash)) * 10.0**log_scale
+        polygons.append(ring + np.array([offset, -offset]))
+    expected = np.array([polygon_area(vertices) for vertices in polygons])
+    assert _areas(polygons).view(np.int64).tolist() == expected.view(np.int64).tolist()
+
+
+@given(
     st.integers(3, 16),
     st.floats(-8.0, 3.0),
     st.floats(-1e4, 1e4),

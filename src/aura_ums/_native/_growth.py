@@ -345,5 +345,10 @@ def grow_commands_compiled(
         commands,
         max_vertices,
     )
-    # Bytes are immutable, so the array is read-only as map values must be.
-    return Grown(np.frombuffer(raw, dtype=np.float64).reshape(-1, 2), x, y, heading, cw, ccw)
+    # Bytes are immutable, so the array is read-only as map values must be (one array over
+    # them: np.frombuffer(raw).reshape(-1, 2) makes two).
+    grown: Array = np.ndarray((len(raw) // _POINT_BYTES, 2), np.float64, raw)
+    return Grown(grown, x, y, heading, cw, ccw)
+
+
+_POINT_BYTES = 2 * np.dtype(np.float64).itemsize

@@ -72,7 +72,16 @@ class ConvexPolygon:
         """Wrap vertices that the library itself computed (already convex, CCW, finite)."""
         # The slots' own setters: the library builds a polygon for every growth and reduction.
         polygon = object.__new__(cls)
-        vertices.setflags(write=False)
+        if vertices.flags.writeable:  # a kernel's bytes are read-only already
+            vertices.setflags(write=False)
+        _set_vertices(polygon, vertices)
+        _set_area(polygon, math.nan)
+        return polygon
+
+    @classmethod
+    def _read_only(cls, vertices: NDArray[np.float64]) -> ConvexPolygon:
+        """:meth:`_trusted` for vertices already read-only (a view of a kernel's bytes): no flag to set."""
+        polygon = object.__new__(cls)
         _set_vertices(polygon, vertices)
         _set_area(polygon, math.nan)
         return polygon

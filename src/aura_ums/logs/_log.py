@@ -309,10 +309,15 @@ class LogObservation:
         landmark id); a 10^6-row file then does not check each value a second time here.
         Only the bearing is wrapped, as :meth:`__post_init__` wraps it.
         """
+        # One setter call per slot, written out: a loop over them costs twice as much.
         observation = object.__new__(cls)
-        values = (time, landmark_id, _wrapped(bearing), range, bearing_error, range_error, line)
-        for setter, value in zip(_OBSERVATION_SETTERS, values, strict=True):
-            setter(observation, value)
+        _set_time(observation, time)
+        _set_landmark_id(observation, landmark_id)
+        _set_bearing(observation, _wrapped(bearing))
+        _set_range(observation, range)
+        _set_bearing_error(observation, bearing_error)
+        _set_range_error(observation, range_error)
+        _set_line(observation, line)
         return observation
 
     @property
@@ -366,6 +371,9 @@ def _same_length(name: str, **columns: NDArray[np.float64]) -> None:
 _OBSERVATION_SETTERS = tuple(
     LogObservation.__dict__[name].__set__
     for name in ("time", "landmark_id", "bearing", "range", "bearing_error", "range_error", "line")
+)
+_set_time, _set_landmark_id, _set_bearing, _set_range, _set_bearing_error, _set_range_error, _set_line = (
+    _OBSERVATION_SETTERS
 )
 
 

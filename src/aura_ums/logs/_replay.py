@@ -71,6 +71,7 @@ _CHUNK = 1024
 _BATCHED_VERTICES = 1024
 _STATES = tuple(ManagerState)
 _STATE_INDEX = {state: index for index, state in enumerate(_STATES)}
+_STATE_VALUES = tuple(state.value for state in _STATES)  # an enum's value is a property: read once
 # HeadingWedge.width caps a wedge at the full circle.
 _FULL_CIRCLE = 2.0 * math.pi
 
@@ -337,7 +338,7 @@ class ReplayTrace:
             judged = "" if inside < 0 else str(inside)
             lines.append(
                 f"{time!r},{judged},{area!r},{width!r},{accepted},{rejected},"
-                f"{update_us:.3f},{_STATES[state].value},{int(relocalized)}"
+                f"{update_us:.3f},{_STATE_VALUES[state]},{int(relocalized)}"
             )
         return lines
 
@@ -860,11 +861,15 @@ def replay_log(
     bearing_only = opts.landmark_class is LandmarkClass.VERTICAL_LINE
     reports = source.reports
     done = source.first
+    identified = board.identified
+    nominal = _STATES[0]
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
-            report_times, report_turns, report_runs = (
-                values.tolist() for values in reports.until(chunk.times)
-            )
+            due_arrays = reports.until(chunk.times)
+            # Checked once for the chunk (finite, runs >= 0), the reports are made without
+            # checking each again; else each is made checked, and a bad one refused as it was.
+            checked = _reports_valid(*due_arrays)
+            report_times, report_turns, report_runs = (values.tolist() for values in due_arrays)
             due_count = len(report_times)
             next_report = 0
             count = len(chunk.times)
@@ -883,7 +888,11 @@ def replay_log(
                 due = []
                 while next_report < due_count and report_times[next_report] <= frame_time:
                     due.append(
-                        PositionReport(
+                        PositionReport._trusted(
+                            report_times[next_report], report_turns[next_report], report_runs[next_report]
+                        )
+                        if checked
+                        else PositionReport(
                             report_times[next_report],
                             TurnAndRun(report_turns[next_report], report_runs[next_report]),
                         )
@@ -900,12 +909,18 @@ def replay_log(
                     before_frame(frame_time, grown.map, logged, grown.focus)
                     began += _time.perf_counter() - paused
                 for observation in working:
-                    board.identified.post(observation)
+                    identified.post(observation)
                 step = manager.update(board, now=frame_time, envelope=envelope)
                 update_us.append((_time.perf_counter() - began) * 1e6)
-                accepted.append(len(step.accepted))
-                rejected.append(len(step.rejected))
-                states.append(_STATE_INDEX[step.state])
+                # len(step.accepted) and len(step.rejected), without building either tuple.
+                taken = 0
+                for outcome in step.outcomes:
+                    if outcome.accepted:
+                        taken += 1
+                accepted.append(taken)
+                rejected.append(len(step.outcomes) - taken)
+                # An enum's hash is computed in Python: the usual state is told by identity.
+                states.append(0 if step.state is nominal else _STATE_INDEX[step.state])
                 relocalized.append(step.relocalized)
                 excluded.append(len(step.excluded))
                 judge.add(index, step.map, step.envelope_map)
@@ -950,6 +965,16 @@ def replay_log(
         tuple(maps) if keep_maps else None,
         state,
         source.start_time,
+    )
+
+
+def _reports_valid(times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64]) -> bool:
+    """Whether every report's time and turn is finite and its run finite and >= 0 (what they check)."""
+    return bool(
+        np.isfinite(times).all()
+        and np.isfinite(turns).all()
+        and np.isfinite(runs).all()
+        and (runs >= 0.0).all()
     )
 
 
@@ -1275,9 +1300,9 @@ class _Judge:
 
     Gives exactly :attr:`SpatialUncertaintyMap.area`, ``wedge.width`` and
     :meth:`SpatialUncertaintyMap.contains`: the same arithmetic, element by element (and
-    the area's two dot products polygon by polygon), over the vertices of many polygons
-    together instead of a few calls per map (which cost more than the map's update on a
-    long log).
+    the area's two dot products by the same BLAS dot, polygon by polygon, see ``_areas``),
+    over the vertices of many polygons together instead of a few calls per map (which cost
+    more than the map's update on a long log).
     """
 
     def __init__(self, trace: ReplayTrace) -> None:
@@ -1302,7 +1327,11 @@ class _Judge:
             trace.area_m2[:count] = _areas(vertices)
             trace.wedge_width_rad[:count] = np.minimum(wedges[:, 1] + wedges[:, 2], _FULL_CIRCLE)
             known = np.flatnonzero(~np.isnan(trace.truth[:count, 0]))
-            if known.size:
+            if known.size == count:  # the truth at every step: no lists to gather
+                trace.inside[:count] = _contains(
+                    self.working, trace.truth[:count], vertices, trace.area_m2[:count], wedges
+                )
+            elif known.size:
                 chosen = known.tolist()
                 trace.inside[known] = _contains(
                     [self.working[i] for i in chosen],
@@ -1330,8 +1359,26 @@ def _wedges(maps: Sequence[SpatialUncertaintyMap]) -> NDArray[np.float64]:
 
 
 def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
-    """Each polygon's area, m^2 (:func:`aura_ums.geometry.polygon_area` of each)."""
-    return np.array([polygon_area(v) for v in vertices], dtype=np.float64)
+    """Each polygon's area, m^2: :func:`aura_ums.geometry.polygon_area` of each, bit for bit.
+
+    The polygons of each vertex count are measured together: their coordinates relative to
+    their first vertex (the same subtractions), in rows, and the two dot products of each
+    row by one ``matmul`` of a row by a column, which numpy computes by the very BLAS dot
+    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers.
+    """
+    counts = np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
+    areas = np.zeros(len(vertices), dtype=np.float64)  # a point or a segment: 0.0, as polygon_area
+    for count in np.unique(counts[counts >= 3]).tolist():
+        chosen = np.flatnonzero(counts == count)
+        stack = np.stack([vertices[index] for index in chosen.tolist()])
+        relative = stack - stack[:, :1, :]
+        x, y = np.ascontiguousarray(relative[:, :, 0]), np.ascontiguousarray(relative[:, :, 1])
+        x_ahead = np.concatenate((x[:, 1:], x[:, :1]), axis=1)
+        y_ahead = np.concatenate((y[:, 1:], y[:, :1]), axis=1)
+        forward = np.matmul(x[:, None, :], y_ahead[:, :, None])[:, 0, 0]
+        backward = np.matmul(y[:, None, :], x_ahead[:, :, None])[:, 0, 0]
+        areas[chosen] = 0.5 * (forward - backward)
+    return areas
 
 
 def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
@@ -1347,11 +1394,9 @@ def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.floa
         return np.array([polygon_area(v) > 0.0 for v in vertices], dtype=np.float64)
     every = np.concatenate(vertices)
     first = np.cumsum(counts) - counts
-    following = np.arange(1, len(every) + 1)
-    following[first + counts - 1] = first
     origin = np.repeat(every[first], counts, axis=0)  # each polygon's first vertex, as polygon_area
     relative = every - origin
-    ahead = relative[following]
+    ahead = _ahead(relative, first, first + counts - 1)
     forward, backward = relative[:, 0] * ahead[:, 1], relative[:, 1] * ahead[:, 0]
     total = np.add.reduceat(forward - backward, first)
     size = np.add.reduceat(np.abs(forward) + np.abs(backward), first)
@@ -1359,6 +1404,20 @@ def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.floa
     # last place of the sum of the products' sizes: beyond twice that, both are above 0.
     result[total > 4.0 * np.finfo(np.float64).eps * (counts + 2) * size] = 1.0
     return result
+
+
+def _ahead(
+    rows: NDArray[np.float64], first: NDArray[np.int64], last: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """Rows of polygons one after another, each moved to its predecessor's place (cyclically per polygon).
+
+    Row ``i`` of the result is row ``i + 1``, but at a polygon's ``last`` row, which gets its
+    ``first``: indexing by each row's follower, in two copies instead of a gather.
+    """
+    ahead = np.empty_like(rows)
+    ahead[:-1] = rows[1:]
+    ahead[last] = rows[first]
+    return ahead
 
 
 def _contains(
@@ -1394,9 +1453,7 @@ def _contains(
     chosen = counts[batched]
     every = np.concatenate([vertices[index] for index in batched.tolist()])
     first = np.cumsum(chosen) - chosen
-    following = np.arange(1, len(every) + 1)
-    following[first + chosen - 1] = first
-    edge = every[following] - every
+    edge = _ahead(every, first, first + chosen - 1) - every
     length = np.hypot(edge[:, 0], edge[:, 1])
     pose = poses[batched]
     relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import bisect
 import operator
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from aura_ums._validate import finite_float
@@ -54,6 +54,19 @@ class PositionReport:
             raise InputError(
                 f"PositionReport.command: expected a TurnAndRun, got {type(self.command).__name__}"
             )
+
+    @classmethod
+    def _trusted(cls, time: float, turn: float, run: float) -> PositionReport:
+        """``PositionReport(time, TurnAndRun(turn, run))`` of checked floats (finite, ``run >= 0``)."""
+        report = object.__new__(cls)
+        _set_time(report, time)
+        _set_command(report, TurnAndRun._trusted(turn, run))
+        return report
+
+
+# The slots' own setters (frozen: the dataclass's __setattr__ refuses), for PositionReport._trusted.
+_set_time: Callable[[PositionReport, float], None] = PositionReport.__dict__["time"].__set__
+_set_command: Callable[[PositionReport, TurnAndRun], None] = PositionReport.__dict__["command"].__set__
 
 
 # The sort key of the reports: attrgetter runs in C, cheaper than a function per comparison.

@@ -91,7 +91,11 @@ or GroundLineObservation, got str
                 "observation: expected a BearingObservation, RangeBearingObservation or "
                 f"GroundLineObservation, got {type(observation).__name__}"
             )
-        bisect.insort_right(self._items, observation, key=_time)
+        items = self._items
+        if not items or items[-1].time <= observation.time:
+            items.append(observation)  # in time order, the usual case: where insort_right puts it
+        else:
+            bisect.insort_right(items, observation, key=_time)
 
     def drain(self, until: float | None = None) -> tuple[Observation, ...]:
         """Remove and return the observations with ``time <= until``, in time order.
@@ -110,6 +114,10 @@ or GroundLineObservation, got str
         taken = tuple(self._items[:stop])
         del self._items[:stop]
         return taken
+
+    def _drop_first(self, count: int) -> None:
+        """Remove the ``count`` oldest observations: :meth:`drain` of what :meth:`peek` just returned."""
+        del self._items[:count]
 
     def peek(self, until: float | None = None) -> tuple[Observation, ...]:
         """Return what :meth:`drain` would, without removing anything."""

@@ -177,6 +177,34 @@ class ManagerStep:
     excluded: tuple[Observation, ...] = ()
     focus_map: SpatialUncertaintyMap | None = None
 
+    @classmethod
+    def _made(
+        cls,
+        time: float,
+        uncertainty_map: SpatialUncertaintyMap,
+        state: ManagerState,
+        lost_reason: str,
+        outcomes: tuple[ObservationOutcome, ...],
+        grown_reports: int,
+        relocalized: bool,
+        envelope_map: SpatialUncertaintyMap | None,
+        excluded: tuple[Observation, ...],
+        focus_map: SpatialUncertaintyMap | None,
+    ) -> ManagerStep:
+        """Build a step by the slots' own setters: half the cost of the frozen dataclass's ``__init__``."""
+        step = object.__new__(cls)
+        _set_step_time(step, time)
+        _set_step_map(step, uncertainty_map)
+        _set_step_state(step, state)
+        _set_step_lost_reason(step, lost_reason)
+        _set_step_outcomes(step, outcomes)
+        _set_step_grown_reports(step, grown_reports)
+        _set_step_relocalized(step, relocalized)
+        _set_step_envelope_map(step, envelope_map)
+        _set_step_excluded(step, excluded)
+        _set_step_focus_map(step, focus_map)
+        return step
+
     @property
     def focus(self) -> SpatialUncertaintyMap:
         """The map to search first: :attr:`focus_map`, or :attr:`map` without the relaxed intersection."""
@@ -191,6 +219,21 @@ class ManagerStep:
     def rejected(self) -> tuple[ObservationOutcome, ...]:
         """The outcomes of the observations that were rejected, with their reasons."""
         return tuple(o for o in self.outcomes if not o.accepted)
+
+
+# The slots' own setters (frozen: the dataclass's __setattr__ refuses), for ManagerStep._made.
+(
+    _set_step_time,
+    _set_step_map,
+    _set_step_state,
+    _set_step_lost_reason,
+    _set_step_outcomes,
+    _set_step_grown_reports,
+    _set_step_relocalized,
+    _set_step_envelope_map,
+    _set_step_excluded,
+    _set_step_focus_map,
+) = (field.__set__ for field in (ManagerStep.__dict__[f.name] for f in dataclasses.fields(ManagerStep)))
 
 
 class UncertaintyMapManager:
@@ -331,6 +374,7 @@ class UncertaintyMapManager:
         "_grown",
         "_joint_above",
         "_joint_sector",
+        "_landmarks",
         "_latest",
         "_latest_committed",
         "_lineages",
@@ -373,6 +417,7 @@ class UncertaintyMapManager:
         self._meadow_map = meadow_map
         self._table = table
         self._only_terrain: TerrainStats | None = None
+        self._landmarks: dict[str, Landmark] = {}  # by id, as found in the meadow map
         self._settings = settings
         # The settings the hot paths read, as plain attributes.
         self._sigmas = settings.sigmas
@@ -596,6 +641,7 @@ class UncertaintyMapManager:
 
         identified = blackboard.identified
         pending = identified.peek(time)
+        # Single-threaded by contract: the commit below drains exactly these.
         # The reports this update consumes (the envelope map has consumed as many).
         reports = blackboard.reports_until(time, start=self._consumed)
         index = self._consumed + len(reports)
@@ -610,7 +656,7 @@ class UncertaintyMapManager:
             wide, wide_time, wide_branches = outer._advance(reports, twins, None, None)
 
         # Commit: nothing above changed the manager or the blackboard.
-        identified.drain(time)  # exactly ``pending``: single-threaded by contract
+        identified._drop_first(len(pending))  # identified.drain(time): exactly ``pending``
         grown = len(reports)
         found = self._commit(current, index, map_time, outcomes, branches, len(excluded))
         relocalized = False
@@ -628,7 +674,7 @@ class UncertaintyMapManager:
                 recent.clear()
                 relocalized = True
         self._update_state(found, missed_in_a_row)
-        return ManagerStep(
+        return ManagerStep._made(
             time,
             self._map,
             self._state,
@@ -668,7 +714,8 @@ class UncertaintyMapManager:
                 )
             else:
                 current = self._reduce_instant(current, instant, map_time, outcomes)
-        current, map_time = self._grow(current, reports, index, len(reports), map_time)
+        if index < len(reports):
+            current, map_time = self._grow(current, reports, index, len(reports), map_time)
         return current, map_time, None
 
     def _advance_relaxed(
@@ -847,7 +894,12 @@ class UncertaintyMapManager:
         if envelope is None:
             factor = self._envelope_factor
             return [_widened(observation, factor) for observation in pending]
-        if isinstance(envelope, (str, bytes)) or not isinstance(envelope, Sequence):
+        # A list or a tuple is told first: the check against the Sequence ABC costs more.
+        if (
+            type(envelope) is not list
+            and type(envelope) is not tuple
+            and (isinstance(envelope, (str, bytes)) or not isinstance(envelope, Sequence))
+        ):
             raise InputError(
                 f"envelope: expected a sequence of observations or None, got {type(envelope).__name__}"
             )
@@ -952,7 +1004,8 @@ class UncertaintyMapManager:
                     f"blackboard: expected the one this manager reads, keeping its last consumed report "
                     f"{self._consumed - 1}, got one that forgot the reports before {released}"
                 )
-            last = blackboard.report(self._consumed - 1).time
+            # blackboard.report(self._consumed - 1), whose index the checks above bound.
+            last = blackboard._reports[self._consumed - 1 - released].time
             if last != self._map_time:
                 raise InputError(
                     f"blackboard: expected the one this manager reads, whose report {self._consumed - 1} "
@@ -977,7 +1030,7 @@ class UncertaintyMapManager:
             # the terrain up once (here, so that a missing one fails where it always did).
             terrain = self._only_terrain = self._table[self._meadow_map.meadows[0].terrain]
         if terrain is not None:
-            commands = [reports[index].command for index in range(start, stop)]
+            commands = [report.command for report in reports[start:stop]]
             if self._anchor_growth:
                 since = reports[start].time if map_time is None else map_time
                 now = reports[stop - 1].time
@@ -1097,10 +1150,14 @@ class UncertaintyMapManager:
         """Return the landmark an observation names, or why it is rejected before any reduction."""
         if map_time is not None and observation.time < map_time:
             return RejectReason.STALE
-        try:
-            landmark = self._meadow_map.landmark(observation.landmark_id).landmark
-        except UnknownLandmarkError:
-            return RejectReason.UNKNOWN_LANDMARK
+        # The meadow map is immutable: each landmark is looked up once.
+        landmark = self._landmarks.get(observation.landmark_id)
+        if landmark is None:
+            try:
+                landmark = self._meadow_map.landmark(observation.landmark_id).landmark
+            except UnknownLandmarkError:
+                return RejectReason.UNKNOWN_LANDMARK
+            self._landmarks[observation.landmark_id] = landmark
         if observation.landmark_class is not landmark.landmark_class:
             return RejectReason.CLASS_MISMATCH
         return landmark

@@ -289,11 +289,13 @@ class BearingObservation:
         sensor_offset: tuple[float, float],
     ) -> BearingObservation:
         """Build from values the library checked already (a log's rows): a long replay builds two per row."""
+        # One setter call per slot, written out: a loop over them costs twice as much.
         observation = object.__new__(cls)
-        for setter, value in zip(
-            _BEARING_SETTERS, (landmark_id, time, bearing, bearing_error, sensor_offset), strict=True
-        ):
-            setter(observation, value)
+        _set_bearing_id(observation, landmark_id)
+        _set_bearing_time(observation, time)
+        _set_bearing_bearing(observation, bearing)
+        _set_bearing_error(observation, bearing_error)
+        _set_bearing_offset(observation, sensor_offset)
         return observation
 
     @property
@@ -341,10 +343,15 @@ class RangeBearingObservation:
         sensor_offset: tuple[float, float],
     ) -> RangeBearingObservation:
         """Build from values the library checked already (a log's rows): a long replay builds two per row."""
+        # One setter call per slot, written out: a loop over them costs twice as much.
         observation = object.__new__(cls)
-        values = (landmark_id, time, bearing, bearing_error, sensor_offset, range_min, range_max)
-        for setter, value in zip(_RANGE_BEARING_SETTERS, values, strict=True):
-            setter(observation, value)
+        _set_range_bearing_id(observation, landmark_id)
+        _set_range_bearing_time(observation, time)
+        _set_range_bearing_bearing(observation, bearing)
+        _set_range_bearing_error(observation, bearing_error)
+        _set_range_bearing_offset(observation, sensor_offset)
+        _set_range_min(observation, range_min)
+        _set_range_max(observation, range_max)
         return observation
 
     @property
@@ -360,6 +367,18 @@ _RANGE_BEARING_SETTERS = tuple(
     RangeBearingObservation.__dict__[name].__set__
     for name in (*_OBSERVATION_FIELDS, "range_min", "range_max")
 )
+_set_bearing_id, _set_bearing_time, _set_bearing_bearing, _set_bearing_error, _set_bearing_offset = (
+    _BEARING_SETTERS
+)
+(
+    _set_range_bearing_id,
+    _set_range_bearing_time,
+    _set_range_bearing_bearing,
+    _set_range_bearing_error,
+    _set_range_bearing_offset,
+    _set_range_min,
+    _set_range_max,
+) = _RANGE_BEARING_SETTERS
 
 
 @dataclass(frozen=True, slots=True)

@@ -10,6 +10,7 @@ polygons and the smallest wedge holding their intervals.
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import overload
@@ -131,6 +132,20 @@ class SpatialUncertaintyMap:
         center.setflags(write=False)
         _set_polygon(result, polygon)
         _set_center(result, center)
+        _set_wedge(result, wedge)
+        _set_pose(result, None)
+        _set_slices(result, None)
+        _set_cells(result, 0)
+        _set_max_slices(result, 0)
+        return result
+
+    @classmethod
+    def _at(cls, polygon: ConvexPolygon, x: float, y: float, wedge: HeadingWedge) -> SpatialUncertaintyMap:
+        """:meth:`_trusted` with the centre given as numbers (a kernel's), made read-only at no cost."""
+        result = object.__new__(cls)
+        _set_polygon(result, polygon)
+        # A view of the two numbers' bytes: read-only, and cheaper than np.array and setflags.
+        _set_center(result, np.frombuffer(_pack_point(x, y), dtype=np.float64))
         _set_wedge(result, wedge)
         _set_pose(result, None)
         _set_slices(result, None)
@@ -455,7 +470,7 @@ class SpatialUncertaintyMap:
         if self._slices is not None:
             return _grow_sliced(self, self._slices, values, terrain, sigmas, max_vertices)
         wedge, (x, y) = self.wedge, self.center.tolist()
-        grown = _native.grow_commands(
+        vertices, x, y, heading, cw, ccw = _native.grow_commands(
             self.polygon.vertices,
             x,
             y,
@@ -467,10 +482,8 @@ class SpatialUncertaintyMap:
             values,
             max_vertices,
         )
-        return SpatialUncertaintyMap._trusted(
-            ConvexPolygon._trusted(grown.vertices),
-            np.array([grown.x, grown.y]),
-            HeadingWedge._trusted(grown.heading, grown.cw, grown.ccw),
+        return SpatialUncertaintyMap._at(
+            ConvexPolygon._trusted(vertices), x, y, HeadingWedge._trusted(heading, cw, ccw)
         )
 
     def reduce(
@@ -665,6 +678,9 @@ class SpatialUncertaintyMap:
             f"heading={self.wedge.center:.4g} rad -{self.wedge.cw:.3g}/+{self.wedge.ccw:.3g}{sliced})"
         )
 
+
+# Two float64 numbers as bytes, in the machine's order (np.frombuffer's float64).
+_pack_point = struct.Struct("=2d").pack
 
 # Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
 _set_polygon: Callable[[SpatialUncertaintyMap, ConvexPolygon | None], None] = SpatialUncertaintyMap.__dict__[

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from aura_ums._validate import finite_float, nonnegative_float
@@ -44,3 +45,16 @@ class TurnAndRun:
     def __post_init__(self) -> None:
         object.__setattr__(self, "turn", finite_float(self.turn, "TurnAndRun.turn"))
         object.__setattr__(self, "run", nonnegative_float(self.run, "TurnAndRun.run"))
+
+    @classmethod
+    def _trusted(cls, turn: float, run: float) -> TurnAndRun:
+        """Build from floats already checked (finite, ``run >= 0``): a long replay makes one per report."""
+        command = object.__new__(cls)
+        _set_turn(command, turn)
+        _set_run(command, run)
+        return command
+
+
+# The slots' own setters (frozen: the dataclass's __setattr__ refuses), for TurnAndRun._trusted.
+_set_turn: Callable[[TurnAndRun, float], None] = TurnAndRun.__dict__["turn"].__set__
+_set_run: Callable[[TurnAndRun, float], None] = TurnAndRun.__dict__["run"].__set__

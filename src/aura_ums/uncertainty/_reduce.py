@@ -182,14 +182,13 @@ def reduce_checked(
     if isinstance(found, int):
         return _REASONS[found]
     raw, lo, width, x, y, area_before, area_after = found
-    # Bytes are immutable, so the array is read-only as map values must be.
-    reduced_vertices = np.frombuffer(raw, _FLOAT64).reshape(-1, 2)
+    # Bytes are immutable, so the array is read-only as map values must be (one array over
+    # them: np.frombuffer(raw).reshape(-1, 2) makes two).
+    reduced_vertices: NDArray[np.float64] = np.ndarray((len(raw) // _POINT_BYTES, 2), _FLOAT64, raw)
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
     if x != center_x or y != center_y:
         x, y = held_centre(reduced_vertices, x, y)
-    reduced = type(prior)._trusted(
-        type(prior.polygon)._trusted(reduced_vertices), np.array([x, y]), reduced_wedge
-    )
+    reduced = type(prior)._at(type(prior.polygon)._read_only(reduced_vertices), x, y, reduced_wedge)
     return reduced, area_before, area_after
 
 
@@ -204,6 +203,13 @@ _Call = tuple[
 def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int) -> _Call:
     """Return the reduction kernels of the observation's class and their arguments after the wedge."""
     forward, left = observation.sensor_offset
+    if type(observation) is RangeBearingObservation and type(landmark) is PointLandmark:
+        # The replay's pairing, told by exact types first (the general tests below cost more).
+        return _native.reduce_cone, _native.reduce_cone_slices, (
+            forward, left, landmark.x, landmark.y, landmark.position_uncertainty, observation.bearing,
+            observation.bearing_error, observation.range_min, observation.range_max, SECTOR_PIECE,
+            max_vertices,
+        )  # fmt: skip
     if isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
         landmark, (VerticalLineLandmark, PointLandmark)
     ):
@@ -341,3 +347,4 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
 
 
 _FLOAT64 = np.dtype(np.float64)
+_POINT_BYTES = 2 * _FLOAT64.itemsize
