@@ -585,6 +585,7 @@ _FORBIDDEN = np.zeros(256, dtype=bool)
 _FORBIDDEN[:32] = True
 _FORBIDDEN[[_TAB, _LF, _CR]] = False
 _FORBIDDEN[ord('"')] = True
+_ALLOWED = bytes(np.flatnonzero(~_FORBIDDEN).astype(np.uint8).tolist())
 # More lines starting with spaces than this: each is looked at alone, so parse_csv reads the file.
 _MOST_INDENTED = 10_000
 
@@ -649,15 +650,17 @@ def parse_csv_floats(
     if isinstance(text, bytes):
         if len(text) > _limit(max_bytes, MAX_BYTES) or not text.isascii():
             return None  # parse_csv says what is wrong
-        body, raw = None, np.frombuffer(text, dtype=np.uint8)
+        body, encoded = None, text
     else:
         body = _text(text, source, max_bytes)
         if not body.isascii():
             return None
-        raw = np.frombuffer(body.encode("ascii"), dtype=np.uint8)
-    if np.any(_FORBIDDEN[raw]):
+        encoded = body.encode("ascii")
+    # What is left once the allowed bytes are deleted: a tenth of the time of a lookup per byte.
+    if encoded.translate(None, _ALLOWED):
         return None
-    returns = np.flatnonzero(raw == _CR)
+    raw = np.frombuffer(encoded, dtype=np.uint8)
+    returns = np.flatnonzero(raw == _CR) if b"\r" in encoded else np.empty(0, dtype=np.intp)
     if returns.size:
         # "\r\n" ends a line for str.splitlines as "\n" does; a lone "\r" too, which "\n" does not.
         if returns[-1] + 1 >= raw.size or np.any(raw[returns + 1] != _LF):
@@ -679,7 +682,7 @@ def parse_csv_floats(
         lead[line] = piece[visible[0]] if visible.size else _LF
     comment = lead == _HASH
     data = (lead != _LF) & ~comment
-    if np.count_nonzero(raw == _HASH) != np.count_nonzero(comment):
+    if encoded.count(b"#") != np.count_nonzero(comment):
         return None  # a "#" inside a row: parse_csv says what it makes of it
     numbers = np.flatnonzero(data)
     rows = numbers.size - 1
