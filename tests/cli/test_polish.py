@@ -374,3 +374,23 @@ def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path) -> No
     )
     seen = invoke(*replay, "--camera", root / "virtual_camera_60deg.toml")
     assert "warning" not in seen.stderr
+
+
+def test_resuming_a_state_saved_at_the_end_is_refused(tmp_path: Path) -> None:
+    # 0 steps and every figure n/a, exit 0: a resumed replay with nothing left
+    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+    end = tmp_path / "end.json"
+    invoke(*replay, "--save-state", end)
+    result = runner.invoke(app, [*replay, "--resume", str(end)])
+    assert result.exit_code == 2
+    assert result.stderr.endswith(
+        f"error: --resume: expected a state with frames left after it, got {end}, saved at 60 s: "
+        "nothing is left to replay\n"
+    )
+    # saving the state again is an answer: the same state
+    again = tmp_path / "again.json"
+    invoke(*replay, "--resume", end, "--save-state", again)
+    assert again.exists()

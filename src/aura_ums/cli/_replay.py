@@ -545,9 +545,15 @@ def replay(
                     steps_csv=steps_path, progress=advance, until=until, resume=saved,
                     save_state=save_state is not None, after_step=None if view is None else view.step,
                 )  # fmt: skip
+            # Inside the outputs' block, so no empty steps CSV is left under its name.
             if resume is None and save_state is None:
-                # Inside the outputs' block, so no empty steps CSV is left under its name.
                 result.require_steps(until)
+            elif saved is not None and save_state is None and not result.trace.time.size:
+                bounded = "" if until is None else f" (--until {until:g})"
+                raise fail(
+                    f"--resume: expected a state with frames left after it, got {resume}, saved at "
+                    f"{saved.last_time:g} s{bounded}: nothing is left to replay"
+                )
     except AuraUmsError as exc:
         message = str(exc)
         if resume is not None and message.startswith("resume: "):
