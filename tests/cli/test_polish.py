@@ -212,7 +212,13 @@ def test_until_before_the_resumed_state_is_refused_naming_both(
     resumed = runner.invoke(
         app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(state), "--until", str(last)]
     )
-    assert resumed.exit_code == 0  # at the state's own last frame: nothing left, but no contradiction
+    # At the state's own last frame: nothing left. It exited 0 with every figure n/a; it is
+    # refused as any replay of no frame is (a state saved again is an answer).
+    assert resumed.exit_code == 2
+    assert resumed.stderr == (
+        f"error: --resume: expected a state with frames left after it, got {state}, saved at {last:g} s "
+        f"(--until {last:g}): nothing is left to replay\n"
+    )
 
 
 def test_a_bad_resume_names_the_option_and_file_and_until_must_be_finite(
