@@ -106,7 +106,10 @@ def test_replay_live_streams_maps_and_windows_then_writes_its_results(terrain: P
 
 def test_simulate_live_streams_each_run(tmp_path: Path) -> None:
     scenario = ROOT / "scenarios" / "paper_sidewalk.toml"
-    done, messages = _watch(["simulate", str(scenario), "--runs", "2", "--live-rate", "0", "-q"])
+    # --live-wait long enough for the client: the run streams as without it
+    done, messages = _watch(
+        ["simulate", str(scenario), "--runs", "2", "--live-rate", "0", "-q", "--live-wait", "60"]
+    )
     assert done.returncode == 0, done.stderr
     metrics = [m.data for m in messages if m.topic == "/metrics"]
     assert {m["run"] for m in metrics} == {1, 2}
@@ -114,6 +117,34 @@ def test_simulate_live_streams_each_run(tmp_path: Path) -> None:
     frames = re.search(r"frames\s+(\d+)", done.stdout)
     assert frames is not None
     assert int(frames.group(1)) == len(metrics)
+
+
+def test_no_client_within_live_wait_exits_2_having_computed_nothing(terrain: Path, tmp_path: Path) -> None:
+    # --live waited for Foxglove with no limit: a scripted run without a client hung. In a
+    # process of its own: the server's import of foxglove stays out of this one
+    # (test_missing_extra_names_it hides the package from it).
+    metrics = tmp_path / "m.json"
+    options = ["--terrain", str(terrain), "-q", "--live", "--live-port", "0", "--metrics-json", str(metrics)]
+    aura = str(Path(sys.executable).with_name("aura-ums"))
+    result = subprocess.run(
+        [aura, "replay", str(SAMPLE), *options, "--live-wait", "0.2"],
+        capture_output=True,
+        text=True,
+        timeout=WAIT,
+        check=False,
+    )
+    assert result.returncode == 2
+    assert re.search(
+        r"error: --live-wait: expected a Foxglove client at ws://127\.0\.0\.1:\d+ within 0\.2 s, got none\n$",
+        result.stderr,
+    )
+    assert "(waiting for up to 0.2 s for it to subscribe; Ctrl-C to stop)" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+    alone = runner.invoke(app, ["replay", str(SAMPLE), "--terrain", str(terrain), "--live-wait", "5"])
+    assert alone.exit_code == 2
+    assert alone.stderr == "error: --live-wait: expected --live too, got no --live\n"
+    bad = runner.invoke(app, ["replay", str(SAMPLE), *options, "--live-wait", "soon"])
+    assert bad.stderr == "error: --live-wait: expected a finite number of seconds >= 0 or none, got 'soon'\n"
 
 
 def test_a_port_in_use_names_the_option(terrain: Path) -> None:

@@ -39,6 +39,7 @@ from aura_ums.cli._interop import (
     LiveHost,
     LivePort,
     LiveRate,
+    LiveWait,
     live_rules,
     live_simulation,
     rosbag_command,
@@ -175,6 +176,7 @@ def simulate(
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,
     live_rate: LiveRate = LIVE_DEFAULTS.rate,
+    live_wait: LiveWait = None,
     workers: Workers = DEFAULTS.workers,
     scheduler: Scheduler = DEFAULTS.scheduler,
     retries: Retries = DEFAULTS.retries,
@@ -227,7 +229,7 @@ def simulate(
             f"--workers {campaign_options.workers}"
             + ("" if campaign_options.scheduler is None else f" --scheduler {campaign_options.scheduler}")
         )
-    watch = live_simulation(loaded, live=live, host=live_host, port=live_port, rate=live_rate)
+    watch = live_simulation(loaded, live=live, host=live_host, port=live_port, rate=live_rate, wait=live_wait)
     try:
         with watch as view, progress_bar(f"{loaded.name}: runs", quiet=quiet, total=runs) as advance:
             if view is None:

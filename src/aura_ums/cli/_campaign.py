@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from aura_ums.campaign import CampaignSettings
-from aura_ums.cli._common import console, fail, progress_bar, refuse_alone
+from aura_ums.cli._common import console, fail, none_or_float, progress_bar, refuse_alone
 from aura_ums.cli._outputs import Target, write_text
 
 if TYPE_CHECKING:
@@ -44,12 +44,8 @@ Retries = Annotated[
 
 def _timeout(text: str) -> float | None:
     """Read ``--run-timeout``: seconds, or ``none`` (the default: no timeout)."""
-    if text.strip().lower() == "none":
-        return None
     try:
-        if "_" in text:
-            raise ValueError(text)
-        return float(text)
+        return none_or_float(text)
     except ValueError:
         raise fail(f"--run-timeout: expected a positive number of seconds or none, got {text!r}") from None
 

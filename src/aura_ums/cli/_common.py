@@ -49,6 +49,18 @@ def fail(message: str) -> typer.Exit:
     return typer.Exit(code=2)
 
 
+def none_or_float(text: str) -> float | None:
+    """Read an option's ``none`` or number (``_`` digit groups refused, as the files refuse them).
+
+    Raises ``ValueError`` for anything else: the option's parser says what it expected.
+    """
+    if text.strip().lower() == "none":
+        return None
+    if "_" in text:
+        raise ValueError(text)
+    return float(text)
+
+
 def warn(message: str) -> None:
     """Print ``warning: <message>`` (markup-safe) on stderr: the command goes on."""
     err_console.print(f"[yellow]warning:[/yellow] {escape(message)}", highlight=False)

@@ -7,6 +7,7 @@ are called by the commands that run a scenario or replay a log.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext, suppress
 from pathlib import Path
@@ -20,6 +21,7 @@ from aura_ums.cli._common import (
     err_console,
     fail,
     folder_argument,
+    none_or_float,
     print_log_summary,
     progress_bar,
 )
@@ -159,7 +161,8 @@ LIVE_DEFAULTS = LiveOptions()
 
 def live_rules(live: bool) -> list[tuple[str, str, str, bool]]:
     """Return the rules of :func:`~aura_ums.cli._common.refuse_alone` for the options of ``--live``."""
-    return [(name, "--live", "no --live", live) for name in ("live_host", "live_port", "live_rate")]
+    names = ("live_host", "live_port", "live_rate", "live_wait")
+    return [(name, "--live", "no --live", live) for name in names]
 
 
 #: ``--live``: stream to Foxglove while computing.
@@ -191,6 +194,30 @@ LiveRate = Annotated[
 ]
 
 
+def _wait(text: str) -> float | None:
+    """Read ``--live-wait``: seconds >= 0, or ``none`` (the default: as long as it takes)."""
+    try:
+        seconds = none_or_float(text)
+    except ValueError:
+        seconds = math.nan
+    if seconds is not None and not 0.0 <= seconds < math.inf:
+        raise fail(f"--live-wait: expected a finite number of seconds >= 0 or none, got {text!r}")
+    return seconds
+
+
+#: ``--live-wait``: how long the live view waits for Foxglove before the run.
+LiveWait = Annotated[
+    float | None,
+    typer.Option(
+        "--live-wait",
+        help="Seconds --live waits for Foxglove to connect before computing; past them it exits 2 "
+        "having computed nothing (default none: as long as it takes).",
+        parser=_wait,
+        metavar="<seconds>",
+    ),
+]
+
+
 def _live_options(host: str, port: int, rate: float) -> LiveOptions:
     from aura_ums.errors import InputError
 
@@ -204,7 +231,7 @@ _View = TypeVar("_View", "LiveSimulation", "LiveReplay")
 
 
 @contextmanager
-def _serving(start: Callable[[], _View], what: str) -> Iterator[_View]:
+def _serving(start: Callable[[], _View], what: str, wait: float | None) -> Iterator[_View]:
     """Start a live view, say where to connect, wait for a client; at the end, wait until it leaves.
 
     The computation runs inside; after it the server stays while a client is subscribed
@@ -220,11 +247,13 @@ def _serving(start: Callable[[], _View], what: str) -> Iterator[_View]:
     except AuraUmsError as exc:  # a port in use, an address refused: "port: ...", "host: ..."
         raise fail(f"--live-{exc}") from None
     with view:
+        waiting = "" if wait is None else f" for up to {wait:g} s"
         _note(
             f"live: serving on {view.url}; in Foxglove: Open connection, Foxglove WebSocket, {view.url} "
-            "(waiting for it to subscribe; Ctrl-C to stop)"
+            f"(waiting{waiting} for it to subscribe; Ctrl-C to stop)"
         )
-        view.wait_for_client()
+        if not view.wait_for_client(wait):
+            raise fail(f"--live-wait: expected a Foxglove client at {view.url} within {wait:g} s, got none")
         _note(f"live: a client subscribed; streaming the {what}")
         yield view
         _note(
@@ -242,7 +271,7 @@ def _note(text: str) -> None:
 
 
 def live_simulation(
-    scenario: Scenario, *, live: bool, host: str, port: int, rate: float
+    scenario: Scenario, *, live: bool, host: str, port: int, rate: float, wait: float | None = None
 ) -> AbstractContextManager[LiveSimulation | None]:
     """With ``--live``, a live view of the scenario's runs (its ``frame`` is ``after_frame``); else None.
 
@@ -254,7 +283,7 @@ def live_simulation(
     from aura_ums.export import serve_simulation
 
     options = _live_options(host, port, rate)
-    return _serving(lambda: serve_simulation(scenario, options), "frames")
+    return _serving(lambda: serve_simulation(scenario, options), "frames", wait)
 
 
 def live_replay(
@@ -266,6 +295,7 @@ def live_replay(
     host: str,
     port: int,
     rate: float,
+    wait: float | None = None,
 ) -> AbstractContextManager[LiveReplay | None]:
     """With ``--live``, a live view of the log's replay (its ``step`` is ``after_step``); else None.
 
@@ -276,4 +306,4 @@ def live_replay(
     from aura_ums.export import serve_replay
 
     options = _live_options(host, port, rate)
-    return _serving(lambda: serve_replay(log, replay_options, camera=camera, options=options), "steps")
+    return _serving(lambda: serve_replay(log, replay_options, camera=camera, options=options), "steps", wait)

@@ -39,7 +39,16 @@ from aura_ums.cli._common import (
     refuse_alone,
     warn,
 )
-from aura_ums.cli._interop import LIVE_DEFAULTS, Live, LiveHost, LivePort, LiveRate, live_replay, live_rules
+from aura_ums.cli._interop import (
+    LIVE_DEFAULTS,
+    Live,
+    LiveHost,
+    LivePort,
+    LiveRate,
+    LiveWait,
+    live_replay,
+    live_rules,
+)
 from aura_ums.cli._outputs import (
     Overwrite,
     Source,
@@ -417,6 +426,7 @@ def replay(
     live_host: LiveHost = LIVE_DEFAULTS.host,
     live_port: LivePort = LIVE_DEFAULTS.port,
     live_rate: LiveRate = LIVE_DEFAULTS.rate,
+    live_wait: LiveWait = None,
     workers: Workers = DEFAULTS.workers,
     scheduler: Scheduler = DEFAULTS.scheduler,
     retries: Retries = DEFAULTS.retries,
@@ -521,7 +531,9 @@ def replay(
         keep_maps = plot is not None or mcap is not None
         lens = None if camera is None else load_camera(camera)
         watch = (
-            live_replay(log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate)
+            live_replay(
+                log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate, wait=live_wait
+            )
             if isinstance(log, RobotLog)
             else contextlib.nullcontext(None)
         )
