@@ -54,7 +54,9 @@ def test_clean_synthetic_log_keeps_the_truth_at_every_step(
     )
     assert grown_only.steps == ()
     with pytest.raises(
-        InputError, match=r"^log 'synthetic': expected a frame \(an observation time\) after the"
+        InputError,
+        match=r"^log 'synthetic': expected a frame \(an observation time\) after the .*: the log has no "
+        r"observation at all$",
     ):
         grown_only.require_steps()
     result.require_steps()

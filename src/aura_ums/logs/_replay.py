@@ -450,7 +450,7 @@ class ReplayResult:
         >>> replay_log(dataclasses.replace(log, observations=()), table).require_steps()  # the edge
         Traceback (most recent call last):
         ...
-        aura_ums.errors.InputError: log 'synthetic': expected a frame (an observation time) after the ...
+        aura_ums.errors.InputError: log 'synthetic': expected a frame ... the log has no observation at all
         """
         if self.trace.time.size:
             return
@@ -459,10 +459,15 @@ class ReplayResult:
                 f"until: expected a frame (an observation time) between the replay's start "
                 f"({self.start_time:g} s) and {until:g} s, got none"
             )
+        why = (
+            "the log has no observation at all"
+            if isinstance(self.log, RobotLog) and not self.log.observations
+            else "the log has no observation after it (the start is the motion's first time, or the "
+            "ground truth's first row when that is later)"
+        )
         raise InputError(
             f"log {self.log.meta.name!r}: expected a frame (an observation time) after the replay's start, "
-            f"{self.start_time:g} s, got none: the log has no observation after it (the start is the "
-            "motion's first time, or the ground truth's first row when that is later)"
+            f"{self.start_time:g} s, got none: {why}"
         )
 
     @property
