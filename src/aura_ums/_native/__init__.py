@@ -16,7 +16,7 @@ import os
 
 from aura_ums._native import _csv, _distance, _expecter, _growth, _reduce, _slices
 from aura_ums._native._expecter import ExpectedPoints
-from aura_ums._native._extension import BUILT
+from aura_ums._native._extension import BUILT, points_view
 from aura_ums._native._growth import Grown, MotionBounds, MotionModel, motion_bounds
 from aura_ums._native._reduce import (
     CONE_PIECE,
@@ -95,6 +95,7 @@ __all__ = [
     "narrowed",
     "parse_float_rows",
     "point_in_solid_convex",
+    "points_view",
     "polygon_distance",
     "reduce_cone",
     "reduce_cone_slices",

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._native import _extension
+from aura_ums._native._extension import points_view
 from aura_ums.geometry import convex_hull, minkowski_sum, outer_disk
 
 if _extension.BUILT:
@@ -271,4 +272,4 @@ def expecter_points_compiled(
     if found is None:
         return None
     raw, x_min, y_min, x_max, y_max = found
-    return ExpectedPoints(np.frombuffer(raw, dtype=np.float64).reshape(-1, 2), x_min, y_min, x_max, y_max)
+    return ExpectedPoints(points_view(raw), x_min, y_min, x_max, y_max)

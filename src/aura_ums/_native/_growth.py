@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._native import _extension
+from aura_ums._native._extension import points_view
 from aura_ums.geometry import minkowski_sum, outer_annular_sector, outer_disk, simplify_outer, wrap_angle
 
 if _extension.BUILT:
@@ -345,10 +346,4 @@ def grow_commands_compiled(
         commands,
         max_vertices,
     )
-    # Bytes are immutable, so the array is read-only as map values must be (one array over
-    # them: np.frombuffer(raw).reshape(-1, 2) makes two).
-    grown: Array = np.ndarray((len(raw) // _POINT_BYTES, 2), np.float64, raw)
-    return Grown(grown, x, y, heading, cw, ccw)
-
-
-_POINT_BYTES = 2 * np.dtype(np.float64).itemsize
+    return Grown(points_view(raw), x, y, heading, cw, ccw)

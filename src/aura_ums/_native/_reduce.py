@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._native import _extension
+from aura_ums._native._extension import points_view
 from aura_ums.geometry import (
     HeadingWedge,
     clip_halfplane,
@@ -630,7 +631,7 @@ def reduce_sectors_reference(
             if isinstance(found, int):
                 break
             data, arc_lo, arc_width, x, y, _, _ = found
-            polygon = np.frombuffer(data, dtype=np.float64).reshape(-1, 2)
+            polygon = points_view(data)
             if arc_width < wedge.width:
                 raw, cw, ccw = arc_parts(arc_lo, arc_width, wedge.center)
                 wedge = HeadingWedge._trusted(raw, cw, ccw)
@@ -663,7 +664,7 @@ def reduce_sectors_compiled(
         vertices, center_x, center_y, lo, step, count, half, arguments, max_vertices
     )
     return ReducedSectors(
-        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2),
+        points_view(raw),
         np.frombuffer(raw_counts, dtype=np.int64),
         np.frombuffer(raw_sectors, dtype=np.int64),
         np.frombuffer(raw_values, dtype=np.float64).reshape(-1, 5),

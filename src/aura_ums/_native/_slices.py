@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._native import _extension
+from aura_ums._native._extension import points_view
 from aura_ums._native._growth import Grown, MotionModel, grow_commands_reference
 from aura_ums._native._reduce import RawReduction, reduce_cone_reference, reduce_strip_reference
 from aura_ums.geometry import convex_hull, simplify_outer
@@ -94,10 +95,7 @@ def merge_groups_compiled(points: Array, counts: Sequence[int], max_vertices: in
     if not points.flags.c_contiguous:
         points = np.ascontiguousarray(points, dtype=np.float64)
     # Bytes are immutable, so the arrays are read-only as map values must be.
-    return tuple(
-        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
-        for raw in _compiled_merge_groups(points, counts, max_vertices)
-    )
+    return tuple(points_view(raw) for raw in _compiled_merge_groups(points, counts, max_vertices))
 
 
 # --- every slice of a map at once -------------------------------------------------------------
@@ -423,7 +421,7 @@ def distribute_slices_compiled(
         points, counts, starts, stops, sources, cells, max_vertices, max_slices, heading
     )
     return Distributed(
-        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2),
+        points_view(raw),
         np.frombuffer(raw_counts, dtype=np.int64),
         np.frombuffer(raw_lo, dtype=np.float64),
         np.frombuffer(raw_hi, dtype=np.float64),
@@ -572,7 +570,7 @@ def grow_slices_compiled(
         terrain.skitter, terrain.skitter_sd, sigmas, commands, max_vertices,
     )  # fmt: skip
     return GrownSlices(
-        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2),
+        points_view(raw),
         np.frombuffer(raw_counts, dtype=np.int64),
         np.frombuffer(raw_starts, dtype=np.float64),
         np.frombuffer(raw_stops, dtype=np.float64),
@@ -642,7 +640,7 @@ def _reduce_slices(
         raw, arc_lo, arc_width, center_x, center_y, _, _ = found
         if arc_width < piece_hi - piece_lo:
             piece_lo, piece_hi = narrowed(arc_lo, arc_width, piece_lo, piece_hi)
-        kept.append((piece_lo, piece_hi, np.frombuffer(raw, np.float64).reshape(-1, 2), center_x, center_y))
+        kept.append((piece_lo, piece_hi, points_view(raw), center_x, center_y))
     if not kept:
         return first_reason
     # A full-circle slice's arc may start anywhere: keep the slices in heading order.
@@ -776,7 +774,7 @@ def _reduced(
         return found
     raw, raw_counts, raw_lo, raw_hi, x, y, center, cw, ccw = found
     return ReducedSlices(
-        np.frombuffer(raw, dtype=np.float64).reshape(-1, 2),
+        points_view(raw),
         np.frombuffer(raw_counts, dtype=np.int64),
         np.frombuffer(raw_lo, dtype=np.float64),
         np.frombuffer(raw_hi, dtype=np.float64),

@@ -182,9 +182,7 @@ def reduce_checked(
     if isinstance(found, int):
         return _REASONS[found]
     raw, lo, width, x, y, area_before, area_after = found
-    # Bytes are immutable, so the array is read-only as map values must be (one array over
-    # them: np.frombuffer(raw).reshape(-1, 2) makes two).
-    reduced_vertices: NDArray[np.float64] = np.ndarray((len(raw) // _POINT_BYTES, 2), _FLOAT64, raw)
+    reduced_vertices = _native.points_view(raw)
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
     if x != center_x or y != center_y:
         x, y = held_centre(reduced_vertices, x, y)
@@ -344,7 +342,3 @@ def held_centre(vertices: NDArray[np.float64], x: float, y: float) -> tuple[floa
             return float(candidate[0]), float(candidate[1])
         step *= 4.0
     return float(inner[0]), float(inner[1])
-
-
-_FLOAT64 = np.dtype(np.float64)
-_POINT_BYTES = 2 * _FLOAT64.itemsize
