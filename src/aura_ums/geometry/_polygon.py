@@ -79,14 +79,6 @@ class ConvexPolygon:
         return polygon
 
     @classmethod
-    def _read_only(cls, vertices: NDArray[np.float64]) -> ConvexPolygon:
-        """:meth:`_trusted` for vertices already read-only (a view of a kernel's bytes): no flag to set."""
-        polygon = object.__new__(cls)
-        _set_vertices(polygon, vertices)
-        _set_area(polygon, math.nan)
-        return polygon
-
-    @classmethod
     def from_points(cls, points: ArrayLike) -> ConvexPolygon:
         """Return the convex hull of any finite points, shape (n, 2), n >= 1.
 

@@ -127,31 +127,14 @@ class SpatialUncertaintyMap:
     def _trusted(
         cls, polygon: ConvexPolygon, center: NDArray[np.float64], wedge: HeadingWedge
     ) -> SpatialUncertaintyMap:
-        # The slots' own setters: every growth and reduction builds a map.
-        result = object.__new__(cls)
         center.setflags(write=False)
-        _set_polygon(result, polygon)
-        _set_center(result, center)
-        _set_wedge(result, wedge)
-        _set_pose(result, None)
-        _set_slices(result, None)
-        _set_cells(result, 0)
-        _set_max_slices(result, 0)
-        return result
+        return cls._made(polygon, center, wedge, None, 0, 0)
 
     @classmethod
     def _at(cls, polygon: ConvexPolygon, x: float, y: float, wedge: HeadingWedge) -> SpatialUncertaintyMap:
         """:meth:`_trusted` with the centre given as numbers (a kernel's), made read-only at no cost."""
-        result = object.__new__(cls)
-        _set_polygon(result, polygon)
         # A view of the two numbers' bytes: read-only, and cheaper than np.array and setflags.
-        _set_center(result, np.frombuffer(_pack_point(x, y), dtype=np.float64))
-        _set_wedge(result, wedge)
-        _set_pose(result, None)
-        _set_slices(result, None)
-        _set_cells(result, 0)
-        _set_max_slices(result, 0)
-        return result
+        return cls._made(polygon, np.frombuffer(_pack_point(x, y), dtype=np.float64), wedge, None, 0, 0)
 
     @classmethod
     def _sliced(
@@ -164,8 +147,21 @@ class SpatialUncertaintyMap:
         polygon: ConvexPolygon | None = None,
     ) -> SpatialUncertaintyMap:
         """Build a sliced map from its slices and their summary wedge (as the slice kernels give it)."""
-        result = object.__new__(cls)
         center.setflags(write=False)
+        return cls._made(polygon, center, wedge, slices, cells, max_slices)
+
+    @classmethod
+    def _made(
+        cls,
+        polygon: ConvexPolygon | None,
+        center: NDArray[np.float64],
+        wedge: HeadingWedge,
+        slices: SliceSet | None,
+        cells: int,
+        max_slices: int,
+    ) -> SpatialUncertaintyMap:
+        """Set every slot of a new map by the slots' own setters: every growth and reduction builds one."""
+        result = object.__new__(cls)
         _set_polygon(result, polygon)
         _set_center(result, center)
         _set_wedge(result, wedge)

@@ -186,7 +186,7 @@ def reduce_checked(
     reduced_wedge = arc_wedge((lo, width), wedge.center) if width < wedge.width else wedge
     if x != center_x or y != center_y:
         x, y = held_centre(reduced_vertices, x, y)
-    reduced = type(prior)._at(type(prior.polygon)._read_only(reduced_vertices), x, y, reduced_wedge)
+    reduced = type(prior)._at(type(prior.polygon)._trusted(reduced_vertices), x, y, reduced_wedge)
     return reduced, area_before, area_after
 
 
@@ -201,13 +201,6 @@ _Call = tuple[
 def _kernel_call(observation: Observation, landmark: Landmark, max_vertices: int) -> _Call:
     """Return the reduction kernels of the observation's class and their arguments after the wedge."""
     forward, left = observation.sensor_offset
-    if type(observation) is RangeBearingObservation and type(landmark) is PointLandmark:
-        # The replay's pairing, told by exact types first (the general tests below cost more).
-        return _native.reduce_cone, _native.reduce_cone_slices, (
-            forward, left, landmark.x, landmark.y, landmark.position_uncertainty, observation.bearing,
-            observation.bearing_error, observation.range_min, observation.range_max, SECTOR_PIECE,
-            max_vertices,
-        )  # fmt: skip
     if isinstance(observation, (BearingObservation, RangeBearingObservation)) and isinstance(
         landmark, (VerticalLineLandmark, PointLandmark)
     ):
