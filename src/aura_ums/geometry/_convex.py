@@ -607,7 +607,9 @@ def points_in_convex(vertices: Array, points: Array, tolerance: float) -> NDArra
         # Signed distance of every point to every edge's line, positive inside.
         relative_x = points[:, 0, None] - vertices[None, :, 0]
         relative_y = points[:, 1, None] - vertices[None, :, 1]
-        signed = _per_length(edge[None, :, 0] * relative_y - edge[None, :, 1] * relative_x, length[None, :])
+        signed = edge_distances(
+            edge[None, :, 0] * relative_y - edge[None, :, 1] * relative_x, length[None, :]
+        )
         return np.asarray(np.all(signed >= -tolerance, axis=1))
     # Many points: find each point's wedge around an interior point by binary search on
     # the vertices' angles, then test the one edge that closes that wedge.
@@ -621,16 +623,32 @@ def points_in_convex(vertices: Array, points: Array, tolerance: float) -> NDArra
     index[index < 0] = n - 1
     start = ordered[index]
     edge = ordered[(index + 1) % n] - start
-    signed = _per_length(cross2(edge, points - start), np.hypot(edge[:, 0], edge[:, 1]))
+    signed = edge_distances(cross2(edge, points - start), np.hypot(edge[:, 0], edge[:, 1]))
     return np.asarray(signed >= -tolerance)
 
 
-def _per_length(cross: NDArray[np.float64], length: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Return ``cross / length``: signed distances (m) to edges' lines, +inf for a zero-length edge.
+def edge_distances(cross: NDArray[np.float64], length: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return ``cross / length``: signed distances (m) to edges' lines, +inf for an edge of no length.
 
     A repeated vertex makes an edge of no length, which constrains nothing: 0 / 0 would
     be NaN (and a warning), and NaN >= -tolerance would put every point outside.
-    ``length`` broadcasts against ``cross``.
+
+    Parameters
+    ----------
+    cross : ndarray
+        Each edge's vector crossed with the point relative to the edge's start, m^2.
+    length : ndarray
+        Each edge's length, m; broadcasts against ``cross``.
+
+    Returns
+    -------
+    ndarray of float64
+        The distances, m, positive on the left of the edge (inside a counter-clockwise polygon).
+
+    Examples
+    --------
+    >>> edge_distances(np.array([2.0, -4.0, 0.0]), np.array([2.0, 2.0, 0.0])).tolist()  # the edge: no length
+    [1.0, -2.0, inf]
     """
     out = np.full(np.broadcast_shapes(cross.shape, length.shape), np.inf)
     return np.asarray(np.divide(cross, length, out=out, where=length > 0.0), dtype=np.float64)

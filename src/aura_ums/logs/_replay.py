@@ -22,7 +22,7 @@ from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
-from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, polygon_area, wedges_contain
+from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, edge_distances, polygon_area, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._io import ODOMETRY, _given, reversed_at
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog, _wrapped
@@ -1463,13 +1463,7 @@ def _contains(
     pose = poses[batched]
     relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]
     relative_y = np.repeat(pose[:, 1], chosen) - every[:, 1]
-    # A zero-length edge (a repeated vertex) constrains nothing: +inf, not 0 / 0 = NaN (outside).
-    signed = np.divide(
-        edge[:, 0] * relative_y - edge[:, 1] * relative_x,
-        length,
-        out=np.full(length.shape, np.inf),
-        where=length > 0.0,
-    )
+    signed = edge_distances(edge[:, 0] * relative_y - edge[:, 1] * relative_x, length)
     in_polygon = np.logical_and.reduceat(signed >= -POSITION_TOLERANCE, first)
     result[batched] = in_polygon & wedges_contain(wedges[batched], pose[:, 2])
     return result
