@@ -23,6 +23,21 @@ from tests.conftest import SHARED_DATA
 runner = CliRunner()
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
 MRCLAM6 = SHARED_DATA / "mrclam6"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+SAMPLE = EXAMPLES / "logs" / "r1"
+
+
+def floor_terrain(path: Path) -> Path:
+    """Write the built-in tile statistics as the terrain 'floor' (the sample logs') to ``path``."""
+    path.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    return path
+
+
+@pytest.fixture(scope="module")
+def sample_replay(tmp_path_factory: pytest.TempPathFactory) -> list[str]:
+    """``aura-ums replay`` of the sample log r1 on the floor terrain, quiet."""
+    terrain = floor_terrain(tmp_path_factory.mktemp("floor") / "terrain.toml")
+    return ["replay", str(SAMPLE), "-q", "--terrain", str(terrain)]
 
 
 def invoke(*arguments: object) -> Result:
@@ -96,9 +111,7 @@ def test_no_progress_when_stderr_is_not_a_terminal() -> None:
 def walk(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     base = tmp_path_factory.mktemp("walk")
     folder = write_log(synthetic_log(np.random.default_rng(6), duration=40.0), base / "log")
-    terrain = base / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
-    return folder, terrain
+    return folder, floor_terrain(base / "terrain.toml")
 
 
 def resumed_alike(folder: Path, terrain: Path, tmp: Path, first: float, last: float, *extra: str) -> None:
@@ -290,11 +303,8 @@ def test_an_option_that_would_have_no_effect_is_refused(walk: tuple[Path, Path],
     assert "containment_rate" in invoke(*replay).stdout
 
 
-def test_until_before_the_start_and_a_run_timeout_of_none(tmp_path: Path) -> None:
-    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
-    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+def test_until_before_the_start_and_a_run_timeout_of_none(tmp_path: Path, sample_replay: list[str]) -> None:
+    replay = sample_replay
     # --until -1 replayed no frame and exited 0 with figures of none
     result = runner.invoke(app, [*replay, "--until", "-1"])
     assert result.exit_code == 2
@@ -307,12 +317,11 @@ def test_until_before_the_start_and_a_run_timeout_of_none(tmp_path: Path) -> Non
     assert bad.stderr == "error: --run-timeout: expected a positive number of seconds or none, got 'soon'\n"
 
 
-def test_a_resumed_state_whose_parts_disagree_names_the_file(tmp_path: Path) -> None:
+def test_a_resumed_state_whose_parts_disagree_names_the_file(
+    tmp_path: Path, sample_replay: list[str]
+) -> None:
     # "blackboard: expected the one this manager reads, ..." named no file
-    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
-    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+    replay = sample_replay
     state = tmp_path / "state.json"
     invoke(*replay, "--until", "20", "--save-state", state)
     document = json.loads(state.read_text())
@@ -329,7 +338,7 @@ def test_a_resumed_state_whose_parts_disagree_names_the_file(tmp_path: Path) -> 
 def test_a_replay_of_no_frame_is_refused_and_leaves_no_output(tmp_path: Path) -> None:
     # a ground truth 10,000 s after the motion (the clocks check allows a day): 0 steps,
     # every figure n/a, exit 0; and --until before the first frame did the same
-    sample = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
+    sample = SAMPLE
     late = tmp_path / "late"
     shutil.copytree(sample, late)
     truth = late / "groundtruth.csv"
@@ -338,8 +347,7 @@ def test_a_replay_of_no_frame_is_refused_and_leaves_no_output(tmp_path: Path) ->
         f"{float(time) + 10000.0!r},{rest}" for time, rest in (line.split(",", 1) for line in lines[2:])
     ]
     truth.write_text("\n".join([*lines[:2], *shifted]) + "\n")
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    terrain = floor_terrain(tmp_path / "terrain.toml")
     steps = tmp_path / "steps.csv"
     result = runner.invoke(
         app, ["replay", str(late), "-q", "--terrain", str(terrain), "--steps-csv", str(steps)]
@@ -364,15 +372,13 @@ def test_a_replay_of_no_frame_is_refused_and_leaves_no_output(tmp_path: Path) ->
     )
 
 
-def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path) -> None:
+def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path, sample_replay: list[str]) -> None:
     # a camera turned backwards reported 0 window observations and n/a, on stdout alone
-    root = Path(__file__).resolve().parents[2] / "examples"
+    root = EXAMPLES
     camera = tmp_path / "back.toml"
     text = (root / "virtual_camera_60deg.toml").read_text()
     camera.write_text(text.replace("pan_deg = 0.0 ", "pan_deg = 180.0", 1))
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
-    replay = ["replay", str(root / "logs" / "r1"), "-q", "--terrain", str(terrain), "--until", "10"]
+    replay = [*sample_replay, "--until", "10"]
     result = invoke(*replay, "--camera", camera)
     assert "window_observations            0\n" in result.stdout
     assert result.stderr.startswith(
@@ -382,12 +388,9 @@ def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path) -> No
     assert "warning" not in seen.stderr
 
 
-def test_resuming_a_state_saved_at_the_end_is_refused(tmp_path: Path) -> None:
+def test_resuming_a_state_saved_at_the_end_is_refused(tmp_path: Path, sample_replay: list[str]) -> None:
     # 0 steps and every figure n/a, exit 0: a resumed replay with nothing left
-    log = Path(__file__).resolve().parents[2] / "examples" / "logs" / "r1"
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
-    replay = ["replay", str(log), "-q", "--terrain", str(terrain)]
+    replay = sample_replay
     end = tmp_path / "end.json"
     invoke(*replay, "--save-state", end)
     result = runner.invoke(app, [*replay, "--resume", str(end)])
