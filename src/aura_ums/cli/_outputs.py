@@ -207,14 +207,16 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
         return
     if where.is_dir():
         raise fail(f"{target.option}: expected a file, got {target.path}, which is a folder")
-    stream = _stream_of(target.path)
+    # The path as given, followed through its links (/dev/stdout on a pipe resolves to a
+    # /proc name that is no file, so `where` cannot tell).
+    given = _followed(target.path)
+    stream = "" if given is None else _stream_of(given)
     if stream:
         raise fail(
             f"{target.option}: expected a file apart from the command's own {stream}, got {target.path} "
             "(results are printed on stdout, errors on stderr, anyway)"
         )
-    # Also the path as given: /dev/stdout on a pipe resolves to a /proc name that is no file.
-    if (where.exists() and not where.is_file()) or _special(target.path):
+    if given is not None and not stat.S_ISREG(given.st_mode):
         # The atomic rename would put a regular file in its place (as root, /dev/null's).
         raise fail(
             f"{target.option}: expected a regular file, got {target.path}, which is a device, pipe or "
@@ -227,15 +229,19 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
         )
 
 
-def _stream_of(path: Path) -> str:
-    """Name the stream of this process that ``path`` is, ``"stdout"`` or ``"stderr"``, else ``""``.
+def _followed(path: Path) -> os.stat_result | None:
+    """``os.stat`` of ``path`` through its links; None when there is no such file (the usual case)."""
+    try:
+        return os.stat(path)
+    except (OSError, ValueError):  # no such file, or a name the system refuses
+        return None
+
+
+def _stream_of(given: os.stat_result) -> str:
+    """Name the stream of this process that a file is, ``"stdout"`` or ``"stderr"``, else ``""``.
 
     ``/dev/stdout``, or the file the stream is redirected to.
     """
-    try:
-        given = os.stat(path)
-    except (OSError, ValueError):
-        return ""
     for name, descriptor in (("stdout", 1), ("stderr", 2)):
         try:
             stream = os.fstat(descriptor)
@@ -244,14 +250,6 @@ def _stream_of(path: Path) -> str:
         if (given.st_dev, given.st_ino) == (stream.st_dev, stream.st_ino):
             return name
     return ""
-
-
-def _special(path: Path) -> bool:
-    """Whether ``path``, followed through its links, is a device, pipe or socket."""
-    try:
-        return not stat.S_ISREG(os.stat(path).st_mode) and not stat.S_ISDIR(os.stat(path).st_mode)
-    except (OSError, ValueError):  # no such file (the usual case), or a name the system refuses
-        return False
 
 
 def _writable(target: Target, where: Path) -> None:
