@@ -247,6 +247,39 @@ def tiny_log(landmarks: tuple[LogLandmark, ...], observations: tuple[LogObservat
     return RobotLog(meta, landmarks, observations, commands=reports)
 
 
+@pytest.mark.parametrize(
+    ("landmark_class", "forward", "left", "spot", "bearing", "distance"),
+    [
+        (LandmarkClass.POINT, 1.0, 0.0, (5.0, 0.0), 0.0, 4.0),
+        (LandmarkClass.VERTICAL_LINE, 0.0, 1.0, (5.0, 1.0), 0.0, None),
+        (LandmarkClass.POINT, 0.5, -0.5, (4.5, 0.5), math.atan2(1.0, 4.0), math.hypot(1.0, 4.0)),
+    ],
+)
+def test_an_exact_sighting_from_an_offset_sensor_is_measured_where_the_landmark_appears(
+    landmark_class: LandmarkClass,
+    forward: float,
+    left: float,
+    spot: tuple[float, float],
+    bearing: float,
+    distance: float | None,
+) -> None:
+    # The sensor sits at (forward, left) on the robot, and so does the camera: the sighting,
+    # exact from there, is where the landmark truly appears in the image.
+    meta = dataclasses.replace(tiny_log((), ()).meta, sensor_forward=forward, sensor_left=left)
+    camera = dataclasses.replace(CAMERA, mount=dataclasses.replace(CAMERA.mount, forward=forward, left=left))
+    landmark = LogLandmark("pole", *spot, z_bottom=0.0, z_top=2.0)
+    observed = LogObservation(1.0, "pole", bearing, range=distance)
+    log = dataclasses.replace(tiny_log((landmark,), (observed,)), meta=meta)
+    _, report = replay_windows(log, FLOOR, camera, ReplayOptions(landmark_class=landmark_class))
+    (ours,) = report.judged("aura-ums")
+    z = 1.0 if landmark_class is LandmarkClass.POINT else camera.mount.height
+    u, v = camera.project(Pose(0.0, 0.0, 0.0), [(*spot, z)])[0]
+    assert ours.measured_u == pytest.approx(u, abs=1e-6)
+    if landmark_class is LandmarkClass.POINT:
+        assert ours.measured_v == pytest.approx(v, abs=1e-6)
+    assert ours.inside is True
+
+
 def test_a_landmark_behind_the_camera_has_no_window_and_is_not_judged() -> None:
     log = tiny_log(
         (LogLandmark("ahead", 5.0, 0.0), LogLandmark("behind", -5.0, 0.0)),

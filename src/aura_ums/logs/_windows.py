@@ -442,6 +442,7 @@ class _Judge:
         self._landmarks = {
             lm.id: _judged_landmark(meadows.landmark(lm.id).landmark) for lm in moved.landmarks
         }
+        self._sensor = moved.meta.sensor_offset
         self._camera = camera
         self._expecter = Expecter(camera)
         self._margin = margin
@@ -483,7 +484,7 @@ class _Judge:
             for method, window in zip(WINDOW_METHODS, windows, strict=True):
                 self.rows.append(self._row(time, row.landmark_id, method, window, measured, true_pixel))
         for row in rows:
-            observation = observation_for(row, self._class, self._bounds)
+            observation = observation_for(row, self._class, self._bounds, sensor_offset=self._sensor)
             if isinstance(observation, (BearingObservation, RangeBearingObservation)):
                 landmark = self._landmarks[row.landmark_id]
                 ekf.update(observation, (landmark.x, landmark.y))
@@ -508,13 +509,23 @@ class _Judge:
         grown: SpatialUncertaintyMap,
     ) -> tuple[float, float]:
         """Return the measured pixel (u, v); v is NaN for Class I, both NaN without a usable range."""
+        forward, left = self._sensor
         distance = row.range
         if distance is None:
             if self._class is LandmarkClass.POINT:
                 return math.nan, math.nan
+            # Bearings are the sensor's: its distance from the landmark at the map's centre pose.
             cx, cy = grown.center
-            distance = math.hypot(landmark.x - cx, landmark.y - cy)
-        point = (distance * math.cos(row.bearing), distance * math.sin(row.bearing), self._height(landmark))
+            heading = grown.wedge.center
+            sx = cx + forward * math.cos(heading) - left * math.sin(heading)
+            sy = cy + forward * math.sin(heading) + left * math.cos(heading)
+            distance = math.hypot(landmark.x - sx, landmark.y - sy)
+        # The landmark in the robot frame: measured from the sensor, which sits at (forward, left).
+        point = (
+            forward + distance * math.cos(row.bearing),
+            left + distance * math.sin(row.bearing),
+            self._height(landmark),
+        )
         u, v = self._camera.project(Pose(0.0, 0.0, 0.0), [point])[0]
         return float(u), float(v) if self._class is LandmarkClass.POINT else math.nan
 
