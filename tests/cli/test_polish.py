@@ -388,6 +388,32 @@ def test_a_camera_that_sees_no_observation_is_warned_about(tmp_path: Path, sampl
     assert "warning" not in seen.stderr
 
 
+@pytest.mark.parametrize("whole", [False, True], ids=["streamed", "loaded"])
+def test_ground_truth_too_sparse_to_score_any_frame_is_warned_about(tmp_path: Path, whole: bool) -> None:
+    # ground truth once a second, off the frames' times: every frame unscored, n/a, nothing said
+    sparse = tmp_path / "sparse"
+    shutil.copytree(SAMPLE, sparse)
+    truth = sparse / "groundtruth.csv"
+    lines = truth.read_text().splitlines()
+    rows = [line.split(",", 1) for line in lines[2:]]
+    kept = [f"{float(time) + 0.013!r},{rest}" for time, rest in rows if float(time) == round(float(time))]
+    truth.write_text("\n".join([*lines[:2], *kept]) + "\n")
+    replay = ["replay", sparse, "-q", "--terrain", floor_terrain(tmp_path / "terrain.toml")]
+    if whole:  # a figure needs the whole log loaded, not streamed
+        replay += ["--plot", tmp_path / "plot"]
+    result = invoke(*replay)
+    assert "steps_with_truth             0\n" in result.stdout
+    assert "containment_rate             n/a\n" in result.stdout
+    assert result.stderr.startswith(
+        f"warning: {sparse}: expected some frames between ground-truth rows at most --max-truth-gap 0.5 s "
+        "apart, got none of the 178 frames"
+    )
+    assert "is recorded more sparsely, pass a larger --max-truth-gap\n" in result.stderr
+    scored = invoke(*replay, "--max-truth-gap", "1.5", "--overwrite")
+    assert "steps_with_truth             178\n" in scored.stdout
+    assert "warning" not in scored.stderr
+
+
 def test_resuming_a_state_saved_at_the_end_is_refused(tmp_path: Path, sample_replay: list[str]) -> None:
     # 0 steps and every figure n/a, exit 0: a resumed replay with nothing left
     replay = sample_replay

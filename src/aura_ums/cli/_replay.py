@@ -62,7 +62,8 @@ from aura_ums.cli._outputs import (
 )
 
 if TYPE_CHECKING:
-    from aura_ums.logs import LogStream, ReplayOptions, ReplayResult, WindowReport
+    from aura_ums import Metrics
+    from aura_ums.logs import LogStream, ReplayOptions, ReplayResult, RobotLog, WindowReport
     from aura_ums.manager import ManagerSettings
     from aura_ums.uncertainty import TerrainTable
 
@@ -580,6 +581,7 @@ def replay(
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     if windows is not None and camera is not None:
         _warn_unseen(windows, camera)
+    _warn_unscored(log, log_dir, metrics)
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if json_target is not None:
@@ -607,6 +609,23 @@ def _warn_unseen(windows: WindowReport, camera: Path) -> None:
             f"--camera: expected some of the {asked} observations to fall in the image of {camera}, "
             "got none (a measured pixel outside the image, or behind the camera): the window figures "
             "are n/a; check its [mount] and [intrinsics]"
+        )
+
+
+def _warn_unscored(log: RobotLog | LogStream, log_dir: Path, metrics: Metrics) -> None:
+    """Say so when a log with ground truth had none near any frame: its containment is n/a."""
+    from aura_ums.logs import RobotLog
+
+    if isinstance(log, RobotLog):
+        gap = None if log.groundtruth is None else log.groundtruth.max_gap
+    else:
+        gap = None if log.truth_box is None else log.max_gap
+    frames = metrics["steps"]
+    if gap is not None and frames and not metrics["steps_with_truth"]:
+        warn(
+            f"{log_dir}: expected some frames between ground-truth rows at most --max-truth-gap "
+            f"{gap:g} s apart, got none of the {frames} frames: the containment is n/a; if the ground "
+            "truth is recorded more sparsely, pass a larger --max-truth-gap"
         )
 
 
