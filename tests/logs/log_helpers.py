@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from aura_ums.logs import GroundTruth, LogLandmark, LogMeta, LogObservation, Odometry, RobotLog
 from aura_ums.manager import PositionReport
-from aura_ums.uncertainty import Pose, TurnAndRun
+from aura_ums.uncertainty import Pose, TerrainStats, TurnAndRun
 
 #: Where the published datasets live (never copied into the repository).
 MRCLAM6 = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "mrclam6"
@@ -140,3 +141,62 @@ def long_odometry_log(rows: int, *, rate: float = 100.0, frame_every: int = 100)
         odometry=Odometry(t, speed, (dx * ddy - dy * ddx) / speed**2),
         groundtruth=GroundTruth(t, x, y, heading),
     )
+
+
+#: A terrain with no losses: exact odometry is inside its growth bound however it is cut.
+LOSSLESS = TerrainStats(
+    translation_loss=0.0,
+    translation_inertial_loss=0.0,
+    translation_sd=0.02,
+    drift=0.01,
+    rotation_loss=0.0,
+    rotation_sd=0.02,
+    skitter=0.0,
+    skitter_sd=0.0,
+)
+
+
+def steady_arc_log(
+    *, duration: float = 40.0, v: float = 0.3, omega: float = 0.2, rate: float = 10.0
+) -> RobotLog:
+    """A robot driving one circle at constant ``v`` and ``omega``, its odometry and truth exact.
+
+    Eight landmarks on a 6 m ring around the circle's centre, each seen every 0.5 s with its
+    exact range and bearing when within 0.6 rad of the heading (bounds 0.005 rad and 0.01 m:
+    tight maps, which a systematic error of the replayed motion leaves); terrain ``lossless``
+    (:data:`LOSSLESS`), a start known to 0.05 m and 0.02 rad.
+    """
+    heading0, radius = 0.3, v / omega
+    time = np.arange(0.0, duration + 1e-9, 1.0 / rate)
+    truth_time = np.arange(0.0, duration + 1e-9, 0.05)
+    heading = heading0 + omega * truth_time
+    x = radius * (np.sin(heading) - math.sin(heading0))
+    y = -radius * (np.cos(heading) - math.cos(heading0))
+    centre = (-radius * math.sin(heading0), radius * math.cos(heading0))
+    landmarks = tuple(
+        LogLandmark(
+            f"L{i}", centre[0] + 6.0 * math.cos(i * math.pi / 4), centre[1] + 6.0 * math.sin(i * math.pi / 4)
+        )
+        for i in range(8)
+    )
+    observations = []
+    for when in np.arange(0.5, duration, 0.5):
+        h = heading0 + omega * when
+        px, py = radius * (math.sin(h) - math.sin(heading0)), -radius * (math.cos(h) - math.cos(heading0))
+        for landmark in landmarks:
+            bearing = math.remainder(math.atan2(landmark.y - py, landmark.x - px) - h, math.tau)
+            if abs(bearing) < 0.6:
+                distance = math.hypot(landmark.x - px, landmark.y - py)
+                observations.append(LogObservation(float(when), landmark.id, bearing, range=distance))
+    meta = LogMeta(
+        "steady arc",
+        terrain="lossless",
+        bearing_error=0.005,
+        range_error=0.01,
+        start=Pose(0.0, 0.0, heading0),
+        start_radius=0.05,
+        start_heading_halfwidth=0.02,
+    )
+    odometry = Odometry(time, np.full(len(time), v), np.full(len(time), omega))
+    truth = GroundTruth(truth_time, x, y, heading)
+    return RobotLog(meta, landmarks, tuple(observations), odometry=odometry, groundtruth=truth)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -33,6 +34,18 @@ def compose(reports: tuple[PositionReport, ...]) -> tuple[float, float, float]:
         x += report.command.run * math.cos(heading)
         y += report.command.run * math.sin(heading)
     return x, y, heading
+
+
+def pieces_of(reports: tuple[PositionReport, ...]) -> list[tuple[float, float, float]]:
+    """(time, turn, run) of each piece: the reports of one time summed."""
+    pieces: list[tuple[float, float, float]] = []
+    for report in reports:
+        if pieces and pieces[-1][0] == report.time:
+            time, turn, run = pieces[-1]
+            pieces[-1] = (time, turn + report.command.turn, run + report.command.run)
+        else:
+            pieces.append((report.time, report.command.turn, report.command.run))
+    return pieces
 
 
 @st.composite
@@ -83,10 +96,11 @@ def test_reports_integrate_the_motion_and_respect_cuts_and_intervals(case: dict[
         start = shifted[0] if end is None else min(shifted[0], end)
     if end is None:
         end = max(shifted[-1], start)
-    times = [report.time for report in reports]
     if end == start:
         assert reports == ()
         return
+    pieces = pieces_of(reports)
+    times = [time for time, _, _ in pieces]
     assert times[-1] == end
     assert all(b > a for a, b in zip([start, *times], times, strict=False))
     for cut in case["cuts"]:
@@ -95,12 +109,17 @@ def test_reports_integrate_the_motion_and_respect_cuts_and_intervals(case: dict[
     edges = [start, *times]
     gaps = np.diff(edges)
     assert np.all(gaps <= case["max_interval"] * (1 + 1e-9) + 1e-12)
-    for low, high, report in zip(edges[:-1], edges[1:], reports, strict=True):
-        assert report.command.run >= 0.0
+    for low, high, (_, piece_turn, piece_run) in zip(edges[:-1], edges[1:], pieces, strict=True):
         run = case["run_scale"] * held_integral(shifted, case["v"], low, high)
         turn = case["turn_scale"] * held_integral(shifted, case["omega"], low, high)
-        assert report.command.run == pytest.approx(run, rel=1e-9, abs=1e-9)
-        assert report.command.turn == pytest.approx(turn, rel=1e-9, abs=1e-9)
+        assert piece_run == pytest.approx(run, rel=1e-9, abs=1e-9)
+        assert piece_turn == pytest.approx(turn, rel=1e-9, abs=1e-9)
+    for report in reports:
+        assert report.command.run >= 0.0
+    for first, second in itertools.pairwise(reports):
+        if first.time == second.time:  # a piece that turns while it runs: half, the run, half
+            assert second.command.run == 0.0 < first.command.run
+            assert first.command.turn == second.command.turn != 0.0
     total_run = case["run_scale"] * held_integral(shifted, case["v"], start, end)
     assert sum(r.command.run for r in reports) == pytest.approx(total_run, rel=1e-9, abs=1e-9)
 
@@ -109,17 +128,31 @@ def test_reports_integrate_the_motion_and_respect_cuts_and_intervals(case: dict[
 def test_constant_curvature_matches_the_arc(max_interval: float) -> None:
     v, omega, duration = 0.5, 0.2, 10.0
     reports = odometry_to_commands([0.0, duration], [v, 0.0], [omega, 0.0], max_interval=max_interval)
-    assert len(reports) == math.ceil(duration / max_interval - 1e-9)
-    for report in reports:  # every piece turns and runs in the ratio of the radius v / omega
-        assert report.command.run == pytest.approx(report.command.turn * v / omega)
+    pieces = math.ceil(duration / max_interval - 1e-9)
+    assert len(reports) == 2 * pieces  # every piece turns while it runs: half, the run, half
+    for ahead, after in zip(reports[::2], reports[1::2], strict=True):
+        assert ahead.time == after.time
+        assert ahead.command.turn == after.command.turn
+        assert after.command.run == 0.0
+        # the piece turns and runs in the ratio of the radius v / omega
+        assert ahead.command.run == pytest.approx(2.0 * ahead.command.turn * v / omega)
     x, y, heading = compose(reports)
     radius, angle = v / omega, omega * duration
     assert heading == pytest.approx(angle)
-    # Turning first puts each piece's run off the arc's chord by half the piece's turn:
-    # the end point is within run * (omega * max_interval) of the arc's.
+    # Half the turn first puts each piece's run along the arc's chord; only its length, the
+    # arc's, is longer than the chord, by about run * turn**2 / 24: second order in the turn.
     error = math.hypot(x - radius * math.sin(angle), y - radius * (1 - math.cos(angle)))
-    assert error <= v * duration * omega * max_interval
-    assert error >= 0.1 * v * duration * omega * max_interval  # and the bound is not loose by far
+    turn = omega * min(max_interval, duration)
+    assert error <= v * duration * turn**2 / 12.0 + 1e-12
+    # Turning first, the whole turn, was first order: off by half the piece's turn.
+    whole = [(r.command.turn, r.command.run) for r in reports]
+    first_x = first_y = first_heading = 0.0
+    for (turn_a, run_a), (turn_b, _) in zip(whole[::2], whole[1::2], strict=True):
+        first_heading += turn_a + turn_b
+        first_x += run_a * math.cos(first_heading)
+        first_y += run_a * math.sin(first_heading)
+    turned_first = math.hypot(first_x - radius * math.sin(angle), first_y - radius * (1 - math.cos(angle)))
+    assert turned_first >= 0.1 * v * duration * omega * max_interval > 2.0 * error
 
 
 def test_delay_shifts_the_reports() -> None:
@@ -160,14 +193,15 @@ def test_flip_reports_reversing_as_turn_round_run_turn_back() -> None:
     time, v, omega = [0.0, 1.0, 2.0, 3.0], [1.0, -1.0, 0.5, 0.0], [0.0, 0.2, 0.0, 0.0]
     reports = odometry_to_commands(time, v, omega, max_interval=math.inf, reverse=ReverseMotion.FLIP)
     assert [r.time for r in reports] == [1.0, 2.0, 2.0, 3.0]  # cut where v changes sign; one flip pair
-    assert reports[1].command.turn == pytest.approx(0.2 + math.pi)
-    assert reports[2].command.turn == -math.pi
+    assert reports[1].command.turn == pytest.approx(0.1 + math.pi)
+    assert reports[2].command.turn == pytest.approx(0.1 - math.pi)
     assert reports[2].command.run == 0.0
     x, y, heading = compose(reports)
-    # Forward 1, then back 1 (turning 0.2 first, as forward pieces do), then forward 0.5.
+    # Forward 1, then back 1 along the chord of the reversing arc (its middle heading, 0.1),
+    # then forward 0.5 at the heading it ended with, 0.2.
     assert heading == pytest.approx(0.2)
-    assert x == pytest.approx(1.0 - math.cos(0.2) + 0.5 * math.cos(0.2))
-    assert y == pytest.approx(-math.sin(0.2) + 0.5 * math.sin(0.2))
+    assert x == pytest.approx(1.0 - math.cos(0.1) + 0.5 * math.cos(0.2))
+    assert y == pytest.approx(-math.sin(0.1) + 0.5 * math.sin(0.2))
     assert sum(r.command.run for r in reports) == pytest.approx(2.5)
 
 
