@@ -21,7 +21,7 @@ from aura_ums.logs import (
     synthetic_log,
 )
 from aura_ums.uncertainty import TerrainTable
-from tests.logs.log_helpers import MRCLAM6
+from tests.logs.log_helpers import MRCLAM6, steady_arc_log
 
 MRCLAM = MRCLAM6
 
@@ -37,6 +37,21 @@ def test_calibration_recovers_the_synthetic_sensor_bounds() -> None:
     assert 0.03 < calibration.working.range_fraction_high < 0.06
     assert calibration.motion.delay_s == 0.0  # the synthetic commands are not delayed
     assert ranges.size == bearing.size
+
+
+def test_a_steady_turn_rate_reveals_no_delay() -> None:
+    # Every delay aligns a constant turn rate alike; the search took the one float noise
+    # favoured (0.75 s), and the replay then lagged the truth by 0.75 s of motion throughout.
+    assert calibrate_logs([steady_arc_log()]).motion.delay_s == 0.0
+
+
+def test_a_delay_the_turns_reveal_is_found() -> None:
+    log = synthetic_log(np.random.default_rng(3), duration=120.0)
+    assert log.commands is not None
+    # Commands recorded 0.3 s before the robot carried them out.
+    early = tuple(dataclasses.replace(report, time=report.time - 0.3) for report in log.commands)
+    delayed = dataclasses.replace(log, commands=early)
+    assert calibrate_logs([delayed]).motion.delay_s == pytest.approx(0.3)
 
 
 def test_sensor_file_round_trips(tmp_path: Path) -> None:
