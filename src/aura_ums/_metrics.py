@@ -287,6 +287,14 @@ _TABLE: tuple[MetricKey, ...] = (
         "Wrong observations the simulator injected (the scenario's inject_wrong_rate).",
     ),
     _key(
+        "ambiguous_identifications",
+        "count",
+        _K.COUNT,
+        (SIMULATE,),
+        "Landmarks found but not posted: each lay where another mapped landmark of the same kind may "
+        "appear, so which one it was could not be told.",
+    ),
+    _key(
         "median_update_us",
         "µs",
         _K.NUMBER,

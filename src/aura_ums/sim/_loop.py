@@ -130,6 +130,9 @@ class FrameRecord:
         Identifications of the frame made wrong (the scenario's ``inject_wrong_rate``).
     excluded : int
         Observations the manager's relaxed intersection excluded in the frame.
+    ambiguous : int
+        Landmarks found in the frame but not posted: each lay where another mapped landmark
+        of the same kind may appear (:attr:`~aura_ums.schemas.StepReport.ambiguous`).
     """
 
     index: int
@@ -150,6 +153,7 @@ class FrameRecord:
     detections: tuple[tuple[str, tuple[float, float, float, float]], ...] = ()
     injected: int = 0
     excluded: int = 0
+    ambiguous: int = 0
 
     @property
     def area_before(self) -> float:
@@ -492,6 +496,7 @@ class _Loop:
                 detections=_detections(report),
                 injected=injected,
                 excluded=len(grown.excluded) + len(after.excluded),
+                ambiguous=len(report.ambiguous),
             )
         )
         self.next_index += 1
@@ -689,7 +694,8 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
     manager rejected), ``accepted_observations``, ``median_frame_ms``, ``frames``,
     ``runs_lost`` (runs that declared themselves lost), ``runs_completed``,
     ``injected_observations`` (identifications made wrong), ``excluded_observations``
-    (observations the relaxed intersection excluded).
+    (observations the relaxed intersection excluded), ``ambiguous_identifications``
+    (landmarks found but withheld: another mapped landmark may appear where each was found).
 
     Examples
     --------
@@ -718,5 +724,6 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
             "runs_completed": sum(result.completed for result in results),
             "injected_observations": sum(r.injected for r in records),
             "excluded_observations": sum(r.excluded for r in records),
+            "ambiguous_identifications": sum(r.ambiguous for r in records),
         }
     )
