@@ -11,7 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.expecter import Expecter
+from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TurnAndRun, VerticalLineLandmark
 from tests.expecter.expecter_helpers import (
     CAMERAS,
     extreme_poses,
@@ -56,3 +58,28 @@ def test_median_area_ratio(kind: str, camera_name: str, rng: np.random.Generator
     )
     assert min(sampled_ratios) >= 1.0 - 1e-9  # sound
     assert median <= 1.25
+
+
+def test_a_distorted_window_of_a_thin_view_is_as_tight_as_the_poses_it_holds() -> None:
+    # A vertical line 6 m ahead of a small grown map projects onto a thin sliver; an outer
+    # polygon of ten vertices around it reached 107 px left of any pose's projection (u 365
+    # against 472), so the window was 4 times wider than the distortion's reach.
+    camera = Camera(
+        CameraIntrinsics(
+            554.256, 554.256, 319.5, 239.5, 640, 480, distortion=(-0.3, 0.1, 0.001, -0.001, 0.0)
+        ),
+        CameraMount(height=0.3),
+    )
+    terrain = TerrainStats(0.0, 0.0, 0.02, 0.01, 0.0, 0.02, 0.0, 0.0)
+    the_map = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.3), 0.05, 0.02)
+    for _ in range(2):
+        the_map = the_map.grow(TurnAndRun(0.0, 0.075), terrain)
+    landmark = VerticalLineLandmark("pole", 6.0, 0.0, 0.0, 1.0)
+    window = Expecter(camera).bounds(the_map, landmark)
+    assert window is not None
+    rng = np.random.default_rng(0)
+    poses = np.vstack([the_map.sample_poses(5000, rng), extreme_poses(the_map, per_edge=16)])
+    pixels = visible_pixels(camera, poses, landmark_points(landmark, rng, count=9))
+    left, right = pixels[:, 0].min(), pixels[:, 0].max()
+    assert 0.0 <= left - window.u_min < 1.0  # sound, and within a pixel
+    assert 0.0 <= window.u_max - right < 1.0

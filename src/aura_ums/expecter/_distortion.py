@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums.camera import distort
-from aura_ums.geometry import convex_hull, simplify_outer
+from aura_ums.geometry import convex_hull, polygon_area, simplify_outer
 
 Array = NDArray[np.float64]
 Interval = tuple[Array, Array]
@@ -38,8 +38,10 @@ Coefficients = tuple[float, float, float, float, float]
 _INITIAL_SPLIT = 4
 _MAX_ROUNDS = 12
 _MAX_CELLS = 2048
-#: The hull is replaced by an outer polygon of at most this many vertices (fewer edges).
+#: The hull is replaced by an outer polygon of at most this many vertices (fewer edges)...
 _HULL_VERTICES = 10
+#: ...when that polygon's area is at most this fraction larger than the hull's.
+_HULL_GROWTH = 0.05
 #: Rounding slack, relative to the sum of the absolute values of the terms: 20 operations
 #: at 2**-53 each, for our evaluation and the camera's, with a safety factor of ten.
 _ROUNDING = 5e-14
@@ -87,10 +89,18 @@ def distorted_range(points: Array, coefficients: Coefficients, tolerance: float)
 
 
 def _hull(points: Array) -> Array:
-    """Return a convex polygon with few vertices that contains the points (an outer one)."""
+    """Return a convex polygon with few vertices that contains the points (an outer one).
+
+    The hull itself when an outer polygon of few vertices would be much larger: the hull of
+    a thin set (a vertical line seen from a narrow map) has nearly parallel edges, whose
+    extensions meet far away, and the bounds over such a polygon were up to 4 times wider
+    than the distortion's reach.
+    """
     hull = convex_hull(points)
     if len(hull) > _HULL_VERTICES:
-        hull = simplify_outer(hull, _HULL_VERTICES)
+        fewer = simplify_outer(hull, _HULL_VERTICES)
+        if polygon_area(fewer) <= (1.0 + _HULL_GROWTH) * polygon_area(hull):
+            return fewer
     return hull
 
 
