@@ -199,7 +199,7 @@ def test_a_state_from_another_log_is_refused(walk: tuple[Path, Path], tmp_path: 
     assert result.exit_code == 2
     assert "resume: expected a state saved from a replay of log" in result.stderr
     broken = tmp_path / "broken.json"
-    broken.write_text('{"format": "aura_ums.ReplayState", "version": 1, "log": "x"}')
+    broken.write_text('{"format": "aura_ums.ReplayState", "version": 2, "log": "x"}')
     result = runner.invoke(app, ["replay", str(folder), "--terrain", str(terrain), "--resume", str(broken)])
     assert result.exit_code == 2
     assert str(broken) in result.stderr

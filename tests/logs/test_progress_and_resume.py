@@ -99,8 +99,8 @@ def test_a_state_before_any_frame_and_bad_states() -> None:
         replay_log(log, TABLE, resume=state, until=1.0)
     with pytest.raises(FileFormatError, match="log_digest: expected a string"):
         ReplayState.from_json(
-            '{"format": "aura_ums.ReplayState", "version": 1, "log": "x", "frames_done": 0, '
+            '{"format": "aura_ums.ReplayState", "version": 2, "log": "x", "frames_done": 0, '
             '"reports_posted": 0, "last_time": null, "log_digest": 1, "manager": {}, "blackboard": {}}'
         )
     with pytest.raises(FileFormatError, match="expected a key 'log', got none"):
-        ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 1}')
+        ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 2}')

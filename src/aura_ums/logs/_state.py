@@ -20,8 +20,10 @@ from aura_ums.errors import InputError
 
 #: The ``format`` of a saved replay state.
 STATE_FORMAT = "aura_ums.ReplayState"
-#: Its version; bumped when the layout changes.
-STATE_VERSION = 1
+#: Its version; bumped when the layout or the meaning of a field changes (2: a piece of
+#: odometry that turns while it runs is two position reports, so ``reports_posted`` counts
+#: them both).
+STATE_VERSION = 2
 _KEYS = (
     "format",
     "version",
@@ -73,7 +75,7 @@ class ReplayState:
     >>> ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 9}')
     Traceback (most recent call last):
     ...
-    aura_ums.errors.FileFormatError: <replay state JSON>: version: expected 1, got 9
+    aura_ums.errors.FileFormatError: <replay state JSON>: version: expected 2, got 9
     """
 
     log_name: str
