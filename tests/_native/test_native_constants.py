@@ -21,6 +21,7 @@ TWINS: dict[str, float] = {
     "SUPPORT_MARGIN": convex._SUPPORT_MARGIN,
     "SAME_POINT": convex._SAME_POINT,
     "MERGE_EPS": convex._MERGE_EPS,
+    "MERGE_ROUNDING": convex._MERGE_ROUNDING,
     "COLLINEAR_EPS": convex._COLLINEAR_EPS,
     "FULL_DISK_SIDES": convex.FULL_DISK_SIDES,
     "SKITTER_SIDES": growth.SKITTER_SIDES,

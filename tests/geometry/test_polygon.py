@@ -111,6 +111,26 @@ def test_hull_is_convex_ccw_and_contains_its_points(points: NDArray[np.float64])
     assert math.isclose(polygon_area(hull), expected, rel_tol=1e-9, abs_tol=1e-6)
 
 
+def test_far_from_the_origin_a_corner_split_by_rounding_stays_in_the_hull() -> None:
+    # A kernel's polygon 3.5e4 m from the origin, its corner kept twice a few rounding steps
+    # apart: both copies read as straight and went, and the hull left the corner 3 cm out.
+    points = np.array(
+        [
+            [21026.33980523356, -34590.833031578346],
+            [21027.369329209858, -34591.1959185171],
+            [21028.275193785597, -34590.853624139316],
+            [21028.479487750963, -34590.51653318358],
+            [21028.49298117922, -34590.48865308879],
+            [21028.492981179203, -34590.48865308876],
+            [21026.339805233416, -34590.83303157805],
+        ]
+    )
+    hull = convex_hull(points)
+    assert_convex_ccw(hull)
+    assert np.all(ConvexPolygon._trusted(hull).contains(points, tolerance=1e-9))
+    assert len(hull) == 5  # each corner once
+
+
 def test_hull_of_collinear_points_is_a_segment() -> None:
     assert convex_hull(np.array([[0.0, 0.0], [1.0, 1.0], [3.0, 3.0], [2.0, 2.0]])).shape == (2, 2)
     assert convex_hull(np.array([[5.0, 5.0]] * 4)).shape == (1, 2)

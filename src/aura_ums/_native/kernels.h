@@ -36,9 +36,10 @@
 #define SUPPORT_MARGIN 1e-12
 /* geometry._convex.FULL_DISK_SIDES: sides of a full-circle annular sector's polygon. */
 #define FULL_DISK_SIDES 32
-/* geometry._convex._SAME_POINT, _MERGE_EPS, _COLLINEAR_EPS */
+/* geometry._convex._SAME_POINT, _MERGE_EPS, _MERGE_ROUNDING, _COLLINEAR_EPS */
 #define SAME_POINT 1e-12
 #define MERGE_EPS 1e-12
+#define MERGE_ROUNDING 1e-14
 #define COLLINEAR_EPS 1e-12
 /* _native._growth.SKITTER_SIDES: sides of the skitter disk's outer polygon. */
 #define SKITTER_SIDES 8

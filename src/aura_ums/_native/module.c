@@ -75,6 +75,7 @@ static int add_constants(PyObject *module) {
         {"ARC_STEP", ARC_STEP},         {"TINY_ANGLE", TINY_ANGLE},   {"PARALLEL_EPS", PARALLEL_EPS},
         {"NOISE_EDGE", NOISE_EDGE},     {"FARTHEST_MERGE", FARTHEST_MERGE}, {"EXTENDABLE", EXTENDABLE},
         {"SUPPORT_MARGIN", SUPPORT_MARGIN}, {"SAME_POINT", SAME_POINT}, {"MERGE_EPS", MERGE_EPS},
+        {"MERGE_ROUNDING", MERGE_ROUNDING},
         {"COLLINEAR_EPS", COLLINEAR_EPS}, {"TOLERANCE", TOLERANCE},  {"TANGENT_STEP", TANGENT_STEP},
     };
     static const struct {

@@ -505,6 +505,9 @@ int remove_collinear(Poly *p, Work *w) {
     double box[4];
     bounding_box(v, n, box);
     double span = greater(box[2] - box[0], box[3] - box[1]);
+    double reach = 0.0;
+    for (Py_ssize_t i = 0; i < 2 * n; i++) reach = greater(reach, fabs(v[i]));
+    double close = MERGE_EPS * span + MERGE_ROUNDING * reach;
     /* Drop each vertex too close to the next; the write index never passes the read one,
        and the first vertex (which the last edge needs) is saved first. */
     double x0 = v[0], y0 = v[1];
@@ -516,7 +519,7 @@ int remove_collinear(Poly *p, Work *w) {
     for (Py_ssize_t i = 0; i < n; i++) {
         double nx = i + 1 < n ? v[2 * i + 2] : x0, ny = i + 1 < n ? v[2 * i + 3] : y0;
         lengths[i] = hypot(nx - v[2 * i], ny - v[2 * i + 1]);
-        if (lengths[i] > MERGE_EPS * span) {
+        if (lengths[i] > close) {
             double x = v[2 * i], y = v[2 * i + 1];
             v[2 * m] = x;
             v[2 * m + 1] = y;

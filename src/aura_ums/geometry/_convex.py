@@ -44,6 +44,9 @@ _TINY_ANGLE = 1e-12
 
 # Vertices closer than this fraction of the polygon's extent are merged.
 _MERGE_EPS = 1e-12
+# ...or closer than this fraction of their coordinates' magnitude (about 45 rounding steps):
+# far from the origin, two vertices a few rounding steps apart make an edge of no direction.
+_MERGE_ROUNDING = 1e-14
 
 #: Sides of the outer polygon of a full-circle annular sector (a disk).
 FULL_DISK_SIDES = 32
@@ -128,8 +131,15 @@ def polygon_area(vertices: Array) -> float:
 def remove_collinear(vertices: Array) -> Array:
     """Drop repeated, nearly coincident and straight (180 degree) vertices of a convex polygon.
 
-    Vertices closer than 1e-12 of the polygon's extent are merged: their rounding
-    noise would otherwise read as a reflex corner.
+    Vertices closer than 1e-12 of the polygon's extent, or than 1e-14 of their
+    coordinates' magnitude, are merged: their rounding noise would otherwise read as a
+    reflex corner, or as a straight one, and both ends of such an edge could go at once.
+
+    Examples
+    --------
+    >>> far = np.array([[2e4, 0.0], [2e4 + 1.0, 0.0], [2e4 + 2.0, 1.0], [2e4 + 2.0, 1.0 + 4e-12], [2e4, 1.0]])
+    >>> remove_collinear(far).tolist()   # the two corners 4e-12 m apart are one
+    [[20000.0, 0.0], [20001.0, 0.0], [20002.0, 1.000000000004], [20000.0, 1.0]]
     """
     n = len(vertices)
     if n < 2:
@@ -137,7 +147,7 @@ def remove_collinear(vertices: Array) -> Array:
     span = float(np.max(np.ptp(vertices, axis=0)))
     following = _edges(vertices)
     length = np.hypot(following[:, 0], following[:, 1])
-    keep = length > _MERGE_EPS * span
+    keep = length > _MERGE_EPS * span + _MERGE_ROUNDING * float(np.max(np.abs(vertices)))
     if not np.all(keep):
         if not np.any(keep):
             return vertices[:1].copy()
