@@ -181,3 +181,31 @@ def test_a_log_lost_to_the_run_timeout_is_named_with_the_option(
         ": expected it to finish within 0 retries, got it lost 1 times "
         "(last: no result within --run-timeout 1e-09 s)\n"
     )
+
+
+def test_a_missing_log_among_many_on_workers_gives_the_clean_message_alone(
+    log_folders: list[Path], tmp_path: Path
+) -> None:
+    # the workers logged "Compute Failed" and the task's traceback before the clean message
+    pytest.importorskip("distributed", reason="the dask extra is not installed")
+    import subprocess
+
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    missing = tmp_path / "r3"
+    aura = Path(sys.executable).with_name("aura-ums")
+    command: list[str | Path] = [
+        aura,
+        "replay",
+        log_folders[0],
+        missing,
+        "--terrain",
+        terrain,
+        "-q",
+        "--workers",
+        "2",
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, check=False, timeout=120)
+    assert done.returncode == 2
+    assert done.stderr == f"error: {missing}: expected a log folder, got no such folder\n"
+    assert done.stdout == ""

@@ -174,14 +174,16 @@ def _client(settings: CampaignSettings) -> Iterator[Client]:
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}))
     environ.pop("MALLOC_TRIM_THRESHOLD_", None)
     with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
-        # Loopback only; no dashboard; the workers' log lines below errors stay out of the terminal.
+        # Loopback only; no dashboard; the workers' log lines stay out of the terminal: a task's
+        # error comes back to the caller, who words it (a worker's 'Compute Failed' and a
+        # traceback printed before the clean message was noise).
         cluster = LocalCluster(
             n_workers=settings.workers,
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",
             dashboard_address=None,
-            silence_logs=logging.ERROR,
+            silence_logs=logging.CRITICAL,
             # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
             scheduler_kwargs={"allowed_failures": 0, "dashboard": False, "dashboard_address": "127.0.0.1:0"},
         )
