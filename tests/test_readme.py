@@ -125,7 +125,7 @@ def test_readme_commands_run_as_printed_on_the_shipped_sample(
     assert json.loads((clone / "m.json").read_text(encoding="utf-8"))["runs_completed"] == 2
     # the sliced, relaxed replay through the virtual camera: a window row per observation and method
     assert (clone / "r2-windows.csv").read_text(encoding="utf-8").count("\n") > 3
-    assert list((clone / "report" / "figures").glob("figure3*.png"))
+    assert list((clone / "figures").glob("figure3*.png"))
 
 
 def test_the_sample_logs_are_what_examples_readme_says(tmp_path: Path) -> None:

@@ -305,7 +305,7 @@ _PROFILE = "settings_profile"
 _PROFILE_BLURBS = {
     MapProfile.PRODUCT: "the paper's polygon x wedge, fastest",
     MapProfile.SLICED: "windows about a quarter of the frame",
-    MapProfile.RELAXED: "the truth kept despite a misread landmark, narrow focus windows, 6-11 ms a frame",
+    MapProfile.RELAXED: "the truth kept despite a misread landmark, narrow focus windows, 2-8 ms a frame",
 }
 
 

@@ -615,20 +615,21 @@ class MapProfile(enum.Enum):
     "The three profiles"):
 
     - ``PRODUCT``: the paper's map, one polygon times one heading wedge (the defaults).
-      The fastest, about 0.1-0.2 ms a frame; its windows cover 0.6 to all of the width
+      The fastest, about 0.05-0.1 ms a frame; its windows cover 0.6 to all of the width
       of a 60 degree camera's frame, and a misread landmark can leave the truth outside
       (it stayed inside 0.90 to 1.00 of the time).
     - ``SLICED``: a polygon per 2 degree heading cell (``slice_width``), so position and
       heading stay coupled: windows about a quarter of the frame and a fifth to a half
-      of the area, at about 0.3-0.9 ms a frame; a misread landmark or an observation beyond its
+      of the area, at about 0.2-0.4 ms a frame; a misread landmark or an observation beyond its
       calibrated bounds cuts deeper (the truth stayed inside 0.89 to 1.00 of the time).
     - ``RELAXED``: ``SLICED`` with the q-relaxed intersection (``relaxed_q = 1`` over
       ``relaxed_window = 5`` observations) and no slice cap (``max_slices`` 180, every cell):
       the truth stays inside whenever at most one landmark among any 5 consecutive
       observations is wrong (it stayed inside 0.998 to 1.000 of the time), for guaranteed
-      windows of 0.33-0.40 of the frame with range and bearing and 0.43-0.60 with bearings
+      windows of 0.33-0.39 of the frame with range and bearing and 0.42-0.59 with bearings
       only, and focus windows (searched first: :attr:`UncertaintyMapManager.focus_map`) of
-      0.26 and 0.27-0.31, at about 5-11 ms a frame.
+      0.26 and 0.27-0.31, at about 2-4 ms a frame with range and bearing and 6-8 ms with
+      bearings only.
 
     Examples
     --------
