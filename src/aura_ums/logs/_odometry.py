@@ -244,10 +244,10 @@ def odometry_report_arrays(
     turn = np.diff(cumulative_integral(t, angular, edges)) * turn_scale
     ahead = np.maximum(np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale, 0.0)
     back = np.maximum(np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale, 0.0)
-    return turned_round(times, turn, ahead, back)
+    return piece_commands(times, turn, ahead, back)
 
 
-def turned_round(
+def piece_commands(
     times: NDArray[np.float64],
     turn: NDArray[np.float64],
     ahead: NDArray[np.float64],
@@ -266,7 +266,7 @@ def turned_round(
 
     Examples
     --------
-    >>> times, turns, runs = turned_round(
+    >>> times, turns, runs = piece_commands(
     ...     np.array([1.0, 2.0, 3.0]), np.array([0.2, 0.0, 0.4]), np.array([0.5, 0.5, 0.0]), np.zeros(3)
     ... )
     >>> times.tolist(), turns.tolist(), runs.tolist()

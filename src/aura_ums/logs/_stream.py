@@ -51,7 +51,7 @@ from aura_ums.logs._io import (
     reversed_at,
 )
 from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
-from aura_ums.logs._odometry import ReverseMotion, ReversingError, report_times, turned_round
+from aura_ums.logs._odometry import ReverseMotion, ReversingError, piece_commands, report_times
 from aura_ums.manager import PositionReport
 
 Array = NDArray[np.float64]
@@ -424,7 +424,7 @@ class OdometryReports:
         self.low = high
         if len(times) == 0:
             return times, times, times
-        return turned_round(times, turn, ahead, back)
+        return piece_commands(times, turn, ahead, back)
 
     def finish(self) -> None:
         """Read and check the rows after the last frame: the whole record is checked, as load_log does."""
