@@ -20,6 +20,7 @@ from aura_ums.uncertainty import (
     GroundLineLandmark,
     GroundLineObservation,
     Landmark,
+    LandmarkClass,
     Observation,
     PointLandmark,
     Pose,
@@ -584,3 +585,72 @@ def test_sensor_offset_on_a_point_map_is_exact_enough() -> None:
     assert left.consistent
     assert left.map.contains(Pose(0.0, 0.0, 0.0))
     assert left.wedge_after.width < 0.1
+
+
+def _far_sighting(
+    landmark_class: LandmarkClass, shift: float
+) -> tuple[SpatialUncertaintyMap, Observation, Landmark, Pose]:
+    """A sighting from an offset sensor of a scene 990 km from the origin, moved back by ``shift`` m."""
+    if landmark_class is LandmarkClass.VERTICAL_LINE:
+        start, heading = (990034.7682559643, 989993.6191717304), -2.5342989458392813
+        spot = (990036.1034977089, 989994.1235845479)
+        truth = Pose(990034.892976438 - shift, 989993.827989183 - shift, -2.0957871794259972)
+        offset, radius, halfwidth = (-0.07994881646781873, 0.27676663020615483), 0.5, 0.5
+    else:
+        start, heading = (989953.5248726772, 989985.7107565039), -1.420145212668884
+        spot = (989957.6413778897, 989976.4656477806)
+        truth = Pose(989953.4942736938 - shift, 989985.7439855458 - shift, -1.402364878993252)
+        offset, radius, halfwidth = (0.13120899606463488, 0.1464460234914861), 0.5, 0.05
+    prior = SpatialUncertaintyMap.from_pose(
+        Pose(start[0] - shift, start[1] - shift, heading), radius, halfwidth
+    )
+    x, y = spot[0] - shift, spot[1] - shift
+    sx = truth.x + offset[0] * math.cos(truth.heading) - offset[1] * math.sin(truth.heading)
+    sy = truth.y + offset[0] * math.sin(truth.heading) + offset[1] * math.cos(truth.heading)
+    bearing = math.atan2(y - sy, x - sx) - truth.heading
+    observation: Observation
+    landmark: Landmark
+    if landmark_class is LandmarkClass.VERTICAL_LINE:
+        landmark = VerticalLineLandmark("L", x, y, 0.0, 2.0)
+        observation = BearingObservation("L", 0.0, bearing, 0.001, sensor_offset=offset)
+    else:
+        distance = math.hypot(x - sx, y - sy)
+        landmark = PointLandmark("L", x, y, 1.0)
+        observation = RangeBearingObservation(
+            "L", 0.0, bearing, 0.001, distance, distance, sensor_offset=offset
+        )
+    return prior, observation, landmark, truth
+
+
+@pytest.mark.parametrize("landmark_class", [LandmarkClass.VERTICAL_LINE, LandmarkClass.POINT])
+def test_far_from_the_origin_a_sighting_from_an_offset_sensor_keeps_the_truth(
+    landmark_class: LandmarkClass,
+) -> None:
+    # At 990 km, inside the coordinates' range, these reductions cut the truth out by 7.7 cm
+    # (Class I) and 1.2 cm (Class II); the same scenes at the origin kept it.
+    for shift in (0.0, 989900.0):
+        prior, observation, landmark, truth = _far_sighting(landmark_class, shift)
+        assert prior.contains(truth)
+        reduction = prior.reduce(observation, landmark)
+        assert reduction.consistent
+        assert reduction.map.contains(truth)
+        assert reduction.area_after <= reduction.area_before
+
+
+def test_far_from_the_origin_reductions_keep_sampled_truths() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(400):
+        x, y = 990000.0 + rng.uniform(-50, 50), 990000.0 + rng.uniform(-50, 50)
+        prior = SpatialUncertaintyMap.from_pose(Pose(x, y, rng.uniform(-math.pi, math.pi)), 0.5, 0.5)
+        tx, ty, th = prior.sample_poses(1, rng)[0].tolist()
+        offset = (float(rng.uniform(-0.3, 0.3)), float(rng.uniform(-0.3, 0.3)))
+        sx = tx + offset[0] * math.cos(th) - offset[1] * math.sin(th)
+        sy = ty + offset[0] * math.sin(th) + offset[1] * math.cos(th)
+        direction = rng.uniform(-math.pi, math.pi)
+        distance = float(rng.choice([0.1, 1.0, 10.0]))
+        pole = VerticalLineLandmark(
+            "L", sx + distance * math.cos(direction), sy + distance * math.sin(direction), 0.0, 2.0
+        )
+        bearing = math.atan2(pole.y - sy, pole.x - sx) - th
+        reduced = prior.reduce(BearingObservation("L", 0.0, bearing, 1e-3, sensor_offset=offset), pole).map
+        assert reduced.contains(tx, ty, th)

@@ -181,10 +181,14 @@ def _cross_noise(vertices: Array, length: Array, preceding_length: Array) -> Arr
     )
 
 
-def convex_hull(points: Array) -> Array:
+def convex_hull(points: Array, *, straight: bool = False) -> Array:
     """Return the convex hull of points as counter-clockwise vertices without repeats.
 
-    The result has one row for a single point, two for collinear points.
+    The result has one row for a single point, two for collinear points. Nearly
+    coincident and nearly straight vertices are merged (:func:`remove_collinear`) unless
+    ``straight``: then every vertex the monotone chain keeps stays, so each edge's line
+    holds all of them, however short the edge (far from the origin, the merge's
+    straightness test drops vertices up to a few nanometres off a chord).
 
     Parameters
     ----------
@@ -223,8 +227,8 @@ def convex_hull(points: Array) -> Array:
 
     lower = half_hull(ordered)
     upper = half_hull(ordered[::-1])
-    hull = lower[:-1] + upper[:-1]
-    return remove_collinear(np.asarray(hull, dtype=np.float64))
+    hull = np.asarray(lower[:-1] + upper[:-1], dtype=np.float64)
+    return hull if straight else remove_collinear(hull)
 
 
 def _lowest_vertex(vertices: Array) -> int:

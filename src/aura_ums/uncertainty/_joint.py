@@ -35,7 +35,15 @@ from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, intersect_arcs
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
 from aura_ums.uncertainty._landmarks import Landmark, Observation
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
-from aura_ums.uncertainty._reduce import Reduction, _kernel_call, arc_wedge, check_pair, reduce_checked
+from aura_ums.uncertainty._reduce import (
+    Reduction,
+    _kernel_call,
+    arc_wedge,
+    check_pair,
+    local_origin,
+    moved_landmark,
+    reduce_checked,
+)
 
 #: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
 DEFAULT_SECTOR = math.radians(5.0)
@@ -130,7 +138,21 @@ def joint_reduced(
     """:func:`reduce_jointly` for checked arguments: the reduced map, or why no heading agrees.
 
     For the map manager, which reads neither area (a sliced map's is a hull of every slice).
+    Far from the origin it runs in a frame moved next to the map (see ``reduce_checked``).
     """
+    origin = local_origin(prior)
+    if origin is not None:
+        ox, oy = origin
+        moved = [(observation, moved_landmark(landmark, -ox, -oy)) for observation, landmark in pairs]
+        found = _joint_here(prior._moved(-ox, -oy), moved, sector, cap)
+        return found if isinstance(found, str) else found._moved(ox, oy, merge=True)
+    return _joint_here(prior, pairs, sector, cap)
+
+
+def _joint_here(
+    prior: SpatialUncertaintyMap, pairs: Sequence[tuple[Observation, Landmark]], sector: float, cap: int
+) -> SpatialUncertaintyMap | str:
+    """:func:`joint_reduced` in the map's own frame."""
     wedge = prior.wedge
     lo, width = wedge.center - wedge.cw, min(wedge.width, _TWO_PI)
     count = max(1, math.ceil(width / sector - 1e-9))

@@ -33,6 +33,7 @@ from aura_ums.geometry import (
     ConvexPolygon,
     HeadingWedge,
     Pose,
+    convex_hull,
     outer_disk,
     points_in_convex,
     polygon_area,
@@ -149,6 +150,34 @@ class SpatialUncertaintyMap:
         """Build a sliced map from its slices and their summary wedge (as the slice kernels give it)."""
         center.setflags(write=False)
         return cls._made(polygon, center, wedge, slices, cells, max_slices)
+
+    def _moved(self, dx: float, dy: float, *, merge: bool = False) -> SpatialUncertaintyMap:
+        """Return this map moved by (dx, dy) metres, headings kept (a frame moved next to it).
+
+        With ``merge``, each polygon is the hull of its moved vertices
+        (:func:`~aura_ums.geometry.convex_hull` keeping straight vertices), which holds it:
+        far from the origin two vertices a rounding step apart make an edge that points
+        anywhere, and its line would cut into the polygon; the hull drops the one that does.
+        """
+        step = np.array([dx, dy])
+        center = self.center + step
+        slices = self._slices
+        if slices is None:
+            vertices = self.polygon.vertices + step
+            if merge:
+                vertices = convex_hull(vertices, straight=True)
+            return SpatialUncertaintyMap._trusted(ConvexPolygon._trusted(vertices), center, self.wedge)
+        if merge:
+            polygons = [convex_hull(polygon + step, straight=True) for polygon in slices.polygons()]
+            points = np.concatenate(polygons)
+            counts = np.array([len(polygon) for polygon in polygons], dtype=np.int64)
+            slices = slices._replace(counts=counts)
+        else:
+            points = slices.points + step
+        points.setflags(write=False)
+        return SpatialUncertaintyMap._sliced(
+            slices._replace(points=points), center, self.wedge, self._cells, self._max_slices
+        )
 
     @classmethod
     def _made(
