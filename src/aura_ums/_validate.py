@@ -12,6 +12,7 @@ numeric field against one, and the docs pages of the file formats list them.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,6 +54,17 @@ def integer_at_least(value: object, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
     return value
+
+
+def vertex_cap(value: object, name: str = "max_vertices") -> int:
+    """Return a polygon's vertex cap, an integer in [3, 2**63 - 1], or raise naming ``name``.
+
+    A cap only bounds what a polygon may keep (1,000,000: no cap at work), so any size the
+    kernels can count (a Py_ssize_t) is a valid one; numpy integers are taken as Python's.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 3 <= value <= sys.maxsize:
+        raise InputError(f"{name}: expected an integer in [3, 2**63 - 1], got {value!r}")
+    return int(value)
 
 
 @dataclass(frozen=True, slots=True)

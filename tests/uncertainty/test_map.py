@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -275,9 +276,15 @@ def test_from_polygon_refuses_a_centre_outside() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"sigmas": 0.0}, r"sigmas: expected a positive finite number, got 0.0"),
-        ({"sigmas": float("nan")}, r"sigmas: expected a positive finite number, got nan"),
-        ({"max_vertices": 2}, r"max_vertices: expected at least 3, got 2"),
+        ({"sigmas": 0.0}, r"sigmas: expected a positive number, got 0.0"),
+        ({"sigmas": float("nan")}, r"sigmas: expected a finite number, got nan"),
+        ({"sigmas": "3"}, r"sigmas: expected a finite number, got '3'"),
+        ({"max_vertices": 2}, r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 2"),
+        ({"max_vertices": 3.5}, r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 3.5"),
+        (
+            {"max_vertices": 2**70},
+            r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 1180591620717411303424",
+        ),
     ],
 )
 def test_grow_refuses_bad_arguments(
@@ -285,6 +292,15 @@ def test_grow_refuses_bad_arguments(
 ) -> None:
     with pytest.raises(InputError, match=message):
         figure5_map.grow(TurnAndRun(0, 1), TERRAINS["tile"], **kwargs)  # type: ignore[arg-type]
+
+
+def test_grow_takes_numpy_scalars(figure5_map: SpatialUncertaintyMap) -> None:
+    # sigmas=np.float32(3.0) was refused, where every other number took numpy scalars
+    plain = figure5_map.grow(TurnAndRun(0, 1), TERRAINS["tile"], sigmas=3.0, max_vertices=64)
+    sigmas: Any = np.float32(3.0)  # numpy scalars, as a config read into arrays gives them
+    cap: Any = np.int64(64)
+    scalar = figure5_map.grow(TurnAndRun(0, 1), TERRAINS["tile"], sigmas=sigmas, max_vertices=cap)
+    assert np.array_equal(plain.polygon.vertices, scalar.polygon.vertices)
 
 
 def test_grow_refuses_a_terrain_name_instead_of_statistics(figure5_map: SpatialUncertaintyMap) -> None:

@@ -5,6 +5,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from aura_ums import (
     FileFormatError,
@@ -244,3 +246,15 @@ def test_a_file_over_the_size_limit_is_refused_stating_it(tmp_path: Path) -> Non
         FileFormatError, match=r"huge\.toml: expected a terrain table TOML file of at most 64 MiB"
     ):
         TerrainTable.from_toml(path)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.text(min_size=1, max_size=12))
+def test_any_terrain_name_round_trips_through_toml(
+    tmp_path_factory: pytest.TempPathFactory, name: str
+) -> None:
+    # names with '"' or '\\' were written unescaped, and 'café' as a bare key: invalid TOML
+    table = TerrainTable({name: TerrainTable.default()["grass"]})
+    path = tmp_path_factory.mktemp("names") / "terrain.toml"
+    path.write_text(table.to_toml(), encoding="utf-8")
+    assert TerrainTable.from_toml(path) == table

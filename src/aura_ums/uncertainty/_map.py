@@ -25,7 +25,9 @@ from aura_ums._validate import (
     integer_at_least,
     nonnegative_float,
     points_array,
+    positive_float,
     read_only,
+    vertex_cap,
 )
 from aura_ums.errors import InputError
 from aura_ums.geometry import (
@@ -469,11 +471,8 @@ class SpatialUncertaintyMap:
             raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
         if not isinstance(terrain, TerrainStats):
             raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
-        if not (isinstance(sigmas, (int, float)) and math.isfinite(sigmas) and sigmas > 0):
-            raise InputError(f"sigmas: expected a positive finite number, got {sigmas!r}")
-        if max_vertices < 3:
-            raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
-        return self._grow_many((command,), terrain, float(sigmas), max_vertices)
+        bound = positive_float(sigmas, "sigmas")
+        return self._grow_many((command,), terrain, bound, vertex_cap(max_vertices))
 
     def _grow_many(
         self,

@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import CONE_PIECE, SECTOR_PIECE, EmptyReason, RawReduction
+from aura_ums._validate import vertex_cap
 from aura_ums.errors import InputError
 from aura_ums.geometry import (
     POSITION_TOLERANCE,
@@ -147,9 +148,8 @@ def reduce_map(
 ) -> Reduction:
     """Reduce a map by one observation of a landmark; see :meth:`SpatialUncertaintyMap.reduce`."""
     check_pair(observation, landmark)
-    if max_vertices < 3:
-        raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
-    found = reduce_checked(prior, observation, landmark, max_vertices)
+    cap = vertex_cap(max_vertices)
+    found = reduce_checked(prior, observation, landmark, cap)
     wedge = prior.wedge
     if isinstance(found, str):
         area = prior.polygon.area

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import math
+import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -15,6 +17,9 @@ from aura_ums._files import Fields, key_path, load_toml
 from aura_ums._validate import Range, float_array
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
+
+#: A key TOML takes without quotes.
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 
 _FRACTION = Range(0.0, 1.0, "", high_open=True)
 _SD = Range(0.0, 10.0, "")
@@ -280,10 +285,17 @@ class TerrainTable(Mapping[str, TerrainStats]):
         return cls(entries)
 
     def to_toml(self) -> str:
-        """Return the table as TOML text that :meth:`from_toml` reads back exactly."""
+        r"""Return the table as TOML text that :meth:`from_toml` reads back exactly.
+
+        Examples
+        --------
+        >>> table = TerrainTable({'wet "grass"': TerrainTable.default()["grass"]})
+        >>> print(table.to_toml().splitlines()[0])   # a name TOML must quote, escaped
+        ["wet \"grass\""]
+        """
         lines: list[str] = []
         for terrain, stats in self.entries.items():
-            lines.append(f'["{terrain}"]' if not terrain.replace("_", "").isalnum() else f"[{terrain}]")
+            lines.append(f"[{_toml_key(terrain)}]")
             lines.extend(f"{name} = {getattr(stats, name)!r}" for name in TerrainStats.field_names())
             lines.append("")
         return "\n".join(lines)
@@ -334,3 +346,11 @@ class TerrainTable(Mapping[str, TerrainStats]):
 
     def __len__(self) -> int:
         return len(self.entries)
+
+
+def _toml_key(name: str) -> str:
+    """Return ``name`` as a TOML key: bare when TOML allows it, else a basic string with escapes."""
+    if _BARE_KEY.fullmatch(name):
+        return name
+    # JSON's escapes are TOML's, but for DEL, which TOML wants escaped too.
+    return json.dumps(name, ensure_ascii=False).replace("\x7f", "\\u007f")
