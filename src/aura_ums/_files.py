@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._validate import Range
-from aura_ums.errors import FileFormatError
+from aura_ums.errors import FileFormatError, InputError
 
 __all__ = [
     "MAX_BYTES",
@@ -144,6 +144,8 @@ def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None
     aura_ums.errors.FileFormatError: .../a.toml: expected a TOML file of at most 4 bytes, got a larger one
     """
     limit = _limit(max_bytes, MAX_BYTES)
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"path: expected a {kind} file's path (str or path-like), got {type(path).__name__}")
     source = str(path)
     try:
         mode = os.stat(path).st_mode

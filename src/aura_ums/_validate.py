@@ -56,6 +56,12 @@ def integer_at_least(value: object, name: str, minimum: int) -> int:
     return value
 
 
+def check_rng(rng: object, name: str = "rng") -> None:
+    """Refuse anything but a ``numpy.random.Generator`` (every random function takes one), naming ``name``."""
+    if not isinstance(rng, np.random.Generator):
+        raise InputError(f"{name}: expected a numpy.random.Generator, got {type(rng).__name__}")
+
+
 def vertex_cap(value: object, name: str = "max_vertices") -> int:
     """Return a polygon's vertex cap, an integer in [3, 2**63 - 1], or raise naming ``name``.
 

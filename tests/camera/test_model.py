@@ -105,3 +105,13 @@ def test_calibration_bounds_are_validated(field: str, value: object, match: str)
 def test_calibration_bounds_default_to_an_exact_calibration() -> None:
     bounds = CalibrationBounds()
     assert all(getattr(bounds, name) == 0.0 for name in CalibrationBounds.field_names())
+
+
+def test_project_refuses_poses_of_the_wrong_shape() -> None:
+    # a (2, 2) array of poses raised numpy's "cannot reshape array of size 4 into shape (3)"
+    camera = Camera(CameraIntrinsics(500.0, 500.0, 319.5, 239.5, 640, 480), CameraMount(height=1.0))
+    with pytest.raises(
+        InputError,
+        match=r"pose: expected a Pose, or x, y and heading of shape \(3,\) or \(m, 3\), got \(2, 2\)",
+    ):
+        camera.project(np.zeros((2, 2)), [(5.0, 0.0, 1.0)])

@@ -338,3 +338,19 @@ def test_most_probable_pose_is_built_once_and_equals_a_fresh_pose(
         assert pose == fresh
         assert uncertainty_map.most_probable_pose() is pose
     assert grown.most_probable_pose() != start.most_probable_pose()
+
+
+def test_bad_arguments_get_the_library_error() -> None:
+    # these raised AttributeError, a numpy ValueError or TypeError from deep inside
+    start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, 0.2)
+    rng = np.random.default_rng(0)
+    pose: Any = (0, 0, 0)
+    with pytest.raises(InputError, match=r"pose: expected a Pose, got tuple \(0, 0, 0\)"):
+        SpatialUncertaintyMap.from_pose(pose, 0.5, 0.2)
+    for count in (-1, 2.5):
+        bad: Any = count
+        with pytest.raises(InputError, match=rf"count: expected an integer >= 0, got {count}"):
+            start.sample_poses(bad, rng)
+    no_rng: Any = None
+    with pytest.raises(InputError, match=r"rng: expected a numpy.random.Generator, got NoneType"):
+        start.sample_poses(3, no_rng)

@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -258,3 +259,29 @@ def test_any_terrain_name_round_trips_through_toml(
     path = tmp_path_factory.mktemp("names") / "terrain.toml"
     path.write_text(table.to_toml(), encoding="utf-8")
     assert TerrainTable.from_toml(path) == table
+
+
+def test_bad_arguments_get_the_library_error() -> None:
+    # these raised AttributeError or TypeError from deep inside
+    tile, rng = TerrainTable.default()["tile"], np.random.default_rng(0)
+    pose: Any = (0, 0, 0)
+    command: Any = (0, 1)
+    nothing: Any = None
+    text: Any = "3"
+    with pytest.raises(InputError, match=r"pose: expected a Pose, got tuple"):
+        tile.sample_motion(pose, TurnAndRun(0, 1), rng)
+    with pytest.raises(InputError, match=r"command: expected a TurnAndRun, got tuple"):
+        tile.sample_motion(Pose(0, 0, 0), command, rng)
+    with pytest.raises(InputError, match=r"rng: expected a numpy.random.Generator, got NoneType"):
+        tile.sample_motion(Pose(0, 0, 0), TurnAndRun(0, 1), nothing)
+    with pytest.raises(InputError, match=r"truncate: expected a positive finite number or None, got '3'"):
+        tile.sample_motion(Pose(0, 0, 0), TurnAndRun(0, 1), rng, truncate=text)
+    with pytest.raises(InputError, match=r"entries: expected a mapping of terrain names"):
+        TerrainTable(nothing)
+    listed: Any = [("a", 1)]
+    with pytest.raises(FileFormatError, match=r"<mapping>: expected a mapping of terrain tables, got list"):
+        TerrainTable.from_mapping(listed)
+    with pytest.raises(
+        InputError, match=r"path: expected a terrain table TOML file's path \(str or path-like\)"
+    ):
+        TerrainTable.from_toml(nothing)

@@ -222,5 +222,9 @@ class Camera:
             pixels = self.project_camera_frame(self.to_camera_frame(pose.as_array(), points_world))
             return np.asarray(pixels[0], dtype=np.float64)
         state = float_array(pose, "pose")
+        if state.shape[-1:] != (3,) or state.ndim > 2:
+            raise InputError(
+                f"pose: expected a Pose, or x, y and heading of shape (3,) or (m, 3), got {state.shape}"
+            )
         pixels = self.project_camera_frame(self.to_camera_frame(state, points_world))
         return np.asarray(pixels[0] if state.ndim == 1 else pixels, dtype=np.float64)

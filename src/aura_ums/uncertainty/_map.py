@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums import _native
 from aura_ums._validate import (
+    check_rng,
     finite_float,
     float_array,
     integer_at_least,
@@ -399,6 +400,8 @@ class SpatialUncertaintyMap:
         heading_halfwidth : float
             Half-width of the heading wedge, radians, >= 0 (pi or more: any heading).
         """
+        if not isinstance(pose, Pose):
+            raise InputError(f"pose: expected a Pose, got {type(pose).__name__} {pose!r}")
         radius = nonnegative_float(position_radius, "position_radius")
         halfwidth = nonnegative_float(heading_halfwidth, "heading_halfwidth")
         center = np.array([pose.x, pose.y])
@@ -671,6 +674,8 @@ class SpatialUncertaintyMap:
         A sliced map draws a slice for each pose with a chance proportional to its area times
         its heading width (a small floor keeps degenerate slices possible), then a pose in it.
         """
+        count = integer_at_least(count, "count", 0)
+        check_rng(rng)
         slices = self._slices
         if slices is not None:
             polygons = slices.polygons()

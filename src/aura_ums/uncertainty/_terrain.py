@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import Range, float_array
+from aura_ums._validate import Range, check_rng, float_array
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
 
@@ -135,6 +135,8 @@ class TerrainStats:
         Pose
             The true pose after the command.
         """
+        if not isinstance(pose, Pose):
+            raise InputError(f"pose: expected a Pose, got {type(pose).__name__} {pose!r}")
         result = self.sample_motions(pose.as_array(), command, rng, truncate=truncate)
         return Pose(float(result[0, 0]), float(result[0, 1]), float(result[0, 2]))
 
@@ -163,8 +165,17 @@ class TerrainStats:
             state = state.reshape(1, -1)
         if state.ndim != 2 or state.shape[1] != 3:
             raise InputError(f"poses: expected shape (n, 3), got {state.shape}")
-        if truncate is not None and not (math.isfinite(truncate) and truncate > 0.0):
-            raise InputError(f"truncate: expected a positive finite number or None, got {truncate!r}")
+        if not isinstance(command, TurnAndRun):
+            raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__} {command!r}")
+        check_rng(rng)
+        if truncate is not None:
+            if (
+                isinstance(truncate, bool)
+                or not isinstance(truncate, (int, float, np.integer, np.floating))
+                or not (math.isfinite(truncate) and truncate > 0.0)
+            ):
+                raise InputError(f"truncate: expected a positive finite number or None, got {truncate!r}")
+            truncate = float(truncate)
         n = len(state)
         z = rng.standard_normal((3, n))
         if truncate is not None:
@@ -222,6 +233,10 @@ class TerrainTable(Mapping[str, TerrainStats]):
     entries: Mapping[str, TerrainStats]
 
     def __post_init__(self) -> None:
+        if not isinstance(self.entries, Mapping):
+            raise InputError(
+                f"entries: expected a mapping of terrain names to TerrainStats, got {self.entries!r}"
+            )
         checked: dict[str, TerrainStats] = {}
         for name, stats in dict(self.entries).items():
             if not isinstance(name, str) or not name:
@@ -257,6 +272,10 @@ class TerrainTable(Mapping[str, TerrainStats]):
     @classmethod
     def from_mapping(cls, document: Mapping[str, object], *, source: str = "<mapping>") -> TerrainTable:
         """Build a table from nested mappings as TOML gives them (see :meth:`from_toml`)."""
+        if not isinstance(document, Mapping):
+            raise FileFormatError(
+                source, "", f"expected a mapping of terrain tables, got {type(document).__name__}"
+            )
         if not document:
             raise FileFormatError(source, "", "expected at least one terrain table, got none")
         reader = Fields(source)
