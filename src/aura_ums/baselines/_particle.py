@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, positive_float
+from aura_ums._validate import check_rng, finite_float, nonnegative_float, positive_float
 from aura_ums.baselines._ekf import _gate_threshold, check_observation, landmark_position
 from aura_ums.baselines._moments import check_motion
 from aura_ums.baselines._region import (
@@ -179,8 +179,7 @@ class ParticleFilter:
     ) -> None:
         if not isinstance(initial, Pose):
             raise InputError(f"initial: expected a Pose, got {type(initial).__name__}")
-        if not isinstance(rng, np.random.Generator):
-            raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+        check_rng(rng)
         if isinstance(particles, bool) or not isinstance(particles, (int, np.integer)) or particles < 1:
             raise InputError(f"particles: expected an integer >= 1, got {particles!r}")
         n = int(particles)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import check_rng, finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog
 from aura_ums.manager import PositionReport
@@ -93,8 +93,7 @@ def synthetic_log(
     ...
     aura_ums.errors.InputError: duration: expected a positive number of seconds, got 0.0
     """
-    if not isinstance(rng, np.random.Generator):
-        raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+    check_rng(rng)
     seconds = finite_float(duration, "duration")
     if not seconds > 0.0:
         raise InputError(f"duration: expected a positive number of seconds, got {seconds!r}")

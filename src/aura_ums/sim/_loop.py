@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._metrics import Metrics
+from aura_ums._validate import check_rng
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
 from aura_ums.geometry import wrap_angle
@@ -639,8 +640,7 @@ def run_scenario(
     """
     if not isinstance(scenario, Scenario):
         raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
-    if not isinstance(rng, np.random.Generator):
-        raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+    check_rng(rng)
     if not isinstance(perception, PerceptionMode):
         raise InputError(f"perception: expected a PerceptionMode, got {perception!r}")
     if stop_after is not None and (

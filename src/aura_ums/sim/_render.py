@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import integer_at_least, nonnegative_float
+from aura_ums._validate import check_rng, integer_at_least, nonnegative_float
 from aura_ums.camera import Camera, undistort_points
 from aura_ums.errors import InputError
 from aura_ums.sim._scene import Building, Pole, Scene
@@ -172,8 +172,7 @@ class SyntheticCamera:
             raise InputError(f"camera: expected a Camera, got {type(camera).__name__}")
         if not isinstance(scene, Scene):
             raise InputError(f"scene: expected a Scene, got {type(scene).__name__}")
-        if not isinstance(rng, np.random.Generator):
-            raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+        check_rng(rng)
         self._noise = nonnegative_float(noise, "noise")
         self._clutter = integer_at_least(clutter_lines, "clutter_lines", 0)
         self._camera = camera

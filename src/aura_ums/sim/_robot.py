@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import check_rng, finite_float
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import Pose, TerrainTable, TurnAndRun
 from aura_ums.world import Meadow, MeadowMap, split_run
@@ -86,8 +86,7 @@ class SimulatedRobot:
             raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
         if not isinstance(pose, Pose):
             raise InputError(f"pose: expected a Pose, got {type(pose).__name__}")
-        if not isinstance(rng, np.random.Generator):
-            raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
+        check_rng(rng)
         if truncate is not None:
             limit = finite_float(truncate, "truncate")
             if limit <= 0.0:
