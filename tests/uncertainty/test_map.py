@@ -259,8 +259,14 @@ def test_contains_takes_a_pose_or_arrays(figure5_map: SpatialUncertaintyMap) -> 
 
 
 def test_contains_refuses_half_a_pose(figure5_map: SpatialUncertaintyMap) -> None:
-    with pytest.raises(InputError, match=r"expected a Pose, or x, y and heading, got x alone"):
-        figure5_map.contains(1.0)  # type: ignore[call-overload]
+    with pytest.raises(
+        InputError, match=r"expected a Pose, x, y and heading, or poses of shape \(3,\) or \(n, 3\), got \(\)"
+    ):
+        figure5_map.contains(1.0)
+    with pytest.raises(InputError, match=r"or poses of shape \(3,\) or \(n, 3\), got \(4, 2\)"):
+        figure5_map.contains(np.zeros((4, 2)))
+    with pytest.raises(InputError, match=r"got x and only one of them"):
+        figure5_map.contains(1.0, 2.0)
     with pytest.raises(InputError, match=r"expected x, y and heading of one shape"):
         figure5_map.contains(np.zeros(2), np.zeros(3), np.zeros(2))
     with pytest.raises(InputError, match=r"got a Pose and more"):
@@ -354,3 +360,13 @@ def test_bad_arguments_get_the_library_error() -> None:
     no_rng: Any = None
     with pytest.raises(InputError, match=r"rng: expected a numpy.random.Generator, got NoneType"):
         start.sample_poses(3, no_rng)
+
+
+def test_contains_takes_the_pose_arrays_the_library_gives(figure5_map: SpatialUncertaintyMap) -> None:
+    # sample_poses and sample_motions give (n, 3) arrays, which contains refused
+    rows = figure5_map.sample_poses(50, np.random.default_rng(3))
+    inside = figure5_map.contains(rows)
+    assert isinstance(inside, np.ndarray)
+    assert inside.tolist() == figure5_map.contains(rows[:, 0], rows[:, 1], rows[:, 2]).tolist()  # type: ignore[union-attr]
+    assert inside.all()
+    assert figure5_map.contains(rows[0]) is True

@@ -614,15 +614,27 @@ class SpatialUncertaintyMap:
     @overload
     def contains(self, pose: Pose, y: None = None, heading: None = None) -> bool: ...
     @overload
-    def contains(self, pose: ArrayLike, y: ArrayLike, heading: ArrayLike) -> bool | NDArray[np.bool_]: ...
+    def contains(
+        self, pose: ArrayLike, y: ArrayLike | None = None, heading: ArrayLike | None = None
+    ) -> bool | NDArray[np.bool_]: ...
     def contains(
         self, pose: Pose | ArrayLike, y: ArrayLike | None = None, heading: ArrayLike | None = None
     ) -> bool | NDArray[np.bool_]:
         """Tell whether pose(s) lie in the map: position in the polygon and heading in the wedge.
 
-        Call it with a :class:`Pose`, or with ``x``, ``y`` and ``heading`` as scalars or
-        equally shaped arrays (metres, metres, radians). A boundary tolerance of
-        ``POSITION_TOLERANCE`` metres and ``ANGLE_TOLERANCE`` radians applies.
+        Call it with a :class:`Pose`, with ``x``, ``y`` and ``heading`` as scalars or
+        equally shaped arrays (metres, metres, radians), or with one array of poses of shape
+        ``(3,)`` or ``(n, 3)``, as :meth:`sample_poses` and
+        :meth:`~aura_ums.uncertainty.TerrainStats.sample_motions` give them. A boundary
+        tolerance of ``POSITION_TOLERANCE`` metres and ``ANGLE_TOLERANCE`` radians applies.
+
+        Examples
+        --------
+        >>> start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.1)
+        >>> start.contains(start.sample_poses(4, np.random.default_rng(0))).tolist()
+        [True, True, True, True]
+        >>> start.contains([0.0, 0.0, 3.0])       # the position is in, the heading is not
+        False
         """
         if isinstance(pose, Pose):
             if y is not None or heading is not None:
@@ -637,8 +649,16 @@ class SpatialUncertaintyMap:
             and math.isfinite(heading)
         ):
             return self._contains_one(pose, y, heading)
-        if y is None or heading is None:
-            raise InputError("contains: expected a Pose, or x, y and heading, got x alone")
+        if y is None and heading is None:
+            rows = float_array(pose, "poses")
+            if rows.shape[-1:] != (3,) or rows.ndim > 2:
+                raise InputError(
+                    "contains: expected a Pose, x, y and heading, or poses of shape (3,) or (n, 3), "
+                    f"got {rows.shape}"
+                )
+            pose, y, heading = rows[..., 0], rows[..., 1], rows[..., 2]
+        elif y is None or heading is None:
+            raise InputError("contains: expected a Pose, or x, y and heading, got x and only one of them")
         xs, ys, hs = float_array(pose, "x"), float_array(y, "y"), float_array(heading, "heading")
         if not (xs.shape == ys.shape == hs.shape):
             shapes = f"{xs.shape}, {ys.shape}, {hs.shape}"
