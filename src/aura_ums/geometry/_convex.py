@@ -185,7 +185,7 @@ def convex_hull(points: Array, *, straight: bool = False) -> Array:
     """Return the convex hull of points as counter-clockwise vertices without repeats.
 
     The result has one row for a single point, two for collinear points. Nearly
-    coincident and nearly straight vertices are merged (:func:`remove_collinear`) unless
+    coincident and nearly straight vertices are merged (``remove_collinear``) unless
     ``straight``: then every vertex the monotone chain keeps stays, so each edge's line
     holds all of them, however short the edge (far from the origin, the merge's
     straightness test drops vertices up to a few nanometres off a chord).
