@@ -122,7 +122,7 @@ def test_repr_counts_what_is_held() -> None:
 
 def full_board() -> Blackboard:
     board = Blackboard()
-    awkward = [0.1 + 0.2, math.pi / 3, 1e-300, -2.5e-17, 123456.789012345]
+    awkward = [0.1 + 0.2, math.pi / 3, 1e-300, -2.5e-17, 123.456789012345]
     for k, value in enumerate(awkward):
         board.post_report(PositionReport(10.0 * k + value, TurnAndRun(value, abs(value))))
     board.identified.post(BearingObservation("pole", 3.0, 0.1 + 0.2, 0.01, (0.3, -0.1)))
@@ -187,7 +187,10 @@ def edited(change: str, value: object) -> str:
             r"position_reports\[1\]\.time: expected a finite number, got true",
         ),
         (edited("position_reports/3/time", 0.5), r"position_reports\[3\]\.time: expected a time >= 20\.0 "),
-        (edited("position_reports/0/command/run", -1.0), r"position_reports\[0\]\.command: .*non-negative"),
+        (
+            edited("position_reports/0/command/run", -1.0),
+            r"position_reports\[0\]\.command: .*expected a number in \[0, 10000\] m, got -1.0",
+        ),
         (edited("position_reports/0/command/spin", 1.0), r"position_reports\[0\]\.command: expected only"),
         (edited("identified/0/class", "Sonar"), r"identified\[0\]\.class: expected one of \['BearingObs"),
         (edited("identified/0/range_max", 1.0), r"identified\[0\]: range_max: expected >= range_min"),

@@ -360,6 +360,13 @@ def test_bad_arguments_get_the_library_error() -> None:
     no_rng: Any = None
     with pytest.raises(InputError, match=r"rng: expected a numpy.random.Generator, got NoneType"):
         start.sample_poses(3, no_rng)
+    # in the ranges the files have: a pose at 1e16 m made a one-point map, a radius of 1e300 a NaN area
+    with pytest.raises(InputError, match=r"Pose.x: expected a number in \[-1e\+06, 1e\+06\] m, got 1e\+16"):
+        Pose(1e16, 1e16, 0.3)
+    with pytest.raises(
+        InputError, match=r"position_radius: expected a number in \[0, 10000\] m, got 1e\+300"
+    ):
+        SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 1e300, 0.1)
 
 
 def test_contains_takes_the_pose_arrays_the_library_gives(figure5_map: SpatialUncertaintyMap) -> None:

@@ -18,7 +18,9 @@ def test_zero_command_is_valid() -> None:
     [
         (float("nan"), 1.0, r"TurnAndRun.turn: expected a finite number, got nan"),
         (0.0, float("inf"), r"TurnAndRun.run: expected a finite number, got inf"),
-        (0.0, -0.5, r"TurnAndRun.run: expected a non-negative number, got -0.5"),
+        (0.0, -0.5, r"TurnAndRun.run: expected a number in \[0, 10000\] m, got -0.5"),
+        (0.0, 1e300, r"TurnAndRun.run: expected a number in \[0, 10000\] m, got 1e\+300"),
+        (1e300, 1.0, r"TurnAndRun.turn: expected a number in \[-1000, 1000\] rad, got 1e\+300"),
         ("1", 1.0, r"TurnAndRun.turn: expected a finite number, got '1'"),
         (True, 1.0, r"TurnAndRun.turn: expected a finite number, got True"),
     ],

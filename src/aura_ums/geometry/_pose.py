@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import COORDINATE, finite_float
 from aura_ums.geometry._angles import wrap_angle
 
 
@@ -18,7 +18,8 @@ class Pose:
     Parameters
     ----------
     x, y : float
-        Position of the robot's reference point, metres (x east, y north).
+        Position of the robot's reference point, metres (x east, y north), each in
+        [-1e6, 1e6] (the coordinates' range: subtract a local origin from UTM-sized ones).
     heading : float
         Radians counter-clockwise from world +x; wrapped to (-pi, pi].
 
@@ -34,8 +35,9 @@ class Pose:
     heading: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "x", finite_float(self.x, "Pose.x"))
-        object.__setattr__(self, "y", finite_float(self.y, "Pose.y"))
+        # Within the coordinates' range: a pose at 1e16 m made a map of one point.
+        object.__setattr__(self, "x", COORDINATE.check(self.x, "Pose.x"))
+        object.__setattr__(self, "y", COORDINATE.check(self.y, "Pose.y"))
         object.__setattr__(self, "heading", wrap_angle(finite_float(self.heading, "Pose.heading")))
 
     def as_array(self) -> NDArray[np.float64]:

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums import _native
 from aura_ums._validate import (
+    START_RADIUS,
     check_rng,
     finite_float,
     float_array,
@@ -402,7 +403,7 @@ class SpatialUncertaintyMap:
         """
         if not isinstance(pose, Pose):
             raise InputError(f"pose: expected a Pose, got {type(pose).__name__} {pose!r}")
-        radius = nonnegative_float(position_radius, "position_radius")
+        radius = START_RADIUS.check(position_radius, "position_radius")
         halfwidth = nonnegative_float(heading_halfwidth, "heading_halfwidth")
         center = np.array([pose.x, pose.y])
         polygon = ConvexPolygon._trusted(outer_disk(center, radius, _START_DISK_SIDES))

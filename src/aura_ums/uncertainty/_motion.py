@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from aura_ums._validate import finite_float, nonnegative_float
+from aura_ums._validate import ANGLE, LENGTH
 from aura_ums.geometry import Pose as Pose  # geometry's; uncertainty/_terrain.py imports it from here
 
 #: One foot in metres, for the paper's experiment (which is in feet).
@@ -19,15 +19,15 @@ class TurnAndRun:
     Parameters
     ----------
     turn : float
-        Commanded rotation, radians, counter-clockwise positive. Any finite amount
-        (a turn of 3*pi/2 is a longer turn than one of -pi/2).
+        Commanded rotation, radians, counter-clockwise positive, in [-1000, 1000] (a turn
+        of 3*pi/2 is a longer turn than one of -pi/2).
     run : float
-        Commanded distance, metres, >= 0. Zero means "turn only".
+        Commanded distance, metres, in [0, 10000]. Zero means "turn only".
 
     Raises
     ------
     InputError
-        For a non-finite turn or run, or a negative run.
+        For a turn or run out of its range (the files' ranges for angles and lengths).
 
     Examples
     --------
@@ -36,15 +36,16 @@ class TurnAndRun:
     >>> TurnAndRun(0.0, -1.0)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: TurnAndRun.run: expected a non-negative number, got -1.0
+    aura_ums.errors.InputError: TurnAndRun.run: expected a number in [0, 10000] m, got -1.0
     """
 
     turn: float
     run: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "turn", finite_float(self.turn, "TurnAndRun.turn"))
-        object.__setattr__(self, "run", nonnegative_float(self.run, "TurnAndRun.run"))
+        # The ranges of every reader's angles and lengths: a run of 1e300 m grew a NaN area.
+        object.__setattr__(self, "turn", ANGLE.check(self.turn, "TurnAndRun.turn"))
+        object.__setattr__(self, "run", LENGTH.check(self.run, "TurnAndRun.run"))
 
     @classmethod
     def _trusted(cls, turn: float, run: float) -> TurnAndRun:
