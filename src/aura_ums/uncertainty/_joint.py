@@ -140,7 +140,7 @@ def joint_reduced(
     For the map manager, which reads neither area (a sliced map's is a hull of every slice).
     Far from the origin it runs in a frame moved next to the map (see ``reduce_checked``).
     """
-    origin = local_origin(prior)
+    origin = local_origin(*prior.center.tolist())
     if origin is not None:
         ox, oy = origin
         moved = [(observation, moved_landmark(landmark, -ox, -oy)) for observation, landmark in pairs]

@@ -166,9 +166,8 @@ def reduce_map(
 LOCAL_FRAME_BEYOND = 1e4
 
 
-def local_origin(prior: SpatialUncertaintyMap) -> tuple[float, float] | None:
-    """Return whole metres near the map's centre to reduce it about, or None near the origin."""
-    x, y = prior.center.tolist()
+def local_origin(x: float, y: float) -> tuple[float, float] | None:
+    """Return whole metres near a map's centre (x, y) to reduce it about, or None near the origin."""
     if abs(x) <= LOCAL_FRAME_BEYOND and abs(y) <= LOCAL_FRAME_BEYOND:
         return None
     return float(round(x)), float(round(y))
@@ -205,32 +204,14 @@ def reduce_checked(
     :data:`LOCAL_FRAME_BEYOND` from the origin the reduction runs in a frame moved next
     to the map.
     """
-    origin = local_origin(prior)
+    center_x, center_y = prior.center.tolist()
+    origin = local_origin(center_x, center_y)
     if origin is not None:
-        ox, oy = origin
-        found = _reduce_here(
-            prior._moved(-ox, -oy), observation, moved_landmark(landmark, -ox, -oy), max_vertices, measured
-        )
-        if isinstance(found, str):
-            return found
-        reduced, before, after = found
-        return reduced._moved(ox, oy, merge=True), before, after
-    return _reduce_here(prior, observation, landmark, max_vertices, measured)
-
-
-def _reduce_here(
-    prior: SpatialUncertaintyMap,
-    observation: Observation,
-    landmark: Landmark,
-    max_vertices: int,
-    measured: bool,
-) -> Reduced:
-    """:func:`reduce_checked` in the map's own frame."""
+        return _reduce_far(prior, origin, observation, landmark, max_vertices, measured)
     slices = prior._slices
     if slices is not None:
         return _reduce_sliced(prior, slices, observation, landmark, max_vertices, measured=measured)
     wedge = prior.wedge
-    center_x, center_y = prior.center.tolist()
     kernel, _, arguments = _kernel_call(observation, landmark, max_vertices)
     found = kernel(prior.polygon.vertices, center_x, center_y, wedge.center, wedge.cw, wedge.ccw, *arguments)
     if isinstance(found, int):
@@ -242,6 +223,29 @@ def _reduce_here(
         x, y = held_centre(reduced_vertices, x, y)
     reduced = type(prior)._at(type(prior.polygon)._trusted(reduced_vertices), x, y, reduced_wedge)
     return reduced, area_before, area_after
+
+
+def _reduce_far(
+    prior: SpatialUncertaintyMap,
+    origin: tuple[float, float],
+    observation: Observation,
+    landmark: Landmark,
+    max_vertices: int,
+    measured: bool,
+) -> Reduced:
+    """:func:`reduce_checked` of a map far from the origin: moved by -``origin``, reduced, moved back."""
+    ox, oy = origin
+    found = reduce_checked(
+        prior._moved(-ox, -oy),
+        observation,
+        moved_landmark(landmark, -ox, -oy),
+        max_vertices,
+        measured=measured,
+    )
+    if isinstance(found, str):
+        return found
+    reduced, before, after = found
+    return reduced._moved(ox, oy, merge=True), before, after
 
 
 #: A reduction kernel with its observation's arguments: called on (vertices, centre x, centre
