@@ -505,9 +505,9 @@ int remove_collinear(Poly *p, Work *w) {
     double box[4];
     bounding_box(v, n, box);
     double span = greater(box[2] - box[0], box[3] - box[1]);
-    double reach = 0.0;
-    for (Py_ssize_t i = 0; i < 2 * n; i++) reach = greater(reach, fabs(v[i]));
-    double close = MERGE_EPS * span + MERGE_ROUNDING * reach;
+    double magnitude = 0.0;
+    for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
+    double close = MERGE_EPS * span + MERGE_ROUNDING * magnitude;
     /* Drop each vertex too close to the next; the write index never passes the read one,
        and the first vertex (which the last edge needs) is saved first. */
     double x0 = v[0], y0 = v[1];
@@ -538,8 +538,10 @@ int remove_collinear(Poly *p, Work *w) {
         p->n = n;
     }
     if (n < 3) return 0;
-    double magnitude = 0.0;
-    for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
+    if (!measured) { /* the kept vertices' own magnitude, as the reference takes it */
+        magnitude = 0.0;
+        for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
+    }
     char *straight = scratch(&w->flags, n, 1);
     if (!straight) return -1;
     Py_ssize_t count = 0;

@@ -147,7 +147,8 @@ def remove_collinear(vertices: Array) -> Array:
     span = float(np.max(np.ptp(vertices, axis=0)))
     following = _edges(vertices)
     length = np.hypot(following[:, 0], following[:, 1])
-    keep = length > _MERGE_EPS * span + _MERGE_ROUNDING * float(np.max(np.abs(vertices)))
+    magnitude = float(np.max(np.abs(vertices)))
+    keep = length > _MERGE_EPS * span + _MERGE_ROUNDING * magnitude
     if not np.all(keep):
         if not np.any(keep):
             return vertices[:1].copy()
@@ -156,11 +157,12 @@ def remove_collinear(vertices: Array) -> Array:
             return vertices
         following = _edges(vertices)
         length = np.hypot(following[:, 0], following[:, 1])
+        magnitude = float(np.max(np.abs(vertices)))
     if len(vertices) < 3:
         return vertices
     preceding = _preceding(following)
     turn = cross2(preceding, following)
-    straight = (np.abs(turn) <= _cross_noise(vertices, length, _preceding(length))) & (
+    straight = (np.abs(turn) <= _cross_noise(vertices, length, _preceding(length), magnitude)) & (
         np.einsum("ij,ij->i", preceding, following) > 0
     )
     if np.any(straight):
@@ -168,13 +170,17 @@ def remove_collinear(vertices: Array) -> Array:
     return vertices
 
 
-def _cross_noise(vertices: Array, length: Array, preceding_length: Array) -> Array:
+def _cross_noise(
+    vertices: Array, length: Array, preceding_length: Array, magnitude: float | None = None
+) -> Array:
     """Return the size below which a corner's cross product is rounding noise.
 
     The cross product of two edges carries rounding error proportional to the
-    coordinates' magnitude times the edge lengths, not only to the edge lengths.
+    coordinates' magnitude (the largest absolute coordinate of ``vertices``, when the
+    caller has not taken it already) times the edge lengths, not only to the edge lengths.
     """
-    magnitude = float(np.max(np.abs(vertices)))
+    if magnitude is None:
+        magnitude = float(np.max(np.abs(vertices)))
     return np.asarray(
         _COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length),
         dtype=np.float64,
