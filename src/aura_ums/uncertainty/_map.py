@@ -175,12 +175,11 @@ class SpatialUncertaintyMap:
             polygons = [convex_hull(polygon + step, straight=True) for polygon in slices.polygons()]
             points = np.concatenate(polygons)
             counts = np.array([len(polygon) for polygon in polygons], dtype=np.int64)
-            slices = slices._replace(counts=counts)
         else:
-            points = slices.points + step
+            points, counts = slices.points + step, slices.counts
         points.setflags(write=False)
         return SpatialUncertaintyMap._sliced(
-            slices._replace(points=points), center, self.wedge, self._cells, self._max_slices
+            slices._replace(points=points, counts=counts), center, self.wedge, self._cells, self._max_slices
         )
 
     @classmethod

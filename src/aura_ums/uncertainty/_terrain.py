@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import Range, check_rng, float_array
+from aura_ums._validate import Range, check_rng, float_array, positive_float
 from aura_ums.errors import FileFormatError, InputError, UnknownTerrainError
 from aura_ums.uncertainty._motion import Pose, TurnAndRun
 
@@ -169,13 +169,12 @@ class TerrainStats:
             raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__} {command!r}")
         check_rng(rng)
         if truncate is not None:
-            if (
-                isinstance(truncate, bool)
-                or not isinstance(truncate, (int, float, np.integer, np.floating))
-                or not (math.isfinite(truncate) and truncate > 0.0)
-            ):
-                raise InputError(f"truncate: expected a positive finite number or None, got {truncate!r}")
-            truncate = float(truncate)
+            try:
+                truncate = positive_float(truncate, "truncate")
+            except InputError:
+                raise InputError(
+                    f"truncate: expected a positive finite number or None, got {truncate!r}"
+                ) from None
         n = len(state)
         z = rng.standard_normal((3, n))
         if truncate is not None:
