@@ -20,7 +20,15 @@ import pytest
 
 from aura_ums.camera import CameraMount, load_camera, load_opencv_calibration
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import calibrate_logs, load_log, load_sensors, read_mrclam, read_rosbag, synthetic_log
+from aura_ums.logs import (
+    _odometry,
+    calibrate_logs,
+    load_log,
+    load_sensors,
+    read_mrclam,
+    read_rosbag,
+    synthetic_log,
+)
 from aura_ums.logs._io import Units, groundtruth_blocks, observation_blocks
 from aura_ums.logs._odometry import report_times
 from aura_ums.perception._york_urban import load_york_urban
@@ -307,6 +315,17 @@ def test_too_many_reports_are_refused_before_allocating_with_the_estimate() -> N
         InputError, match=r"expected at most 2000000 reports \(about 500 MB\), got 9608000 \(about 2,402 MB"
     ):
         report_times(np.empty(0), 0.0, 2_402_000.0, 0.25)
+
+
+def test_the_report_limit_counts_both_reports_of_a_piece_that_turns_while_it_runs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(_odometry, "MAX_REPORTS", 3)
+    # Two pieces of an arc pass the pieces' bound (2 <= 3) but are four reports.
+    with pytest.raises(InputError, match=r"expected at most 3 reports .*, got 4 \(about 0 MB"):
+        _odometry.odometry_to_commands([0.0, 2.0], [0.5, 0.0], [0.1, 0.0], max_interval=1.0)
+    straight = _odometry.odometry_to_commands([0.0, 2.0], [0.5, 0.0], [0.0, 0.0], max_interval=1.0)
+    assert [report.command.run for report in straight] == [0.5, 0.5]
 
 
 def test_mrclam_values_out_of_range_name_the_column(tmp_path: Path) -> None:

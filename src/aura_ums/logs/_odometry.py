@@ -138,11 +138,7 @@ def report_times(
     pieces = np.maximum(np.ceil(gaps / max_interval), 1.0)
     total = float(pieces.sum())
     if total > MAX_REPORTS:
-        raise InputError(
-            f"max_interval: expected at most {MAX_REPORTS} reports (about {_megabytes(MAX_REPORTS)}), "
-            f"got {total:.0f} (about {_megabytes(total)}; max_interval {max_interval!r} s over "
-            f"{end - start!r} s)"
-        )
+        raise _too_many_reports(total, max_interval, end - start)
     counts = pieces.astype(np.int64)
     gap_index = np.repeat(np.arange(len(gaps)), counts)
     step = np.arange(len(gap_index)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
@@ -295,6 +291,13 @@ def _megabytes(reports: float) -> str:
     return f"{reports * REPORT_BYTES / 1e6:,.0f} MB"
 
 
+def _too_many_reports(total: float, max_interval: float, span: float) -> InputError:
+    return InputError(
+        f"max_interval: expected at most {MAX_REPORTS} reports (about {_megabytes(MAX_REPORTS)}), "
+        f"got {total:.0f} (about {_megabytes(total)}; max_interval {max_interval!r} s over {span!r} s)"
+    )
+
+
 def odometry_to_commands(
     time: ArrayLike,
     v: ArrayLike,
@@ -385,6 +388,10 @@ def odometry_to_commands(
         end=end,
         reverse=reverse,
     )
+    # report_times bounds the pieces; a piece that turns while it runs is two reports, and
+    # each report here is a Python object, so the bound is checked again on the reports.
+    if len(times) > MAX_REPORTS:
+        raise _too_many_reports(len(times), max_interval, float(times[-1] - times[0]))
     return tuple(reports_of(times, turns, runs))
 
 
