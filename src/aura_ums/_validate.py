@@ -130,9 +130,9 @@ class Range:
 #: Any position in a world frame, each coordinate, metres: a 2000 km square is far beyond a
 #: mobile robot's work area, and keeps areas (m^2) and squared distances far from overflow.
 COORDINATE = Range(-1e6, 1e6, "m")
-#: Radius of the start position's uncertainty, metres (10 km).
 #: Where a sensor sits in the robot frame (forward, left), metres.
 SENSOR_OFFSET = Range(-100.0, 100.0, "m")
+#: Radius of the start position's uncertainty, metres (10 km).
 START_RADIUS = Range(0.0, 1e4, "m")
 #: Radius of a landmark's position uncertainty, metres (1 km).
 POSITION_UNCERTAINTY = Range(0.0, 1e3, "m")
@@ -158,6 +158,10 @@ FACTOR = Range(0.0, 100.0, "", low_open=True)
 #: or 1e3 for odometry in other units (millimetres, milliradians); 1e-300 passed and stopped
 #: the map growing.
 ODOMETRY_SCALE = Range(1e-3, 1e3, "")
+#: Standard deviations of the motion model that a growth bounds, from a tenth (almost none)
+#: to 100 (Chebyshev leaves 1e-4 outside): 1e300 overflowed the polygon's coordinates, 1e-300
+#: bounded nothing.
+SIGMAS = Range(0.1, 100.0, "")
 #: Delay of recorded motion behind the true motion, seconds (an hour).
 DELAY = Range(0.0, 3600.0, "s")
 #: Seconds between two motion rows of a log: a longer gap is a clock jump, not a held velocity.

@@ -156,7 +156,7 @@ def test_codac_leaves_the_callers_rounding_mode() -> None:
     [
         ({"q": -1}, r"q: expected an integer >= 0, got -1"),
         ({"q": 3, "window": 3}, r"window: expected an integer > q \(3\), got 3"),
-        ({"sigmas": 0.0}, r"sigmas: expected a positive number, got 0.0"),
+        ({"sigmas": 0.0}, r"sigmas: expected a number in \[0\.1, 100\], got 0\.0"),
         ({"position_halfwidth": -1.0}, r"position_halfwidth: expected a non-negative number, got -1.0"),
     ],
 )

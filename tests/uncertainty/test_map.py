@@ -282,7 +282,8 @@ def test_from_polygon_refuses_a_centre_outside() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"sigmas": 0.0}, r"sigmas: expected a positive number, got 0.0"),
+        ({"sigmas": 0.0}, r"sigmas: expected a number in \[0\.1, 100\], got 0\.0"),
+        ({"sigmas": 1e300}, r"sigmas: expected a number in \[0\.1, 100\], got 1e\+300"),
         ({"sigmas": float("nan")}, r"sigmas: expected a finite number, got nan"),
         ({"sigmas": "3"}, r"sigmas: expected a finite number, got '3'"),
         ({"max_vertices": 2}, r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 2"),

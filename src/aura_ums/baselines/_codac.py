@@ -66,7 +66,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from aura_ums._validate import nonnegative_float, positive_float
+from aura_ums._validate import SIGMAS, nonnegative_float
 from aura_ums.baselines._ekf import check_observation
 from aura_ums.baselines._moments import check_motion
 from aura_ums.baselines._region import ConfidenceRegion, check_probability
@@ -262,7 +262,7 @@ class CodacLocalizer:
     heading_halfwidth : float
         Half-width of the start heading interval, radians, >= 0.
     sigmas : float
-        Standard deviations of the terrain model the command bounds cover, > 0 (the
+        Standard deviations of the terrain model the command bounds cover, in [0.1, 100] (the
         map's ``ManagerSettings.sigmas``).
     q : int
         Wrong observations tolerated among ``window`` consecutive ones, >= 0
@@ -325,7 +325,7 @@ class CodacLocalizer:
             raise InputError(f"initial: expected a Pose, got {type(initial).__name__}")
         radius = nonnegative_float(position_halfwidth, "position_halfwidth")
         spread = nonnegative_float(heading_halfwidth, "heading_halfwidth")
-        self._sigmas = positive_float(sigmas, "sigmas")
+        self._sigmas = SIGMAS.check(sigmas, "sigmas")
         if isinstance(q, bool) or not isinstance(q, int) or q < 0:
             raise InputError(f"q: expected an integer >= 0, got {q!r}")
         if isinstance(window, bool) or not isinstance(window, int) or window <= q:

@@ -25,7 +25,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, key_path, load_toml
-from aura_ums._validate import ANGLE_ERROR, DELAY, LENGTH, ODOMETRY_SCALE, Range, finite_float, positive_float
+from aura_ums._validate import (
+    ANGLE_ERROR,
+    DELAY,
+    LENGTH,
+    ODOMETRY_SCALE,
+    SIGMAS,
+    Range,
+    finite_float,
+    positive_float,
+)
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import (
@@ -761,7 +770,7 @@ def horizon_checks(
     move, stride : float
         Seconds, > 0.
     sigmas : float
-        Standard deviations the growth bounds, > 0.
+        Standard deviations the growth bounds, in [0.1, 100].
     anchor : bool
         Grow from the start pose once by the composite of the window's moves
         (:func:`~aura_ums.uncertainty.grow_from_anchor`) rather than move by move.
@@ -788,7 +797,7 @@ def horizon_checks(
     step = positive_float(move, "move")
     every = max(1, round(positive_float(stride, "stride") / step))
     lengths = [max(1, round(positive_float(h, "horizons") / step)) for h in horizons]
-    sigma = positive_float(sigmas, "sigmas")
+    sigma = SIGMAS.check(sigmas, "sigmas")
     rows: list[list[tuple[bool, float, float, float, float]]] = [[] for _ in lengths]
     longest = max(lengths, default=0)
     for log in logs:
@@ -928,7 +937,7 @@ def calibrate_logs(
     horizons : sequence of float
         Seconds, each >= ``move``: where the bound must hold.
     sigmas : float
-        Standard deviations the replay's growth bounds (its ``sigmas`` setting), > 0.
+        Standard deviations the replay's growth bounds (its ``sigmas`` setting), in [0.1, 100].
     envelope_margin : float
         >= 1.
     max_delay : float
@@ -983,7 +992,7 @@ def calibrate_logs(
     if max(spans) > MAX_HORIZON:
         # a horizon of 1e308 s was an OverflowError traceback (its moves counted as an integer)
         raise InputError(f"horizons: expected seconds, each <= {MAX_HORIZON:g} (a day), got {list(spans)}")
-    sigma = positive_float(sigmas, "sigmas")
+    sigma = SIGMAS.check(sigmas, "sigmas")
     margin = finite_float(envelope_margin, "envelope_margin")
     if margin < 1.0:
         raise InputError(f"envelope_margin: expected a number >= 1, got {margin!r}")

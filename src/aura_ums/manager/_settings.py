@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
+from aura_ums._validate import SIGMAS
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import cell_count
 
@@ -164,10 +165,6 @@ _DEGREES = ("deg", "\N{DEGREE SIGN}")
 #: The largest vertex and slice caps: arrays are sized by them (a cap of 1e9 is 7.45 GiB).
 #: Also the largest count of frames or observations a setting counts to.
 _MOST = 100_000
-#: The growth's bounds from a tenth of a standard deviation (almost none) to 100 (Chebyshev
-#: leaves 1e-4 outside): 1e300 overflowed the polygon's coordinates, 1e-300 bounded nothing.
-_FEWEST_SIGMAS = 0.1
-_MOST_SIGMAS = 100.0
 #: Widest factor on a window or a bound (1e300 overflowed the envelope's coordinates).
 _WIDEST = 100.0
 
@@ -222,8 +219,8 @@ relocalize_after (2), got 1
             "Standard deviations of the motion and terrain model that the growth bounds",
             "",
             float,
-            low=_FEWEST_SIGMAS,
-            high=_MOST_SIGMAS,
+            low=SIGMAS.low,
+            high=SIGMAS.high,
         ),
     )
     area_limit: float | None = _setting(

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums import _native
 from aura_ums._validate import (
+    SIGMAS,
     START_RADIUS,
     check_rng,
     finite_float,
@@ -27,7 +28,6 @@ from aura_ums._validate import (
     integer_at_least,
     nonnegative_float,
     points_array,
-    positive_float,
     read_only,
     vertex_cap,
 )
@@ -466,7 +466,7 @@ class SpatialUncertaintyMap:
         terrain : TerrainStats
             Statistics of the terrain the motion happens on.
         sigmas : float
-            Number of standard deviations bounded, > 0 (3 keeps >= 99 % in practice).
+            Number of standard deviations bounded, in [0.1, 100] (3 keeps >= 99 % in practice).
         max_vertices : int
             Cap on the polygon's vertex count (>= 3); beyond it an outer approximation.
         """
@@ -474,7 +474,7 @@ class SpatialUncertaintyMap:
             raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
         if not isinstance(terrain, TerrainStats):
             raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
-        bound = positive_float(sigmas, "sigmas")
+        bound = SIGMAS.check(sigmas, "sigmas")
         return self._grow_many((command,), terrain, bound, vertex_cap(max_vertices))
 
     def _grow_many(
