@@ -115,3 +115,50 @@ def test_project_refuses_poses_of_the_wrong_shape() -> None:
         match=r"pose: expected a Pose, or x, y and heading of shape \(3,\) or \(m, 3\), got \(2, 2\)",
     ):
         camera.project(np.zeros((2, 2)), [(5.0, 0.0, 1.0)])
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"fx": 1e-300}, r"CameraIntrinsics\.fx: expected a number in \[1, 1e\+06\] px, got 1e-300"),
+        ({"cy": 1e300}, r"CameraIntrinsics\.cy: expected a number in \[-100000, 100000\] px, got 1e\+300"),
+        (
+            {"width": 2_000_000},
+            r"CameraIntrinsics\.width: expected an integer in \[1, 20000\] px, got 2000000",
+        ),
+        ({"height": 0}, r"CameraIntrinsics\.height: expected an integer in \[1, 20000\] px, got 0"),
+        (
+            {"distortion": (0.1, 1e300, 0.0, 0.0, 0.0)},
+            r"CameraIntrinsics\.distortion\[1\]: expected a number in \[-1000, 1000\], got 1e\+300",
+        ),
+    ],
+)
+def test_intrinsics_built_in_code_have_the_camera_files_ranges(
+    arguments: dict[str, object], message: str
+) -> None:
+    # a camera file was refused these values; built in code, an image 2e6 px wide was taken
+    values: dict[str, object] = {
+        "fx": 500.0,
+        "fy": 480.0,
+        "cx": 320.0,
+        "cy": 240.0,
+        "width": 640,
+        "height": 480,
+    }
+    with pytest.raises(InputError, match=message):
+        CameraIntrinsics(**{**values, **arguments})  # type: ignore[arg-type]
+    assert CameraIntrinsics(1.0, 1e6, -1e5, 1e5, 1, 20_000, (-1000.0, 1000.0, 0.0, 0.0, 0.0)).width == 1
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"height": 1e300}, r"CameraMount\.height: expected a height <= 100 m above the ground, got 1e\+300"),
+        ({"height": 1.0, "forward": 1e300}, r"CameraMount\.forward: expected a number in \[-100, 100\] m"),
+        ({"height": 1.0, "pan": 1e300}, r"CameraMount\.pan: expected a number in \[-1000, 1000\] rad"),
+    ],
+)
+def test_a_mount_built_in_code_has_the_camera_files_ranges(arguments: dict[str, float], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        CameraMount(**arguments)
+    assert CameraMount(100.0, forward=-100.0, left=100.0).height == 100.0

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import Fields, describe, load_toml, parse_json, read_text
-from aura_ums._validate import ANGLE, DISTORTION, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, Range
+from aura_ums._validate import ANGLE, DISTORTION, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, SENSOR_OFFSET, Range
 from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
 from aura_ums.camera._observe import CalibrationBounds
 from aura_ums.errors import FileFormatError, InputError
@@ -51,8 +51,9 @@ _DISTORTION_LENGTHS = (4, 5, 8, 12, 14)
 
 _INTRINSIC_KEYS = ("fx", "fy", "cx", "cy", "width", "height", "distortion")
 _ANGLES = ("pan", "tilt")
-#: Where a camera sits on the robot, metres from the robot's reference point.
-MOUNT_OFFSET = Range(-100.0, 100.0, "m")
+#: Where a camera sits on the robot, metres from the robot's reference point: a sensor's
+#: offset (``CameraMount`` checks the same range).
+MOUNT_OFFSET = SENSOR_OFFSET
 #: The physical range of every number of a camera file, by table and key (docs/formats.md
 #: lists them); the bounds of ``[calibration_bounds]`` are bounds on errors, >= 0.
 KEY_RANGES: dict[str, dict[str, Range]] = {

@@ -13,7 +13,16 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, float_array
+from aura_ums._validate import (
+    ANGLE,
+    DISTORTION,
+    FOCAL_LENGTH,
+    IMAGE_SIDE,
+    PIXEL,
+    SENSOR_OFFSET,
+    finite_float,
+    float_array,
+)
 from aura_ums.errors import InputError
 from aura_ums.geometry import Pose
 
@@ -62,13 +71,14 @@ class CameraIntrinsics:
     Parameters
     ----------
     fx, fy : float
-        Focal lengths, pixels, > 0.
+        Focal lengths, pixels, in [1, 1e6].
     cx, cy : float
-        Principal point, pixels ((0, 0) is the centre of the top-left pixel).
+        Principal point, pixels ((0, 0) is the centre of the top-left pixel), in [-1e5, 1e5].
     width, height : int
-        Image size, pixels, > 0.
+        Image size, pixels, in [1, 20000].
     distortion : tuple of 5 floats, optional
-        OpenCV coefficients (k1, k2, p1, p2, k3); None for an ideal pinhole.
+        OpenCV coefficients (k1, k2, p1, p2, k3), each in [-1000, 1000]; None for an ideal
+        pinhole.
     """
 
     fx: float
@@ -80,17 +90,23 @@ class CameraIntrinsics:
     distortion: tuple[float, float, float, float, float] | None = None
 
     def __post_init__(self) -> None:
+        # The camera file's ranges (camera/_io.py reads the same ones), for intrinsics built in code.
         for name in ("fx", "fy"):
-            value = finite_float(getattr(self, name), f"CameraIntrinsics.{name}")
-            if value <= 0.0:
-                raise InputError(f"CameraIntrinsics.{name}: expected a positive focal length, got {value}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(
+                self, name, FOCAL_LENGTH.check(getattr(self, name), f"CameraIntrinsics.{name}")
+            )
         for name in ("cx", "cy"):
-            object.__setattr__(self, name, finite_float(getattr(self, name), f"CameraIntrinsics.{name}"))
+            object.__setattr__(self, name, PIXEL.check(getattr(self, name), f"CameraIntrinsics.{name}"))
         for name in ("width", "height"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
-                raise InputError(f"CameraIntrinsics.{name}: expected a positive integer, got {value!r}")
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, np.integer))
+                or not IMAGE_SIDE.contains(float(value))
+            ):
+                raise InputError(
+                    f"CameraIntrinsics.{name}: expected an integer in {IMAGE_SIDE.interval()}, got {value!r}"
+                )
             object.__setattr__(self, name, int(value))
         if self.distortion is not None:
             coefficients = float_array(self.distortion, "CameraIntrinsics.distortion")
@@ -99,7 +115,10 @@ class CameraIntrinsics:
                     f"CameraIntrinsics.distortion: expected 5 coefficients (k1, k2, p1, p2, k3), "
                     f"got shape {coefficients.shape}"
                 )
-            k1, k2, p1, p2, k3 = (float(c) for c in coefficients)
+            k1, k2, p1, p2, k3 = (
+                DISTORTION.check(float(c), f"CameraIntrinsics.distortion[{index}]")
+                for index, c in enumerate(coefficients)
+            )
             object.__setattr__(self, "distortion", (k1, k2, p1, p2, k3))
 
     def matrix(self) -> Array:
@@ -114,11 +133,12 @@ class CameraMount:
     Parameters
     ----------
     height : float
-        Optical centre above the ground plane, metres, >= 0.
+        Optical centre above the ground plane, metres, in [0, 100].
     forward, left : float
-        Optical centre's offset from the robot's reference point, metres (robot frame).
+        Optical centre's offset from the robot's reference point, metres (robot frame), in
+        [-100, 100].
     pan : float
-        Radians, counter-clockwise positive (towards the robot's left).
+        Radians, counter-clockwise positive (towards the robot's left), in [-1000, 1000].
     tilt : float
         Radians, positive when the optical axis points below the horizon; |tilt| < pi/2.
     """
@@ -130,12 +150,21 @@ class CameraMount:
     tilt: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("height", "forward", "left", "pan", "tilt"):
-            object.__setattr__(self, name, finite_float(getattr(self, name), f"CameraMount.{name}"))
+        # The camera file's ranges (camera/_io.py reads the same ones), for a mount built in code.
+        for name in ("forward", "left"):
+            object.__setattr__(self, name, SENSOR_OFFSET.check(getattr(self, name), f"CameraMount.{name}"))
+        for name in ("pan", "tilt"):
+            object.__setattr__(self, name, ANGLE.check(getattr(self, name), f"CameraMount.{name}"))
+        object.__setattr__(self, "height", finite_float(self.height, "CameraMount.height"))
         if self.height < 0.0:
             # below the ground plane every landmark's foot is above the camera: all windows were empty
             raise InputError(
                 f"CameraMount.height: expected a height >= 0 m above the ground, got {self.height}"
+            )
+        if self.height > SENSOR_OFFSET.high:
+            raise InputError(
+                f"CameraMount.height: expected a height <= {SENSOR_OFFSET.high:g} m above the ground, "
+                f"got {self.height}"
             )
         if abs(self.tilt) >= math.pi / 2:
             raise InputError(f"CameraMount.tilt: expected |tilt| < pi/2, got {self.tilt}")
