@@ -201,6 +201,21 @@ def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[n
     return array
 
 
+def world_points(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:
+    """Return ``value`` as ``(n, 2)`` positions in the world frame, each coordinate in :data:`COORDINATE`.
+
+    :func:`points_array`, then the range: 1e300 m passed and overflowed a polygon's area.
+    """
+    array = points_array(value, name, min_rows=min_rows)
+    outside = np.abs(array) > COORDINATE.high
+    if np.any(outside):
+        row = int(np.argwhere(outside)[0, 0])
+        raise InputError(
+            f"{name}: expected coordinates {COORDINATE.text()}, got {array[row].tolist()} at row {row}"
+        )
+    return array
+
+
 def float_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
     """Return ``value`` as a finite float array of any shape, or raise naming ``name``."""
     try:

@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -294,8 +295,30 @@ def test_outer_disk_contains_the_disk_and_is_tight() -> None:
     assert np.all(disk.contains(np.column_stack([1 + 3 * np.cos(t), 2 + 3 * np.sin(t)])))
     assert disk.area / (math.pi * 9) < 1.03
     assert outer_disk(np.zeros(2), 0.0).shape == (1, 2)
-    with pytest.raises(InputError, match=r"radius: expected a non-negative number"):
+    with pytest.raises(InputError, match=r"radius: expected a number in \[0, 2e\+06\] m, got -1\.0"):
         ConvexPolygon.disk((0, 0), -1.0)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (
+            lambda: ConvexPolygon([(0, 0), (1e300, 0), (0, 1)]),
+            r"ConvexPolygon\.vertices: expected coordinates",
+        ),
+        (lambda: ConvexPolygon.from_points([(0, 0), (0, -2e6)]), r"points: expected coordinates .* at row 1"),
+        (lambda: ConvexPolygon.point(0.0, 1e300), r"y: expected a number in \[-1e\+06, 1e\+06\] m"),
+        (lambda: ConvexPolygon.disk((1e7, 0), 1.0), r"center: expected coordinates"),
+        (lambda: ConvexPolygon.disk((0, 0), 1e300), r"radius: expected a number in \[0, 2e\+06\] m"),
+    ],
+)
+def test_polygons_beyond_the_world_frame_are_refused(
+    build: Callable[[], ConvexPolygon], message: str
+) -> None:
+    # 1e300 m was taken and its area overflowed (a RuntimeWarning, inf)
+    with pytest.raises(InputError, match=message):
+        build()
+    assert ConvexPolygon([(-1e6, -1e6), (1e6, -1e6), (1e6, 1e6)]).area == 2e12
 
 
 # --- outer simplification ---------------------------------------------------------------------------

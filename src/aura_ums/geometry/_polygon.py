@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, points_array, read_only
+from aura_ums._validate import COORDINATE, Range, finite_float, points_array, read_only, world_points
 from aura_ums.errors import InputError
 from aura_ums.geometry import _convex
 
@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 #: Points within this many metres of a polygon count as inside it, so that bounds
 #: computed in floating point are not refused by their own rounding.
 POSITION_TOLERANCE = 1e-9
+#: A disk's radius, metres: up to a world frame's width (``COORDINATE``).
+DISK_RADIUS = Range(0.0, 2.0 * COORDINATE.high, "m")
 
 
 @dataclass(frozen=True, slots=True, eq=False, init=False)
@@ -56,7 +58,7 @@ class ConvexPolygon:
     _area: float = field(init=False, repr=False, compare=False)
 
     def __init__(self, vertices: ArrayLike) -> None:
-        vertices = points_array(vertices, "ConvexPolygon.vertices", min_rows=1)
+        vertices = world_points(vertices, "ConvexPolygon.vertices", min_rows=1)
         if len(vertices) >= 2 and np.array_equal(vertices[0], vertices[-1]):
             vertices = vertices[:-1]
         defect = _convex.convexity_defect(vertices)
@@ -87,13 +89,13 @@ class ConvexPolygon:
         >>> ConvexPolygon.from_points([(0, 0), (1, 1), (1, 0), (0, 1), (0.5, 0.5)]).vertex_count
         4
         """
-        pts = points_array(points, "points", min_rows=1)
+        pts = world_points(points, "points", min_rows=1)
         return cls._trusted(_convex.convex_hull(pts))
 
     @classmethod
     def point(cls, x: float, y: float) -> ConvexPolygon:
         """Return the degenerate polygon of one point."""
-        return cls([(finite_float(x, "x"), finite_float(y, "y"))])
+        return cls([(COORDINATE.check(x, "x"), COORDINATE.check(y, "y"))])
 
     @classmethod
     def disk(cls, center: ArrayLike, radius: float, sides: int = 16) -> ConvexPolygon:
@@ -101,10 +103,8 @@ class ConvexPolygon:
 
         A zero radius gives the point itself.
         """
-        c = points_array(center, "center", min_rows=1)[0]
-        r = finite_float(radius, "radius")
-        if r < 0.0:
-            raise InputError(f"radius: expected a non-negative number, got {r}")
+        c = world_points(center, "center", min_rows=1)[0]
+        r = DISK_RADIUS.check(radius, "radius")
         if sides < 3:
             raise InputError(f"sides: expected at least 3, got {sides}")
         return cls._trusted(_convex.outer_disk(c, r, sides))
