@@ -193,6 +193,25 @@ def present(path: str | os.PathLike[str]) -> bool:
     return os.path.lexists(path)
 
 
+def path_mode(path: str | os.PathLike[str]) -> int:
+    r"""Return the ``st_mode`` of what ``path`` leads to, 0 where it leads nowhere.
+
+    ``Path.is_file`` and ``Path.is_dir`` raise for a name too long or a NUL in it (they
+    were tracebacks); such a path names nothing, so it reads as absent here, and the
+    reader that then opens it says why.
+
+    Examples
+    --------
+    >>> import stat, tempfile
+    >>> stat.S_ISDIR(path_mode(tempfile.gettempdir())), path_mode("x" * 300), path_mode("a\0b")
+    (True, 0, 0)
+    """
+    try:
+        return os.stat(path).st_mode
+    except (OSError, ValueError):
+        return 0
+
+
 def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
     """Return ``path`` as a folder whose files can be read, or refuse it naming why.
 
@@ -217,9 +236,19 @@ def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
     aura_ums.errors.FileFormatError: /nowhere: expected a log folder, got no such folder
     """
     folder = Path(path)
-    if not folder.is_dir():
-        got = "a file" if folder.exists() else "no such folder"
-        raise FileFormatError(str(folder), "", f"expected a {kind}, got {got}")
+    try:
+        mode = os.stat(folder).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        raise FileFormatError(str(folder), "", f"expected a {kind}, got no such folder") from None
+    except OSError as exc:  # a name too long, a loop of links: Path.is_dir raised them
+        reason = exc.strerror or type(exc).__name__
+        raise FileFormatError(str(folder), "", f"expected a {kind}, got {reason}") from None
+    except ValueError:  # a NUL in the path
+        raise FileFormatError(
+            str(folder), "", f"expected the path of a {kind}, got an invalid path"
+        ) from None
+    if not stat.S_ISDIR(mode):
+        raise FileFormatError(str(folder), "", f"expected a {kind}, got a file")
     # Listing needs read permission, opening a file inside needs execute (search).
     if not os.access(folder, os.R_OK | os.X_OK):
         raise FileFormatError(str(folder), "", f"expected a readable {kind}, got {os.strerror(errno.EACCES)}")

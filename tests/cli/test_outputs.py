@@ -675,3 +675,13 @@ def test_a_log_file_that_is_a_named_pipe_is_refused_not_waited_on(
     else:
         result = invoke("calibrate", log, "--out", tmp_path / "out.toml", "--quiet")
     refused(result, str(log / name), "named pipe")
+
+
+def test_input_names_too_long_for_the_file_system_are_refused_cleanly(inputs: Path, tmp_path: Path) -> None:
+    # Path.is_dir and Path.is_file raised OSError for them: a traceback, exit 1
+    long = "q" * 256
+    too_long = os.strerror(errno.ENAMETOOLONG)
+    terrain = inputs / "terrain.toml"
+    refused(invoke("replay", tmp_path / long, "--terrain", terrain), f"expected a log folder, got {too_long}")
+    refused(invoke("replay", inputs / "log", "--terrain", tmp_path / f"{long}.toml"), too_long)
+    refused(invoke("simulate", tmp_path / f"{long}.toml"), "expected a scenario TOML file, got no such file")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import stat
 from pathlib import Path
 from typing import Annotated
 
@@ -195,6 +196,7 @@ def simulate(
     import numpy as np
 
     from aura_ums import Metrics
+    from aura_ums._files import path_mode
     from aura_ums.campaign import run_campaign, run_seeds, simulate_campaign
     from aura_ums.errors import AuraUmsError
     from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
@@ -204,9 +206,9 @@ def simulate(
     if runs < 1:
         raise fail(f"--runs: expected an integer >= 1, got {runs}")
     check_seed(seed)
-    if not scenario.is_file():
-        got = "a folder" if scenario.is_dir() else "no such file"
-        got = "a named pipe or socket" if scenario.exists() and not scenario.is_dir() else got
+    mode = path_mode(scenario)
+    if not stat.S_ISREG(mode):
+        got = "a folder" if stat.S_ISDIR(mode) else "a named pipe or socket" if mode else "no such file"
         raise fail(f"{scenario}: expected a scenario TOML file, got {got}")
     json_target = None if metrics_json is None else Target("--metrics-json", metrics_json)
     mcap_target = None if mcap is None else Target("--mcap", mcap)

@@ -8,6 +8,7 @@ are called by the commands that run a scenario or replay a log.
 from __future__ import annotations
 
 import math
+import stat
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext, suppress
 from pathlib import Path
@@ -82,11 +83,12 @@ def rosbag_command(
     """
     import dataclasses
 
+    from aura_ums._files import path_mode
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import LogMeta, read_rosbag, write_log
 
     target = Target("OUT_DIR", out_dir, folder=True)
-    sources = [Source("BAG", bag, folder=bag.is_dir()), Source("--landmarks", landmarks)]
+    sources = [Source("BAG", bag, folder=stat.S_ISDIR(path_mode(bag))), Source("--landmarks", landmarks)]
     check_outputs([target], sources, overwrite=overwrite)
     try:
         meta = None if name is None else LogMeta(name, source=f"ROS bag {bag.name}")

@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import NoReturn
 
 import numpy as np
 
-from aura_ums._files import Fields, describe, load_json
+from aura_ums._files import Fields, describe, load_json, path_mode
 from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, POSITION_UNCERTAINTY, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
@@ -84,7 +85,7 @@ class _Reader:
             path = self.base / table_file
             # Checked though a table given by the caller overrides it: a broken reference is
             # a broken file, not a silent fallback.
-            if not path.is_file():
+            if not stat.S_ISREG(path_mode(path)):
                 self.fail("terrain_table", f"expected a terrain table file, got no file at {path}")
             if table is None:
                 table = TerrainTable.from_toml(path)
