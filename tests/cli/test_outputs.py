@@ -115,6 +115,18 @@ def test_a_hard_link_to_an_input_is_refused_as_output(
     refused(result, "--metrics-json", "a hard link to the input --terrain", str(link.name))
 
 
+def test_a_hard_link_to_a_file_of_the_input_folder_is_refused_as_output(
+    inputs: Path, tmp_path: Path, untouched: object
+) -> None:
+    link = tmp_path / "hard.csv"
+    os.link(inputs / "log" / "observations.csv", link)
+    result = invoke(
+        "replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--steps-csv", link, "--overwrite"
+    )
+    refused(result, "--steps-csv", "a hard link to a file of the input LOG_DIR", str(link.name))
+    assert os.stat(link).st_nlink == 2
+
+
 def test_two_outputs_may_not_share_a_path(inputs: Path, tmp_path: Path, untouched: object) -> None:
     same = tmp_path / "same.toml"
     refused(

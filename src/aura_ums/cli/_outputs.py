@@ -173,12 +173,34 @@ def _apart(target: Target, where: Path, source: Source, origin: Path) -> None:
         # a hard link: another name of the input's bytes (replaced atomically, the input would
         # survive, but the name given is the input)
         raise fail(f"{option}: expected an output apart from the inputs, got {given}, a hard link to {what}")
+    if source.folder and _linked_into(where, origin):
+        raise fail(
+            f"{option}: expected an output apart from the inputs, got {given}, "
+            f"a hard link to a file of {what}"
+        )
     if source.folder and where.is_relative_to(origin):
         raise fail(f"{option}: expected an output outside the input folders, got {given}, inside {what}")
     if target.folder and origin.is_relative_to(where):
         raise fail(
             f"{option}: expected an output folder apart from the inputs, got {given}, which holds {what}"
         )
+
+
+def _linked_into(where: Path, folder: Path) -> bool:
+    """Whether ``where`` is an existing file hard-linked to a file of ``folder`` (its top level)."""
+    try:
+        info = os.stat(where)
+        if not stat.S_ISREG(info.st_mode) or info.st_nlink < 2:  # no other name anywhere
+            return False
+        with os.scandir(folder) as entries:
+            for entry in entries:
+                if entry.is_file():
+                    other = entry.stat()
+                    if (other.st_dev, other.st_ino) == (info.st_dev, info.st_ino):
+                        return True
+    except OSError:
+        return False
+    return False
 
 
 def _same_file(one: Path, other: Path) -> bool:
