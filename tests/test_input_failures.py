@@ -644,6 +644,12 @@ def test_a_maps_terrain_table_reference_is_checked_when_another_table_is_given(t
     table = TerrainTable.default()
     with pytest.raises(FileFormatError, match=r"map\.geojson: terrain_table: expected a terrain table file"):
         MeadowMap.from_geojson(path, terrain_table=table)
+    # a file that is there but no terrain table (/etc/passwd) was taken as well
+    (tmp_path / "notes.toml").write_text("root:x:0:0:root:/root:/bin/bash\n")
+    document["terrain_table"] = "notes.toml"
+    path.write_text(json.dumps(document))
+    with pytest.raises(FileFormatError, match=r"notes\.toml:1:5: expected valid TOML"):
+        MeadowMap.from_geojson(path, terrain_table=table)
 
 
 def test_a_camera_below_the_ground_is_refused(tmp_path: Path) -> None:

@@ -83,12 +83,13 @@ class _Reader:
             if not isinstance(table_file, str) or not table_file:
                 self.fail("terrain_table", f"expected the name of a TOML file, got {_kind(table_file)}")
             path = self.base / table_file
-            # Checked though a table given by the caller overrides it: a broken reference is
-            # a broken file, not a silent fallback.
+            # Read though a table given by the caller overrides it: a broken reference (no
+            # file, or a file that is no terrain table) is a broken file, not a silent fallback.
             if not stat.S_ISREG(path_mode(path)):
                 self.fail("terrain_table", f"expected a terrain table file, got no file at {path}")
+            referenced = TerrainTable.from_toml(path)
             if table is None:
-                table = TerrainTable.from_toml(path)
+                table = referenced
         self.table = table
 
         places: dict[str, tuple[int, str]] = {}
