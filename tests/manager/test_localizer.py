@@ -36,7 +36,7 @@ from aura_ums.uncertainty import (
     TurnAndRun,
     VerticalLineLandmark,
 )
-from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
+from aura_ums.world import LandmarkRecord, Meadow, MeadowMap, make_grid_world
 
 FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
 POLE = VerticalLineLandmark("pole", 8.0, 6.0, 0.0, 4.0)
@@ -111,6 +111,34 @@ def test_an_inconsistent_observation_re_localizes_from_the_envelope() -> None:
     assert with_recovery[2].envelope_map is not None
     assert with_recovery[2].map.area <= with_recovery[2].envelope_map.area
     assert robust.map.contains(Pose(6.0, 0.0, 0.0))
+
+
+def test_the_observation_found_inconsistent_does_not_re_seed_the_map() -> None:
+    # A gross outlier the working map rejects, but the wider envelope map accepts, re-seeded
+    # the map to its own region: the truth, in both maps before it, was outside after it.
+    world = make_grid_world(2, 3)  # poles at (0, 0), (10, 0), (0, 10), (10, 10)
+    poles = {"pole_0_2": (10.0, 0.0), "pole_2_0": (0.0, 10.0), "pole_2_2": (10.0, 10.0)}
+    truth = Pose(5.0, 5.0, 0.0)
+
+    def seen(landmark: str, time: float, error: float, bound: float) -> BearingObservation:
+        x, y = poles[landmark]
+        return BearingObservation(landmark, time, math.atan2(y - truth.y, x - truth.x) + error, bound)
+
+    start = SpatialUncertaintyMap.from_pose(truth, 0.5, 0.3)
+    manager = UncertaintyMapManager(start, world, TerrainTable.default(), ManagerSettings(joint_above=None))
+    board = Blackboard()
+    for time, sightings_now in ((1.0, (("pole_0_2", 0.0), ("pole_2_0", 0.0))), (2.0, (("pole_2_2", 0.25),))):
+        board.post_report(PositionReport(time, TurnAndRun(0.0, 0.0)))
+        for landmark, error in sightings_now:
+            board.identified.post(seen(landmark, time, error, 0.01))
+        twins = [seen(landmark, time, error, 0.2) for landmark, error in sightings_now]
+        step = manager.update(board, now=time, envelope=twins)
+        assert step.envelope_map is not None
+        assert step.envelope_map.contains(truth)
+    assert [o.reason for o in step.rejected] == [RejectReason.NO_POSITION]
+    assert step.relocalized
+    assert step.map.contains(truth)
+    assert step.map.area <= step.envelope_map.area
 
 
 def test_without_twins_the_envelope_is_reduced_by_the_observations_widened() -> None:

@@ -669,7 +669,11 @@ class UncertaintyMapManager:
                 if reason is None or reason.reached_reduction:
                     recent.append(reason is not None and reason.inconsistent)
             if sum(recent) >= self._settings.relocalize_after:
-                self._reseed_from(wide, [o.observation for o in outcomes])
+                # Not the observations the map found inconsistent: one is as likely a misread
+                # (a gross outlier) as the map wrong, and one that is consistent with the wider
+                # envelope map would cut the re-seeded map to its own region.
+                agreeing = [o.observation for o in outcomes if o.reason is None or not o.reason.inconsistent]
+                self._reseed_from(wide, agreeing)
                 self._relocalizations += 1
                 recent.clear()
                 relocalized = True
@@ -917,7 +921,7 @@ class UncertaintyMapManager:
         return list(envelope)
 
     def _reseed_from(self, envelope_map: SpatialUncertaintyMap, observations: Sequence[Observation]) -> None:
-        """Re-seed the map from the envelope map and the update's observations (their typical bounds).
+        """Re-seed the map from the envelope map and the update's consistent observations (typical bounds).
 
         With ``relaxed_q > 0`` the branches restart from the envelope map with an empty
         window, and the observations go through the relaxed intersection one by one.
