@@ -138,7 +138,9 @@ def test_the_observation_found_inconsistent_does_not_re_seed_the_map() -> None:
     assert [o.reason for o in step.rejected] == [RejectReason.NO_POSITION]
     assert step.relocalized
     assert step.map.contains(truth)
-    assert step.map.area <= step.envelope_map.area
+    envelope_map = step.envelope_map
+    assert envelope_map is not None
+    assert step.map.area <= envelope_map.area
 
 
 def test_without_twins_the_envelope_is_reduced_by_the_observations_widened() -> None:
