@@ -644,3 +644,34 @@ def test_a_negative_odometry_speed_is_refused_naming_the_file_and_line(
         f"error: {folder / 'odometry.csv'}:{row + 1}: expected forward velocities >= 0 in column 'v' "
     )
     assert result.stderr.endswith("--reverse flip to aura-ums, or reverse=ReverseMotion.FLIP), got -1.0\n")
+
+
+def test_a_calibration_whose_envelope_or_odometry_replay_will_struggle_with_is_warned_about(
+    tmp_path: Path,
+) -> None:
+    # one sighting off by 3 rad (a misread landmark) made the envelope bearing bound 3.7 rad,
+    # and a log's negative speeds calibrated in silence that replay then refused
+    folder = write_log(long_odometry_log(6000, frame_every=20), tmp_path / "odo")
+    observations = folder / "observations.csv"
+    lines = observations.read_text().splitlines()
+    first = next(index for index, line in enumerate(lines) if line[:1].isdigit() or line[:1] == "-")
+    row = lines[first].split(",")
+    row[2] = repr(float(row[2]) + 3.0)
+    lines[first] = ",".join(row)
+    observations.write_text("\n".join(lines) + "\n")
+    odometry = folder / "odometry.csv"
+    lines = odometry.read_text().splitlines()
+    at = next(index for index, line in enumerate(lines) if line[:1].isdigit()) + 5
+    row = lines[at].split(",")
+    row[1] = "-0.002"
+    lines[at] = ",".join(row)
+    odometry.write_text("\n".join(lines) + "\n")
+    result = runner.invoke(app, ["calibrate", str(folder), "--out", str(tmp_path / "t.toml"), "-q"])
+    assert result.exit_code == 0, result.output
+    assert "warning: envelope bearing bound: expected less than pi rad, got +-" in result.stderr
+    assert f"warning: {folder}: 1 odometry rows with a negative forward speed (down to -0.002 m/s)" in (
+        result.stderr
+    )
+    replayed = runner.invoke(app, ["replay", str(folder), "--terrain", str(tmp_path / "t.toml"), "-q"])
+    assert replayed.exit_code == 2
+    assert "pass --reverse flip" in replayed.stderr

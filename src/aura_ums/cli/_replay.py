@@ -295,6 +295,8 @@ def calibrate(
 
     With --workers N or --scheduler the logs are read on Dask workers; the fit pools them.
     """
+    import numpy as np
+
     from aura_ums.campaign import LoadLog, run_campaign
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import calibrate_logs
@@ -366,6 +368,22 @@ def calibrate(
             f"{_LOOSE_BEARING_RAD:g} rad, got +-{working.bearing_error:.4f} rad: no sighting will shrink the "
             "map much; check the logs' landmark ids, and their bearings' sign and units"
         )
+    if envelope.bearing_error >= math.pi:
+        # The largest error seen sets it: one misidentified landmark in the logs is enough.
+        warn(
+            f"envelope bearing bound: expected less than pi rad, got +-{envelope.bearing_error:.4f} rad (the "
+            "largest bearing error seen, times the margin): the envelope map learns nothing from bearings, "
+            "and replays reduce it jointly at every frame (slow); check the logs for a misidentified landmark"
+        )
+    for folder, log in zip(log_dirs, logs, strict=True):
+        speeds = np.empty(0) if log.odometry is None else log.odometry.v
+        backing = int(np.count_nonzero(speeds < 0.0))
+        if backing:
+            warn(
+                f"{folder}: {backing} odometry rows with a negative forward speed (down to "
+                f"{float(speeds.min()):.4g} m/s) calibrated by the length they ran, as replay "
+                "--reverse flip replays them; replay refuses them without --reverse flip"
+            )
     if campaign_options.distributed:
         console.print(f"logs read on Dask workers: {len(logs)} ({loaded.retried} retried)", highlight=False)
     console.print("growth bound against the truth, by horizon without correction:", highlight=False)
