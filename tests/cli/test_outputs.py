@@ -697,3 +697,12 @@ def test_input_names_too_long_for_the_file_system_are_refused_cleanly(inputs: Pa
     refused(invoke("replay", tmp_path / long, "--terrain", terrain), f"expected a log folder, got {too_long}")
     refused(invoke("replay", inputs / "log", "--terrain", tmp_path / f"{long}.toml"), too_long)
     refused(invoke("simulate", tmp_path / f"{long}.toml"), "expected a scenario TOML file, got no such file")
+    bag = ("import", "rosbag", "--odom", "/odom", "--observations", "/seen")
+    landmarks = inputs / "log" / "landmarks.csv"
+    refused(
+        invoke(*bag, "--landmarks", landmarks, tmp_path / long, tmp_path / "out"),
+        "got no such file or folder",
+    )
+    refused(
+        invoke(*bag, "--landmarks", tmp_path / long, inputs / "log", tmp_path / "out"), "got no such file"
+    )

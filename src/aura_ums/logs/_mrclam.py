@@ -20,7 +20,7 @@ from typing import NoReturn
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import MAX_ROWS, read_folder, read_text
+from aura_ums._files import MAX_ROWS, present, read_folder, read_text
 from aura_ums._validate import (
     ANGLE,
     ANGULAR_SPEED,
@@ -75,7 +75,7 @@ class _DatFile:
 
     def __init__(self, path: Path, columns: tuple[str, ...]) -> None:
         self.source = str(path)
-        if not path.exists():  # a folder or a pipe: read_text names what it is
+        if not present(path):  # a folder or a pipe: read_text names what it is
             self.fail("", f"expected an MRCLAM data file ({', '.join(columns)}), got no such file")
         # The same reader as every other file: size limit, UTF-8 with an optional BOM.
         text = read_text(path, kind="MRCLAM data")
@@ -227,13 +227,13 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     robot = int(robot)
     folder = read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder")
     prefix = f"Robot{robot}_"
-    if not (folder / f"{prefix}Measurement.dat").exists():
-        present = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})
+    if not present(folder / f"{prefix}Measurement.dat"):
+        found = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})
         raise FileFormatError(
             str(folder / f"{prefix}Measurement.dat"),
             "",
             f"expected robot {robot}'s measurements, got no such file "
-            f"(robots in this folder: {', '.join(present) or 'none'})",
+            f"(robots in this folder: {', '.join(found) or 'none'})",
         )
 
     barcodes = _DatFile(folder / "Barcodes.dat", ("subject", "barcode"))

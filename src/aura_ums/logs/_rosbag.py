@@ -51,6 +51,7 @@ from typing import Any
 
 import numpy as np
 
+from aura_ums._files import present
 from aura_ums._validate import ROW_GAP
 from aura_ums.errors import AuraUmsError, FileFormatError, InputError, MissingDependencyError
 from aura_ums.logs._io import (
@@ -121,7 +122,7 @@ def _no_pipes(path: Path) -> None:
 def _landmarks(value: object) -> tuple[LogLandmark, ...]:
     if isinstance(value, (str, os.PathLike)):
         path = Path(value)
-        if not path.exists():  # a folder or a pipe: the reader names what it is
+        if not present(path):  # a folder or a pipe: the reader names what it is
             raise FileFormatError(str(path), "", "expected a landmarks CSV file, got no such file")
         return _read_landmarks(path, Units())
     if not isinstance(value, Sequence):
@@ -383,7 +384,7 @@ def read_rosbag(
     if not isinstance(bag_path, (str, os.PathLike)):
         raise InputError(f"bag_path: expected a path, got {type(bag_path).__name__}")
     path = Path(bag_path)
-    if not path.exists():
+    if not present(path):
         raise FileFormatError(
             str(path),
             "",
