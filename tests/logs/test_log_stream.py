@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -167,6 +168,33 @@ def test_a_bad_row_far_in_a_file_fails_the_replay_with_load_logs_message(
     assert f":{row + 1}:" in str(expected.value)
 
 
+@pytest.mark.parametrize(
+    ("name", "shift"), [("observations.csv", 2 * 86_400.0), ("odometry.csv", -30 * 86_400.0)]
+)
+def test_files_on_other_clocks_are_refused_on_opening_as_load_log_refuses_them(
+    folder: Path, tmp_path: Path, name: str, shift: float
+) -> None:
+    # a streamed replay read them as they came: exit 0, every sighting inconsistent (or a
+    # report limit naming max_interval for a month of odometry before the first frame)
+    shifted = tmp_path / "shifted"
+    shifted.mkdir()
+    for path in folder.iterdir():
+        (shifted / path.name).write_bytes(path.read_bytes())
+    lines = (shifted / name).read_text().splitlines()
+    for index, line in enumerate(lines):
+        if line[:1].isdigit() or line[:1] == "-":
+            cells = line.split(",")
+            cells[0] = repr(float(cells[0]) + shift)
+            lines[index] = ",".join(cells)
+    (shifted / name).write_text("\n".join(lines) + "\n")
+    with pytest.raises(FileFormatError) as expected:
+        load_log(shifted)
+    assert "a clock offset between them" in str(expected.value)
+    with pytest.raises(FileFormatError, match=f"^{re.escape(str(expected.value))}$"):
+        open_log(shifted)
+    assert open_log(folder).meta == load_log(folder).meta  # aligned files: no refusal
+
+
 def test_open_log_refuses_a_bad_block_size(folder: Path) -> None:
     with pytest.raises(InputError, match=r"^block_bytes: expected an integer >= 1, got 0$"):
         open_log(folder, block_bytes=0)
@@ -274,3 +302,28 @@ def test_ground_truth_readers_of_one_stream_keep_their_own_places(folder: Path) 
         assert truth is not None
         assert np.array_equal(joined[0], truth.time)
         assert np.array_equal(joined[3], truth.heading)
+
+
+def test_a_files_span_is_read_from_its_two_ends_or_not_at_all(tmp_path: Path) -> None:
+    from aura_ums.logs._io import Units
+    from aura_ums.logs._stream import _file_span
+
+    path = tmp_path / "odometry.csv"
+    rows = "".join(f"{0.01 * k!r},0.5,0.0\n" for k in range(20_000))  # beyond both ends' probes
+    path.write_text("\ufeff# odometry\ntime,v,omega\n" + rows)
+    assert _file_span(path, Units()) == (0.0, 0.01 * 19_999)
+    path.write_text("time,v,omega\n")  # no rows: the reader refuses it, not the probe
+    assert _file_span(path, Units()) is None
+    path.write_text('landmark_id,time\n"a,b",1.0\n"c",2.0\n')  # quoted: left to the blocks
+    assert _file_span(path, Units()) is None
+    assert _file_span(tmp_path / "missing.csv", Units()) is None
+
+
+def test_a_files_span_is_not_probed_through_a_named_pipe(tmp_path: Path) -> None:
+    # opening one waits for a writer: the probe must not, the file's reader refuses it
+    from aura_ums.logs._io import Units
+    from aura_ums.logs._stream import _file_span
+
+    pipe = tmp_path / "observations.csv"
+    os.mkfifo(pipe)
+    assert _file_span(pipe, Units()) is None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import enum
 import itertools
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import cast
@@ -538,6 +538,24 @@ def _tuple_of(value: object, kind: type, name: str) -> tuple[object, ...]:
     return items
 
 
+def unaligned_spans(spans: Sequence[tuple[str, float, float]]) -> str | None:
+    """Return why records of one run disagree in their clocks, or None.
+
+    ``spans``: each record's name (a file, a topic), first and last time, seconds. Two
+    records more than a day (``ROW_GAP``) apart are a clock offset between them.
+    """
+    for (name, start, end), (other, other_start, other_end) in itertools.combinations(spans, 2):
+        gap = max(start - other_end, other_start - end)
+        if gap > ROW_GAP.high:
+            return (
+                f"expected the times of {name} and {other} to overlap (at most "
+                f"{ROW_GAP.high:g} s apart), "
+                f"got {start:.17g} to {end:.17g} s and {other_start:.17g} to {other_end:.17g} s, "
+                f"{gap:.6g} s apart: a clock offset between them"
+            )
+    return None
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class RobotLog:
     """A recorded run of a robot: its motion, its landmark observations and the landmarks.
@@ -701,16 +719,7 @@ class RobotLog:
         if self.groundtruth is not None:
             truth = self.groundtruth.time
             spans.append((names["ground truth"], float(truth[0]), float(truth[-1])))
-        for (name, start, end), (other, other_start, other_end) in itertools.combinations(spans, 2):
-            gap = max(start - other_end, other_start - end)
-            if gap > ROW_GAP.high:
-                return (
-                    f"expected the times of {name} and {other} to overlap (at most "
-                    f"{ROW_GAP.high:g} s apart), "
-                    f"got {start:.17g} to {end:.17g} s and {other_start:.17g} to {other_end:.17g} s, "
-                    f"{gap:.6g} s apart: a clock offset between them"
-                )
-        return None
+        return unaligned_spans(spans)
 
     def position_reports(
         self,

@@ -15,6 +15,7 @@ import contextlib
 import dataclasses
 import math
 import os
+import stat
 import tempfile
 import threading
 import weakref
@@ -26,7 +27,7 @@ from typing import BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import present, read_folder
+from aura_ums._files import path_mode, present, read_folder
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -50,7 +51,14 @@ from aura_ums.logs._io import (
     odometry_blocks,
     reversed_at,
 )
-from aura_ums.logs._log import DEFAULT_MAX_TRUTH_GAP, LogLandmark, LogMeta, RobotLog, _max_gap
+from aura_ums.logs._log import (
+    DEFAULT_MAX_TRUTH_GAP,
+    LogLandmark,
+    LogMeta,
+    RobotLog,
+    _max_gap,
+    unaligned_spans,
+)
 from aura_ums.logs._odometry import ReverseMotion, ReversingError, piece_commands, report_times
 from aura_ums.manager import PositionReport
 
@@ -209,10 +217,72 @@ def open_log(
         got = "both" if has_odometry else "neither"
         raise FileFormatError(str(base), "", f"expected exactly one of {ODOMETRY} and {COMMANDS}, got {got}")
     commands = None if has_odometry else _read_commands(base / COMMANDS, units)
+    _check_clocks(base, units, commands)
     box, scratch = None, None
     if present(base / GROUNDTRUTH):
         box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
     return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch)
+
+
+#: Bytes read at each end of a file to find its first and last time.
+_PROBE_BYTES = 65_536
+
+
+def _file_span(path: Path, units: Units) -> tuple[float, float] | None:
+    """Return the first and last time, s, of a log CSV file from its two ends, or None.
+
+    Only the first and the last data row are read (a quoted cell, a short row, anything
+    not plain gives None): the blocks check every row as the replay reads them.
+    """
+    if not stat.S_ISREG(path_mode(path)):  # a named pipe would block the open: its reader refuses it
+        return None
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(_PROBE_BYTES)
+            size = handle.seek(0, os.SEEK_END)
+            handle.seek(max(0, size - _PROBE_BYTES))
+            tail = handle.read(_PROBE_BYTES)
+    except OSError:
+        return None
+    head_lines = head.decode("utf-8-sig", errors="replace").splitlines()
+    if len(head) == _PROBE_BYTES:  # its last line may be cut short
+        head_lines = head_lines[:-1]
+    rows = [line.strip() for line in head_lines if line.strip() and not line.lstrip().startswith("#")]
+    ends = [line.strip() for line in tail.decode("utf-8", errors="replace").splitlines()[1:]]
+    last_rows = [line for line in ends if line and not line.startswith("#")]
+    if len(rows) < 2 or not last_rows:
+        return None
+    names = [name.strip() for name in rows[0].split(",")]
+    if "time" not in names:
+        return None
+    column = names.index("time")
+    times = []
+    for row in (rows[1], last_rows[-1]):
+        cells = row.split(",")
+        if '"' in row or len(cells) <= column:
+            return None
+        try:
+            value = float(cells[column]) * units.factor("time")
+        except ValueError:
+            return None
+        if not math.isfinite(value):
+            return None
+        times.append(value)
+    return times[0], times[1]
+
+
+def _check_clocks(base: Path, units: Units, commands: tuple[PositionReport, ...] | None) -> None:
+    """Refuse, as load_log does, a log whose files do not share a clock: before the replay reads them."""
+    spans: list[tuple[str, float, float]] = []
+    if commands:
+        spans.append((COMMANDS, commands[0].time, commands[-1].time))
+    for name in (() if commands is not None else (ODOMETRY,)) + (OBSERVATIONS, GROUNDTRUTH):
+        span = _file_span(base / name, units) if present(base / name) else None
+        if span is not None:
+            spans.append((name, *span))
+    problem = unaligned_spans(spans)
+    if problem is not None:
+        raise FileFormatError(str(base), "", problem)
 
 
 def _read_truth(
