@@ -200,7 +200,10 @@ def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
     beside = sensors_path(terrain)
     if _is_file(beside):
         # Replaying without the calibrated sensor bounds is silently much worse: read them.
-        console.print(f"sensors: {beside} (written by calibrate beside {terrain})", highlight=False)
+        # A note, not a result: on stderr, so that stdout holds the metrics alone.
+        err_console.print(
+            f"note: sensors: {beside} (written by calibrate beside {terrain})", markup=False, highlight=False
+        )
         return beside
     return None
 
