@@ -39,6 +39,32 @@ def test_calibration_recovers_the_synthetic_sensor_bounds() -> None:
     assert ranges.size == bearing.size
 
 
+def test_the_envelope_covers_a_range_read_far_short_of_the_truth(tmp_path: Path) -> None:
+    # capped at 0.95, the envelope said the truth was at most 1.95 times the measured range,
+    # and a landmark 7 m away read at 0.3 m left the envelope map without the truth
+    log = synthetic_log(np.random.default_rng(0), duration=120.0, bearing_noise=0.02, range_noise=0.05)
+    first = next(index for index, seen in enumerate(log.observations) if seen.range is not None)
+    seen = log.observations[first]
+    assert seen.range is not None
+    short = dataclasses.replace(seen, range=seen.range / 20.0)
+    observations = (*log.observations[:first], short, *log.observations[first + 1 :])
+    calibration = calibrate_logs([dataclasses.replace(log, observations=observations)])
+    envelope = calibration.envelope
+    assert envelope.range_fraction_low > 19.0 * 1.25 * 0.99
+    _, upper = envelope.range_interval(short.range or 0.0)
+    assert upper >= seen.range * 0.99
+    assert calibration.working.range_fraction_low < 0.06  # one outlier: not in the 0.99 quantile
+    path = tmp_path / "sensors.toml"
+    path.write_text(calibration.sensors_toml())
+    assert load_sensors(path)[2] == envelope
+    with pytest.raises(
+        InputError, match=r"SensorBounds\.range_fraction_low: expected a number in \[0, 100\]"
+    ):
+        SensorBounds(0.1, 0.0, 101.0, 0.0)
+    with pytest.raises(InputError, match=r"SensorBounds\.range_fraction_high: expected a number in \[0, 1\)"):
+        SensorBounds(0.1, 0.0, 0.0, 1.0)
+
+
 def test_a_steady_turn_rate_reveals_no_delay() -> None:
     # Every delay aligns a constant turn rate alike; the search took the one float noise
     # favoured (0.75 s), and the replay then lagged the truth by 0.75 s of motion throughout.

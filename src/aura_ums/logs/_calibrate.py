@@ -57,11 +57,18 @@ KEY_RANGES: dict[str, Range] = {
     "turn_scale": ODOMETRY_SCALE,
     "bearing_error": ANGLE_ERROR,
     "range_error": LENGTH,
-    "range_fraction_low": Range(0.0, 1.0, high_open=True),
+    # The true range is at most (1 + low) times the measured one: a sensor that read a landmark
+    # 7 m away at 0.3 m needs a low fraction of 22 (at most 100); it is at least (1 - high)
+    # times it, so high < 1.
+    "range_fraction_low": Range(0.0, 100.0),
     "range_fraction_high": Range(0.0, 1.0, high_open=True),
     "bearing_sd": ANGLE_ERROR,
     "range_sd_fraction": Range(0.0, 10.0, low_open=True),
 }
+#: The largest low range fraction (the true range up to 101 times the measured one).
+_FARTHEST = KEY_RANGES["range_fraction_low"].high
+#: The largest high range fraction a calibration writes: below 1, the true range above 0.
+_NEAREST = 0.95
 _KIND = "aura-ums/sensor-calibration"
 #: How the sensors file's header names the growth the terrain statistics are for.
 _GROWTH_WORDS = {False: "move by move", True: "from an anchor (replay --anchor-growth)"}
@@ -85,8 +92,10 @@ class SensorBounds:
         Radians, > 0.
     range_error : float
         Metres, >= 0.
-    range_fraction_low, range_fraction_high : float
-        Fractions of the measured range, in [0, 1).
+    range_fraction_low : float
+        Fraction of the measured range the true range may exceed it by, in [0, 100].
+    range_fraction_high : float
+        Fraction of the measured range the true range may fall short of it by, in [0, 1).
 
     Raises
     ------
@@ -120,10 +129,9 @@ class SensorBounds:
             raise InputError(f"SensorBounds.range_error: expected a number >= 0, got {value!r}")
         object.__setattr__(self, "range_error", value)
         for name in ("range_fraction_low", "range_fraction_high"):
-            value = finite_float(getattr(self, name), f"SensorBounds.{name}")
-            if not 0.0 <= value < 1.0:
-                raise InputError(f"SensorBounds.{name}: expected a fraction in [0, 1), got {value!r}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(
+                self, name, KEY_RANGES[name].check(getattr(self, name), f"SensorBounds.{name}")
+            )
 
     def range_interval(self, measured: float) -> tuple[float, float]:
         """Return ``(range_min, range_max)``, metres, of the true range for a measured range (m)."""
@@ -132,12 +140,12 @@ class SensorBounds:
         return round(low, 12), round(high, 12)
 
     def widened(self, factor: float) -> SensorBounds:
-        """Return these bounds times ``factor`` (>= 1), fractions capped below 1."""
+        """Return these bounds times ``factor`` (>= 1), the low fraction capped at 100, the high at 0.95."""
         return SensorBounds(
             self.bearing_error * factor,
             self.range_error * factor,
-            min(self.range_fraction_low * factor, 0.95),
-            min(self.range_fraction_high * factor, 0.95),
+            min(self.range_fraction_low * factor, _FARTHEST),
+            min(self.range_fraction_high * factor, _NEAREST),
         )
 
 
@@ -1151,15 +1159,15 @@ def _sensor_bounds(
     envelope_bearing = max(float(magnitude.max()) * margin, working_bearing)
     if errors.size:
         relative = errors / measured
-        low = min(max(0.0, -float(np.quantile(relative, (1.0 - q) / 2.0))), 0.95)
-        high = min(max(0.0, float(np.quantile(relative, (1.0 + q) / 2.0))), 0.95)
+        low = min(max(0.0, -float(np.quantile(relative, (1.0 - q) / 2.0))), _FARTHEST)
+        high = min(max(0.0, float(np.quantile(relative, (1.0 + q) / 2.0))), _NEAREST)
         # Plus an absolute part, so that short ranges never get a zero-width bound: the
         # median error of the shortest tenth of the ranges, where the relative part vanishes.
         shortest = measured <= float(np.quantile(measured, 0.1))
         absolute = float(np.median(np.abs(errors[shortest])))
         wide = absolute * margin
-        env_low = min(max(0.0, -float(relative.min())) * margin, 0.95)
-        env_high = min(max(0.0, float(relative.max())) * margin, 0.95)
+        env_low = min(max(0.0, -float(relative.min())) * margin, _FARTHEST)
+        env_high = min(max(0.0, float(relative.max())) * margin, _NEAREST)
     else:
         absolute = wide = low = high = env_low = env_high = 0.0
     working = SensorBounds(working_bearing, absolute, low, high)
