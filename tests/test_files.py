@@ -338,7 +338,7 @@ def test_a_folder_is_read_only_when_it_is_a_folder_this_process_may_enter(
         read_folder(file, kind="log folder")
     with pytest.raises(FileFormatError, match=r"/gone: expected a dataset folder, got no such folder$"):
         read_folder(tmp_path / "gone", kind="dataset folder")
-    with pytest.raises(FileFormatError, match=r"expected a log folder, got no such folder$"):
+    with pytest.raises(FileFormatError, match=r"expected the path of a log folder, got an invalid path$"):
         read_folder(str(tmp_path / "a\0b"), kind="log folder")
     locked = tmp_path / "locked"
     locked.mkdir(mode=0o600)  # listable by its owner, not enterable
