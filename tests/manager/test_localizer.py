@@ -351,3 +351,33 @@ def test_a_coarse_envelope_stays_sound_and_re_seeds_within_the_working_cap(clean
     assert all(step.envelope_inside for step in steps)
     assert all(len(step.map.polygon.vertices) <= 24 for step in steps[1:])
     assert sum(step.inside is True for step in steps) == len(steps)
+
+
+def test_sightings_that_say_nothing_of_the_heading_are_not_reduced_jointly(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # An envelope calibrated on a misread landmark bounds bearings by 3.7 rad: its wedge never
+    # narrows, and every frame was reduced jointly (40 times the map's own update time).
+    world = make_grid_world(2, 3)
+    truth = Pose(5.0, 5.0, 0.3)
+    joint_calls: list[int] = []
+    reduce_jointly = SpatialUncertaintyMap._reduce_jointly
+
+    def counted(self: SpatialUncertaintyMap, *args: object, **kwargs: object) -> object:
+        joint_calls.append(1)
+        return reduce_jointly(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(SpatialUncertaintyMap, "_reduce_jointly", counted)
+    for bound, joint in ((3.5, False), (0.05, True)):
+        joint_calls.clear()
+        start = SpatialUncertaintyMap.from_pose(truth, 0.5, 2.0)  # a wedge wider than joint_above
+        manager = UncertaintyMapManager(start, world, TerrainTable.default(), ManagerSettings(robust=False))
+        board = Blackboard()
+        board.post_report(PositionReport(1.0, TurnAndRun(0.0, 0.0)))
+        for landmark, (x, y) in (("pole_0_2", (10.0, 0.0)), ("pole_2_0", (0.0, 10.0))):
+            seen = math.atan2(y - truth.y, x - truth.x) - truth.heading
+            board.identified.post(BearingObservation(landmark, 1.0, seen, bound))
+        step = manager.update(board, now=1.0)
+        assert bool(joint_calls) is joint
+        assert step.map.contains(truth)
+        assert len(step.accepted) == 2
