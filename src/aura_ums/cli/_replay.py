@@ -376,7 +376,7 @@ def calibrate(
         warn(
             f"envelope bearing bound: expected less than pi rad, got +-{envelope.bearing_error:.4f} rad (the "
             "largest bearing error seen, times the margin): the envelope map learns nothing from bearings, "
-            "and replays reduce it jointly at every frame (slow); check the logs for a misidentified landmark"
+            "and re-localizes from a wide map; check the logs for a misidentified landmark"
         )
     for folder, log in zip(log_dirs, logs, strict=True):
         speeds = np.empty(0) if log.odometry is None else log.odometry.v
