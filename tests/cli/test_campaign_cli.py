@@ -43,6 +43,14 @@ def log_folders(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
     ]
 
 
+@pytest.fixture
+def floor_terrain(tmp_path: Path) -> Path:
+    """A terrain table naming the synthetic logs' terrain, ``floor``."""
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    return terrain
+
+
 def test_simulate_on_two_workers_writes_the_serial_metrics(tmp_path: Path) -> None:
     pytest.importorskip("distributed", reason="the dask extra is not installed")
     written = {}
@@ -166,12 +174,11 @@ def test_simulate_refuses_an_unknown_perception() -> None:
 
 
 def test_a_log_lost_to_the_run_timeout_is_named_with_the_option(
-    log_folders: list[Path], tmp_path: Path
+    log_folders: list[Path], floor_terrain: Path
 ) -> None:
     # "run 0: ... (last: no result within 1e-09 s)" named neither the log nor --run-timeout
     pytest.importorskip("distributed", reason="the dask extra is not installed")
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    terrain = floor_terrain
     options = ["--terrain", str(terrain), "-q", "--workers", "2", "--retries", "0", "--run-timeout", "1e-9"]
     result = runner.invoke(app, ["replay", *map(str, log_folders), *options])
     assert result.exit_code == 2
@@ -184,14 +191,13 @@ def test_a_log_lost_to_the_run_timeout_is_named_with_the_option(
 
 
 def test_a_missing_log_among_many_on_workers_gives_the_clean_message_alone(
-    log_folders: list[Path], tmp_path: Path
+    log_folders: list[Path], tmp_path: Path, floor_terrain: Path
 ) -> None:
     # the workers logged "Compute Failed" and the task's traceback before the clean message
     pytest.importorskip("distributed", reason="the dask extra is not installed")
     import subprocess
 
-    terrain = tmp_path / "terrain.toml"
-    terrain.write_text(TerrainTable({"floor": TerrainTable.default()["tile"]}).to_toml())
+    terrain = floor_terrain
     missing = tmp_path / "r3"
     aura = Path(sys.executable).with_name("aura-ums")
     command: list[str | Path] = [
