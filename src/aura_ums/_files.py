@@ -212,6 +212,11 @@ def path_mode(path: str | os.PathLike[str]) -> int:
         return 0
 
 
+def regular_file(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` leads to a regular file: never raising, never opening it (``path_mode``)."""
+    return stat.S_ISREG(path_mode(path))
+
+
 def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
     """Return ``path`` as a folder whose files can be read, or refuse it naming why.
 

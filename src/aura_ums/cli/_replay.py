@@ -7,7 +7,6 @@ import dataclasses
 import enum
 import inspect
 import math
-import stat
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -175,30 +174,26 @@ def _terrain_table(terrain: Path, name: str, log_dir: Path) -> TerrainTable:
     return table
 
 
-def _is_file(path: Path) -> bool:
-    from aura_ums._files import path_mode
-
-    return stat.S_ISREG(path_mode(path))
-
-
 def _sensors_source(sensors: Path | None, terrain: Path) -> Source | None:
     """Return the sensors file as an input: the one given, else the one :func:`_sensors_file` reads."""
+    from aura_ums._files import regular_file
     from aura_ums.logs import sensors_path
 
     if sensors is not None:
         return Source("--sensors", sensors)
     beside = sensors_path(terrain)
-    return Source("--sensors (by default, beside --terrain)", beside) if _is_file(beside) else None
+    return Source("--sensors (by default, beside --terrain)", beside) if regular_file(beside) else None
 
 
 def _sensors_file(sensors: Path | None, terrain: Path) -> Path | None:
     """Return the sensors file to read: the one given, else the one calibrate wrote beside ``terrain``."""
+    from aura_ums._files import regular_file
     from aura_ums.logs import sensors_path
 
     if sensors is not None:
         return sensors
     beside = sensors_path(terrain)
-    if _is_file(beside):
+    if regular_file(beside):
         # Replaying without the calibrated sensor bounds is silently much worse: read them.
         # A note, not a result: on stderr, so that stdout holds the metrics alone.
         err_console.print(

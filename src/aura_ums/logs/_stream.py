@@ -15,7 +15,6 @@ import contextlib
 import dataclasses
 import math
 import os
-import stat
 import tempfile
 import threading
 import weakref
@@ -27,7 +26,7 @@ from typing import BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import path_mode, present, read_folder
+from aura_ums._files import present, read_folder, regular_file
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -234,7 +233,7 @@ def _file_span(path: Path, units: Units) -> tuple[float, float] | None:
     Only the first and the last data row are read (a quoted cell, a short row, anything
     not plain gives None): the blocks check every row as the replay reads them.
     """
-    if not stat.S_ISREG(path_mode(path)):  # a named pipe would block the open: its reader refuses it
+    if not regular_file(path):  # a named pipe would block the open: its reader refuses it
         return None
     try:
         with open(path, "rb") as handle:
@@ -277,7 +276,7 @@ def _check_clocks(base: Path, units: Units, commands: tuple[PositionReport, ...]
     if commands:
         spans.append((COMMANDS, commands[0].time, commands[-1].time))
     for name in (() if commands is not None else (ODOMETRY,)) + (OBSERVATIONS, GROUNDTRUTH):
-        span = _file_span(base / name, units) if present(base / name) else None
+        span = _file_span(base / name, units)  # None for a file absent
         if span is not None:
             spans.append((name, *span))
     problem = unaligned_spans(spans)

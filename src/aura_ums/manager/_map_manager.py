@@ -850,9 +850,9 @@ class UncertaintyMapManager:
         """
         if (
             joint
-            and _coupled(observation for observation, _ in pairs) >= 2
             and self._joint_above is not None
             and current.wedge.width > self._joint_above
+            and _coupled(observation for observation, _ in pairs) >= 2
         ):
             together = current._reduce_jointly(pairs, self._joint_sector, self._max_vertices)
             if not isinstance(together, str):

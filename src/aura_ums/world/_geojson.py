@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import json
 import math
-import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import NoReturn
 
 import numpy as np
 
-from aura_ums._files import Fields, describe, load_json, path_mode
+from aura_ums._files import Fields, describe, load_json, regular_file
 from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, POSITION_UNCERTAINTY, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
@@ -85,7 +84,7 @@ class _Reader:
             path = self.base / table_file
             # Read though a table given by the caller overrides it: a broken reference (no
             # file, or a file that is no terrain table) is a broken file, not a silent fallback.
-            if not stat.S_ISREG(path_mode(path)):
+            if not regular_file(path):
                 self.fail("terrain_table", f"expected a terrain table file, got no file at {path}")
             referenced = TerrainTable.from_toml(path)
             if table is None:
