@@ -386,6 +386,8 @@ def test_a_log_too_short_to_calibrate_from_is_named(log_folder: Path, tmp_path: 
         "default horizons: expected a horizon of which the logs hold at least 10 windows of motion, "
         "got 1 s (0 windows in their " in result.stderr
     )
+    # the files whose times overlap too little are named with their spans
+    assert f"{folder}: commands.csv 0.1 to 0.1 s, groundtruth.csv " in result.stderr
     assert not (tmp_path / "t.toml").exists()
     # a --horizon too long for the logs is named as the option (it named neither)
     longer = runner.invoke(
@@ -675,3 +677,14 @@ def test_a_calibration_whose_envelope_or_odometry_replay_will_struggle_with_is_w
     replayed = runner.invoke(app, ["replay", str(folder), "--terrain", str(tmp_path / "t.toml"), "-q"])
     assert replayed.exit_code == 2
     assert "pass --reverse flip" in replayed.stderr
+
+
+def test_calibrate_refuses_one_log_folder_given_twice(log_folder: Path, tmp_path: Path) -> None:
+    link = tmp_path / "again"
+    link.symlink_to(log_folder)
+    result = runner.invoke(app, ["calibrate", str(log_folder), str(link), "--out", str(tmp_path / "t.toml")])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        f"error: LOG_DIRS: expected distinct log folders, got {log_folder} and {link}, one folder\n"
+    )
+    assert not (tmp_path / "t.toml").exists()

@@ -301,6 +301,11 @@ def calibrate(
 
     if not out.name:
         raise fail(f"--out: expected a file path, got {str(out)!r}")
+    seen: dict[Path, Path] = {}
+    for folder in log_dirs:
+        first = seen.setdefault(folder.resolve(), folder)
+        if first is not folder:  # its windows would count twice, as if two robots had run it
+            raise fail(f"LOG_DIRS: expected distinct log folders, got {first} and {folder}, one folder")
     _check_truth_gap(max_truth_gap)
     out_target = Target("--out", out)
     sensors_target = Target(

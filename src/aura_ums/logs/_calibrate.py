@@ -36,6 +36,7 @@ from aura_ums._validate import (
     positive_float,
 )
 from aura_ums.errors import InputError
+from aura_ums.logs._io import COMMANDS, GROUNDTRUTH, ODOMETRY
 from aura_ums.logs._log import RobotLog
 from aura_ums.uncertainty import (
     Composite,
@@ -448,6 +449,23 @@ def _truth_span(log: RobotLog) -> float:
     assert truth is not None
     first, last = log.motion_span
     return max(0.0, min(last, float(truth.time[-1])) - max(first, float(truth.time[0])))
+
+
+def _record_spans(log: RobotLog) -> str:
+    """Name the files whose times overlap too little to calibrate from, with their spans.
+
+    The message of a log too short to calibrate from: one row of odometry spans 0 s, and
+    only the files say which record is the short one.
+    """
+    truth = log.groundtruth
+    assert truth is not None
+    first, last = log.motion_span
+    motion = ODOMETRY if log.odometry is not None else COMMANDS
+    where = f"{log.path}: " if log.path is not None else f"log {log.meta.name!r}: "
+    return (
+        f"{where}{motion} {first:g} to {last:g} s, "
+        f"{GROUNDTRUTH} {float(truth.time[0]):g} to {float(truth.time[-1]):g} s"
+    )
 
 
 def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
@@ -1028,7 +1046,8 @@ def calibrate_logs(
         # horizon, which the caller may shorten; the CLI blames the logs when it is a default.
         raise InputError(
             f"horizons: expected a horizon of which the logs hold at least 10 windows of motion, "
-            f"got {spans[0]:g} s ({windows[0].run.size} windows in their {seconds:g} s with ground truth)"
+            f"got {spans[0]:g} s ({windows[0].run.size} windows in their {seconds:g} s with ground truth: "
+            f"{'; '.join(_record_spans(log) for log in logs)})"
         )
     valid = np.concatenate([m.valid for m in moves])
     run_gain = _gain(
