@@ -80,7 +80,7 @@ def test_the_lazy_top_level_takes_each_name_from_where_the_type_checkers_see_it(
     seen = {
         alias.name: node.module
         for node in guard.body
-        if isinstance(node, ast.ImportFrom)
+        if isinstance(node, ast.ImportFrom) and node.module != "typing"  # typing.Any, for __getattr__
         for alias in node.names
     }
     assert seen == aura_ums._HOMES

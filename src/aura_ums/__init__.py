@@ -16,10 +16,14 @@ True
 from __future__ import annotations
 
 import importlib
-import importlib.util
-from typing import TYPE_CHECKING, Any
 
+# typing.TYPE_CHECKING without importing typing (with re and enum, a few milliseconds): the
+# console script reaches the command line's Ctrl-C handler that much sooner. Type checkers
+# take any TYPE_CHECKING as true.
+TYPE_CHECKING = False
 if TYPE_CHECKING:
+    from typing import Any
+
     from aura_ums._metrics import Metrics
     from aura_ums.camera import (
         CalibrationBounds,
@@ -212,12 +216,19 @@ if not TYPE_CHECKING:  # hidden from type checkers, which would take any name as
         home = _HOMES.get(name)
         if home is not None:
             value = getattr(importlib.import_module(home), name)
-        elif not name.startswith("__") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        elif not name.startswith("__") and _find_spec(f"{__name__}.{name}") is not None:
             value = importlib.import_module(f"{__name__}.{name}")  # a subpackage, as after its import
         else:
             raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
         globals()[name] = value
         return value
+
+    def _find_spec(name: str) -> object:
+        # importlib.util on first use: it loads contextlib and collections, which the
+        # console script would otherwise load before its Ctrl-C handler is in place.
+        import importlib.util
+
+        return importlib.util.find_spec(name)
 
     def __dir__() -> list[str]:
         return sorted({*globals(), *_HOMES})

@@ -173,3 +173,49 @@ def test_a_real_ctrl_c_early_in_a_command_exits_130_without_a_traceback(tmp_path
     assert "interrupted: nothing was written" in stderr
     assert not out.exists()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_console_script_loads_nothing_heavy_before_its_ctrl_c_handler() -> None:
+    """A Ctrl-C is a traceback until ``main`` runs: ``from aura_ums.cli import main`` stays light.
+
+    (The interpreter's own start is out of reach; typing, re and enum would add milliseconds.)
+    """
+    listed = "import sys{}\nsys.stdout.write(' '.join(sorted(sys.modules)))"
+    modules = [
+        set(
+            subprocess.run(
+                [sys.executable, "-c", listed.format(extra)], capture_output=True, text=True, check=True
+            ).stdout.split()
+        )
+        for extra in ("", "\nfrom aura_ums.cli import main")
+    ]
+    loaded = modules[1] - modules[0]
+    assert "aura_ums.cli" in loaded
+    assert loaded & {"typing", "re", "enum", "contextlib", "collections", "signal", "numpy"} == set()
+
+
+# A Ctrl-C once the command is over (its outputs written whole): while Python joins threads
+# and runs its exit functions, and after them, while it tears the modules down. Either way the
+# command's own exit status, not death by the signal (which a caller reads as a crash).
+_INTERRUPTED_AFTER_THE_COMMAND = {
+    "shutting down": (
+        "try:\n    main()\nfinally:\n    os.kill(os.getpid(), signal.SIGINT)\n    time.sleep(5)\n"
+    ),
+    "tearing down": (
+        "class Late:\n    def __del__(self):\n        os.kill(os.getpid(), signal.SIGINT)\n"
+        "late = Late()\nmain()\n"
+    ),
+}
+
+
+@pytest.mark.parametrize("moment", sorted(_INTERRUPTED_AFTER_THE_COMMAND))
+def test_a_ctrl_c_after_the_command_keeps_its_exit_status(moment: str) -> None:
+    script = (
+        "import os, signal, sys, time\nsys.argv = ['aura-ums', '--version']\n"
+        "from aura_ums.cli import main\n" + _INTERRUPTED_AFTER_THE_COMMAND[moment]
+    )
+    command = [sys.executable, "-c", script]
+    done = subprocess.run(command, capture_output=True, text=True, check=False, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("aura-ums ")
+    assert "Traceback" not in done.stderr

@@ -7,11 +7,13 @@ the command line itself are still loading.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
+from aura_ums import TYPE_CHECKING
 from aura_ums.cli._interrupt import INTERRUPTED, say_interrupted
 
 if TYPE_CHECKING:
+    from types import FrameType
+    from typing import Any
+
     from aura_ums.cli._app import app
 
 __all__ = ["app", "main"]
@@ -29,12 +31,52 @@ def main() -> None:
 
         run()
     except KeyboardInterrupt:
+        _finish_on_interrupt(INTERRUPTED)
         say_interrupted()
         raise SystemExit(INTERRUPTED) from None
     except SystemExit as exc:
+        _finish_on_interrupt(_status(exc.code))
         if exc.code == INTERRUPTED:  # typer's own answer to a Ctrl-C while it reads the arguments
             say_interrupted()
         raise
+    _finish_on_interrupt(0)
+
+
+def _status(code: object) -> int:
+    """Return the exit status ``SystemExit(code)`` gives: None is 0, a message 1."""
+    if code is None:
+        return 0
+    return code if isinstance(code, int) else 1
+
+
+def _finish_on_interrupt(status: int) -> None:
+    """From now on, let a Ctrl-C end the process at once with ``status``, not by the signal.
+
+    The command is over: its outputs are written whole (or it was interrupted and said
+    so). A Ctrl-C while Python shuts down (joining threads, closing a Dask client) would
+    otherwise be a KeyboardInterrupt nothing catches, and Python then ends the process by
+    SIGINT itself, which a caller reads as a crash rather than as the command's status.
+    """
+    # Imported here, not at the top, where they would delay main()'s Ctrl-C handler (the
+    # enum of signal alone by a millisecond).
+    import atexit
+    import contextlib
+    import os
+    import signal
+    import sys
+
+    def finish(signum: int, frame: FrameType | None) -> None:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):  # a closed pipe: nothing left to say
+                stream.flush()
+        os._exit(status)
+
+    with contextlib.suppress(ValueError):  # not the main thread: an embedding caller's signals
+        signal.signal(signal.SIGINT, finish)
+        # Python puts back the default action of SIGINT after the exit functions, before it
+        # tears the modules down, unless it is ignored: a Ctrl-C in that last stretch would
+        # end the process by the signal. By then nothing is left that a Ctrl-C could stop.
+        atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
 
 
 def __getattr__(name: str) -> Any:
