@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import socket
 import sys
 import time
 from collections.abc import Iterator
@@ -131,6 +132,15 @@ def test_a_run_searches_where_its_perception_says() -> None:
 def test_bad_settings_are_refused_by_name(kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(InputError, match=message):
         CampaignSettings(**kwargs)  # type: ignore[arg-type]
+
+
+def test_a_scheduler_nothing_listens_at_is_refused_by_name() -> None:
+    with socket.socket() as probe:  # a port just free: nothing listens at it
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    settings = CampaignSettings(scheduler=f"tcp://127.0.0.1:{port}")
+    with pytest.raises(InputError, match=r"scheduler: expected a Dask scheduler at .*ConnectionRefusedError"):
+        run_campaign(abs, [1], settings)
 
 
 def test_without_the_extra_a_dask_campaign_names_it(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import socket
 import sys
 from pathlib import Path
 from typing import Any
@@ -85,6 +86,19 @@ def test_bad_campaign_options_are_clean_errors(options: list[str], message: str)
     assert result.exit_code == 2
     assert message in result.output
     assert "Traceback" not in result.output
+
+
+def test_a_scheduler_address_nothing_listens_at_is_refused_at_once() -> None:
+    """Not after distributed's 30 s of retries: the port is probed first."""
+    with socket.socket() as probe:  # a port just free: nothing listens at it
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    result = runner.invoke(app, ["simulate", SCENARIO, "--runs", "1", "--scheduler", address])
+    assert result.exit_code == 2
+    assert result.stderr.startswith(
+        f"error: --scheduler: expected a Dask scheduler at '{address}', got ConnectionRefusedError"
+    )
 
 
 def test_without_the_extra_workers_name_it_and_one_worker_runs(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -20,6 +20,7 @@ import importlib
 import logging
 import os
 import queue
+import socket
 import time
 import uuid
 from collections import deque
@@ -145,12 +146,37 @@ def _require_dask() -> None:
             ) from exc
 
 
+def _probe(address: str) -> None:
+    """Refuse at once a TCP scheduler address that nothing listens at, or whose host is unknown.
+
+    distributed's client retries a refused connection until its timeout (30 s) in case the
+    scheduler is still starting; a typo in the port should not cost half a minute.
+    """
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme not in ("tcp", "tls"):
+            return  # another transport (inproc, ucx): the client's own connection decides
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError):
+        return  # not host:port: the client says what is wrong with it
+    try:
+        socket.create_connection((host, port), timeout=_CONNECT_S).close()
+    except (ConnectionRefusedError, socket.gaierror) as exc:
+        why = f"{type(exc).__name__}: {exc}"
+        raise InputError(f"scheduler: expected a Dask scheduler at {address!r}, got {why}") from None
+    except OSError:
+        return  # a timeout or an unreachable network: the client retries and reports it
+
+
 @contextmanager
 def _client(settings: CampaignSettings) -> Iterator[Client]:
     """Yield a client of the scheduler given, or of a local cluster started (and stopped) here."""
     from distributed import Client, LocalCluster
 
     if settings.scheduler is not None:
+        _probe(settings.scheduler)
         try:
             client = Client(settings.scheduler, timeout=_CONNECT_S, set_as_default=False)
         except (OSError, ValueError) as exc:

@@ -79,6 +79,9 @@ def campaign_failure(exc: Exception) -> str:
     ``--run-timeout``.
     """
     message = str(exc)
+    name, colon, rest = message.partition(": ")
+    if colon and name in _FLAGS:  # a setting refused as a whole: "scheduler: expected ..."
+        message = f"{_FLAGS[name]}: {rest}"
     for name, flag in _FLAGS.items():
         message = message.replace(f"{name} = ", f"{flag} ")
     return message
