@@ -150,6 +150,30 @@ def test_missing_landmarks_file(bag: Path, tmp_path: Path) -> None:
     assert "expected a landmarks CSV file, got no such file" in result.output
 
 
+def test_a_landmarks_file_without_rows_is_named(bag: Path, landmarks: Path, tmp_path: Path) -> None:
+    header_only = tmp_path / "landmarks.csv"
+    header_only.write_text(landmarks.read_text().splitlines()[0] + "\n")
+    args = ["--odom", "/cmd", "--observations", "/seen", "--landmarks", str(header_only)]
+    result = invoke("import", "rosbag", str(bag), str(tmp_path / "log"), *args)
+    assert result.exit_code == 2
+    assert (
+        result.stderr == f"error: {header_only}: expected a landmark per row after the header, got no row\n"
+    )
+
+
+def test_a_name_that_cannot_be_a_log_name_is_named_as_the_option(
+    bag: Path, landmarks: Path, tmp_path: Path
+) -> None:
+    args = ["--odom", "/cmd", "--observations", "/seen", "--landmarks", str(landmarks), "--name", "a\nb"]
+    result = invoke("import", "rosbag", str(bag), str(tmp_path / "log"), *args)
+    assert result.exit_code == 2
+    assert (
+        result.stderr
+        == "error: --name: expected printable characters (no line breaks or tabs), got 'a\\nb'\n"
+    )
+    assert not (tmp_path / "log").exists()
+
+
 def test_simulate_mcap_option(tmp_path: Path) -> None:
     out = tmp_path / "run.mcap"
     result = invoke("simulate", str(SCENARIOS / "paper_sidewalk.toml"), "--mcap", str(out), "--seed", "2")

@@ -92,6 +92,10 @@ def rosbag_command(
     check_outputs([target], sources, overwrite=overwrite)
     try:
         meta = None if name is None else LogMeta(name, source=f"ROS bag {bag.name}")
+    except AuraUmsError as exc:  # "LogMeta.name: expected ...": the user typed --name
+        field, _, rest = str(exc).partition(": ")
+        raise fail(f"--name: {rest}" if field == "LogMeta.name" else f"BAG {bag}: {exc}") from None
+    try:
         log = read_rosbag(
             bag,
             odom_topic=odom,

@@ -124,7 +124,10 @@ def _landmarks(value: object) -> tuple[LogLandmark, ...]:
         path = Path(value)
         if not present(path):  # a folder or a pipe: the reader names what it is
             raise FileFormatError(str(path), "", "expected a landmarks CSV file, got no such file")
-        return _read_landmarks(path, Units())
+        listed = _read_landmarks(path, Units())
+        if not listed:  # else every observation is refused as naming no landmark, the file unnamed
+            raise FileFormatError(str(path), "", "expected a landmark per row after the header, got no row")
+        return listed
     if not isinstance(value, Sequence):
         raise InputError(
             "landmarks: expected a sequence of LogLandmark or a landmarks.csv path, "
