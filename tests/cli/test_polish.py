@@ -355,7 +355,7 @@ def test_a_replay_of_no_frame_is_refused_and_leaves_no_output(tmp_path: Path) ->
     assert result.exit_code == 2
     assert result.stdout == ""
     assert result.stderr.startswith(
-        "error: log 'sample-r1': expected a frame (an observation time) after the replay's start, "
+        f"error: {late}: log 'sample-r1': expected a frame (an observation time) after the replay's start, "
         "10000 s, got none"
     )
     assert not steps.exists()

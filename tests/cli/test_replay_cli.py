@@ -295,6 +295,14 @@ def test_compare_takes_the_filters_noise_from_the_calibration_never_the_log(
         noise.bearing_sd,
         noise.range_sd_fraction,
     )
+    # nor from the log itself when named as a calibration log (here through a symlink)
+    again = tmp_path / "again"
+    again.symlink_to(log_folder)
+    itself = runner.invoke(app, [*args, "--noise-from", str(again)])
+    assert itself.exit_code == 2
+    assert itself.stderr.startswith(
+        f"error: --noise-from: expected calibration logs other than LOG_DIR, got {again}, which is LOG_DIR"
+    )
 
 
 def test_reversing_is_replayable_from_the_command_line(tmp_path: Path) -> None:

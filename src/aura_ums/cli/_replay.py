@@ -143,6 +143,8 @@ _WindowsCsv = Annotated[
 
 # How the library names the parts of a saved state in its messages (--resume names the file).
 _STATE_PARTS = ("blackboard: ", "<manager JSON>", "<blackboard JSON>")
+#: How the library's messages start when they name a log by its name (its repr's quotes).
+_LOG_NAMED = ("log '", 'log "')
 #: Most particles of compare's particle filter (about 100 bytes each, several arrays).
 _MOST_PARTICLES = 1_000_000
 
@@ -605,6 +607,8 @@ def replay(
             message = f"{resume}: --resume: {message}"
         elif message.startswith("until: "):
             message = f"--{message.replace('the resumed state', f'the state in {resume}', 1)}"
+        elif message.startswith(_LOG_NAMED):  # the library names the log; the user gave its folder
+            message = f"{log_dir}: {message}"
         raise fail(message) from None
     metrics = result.metrics() if windows is None else Metrics({**result.metrics(), **windows.metrics()})
     if windows is not None and camera is not None:
@@ -733,6 +737,14 @@ def compare(
         *(Source("--noise-from", p, folder=True) for p in calibration_logs or ()),
     ]
     check_outputs([json_target], sources, overwrite=overwrite)
+    for source in calibration_logs or ():
+        if (
+            source.resolve() == log_dir.resolve()
+        ):  # the filters would be fitted to the errors they are judged on
+            raise fail(
+                f"--noise-from: expected calibration logs other than LOG_DIR, got {source}, which is LOG_DIR "
+                f"{log_dir}: noise fitted on the log compared on flatters the filters"
+            )
     try:
         log = LoadLog(max_truth_gap)(log_dir)
         if log.groundtruth is None:  # was named by the log's name alone, deep in the comparison
@@ -783,7 +795,11 @@ def compare(
             )
     except AuraUmsError as exc:
         message = str(exc)
-        raise fail(f"--{message}" if message.startswith("particles: ") else message) from None
+        if message.startswith("particles: "):
+            message = f"--{message}"
+        elif message.startswith(_LOG_NAMED):  # the library names the log; the user gave its folder
+            message = f"{log_dir}: {message}"
+        raise fail(message) from None
     boxes = ", the Codac box" if with_codac else ""
     grid = Table(title=f"{log.meta.name}: Class {classes}, 99% regions of the filters{boxes}")
     for column in (
