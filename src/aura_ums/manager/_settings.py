@@ -258,6 +258,7 @@ relocalize_after (2), got 1
             "rad",
             float,
             low=0.0,
+            high=_TWO_PI,  # a wedge is never wider: above it, the same as none
             nullable=True,
             off_flag="--one-by-one",
         ),
