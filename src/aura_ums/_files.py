@@ -718,7 +718,8 @@ def parse_csv_floats(
         lead[line] = piece[visible[0]] if visible.size else _LF
     comment = lead == _HASH
     data = (lead != _LF) & ~comment
-    if encoded.count(b"#") != np.count_nonzero(comment):
+    # Counted only when there is one ("in" finds a byte many times faster than count counts them).
+    if b"#" in encoded and encoded.count(b"#") != np.count_nonzero(comment):
         return None  # a "#" inside a row: parse_csv says what it makes of it
     numbers = np.flatnonzero(data)
     rows = numbers.size - 1
@@ -953,7 +954,8 @@ def csv_blocks(
                 lines = np.asarray(found.lines, dtype=np.int64) - 1 + lines_before
                 head = False
             rows += len(found)
-            lines_before += block.count(b"\n")
+            # numpy counts the line breaks a few times faster than bytes.count.
+            lines_before += int(np.count_nonzero(np.frombuffer(block, dtype=np.uint8) == _LF))
             if len(found) or head:
                 lines = np.asarray(lines, dtype=np.int64)
                 if isinstance(found, CsvFloats):
