@@ -484,12 +484,20 @@ class OdometryReports:
         edges = np.concatenate(([self.low], times))
         carry = self.carry
         meta = self.meta
-        turn = np.diff(self._integral(angular, edges, None if carry is None else carry[0])) * meta.turn_scale
-        ahead_sum = self._integral(np.maximum(forward, 0.0), edges, None if carry is None else carry[1])
-        back_sum = self._integral(np.maximum(-forward, 0.0), edges, None if carry is None else carry[2])
+        # The integral from the record's first row to each row, of each value (once: the
+        # rows dropped below carry theirs from these same sums).
+        rates = (angular, np.maximum(forward, 0.0), np.maximum(-forward, 0.0))
+        steps = np.diff(t)
+        sums = [
+            self._sums(values, steps, None if carry is None else carry[index])
+            for index, values in enumerate(rates)
+        ]
+        turn = np.diff(self._integral(rates[0], sums[0], edges)) * meta.turn_scale
+        ahead_sum = self._integral(rates[1], sums[1], edges)
+        back_sum = self._integral(rates[2], sums[2], edges)
         ahead = np.maximum(np.diff(ahead_sum) * meta.run_scale, 0.0)
         back = np.maximum(np.diff(back_sum) * meta.run_scale, 0.0)
-        self._drop_before(high)
+        self._drop_before(high, sums)
         self.low = high
         if len(times) == 0:
             return times, times, times
@@ -501,16 +509,16 @@ class OdometryReports:
             self.time, self.v, self.omega = self.time[-1:], self.v[-1:], self.omega[-1:]
             self._read()
 
-    def _sums(self, values: Array, carry: float | None) -> Array:
-        """Return the integral from the record's first row to each row of the window."""
-        steps = values[:-1] * np.diff(self.time)
+    @staticmethod
+    def _sums(values: Array, steps: Array, carry: float | None) -> Array:
+        """Return the integral from the record's first row to each row of the window (its time ``steps``)."""
+        products = values[:-1] * steps
         if carry is None:
-            return np.concatenate(([0.0], np.cumsum(steps)))
-        return np.cumsum(np.concatenate(([carry], steps)))
+            return np.concatenate(([0.0], np.cumsum(products)))
+        return np.cumsum(np.concatenate(([carry], products)))
 
-    def _integral(self, values: Array, query: Array, carry: float | None) -> Array:
-        # cumulative_integral's arithmetic, on the window's rows from the carried sums.
-        at_rows = self._sums(values, carry)
+    def _integral(self, values: Array, at_rows: Array, query: Array) -> Array:
+        # cumulative_integral's arithmetic, on the window's rows from the carried sums (``at_rows``).
         t = self.time
         # Not ended: every query is before the window's last row, which is then not the record's.
         clipped = np.clip(query, t[0], t[-1])
@@ -519,16 +527,11 @@ class OdometryReports:
         result: Array = at_rows[row] + partial
         return result
 
-    def _drop_before(self, high: float) -> None:
-        """Drop the rows before the one holding ``high``, carrying their integrals."""
+    def _drop_before(self, high: float, sums: list[Array]) -> None:
+        """Drop the rows before the one holding ``high``, carrying their integrals (``sums``, at each row)."""
         keep = max(int(np.searchsorted(self.time, high, side="right")) - 1, 0)
         if not keep:
             return
-        carry = self.carry
-        sums = [
-            float(self._sums(values, None if carry is None else carry[index])[keep])
-            for index, values in enumerate((self.omega, np.maximum(self.v, 0.0), np.maximum(-self.v, 0.0)))
-        ]
-        self.carry = (sums[0], sums[1], sums[2])
+        self.carry = (float(sums[0][keep]), float(sums[1][keep]), float(sums[2][keep]))
         self.time, self.v, self.omega = self.time[keep:], self.v[keep:], self.omega[keep:]
         self.row += keep
