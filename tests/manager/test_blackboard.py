@@ -54,6 +54,21 @@ def test_reports_are_appended_in_time_order_and_older_ones_refused() -> None:
         board.post_report(TurnAndRun(0.0, 1.0))  # type: ignore[arg-type]
 
 
+def test_reports_in_order_are_posted_in_one_call_and_an_older_first_one_refused() -> None:
+    board, one_by_one = Blackboard(), Blackboard()
+    reports = [report(1.0), report(2.0), report(2.0, run=0.5)]
+    board._post_in_order(reports[:1])
+    board._post_in_order([])
+    board._post_in_order(reports[1:])
+    one_by_one.post_reports(reports)
+    assert board.position_reports == one_by_one.position_reports
+    with pytest.raises(
+        InputError, match=r"report\.time: expected a time >= 2\.0 \(the last report's\), got 1\.5"
+    ):
+        board._post_in_order([report(1.5), report(3.0)])
+    assert board.report_count == 3  # neither was added
+
+
 def test_reports_until_takes_from_start_up_to_until_inclusive() -> None:
     board = Blackboard()
     board.post_reports(report(t) for t in (1.0, 2.0, 3.0, 4.0))

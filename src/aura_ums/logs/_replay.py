@@ -871,12 +871,17 @@ def replay_log(
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
             due_arrays = reports.until(chunk.times)
-            # Checked once for the chunk (finite, runs >= 0), the reports are made without
-            # checking each again; else each is made checked, and a bad one refused as it was.
+            # Checked once for the chunk (finite, runs >= 0, in time order), the reports are
+            # made at once without checking each again, and each frame's posted in one call;
+            # else each is made checked, and a bad one refused as it was.
             checked = _reports_valid(*due_arrays)
             report_times, report_turns, report_runs = (values.tolist() for values in due_arrays)
             due_count = len(report_times)
             next_report = 0
+            if checked:
+                made = list(map(PositionReport._trusted, report_times, report_turns, report_runs))
+                # Where each frame's reports end: those at or before its time (the times are in order).
+                cuts = np.searchsorted(due_arrays[0], chunk.times, side="right").tolist()
             count = len(chunk.times)
             part = trace.start(count)
             part.time[:] = chunk.times
@@ -890,22 +895,25 @@ def replay_log(
                 frame = rows[offsets[index] : offsets[index + 1]]
                 working = _observations(frame, bearing_only, working_bounds, offset)
                 envelope = _observations(frame, bearing_only, envelope_bounds, offset) if robust else None
-                due = []
-                while next_report < due_count and report_times[next_report] <= frame_time:
-                    due.append(
-                        PositionReport._trusted(
-                            report_times[next_report], report_turns[next_report], report_runs[next_report]
+                if checked:
+                    due = made[next_report : cuts[index]]
+                    next_report = cuts[index]
+                else:
+                    due = []
+                    while next_report < due_count and report_times[next_report] <= frame_time:
+                        due.append(
+                            PositionReport(
+                                report_times[next_report],
+                                TurnAndRun(report_turns[next_report], report_runs[next_report]),
+                            )
                         )
-                        if checked
-                        else PositionReport(
-                            report_times[next_report],
-                            TurnAndRun(report_turns[next_report], report_runs[next_report]),
-                        )
-                    )
-                    next_report += 1
+                        next_report += 1
                 began = _time.perf_counter()
-                for report in due:
-                    board.post_report(report)
+                if checked:
+                    board._post_in_order(due)
+                else:
+                    for report in due:
+                        board.post_report(report)
                 if before_frame is not None:
                     grown = manager.update(board, now=frame_time)
                     paused = _time.perf_counter()
@@ -974,12 +982,13 @@ def replay_log(
 
 
 def _reports_valid(times: NDArray[np.float64], turns: NDArray[np.float64], runs: NDArray[np.float64]) -> bool:
-    """Whether every report's time and turn is finite and its run finite and >= 0 (what they check)."""
+    """Whether every report's time and turn is finite, its run finite and >= 0 (as checked), in time order."""
     return bool(
         np.isfinite(times).all()
         and np.isfinite(turns).all()
         and np.isfinite(runs).all()
         and (runs >= 0.0).all()
+        and (times[1:] >= times[:-1]).all()
     )
 
 

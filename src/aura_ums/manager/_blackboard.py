@@ -154,6 +154,21 @@ class Blackboard:
             )
         self._reports.append(report)
 
+    def _post_in_order(self, reports: list[PositionReport]) -> None:
+        """:meth:`post_report` of each of ``reports``, known to be reports in time order (a replay's).
+
+        Only the first is checked against the last report posted: one call a frame instead
+        of one a report.
+        """
+        if not reports:
+            return
+        if self._reports and reports[0].time < self._reports[-1].time:
+            raise InputError(
+                f"report.time: expected a time >= {self._reports[-1].time!r} (the last report's), "
+                f"got {reports[0].time!r}"
+            )
+        self._reports += reports
+
     def post_reports(self, reports: Iterable[PositionReport]) -> None:
         """Append several position reports in turn (see :meth:`post_report`)."""
         for report in reports:
