@@ -484,20 +484,22 @@ class OdometryReports:
         edges = np.concatenate(([self.low], times))
         carry = self.carry
         meta = self.meta
-        # The integral from the record's first row to each row, of each value (once: the
-        # rows dropped below carry theirs from these same sums).
-        rates = (angular, np.maximum(forward, 0.0), np.maximum(-forward, 0.0))
+        # The integral from the record's first row to each row, of each rate, summed once: the
+        # rows dropped below carry theirs from the same sums (one window-long array at a time).
+        keep = max(int(np.searchsorted(t, high, side="right")) - 1, 0)
         steps = np.diff(t)
-        sums = [
-            self._sums(values, steps, None if carry is None else carry[index])
-            for index, values in enumerate(rates)
-        ]
-        turn = np.diff(self._integral(rates[0], sums[0], edges)) * meta.turn_scale
-        ahead_sum = self._integral(rates[1], sums[1], edges)
-        back_sum = self._integral(rates[2], sums[2], edges)
-        ahead = np.maximum(np.diff(ahead_sum) * meta.run_scale, 0.0)
-        back = np.maximum(np.diff(back_sum) * meta.run_scale, 0.0)
-        self._drop_before(high, sums)
+        integrals, carried = [], []
+        for index, values in enumerate((angular, np.maximum(forward, 0.0), np.maximum(-forward, 0.0))):
+            at_rows = self._sums(values, steps, None if carry is None else carry[index])
+            integrals.append(self._integral(values, at_rows, edges))
+            carried.append(float(at_rows[keep]))
+        turn = np.diff(integrals[0]) * meta.turn_scale
+        ahead = np.maximum(np.diff(integrals[1]) * meta.run_scale, 0.0)
+        back = np.maximum(np.diff(integrals[2]) * meta.run_scale, 0.0)
+        if keep:  # drop the rows before the one holding ``high``, carrying their integrals
+            self.carry = (carried[0], carried[1], carried[2])
+            self.time, self.v, self.omega = t[keep:], forward[keep:], angular[keep:]
+            self.row += keep
         self.low = high
         if len(times) == 0:
             return times, times, times
@@ -526,12 +528,3 @@ class OdometryReports:
         partial = np.where(row < len(t) - 1, values[row] * (clipped - t[row]), 0.0)
         result: Array = at_rows[row] + partial
         return result
-
-    def _drop_before(self, high: float, sums: list[Array]) -> None:
-        """Drop the rows before the one holding ``high``, carrying their integrals (``sums``, at each row)."""
-        keep = max(int(np.searchsorted(self.time, high, side="right")) - 1, 0)
-        if not keep:
-            return
-        self.carry = (float(sums[0][keep]), float(sums[1][keep]), float(sums[2][keep]))
-        self.time, self.v, self.omega = self.time[keep:], self.v[keep:], self.omega[keep:]
-        self.row += keep
