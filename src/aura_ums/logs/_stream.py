@@ -346,41 +346,58 @@ class TruthWindow:
         self.blocks = blocks
         self.max_gap = max_gap
         empty = np.empty(0)
-        self.time, self.x, self.y, self.heading, self.unwrapped = empty, empty, empty, empty, empty
+        self.time, self.x, self.y, self.unwrapped = empty, empty, empty, empty
+        self.last_heading = empty  # the last row's heading, as read (none before the first block)
         self.correction: float | None = None  # the running sum of the unwrapping corrections
         self.ended = False
-        self._read()
+        self._read(-math.inf)
         self.first = float(self.time[0])
 
-    def _read(self) -> None:
-        try:
-            time, x, y, heading = next(self.blocks)
-        except StopIteration:
-            self.ended = True
-            return
+    def _read(self, latest: float) -> None:
+        """Read the next block, and those after it while the last row read is at or before ``latest``.
+
+        The window is joined to the blocks read once (a join per block copied it again each time).
+        """
+        parts = [(self.time, self.x, self.y, self.unwrapped)]
+        while True:
+            try:
+                time, x, y, heading = next(self.blocks)
+            except StopIteration:
+                self.ended = True
+                break
+            parts.append((time, x, y, self._unwrapped(heading)))
+            if time[-1] > latest:
+                break
+        if len(parts) > 1:
+            joined = [np.concatenate(column) for column in zip(*parts, strict=True)]
+            self.time, self.x, self.y, self.unwrapped = joined
+
+    def _unwrapped(self, heading: Array) -> Array:
+        """Return a block's headings unwrapped, the corrections' running sum carried from the last block."""
         # numpy.unwrap's arithmetic (period 2 pi), its cumulative sum carried from block to block.
-        joined = np.concatenate((self.heading[-1:], heading))
-        dd = np.diff(joined)
-        ddmod = np.mod(dd - (-np.pi), 2 * np.pi) + (-np.pi)
-        np.copyto(ddmod, np.pi, where=(ddmod == -np.pi) & (dd > 0))
-        ph_correct = ddmod - dd
-        np.copyto(ph_correct, 0, where=abs(dd) < np.pi)
+        dd = np.diff(np.concatenate((self.last_heading, heading)))
+        # Its correction is 0 but where a step is pi or more (or NaN): only those steps are
+        # taken modulo 2 pi (the slowest of its operations), each as numpy.unwrap takes it.
+        wide = np.flatnonzero(~(abs(dd) < np.pi))
+        ph_correct = np.zeros_like(dd)
+        if wide.size:
+            step = dd[wide]
+            ddmod = np.mod(step - (-np.pi), 2 * np.pi) + (-np.pi)
+            np.copyto(ddmod, np.pi, where=(ddmod == -np.pi) & (step > 0))
+            ph_correct[wide] = ddmod - step
         if self.correction is None:
             sums = ph_correct.cumsum()
         else:
             sums = np.concatenate(([self.correction], ph_correct)).cumsum()[1:]
-        if self.heading.size:
-            unwrapped = heading + sums
+        if self.last_heading.size:
+            unwrapped: Array = heading + sums
         else:  # the record's first row is its own unwrapped heading
             unwrapped = np.array(heading, copy=True)
             unwrapped[1:] = heading[1:] + sums
         if sums.size:
             self.correction = float(sums[-1])
-        self.time = np.concatenate((self.time, time))
-        self.x = np.concatenate((self.x, x))
-        self.y = np.concatenate((self.y, y))
-        self.heading = np.concatenate((self.heading, heading))
-        self.unwrapped = np.concatenate((self.unwrapped, unwrapped))
+        self.last_heading = heading[-1:].copy()  # not a view holding the whole block
+        return unwrapped
 
     def at(self, times: Array) -> Array:
         """Return the poses (rows of x, y, heading) at ``times``: increasing, none before earlier ones."""
@@ -388,8 +405,8 @@ class TruthWindow:
         if not query.size:
             return np.empty((0, 3))
         latest = float(query.max())
-        while not self.ended and self.time[-1] <= latest:
-            self._read()
+        if not self.ended and self.time[-1] <= latest:
+            self._read(latest)
         time = self.time
         out = np.empty((len(query), 3))
         out[:, 0] = np.interp(query, time, self.x)
@@ -406,7 +423,7 @@ class TruthWindow:
         keep = max(int(np.searchsorted(time, latest, side="right")) - 1, 0)
         if keep:
             self.time, self.x, self.y = time[keep:], self.x[keep:], self.y[keep:]
-            self.heading, self.unwrapped = self.heading[keep:], self.unwrapped[keep:]
+            self.unwrapped = self.unwrapped[keep:]
         return out
 
 
