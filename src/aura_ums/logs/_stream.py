@@ -465,23 +465,33 @@ class OdometryReports:
         """The (delayed) time of the record's first row, s."""
         return float(self.time[0]) if self.row == 0 else math.nan
 
-    def _read(self) -> None:
-        try:
-            time, v, omega = next(self.blocks)
-        except StopIteration:
-            self.ended = True
-            return
-        reversing = v < 0.0
-        if self.reverse is ReverseMotion.ERROR and np.any(reversing):
-            row = int(np.argmax(reversing))
-            refused = ReversingError(self.read + row, float(v[row]))
-            if self.source is None:
-                raise refused
-            raise reversed_at(self.source, refused)
-        self.read += len(time)
-        self.time = np.concatenate((self.time, time + self.meta.delay_s))
-        self.v = np.concatenate((self.v, v))
-        self.omega = np.concatenate((self.omega, omega))
+    def _read(self, high: float = -math.inf) -> None:
+        """Read the next block, and those after it while the last row read is at or before ``high``.
+
+        The window is joined to the blocks read once (a join per block copied it again each time).
+        """
+        parts = [(self.time, self.v, self.omega)]
+        while True:
+            try:
+                time, v, omega = next(self.blocks)
+            except StopIteration:
+                self.ended = True
+                break
+            reversing = v < 0.0
+            if self.reverse is ReverseMotion.ERROR and np.any(reversing):
+                row = int(np.argmax(reversing))
+                refused = ReversingError(self.read + row, float(v[row]))
+                if self.source is None:
+                    raise refused
+                raise reversed_at(self.source, refused)
+            self.read += len(time)
+            delayed = time + self.meta.delay_s
+            parts.append((delayed, v, omega))
+            if delayed[-1] > high:
+                break
+        if len(parts) > 1:
+            joined = [np.concatenate(column) for column in zip(*parts, strict=True)]
+            self.time, self.v, self.omega = joined
 
     def until(self, frames: Array) -> tuple[Array, Array, Array]:
         """Return the reports (times, turns, runs) after the previous call's last frame up to ``frames[-1]``.
@@ -489,8 +499,8 @@ class OdometryReports:
         ``frames``: the next frame times, increasing, after the previous call's.
         """
         high = float(frames[-1])
-        while not self.ended and self.time[-1] <= high:
-            self._read()
+        if not self.ended and self.time[-1] <= high:
+            self._read(high)
         t, forward, angular = self.time, self.v, self.omega
         reversing = forward < 0.0
         boundaries = frames
