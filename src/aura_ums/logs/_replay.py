@@ -888,13 +888,16 @@ def replay_log(
             part.truth[:] = source.truth(chunk.times)
             judge = _Judge(part)
             rows, offsets = chunk.rows, chunk.offsets
+            # The chunk's observations at once (each frame's are a slice): a call a chunk, not a frame.
+            chunk_working = _observations(rows, bearing_only, working_bounds, offset)
+            chunk_envelope = _observations(rows, bearing_only, envelope_bounds, offset) if robust else None
             # Each step's figures, into the trace's arrays once the chunk is done (or at
             # once for after_step, which reads them).
             update_us, accepted, rejected, states, relocalized, excluded = [], [], [], [], [], []
             for index, frame_time in enumerate(chunk.times.tolist()):
-                frame = rows[offsets[index] : offsets[index + 1]]
-                working = _observations(frame, bearing_only, working_bounds, offset)
-                envelope = _observations(frame, bearing_only, envelope_bounds, offset) if robust else None
+                begin, end = offsets[index], offsets[index + 1]
+                working = chunk_working[begin:end]
+                envelope = None if chunk_envelope is None else chunk_envelope[begin:end]
                 if checked:
                     due = made[next_report : cuts[index]]
                     next_report = cuts[index]
@@ -918,7 +921,7 @@ def replay_log(
                     grown = manager.update(board, now=frame_time)
                     paused = _time.perf_counter()
                     assert chunk.logged is not None
-                    logged = chunk.logged[offsets[index] : offsets[index + 1]]
+                    logged = chunk.logged[begin:end]
                     before_frame(frame_time, grown.map, logged, grown.focus)
                     began += _time.perf_counter() - paused
                 for observation in working:
