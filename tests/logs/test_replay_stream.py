@@ -147,7 +147,7 @@ def test_the_judges_batched_areas_are_polygon_area_bit_for_bit(
 ) -> None:
     """Polygons of every vertex count (BLAS's unrolled dot from 16 on), far from the origin, thin."""
     from aura_ums.geometry import polygon_area
-    from aura_ums.logs._replay import _areas
+    from aura_ums.logs._replay import _areas, _Rings
 
     rng = np.random.default_rng(seed)
     polygons = []
@@ -157,6 +157,8 @@ def test_the_judges_batched_areas_are_polygon_area_bit_for_bit(
         polygons.append(ring + np.array([offset, -offset]))
     expected = np.array([polygon_area(vertices) for vertices in polygons])
     assert _areas(polygons).view(np.int64).tolist() == expected.view(np.int64).tolist()
+    # Each group gathered from the polygons' rows, as a flush shares them.
+    assert _areas(polygons, _Rings(polygons)).view(np.int64).tolist() == expected.view(np.int64).tolist()
 
 
 @given(
@@ -172,7 +174,7 @@ def test_the_envelope_gate_calls_an_area_positive_only_when_polygon_area_does(
 ) -> None:
     """The judge's batched area sign never admits a polygon polygon_area calls flat or worse."""
     from aura_ums.geometry import polygon_area
-    from aura_ums.logs._replay import _surely_positive
+    from aura_ums.logs._replay import _Rings, _surely_positive
 
     rng = np.random.default_rng(seed)
     angles = np.sort(rng.uniform(0.0, 2.0 * math.pi, count))
@@ -182,6 +184,9 @@ def test_the_envelope_gate_calls_an_area_positive_only_when_polygon_area_does(
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) + origin
     line = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]) + origin
     gate = _surely_positive([vertices, square, line])
+    assert (
+        _surely_positive([vertices, square, line], _Rings([vertices, square, line])).tolist() == gate.tolist()
+    )
     if gate[0] == 1.0:
         assert polygon_area(vertices) > 0.0
     assert gate[1:].tolist() == [1.0, 0.0]
@@ -190,7 +195,7 @@ def test_the_envelope_gate_calls_an_area_positive_only_when_polygon_area_does(
 def test_the_batched_truth_check_takes_a_repeated_vertex_as_no_edge() -> None:
     # 0 / 0 on the repeated vertex's edge: a RuntimeWarning and the truth judged outside
     from aura_ums.geometry import ConvexPolygon, HeadingWedge
-    from aura_ums.logs._replay import _contains
+    from aura_ums.logs._replay import _contains, _Rings
     from aura_ums.uncertainty import SpatialUncertaintyMap
 
     square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
@@ -198,3 +203,10 @@ def test_the_batched_truth_check_takes_a_repeated_vertex_as_no_edge() -> None:
     repeated = SpatialUncertaintyMap._trusted(polygon, np.array([1.0, 1.0]), HeadingWedge(0.0, 0.5, 0.5))
     poses = np.array([[1.0, 1.0, 0.0], [2.5, 1.0, 0.0], [1.0, 1.0, 1.0]])
     assert _contains([repeated] * 3, poses).tolist() == [1, 0, 0]
+    # The shared rows of a flush give the same (all batched, and some not: a segment).
+    segment = SpatialUncertaintyMap._trusted(
+        ConvexPolygon._trusted(square[:2]), np.array([1.0, 0.0]), HeadingWedge(0.0, 0.5, 0.5)
+    )
+    for maps in ([repeated] * 3, [repeated, segment, repeated]):
+        vertices = [m.polygon.vertices for m in maps]
+        assert _contains(maps, poses, rings=_Rings(vertices)).tolist() == _contains(maps, poses).tolist()

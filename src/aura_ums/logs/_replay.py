@@ -1338,15 +1338,15 @@ class _Judge:
         trace = self.trace
         count = len(self.working)
         if count:
-            polygons = [step_map.polygon for step_map in self.working]
-            vertices = [polygon.vertices for polygon in polygons]
+            vertices = [step_map.polygon.vertices for step_map in self.working]
+            rings = _Rings(vertices)  # shared by the areas and the containment
             wedges = _wedges(self.working)
-            trace.area_m2[:count] = _areas(vertices)
+            trace.area_m2[:count] = _areas(vertices, rings)
             trace.wedge_width_rad[:count] = np.minimum(wedges[:, 1] + wedges[:, 2], _FULL_CIRCLE)
             known = np.flatnonzero(~np.isnan(trace.truth[:count, 0]))
             if known.size == count:  # the truth at every step: no lists to gather
                 trace.inside[:count] = _contains(
-                    self.working, trace.truth[:count], vertices, trace.area_m2[:count], wedges
+                    self.working, trace.truth[:count], vertices, trace.area_m2[:count], wedges, rings
                 )
             elif known.size:
                 chosen = known.tolist()
@@ -1362,9 +1362,10 @@ class _Judge:
             at = np.array([i for i, _ in with_envelope])
             maps = [m for _, m in with_envelope]
             vertices = [m.polygon.vertices for m in maps]
+            rings = _Rings(vertices)
             # The envelope's areas are not reported: only whether each is surely positive.
             trace.envelope_inside[at] = _contains(
-                maps, trace.truth[at], vertices, _surely_positive(vertices), _wedges(maps)
+                maps, trace.truth[at], vertices, _surely_positive(vertices, rings), _wedges(maps), rings
             )
         self.working, self.envelope = [], []
 
@@ -1375,19 +1376,50 @@ def _wedges(maps: Sequence[SpatialUncertaintyMap]) -> NDArray[np.float64]:
     return np.array([(w.center, w.cw, w.ccw) for w in wedges], dtype=np.float64).reshape(-1, 3)
 
 
-def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
+class _Rings:
+    """Polygons' vertices one after another, for arithmetic over all of them at once.
+
+    Made once for the maps a flush judges, and shared by the computations that read all
+    their vertices (each gathered them from the polygons again, and found each vertex's
+    follower again).
+    """
+
+    __slots__ = ("_ahead", "counts", "every", "first")
+
+    def __init__(self, vertices: Sequence[NDArray[np.float64]]) -> None:
+        self.counts = np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
+        self.every = np.concatenate(vertices) if len(vertices) else np.empty((0, 2))
+        self.first = np.cumsum(self.counts) - self.counts  # each polygon's first row in ``every``
+        self._ahead: NDArray[np.float64] | None = None
+
+    def ahead(self) -> NDArray[np.float64]:
+        """Each vertex's follower (:func:`_ahead`); every polygon must have a vertex."""
+        if self._ahead is None:
+            self._ahead = _ahead(self.every, self.first, self.first + self.counts - 1)
+        return self._ahead
+
+
+def _areas(vertices: Sequence[NDArray[np.float64]], rings: _Rings | None = None) -> NDArray[np.float64]:
     """Each polygon's area, m^2: :func:`aura_ums.geometry.polygon_area` of each, bit for bit.
 
     The polygons of each vertex count are measured together: their coordinates relative to
     their first vertex (the same subtractions), in rows, and the two dot products of each
     row by one ``matmul`` of a row by a column, which numpy computes by the very BLAS dot
-    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers.
+    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers. With ``rings`` (of
+    ``vertices``), each group is gathered from its rows in one indexing.
     """
-    counts = np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
+    counts = (
+        np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
+        if rings is None
+        else rings.counts
+    )
     areas = np.zeros(len(vertices), dtype=np.float64)  # a point or a segment: 0.0, as polygon_area
     for count in np.unique(counts[counts >= 3]).tolist():
         chosen = np.flatnonzero(counts == count)
-        stack = np.stack([vertices[index] for index in chosen.tolist()])
+        if rings is None:
+            stack = np.stack([vertices[index] for index in chosen.tolist()])
+        else:  # the same numbers, (polygons, count, 2)
+            stack = rings.every[rings.first[chosen][:, None] + np.arange(count)]
         relative = stack - stack[:, :1, :]
         x, y = np.ascontiguousarray(relative[:, :, 0]), np.ascontiguousarray(relative[:, :, 1])
         x_ahead = np.concatenate((x[:, 1:], x[:, :1]), axis=1)
@@ -1398,22 +1430,26 @@ def _areas(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
     return areas
 
 
-def _surely_positive(vertices: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
+def _surely_positive(
+    vertices: Sequence[NDArray[np.float64]], rings: _Rings | None = None
+) -> NDArray[np.float64]:
     """1.0 where a polygon's area is surely above 0, else 0.0: the shoelace of all at once.
 
     Summed otherwise than :func:`~aura_ums.geometry.polygon_area` (whose two dot products
     give the reported areas), so a value is trusted only beyond a bound on its rounding; a
     polygon within it (a degenerate one, or nearly) is then judged by ``contains`` itself.
     """
-    counts = np.array([len(v) for v in vertices], dtype=np.int64)
+    counts = np.array([len(v) for v in vertices], dtype=np.int64) if rings is None else rings.counts
     result = np.zeros(len(vertices))
     if not len(vertices) or counts.min() < 3:
         return np.array([polygon_area(v) > 0.0 for v in vertices], dtype=np.float64)
-    every = np.concatenate(vertices)
-    first = np.cumsum(counts) - counts
+    if rings is None:
+        rings = _Rings(vertices)
+    every, first = rings.every, rings.first
     origin = np.repeat(every[first], counts, axis=0)  # each polygon's first vertex, as polygon_area
     relative = every - origin
-    ahead = _ahead(relative, first, first + counts - 1)
+    # The followers of ``relative``: those of ``every`` less the same origin (a polygon's own).
+    ahead = rings.ahead() - origin
     forward, backward = relative[:, 0] * ahead[:, 1], relative[:, 1] * ahead[:, 0]
     total = np.add.reduceat(forward - backward, first)
     size = np.add.reduceat(np.abs(forward) + np.abs(backward), first)
@@ -1443,12 +1479,13 @@ def _contains(
     vertices: Sequence[NDArray[np.float64]] | None = None,
     areas: NDArray[np.float64] | None = None,
     wedges: NDArray[np.float64] | None = None,
+    rings: _Rings | None = None,
 ) -> NDArray[np.int8]:
     """Return 1 where ``poses[i]`` (x, y, heading) lies in ``maps[i]``, else 0 (as ``contains``).
 
-    ``vertices``, ``areas`` and ``wedges`` are those of each map's polygon and wedge, when
-    the caller has them already; only whether each area is above 0 counts (a polygon
-    without one is judged by ``contains`` itself).
+    ``vertices``, ``areas``, ``wedges`` and ``rings`` (of ``vertices``) are those of each
+    map's polygon and wedge, when the caller has them already; only whether each area is
+    above 0 counts (a polygon without one is judged by ``contains`` itself).
     """
     if vertices is None:
         vertices = [step_map.polygon.vertices for step_map in maps]
@@ -1457,7 +1494,7 @@ def _contains(
     if wedges is None:
         wedges = _wedges(maps)
     result = np.zeros(len(maps), dtype=np.int8)
-    counts = np.array([len(v) for v in vertices], dtype=np.int64)
+    counts = np.array([len(v) for v in vertices], dtype=np.int64) if rings is None else rings.counts
     sliced = np.array([step_map.is_sliced for step_map in maps], dtype=bool)
     # A sliced map is judged by its slices (its polygon and wedge are only their summary).
     batch = ~sliced & (counts >= 3) & (counts <= _BATCHED_VERTICES) & (areas > 0.0)
@@ -1467,10 +1504,14 @@ def _contains(
     batched = np.flatnonzero(batch)
     if not batched.size:
         return result
-    chosen = counts[batched]
-    every = np.concatenate([vertices[index] for index in batched.tolist()])
-    first = np.cumsum(chosen) - chosen
-    edge = _ahead(every, first, first + chosen - 1) - every
+    if rings is not None and batched.size == len(maps):  # every polygon: their rows as they are
+        chosen, every, first = rings.counts, rings.every, rings.first
+        edge = rings.ahead() - every
+    else:
+        chosen = counts[batched]
+        every = np.concatenate([vertices[index] for index in batched.tolist()])
+        first = np.cumsum(chosen) - chosen
+        edge = _ahead(every, first, first + chosen - 1) - every
     length = np.hypot(edge[:, 0], edge[:, 1])
     pose = poses[batched]
     relative_x = np.repeat(pose[:, 0], chosen) - every[:, 0]
