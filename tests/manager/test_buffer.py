@@ -59,6 +59,21 @@ def test_out_of_order_posts_are_sorted_and_ties_keep_posting_order() -> None:
     assert list(buffer.drain()) == [o for o in expected if o.time > 4.0]
 
 
+def test_observations_in_order_are_posted_in_one_call_as_one_by_one() -> None:
+    rng = np.random.default_rng(11)
+    frames = [
+        [bearing(f"lm{k}{j}", float(t)) for j in range(3)] for k, t in enumerate(rng.integers(0, 10, 12))
+    ]
+    buffer, one_by_one = IdentifiedLandmarkBuffer(), IdentifiedLandmarkBuffer()
+    for frame in frames:  # some older than those held: posted in their place
+        buffer._post_in_order(frame)
+        for observation in frame:
+            one_by_one.post(observation)
+        assert buffer.peek() == one_by_one.peek()
+    buffer._post_in_order([])
+    assert buffer.peek() == one_by_one.peek()
+
+
 def test_peek_does_not_remove() -> None:
     buffer = IdentifiedLandmarkBuffer([bearing("a", 1.0), bearing("b", 5.0)])
     assert [o.landmark_id for o in buffer.peek(until=2.0)] == ["a"]

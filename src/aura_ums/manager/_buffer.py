@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bisect
 import operator
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 from aura_ums._validate import finite_float
 from aura_ums.errors import InputError
@@ -96,6 +96,21 @@ or GroundLineObservation, got str
             items.append(observation)  # in time order, the usual case: where insort_right puts it
         else:
             bisect.insort_right(items, observation, key=_time)
+
+    def _post_in_order(self, observations: Sequence[Observation]) -> None:
+        """:meth:`post` of each of ``observations``, known to be observations in time order (a frame).
+
+        Appended in one call when none is older than those held (the usual case), else
+        posted one by one.
+        """
+        items = self._items
+        if not observations:
+            return
+        if items and observations[0].time < items[-1].time:
+            for observation in observations:
+                self.post(observation)
+            return
+        items += observations
 
     def drain(self, until: float | None = None) -> tuple[Observation, ...]:
         """Remove and return the observations with ``time <= until``, in time order.
