@@ -328,12 +328,19 @@ class _CsvFile:
             cells = self.cells[column]
             # float() reads "0_03" as 3.0 (Python's digit grouping) and full-width or Arabic-Indic
             # digits as digits: no CSV writer means either.
-            grouped = next((row for row, cell in enumerate(cells) if "_" in cell or not cell.isascii()), None)
+            # Looked for in all the cells at once first (the usual case: none), then row by row.
+            joined = "".join(cells)
+            grouped = None
+            if "_" in joined or not joined.isascii():
+                grouped = next(row for row, cell in enumerate(cells) if "_" in cell or not cell.isascii())
             if grouped is not None:
                 got = describe(cells[grouped])
                 self.fail_at(grouped, f"expected a number in column {column!r}, got {got}")
             try:
-                values = np.array([float(cell) if cell or not optional else math.nan for cell in cells])
+                if optional and "" in cells:
+                    values = np.array([float(cell) if cell else math.nan for cell in cells])
+                else:  # every cell read (an empty one refused by float, as below)
+                    values = np.array(list(map(float, cells)))
             except ValueError:
                 for row, cell in enumerate(cells):
                     try:
@@ -468,6 +475,11 @@ def _within(values: NDArray[np.float64], bounds: Range) -> NDArray[np.bool_]:
 
 
 def _given(values: NDArray[np.float64]) -> list[float | None]:
+    absent = np.isnan(values)
+    if not absent.any():
+        return values.tolist()  # type: ignore[no-any-return]
+    if absent.all():  # a column the file does not have
+        return [None] * len(values)
     return [None if math.isnan(value) else value for value in values.tolist()]
 
 
