@@ -518,7 +518,8 @@ def parse_csv(
     numbers: list[int] = []
     lines: list[str] = []
     for number, line in enumerate(body.splitlines(), start=1):
-        if _is_row(line):
+        stripped = line.strip()  # _is_row, inline: a call a line cost a long file's reading
+        if stripped and stripped[0] != "#":
             if len(lines) > most:
                 raise FileFormatError(source, "", f"expected at most {most} data rows, got more", line=number)
             numbers.append(number)
@@ -552,12 +553,15 @@ def parse_csv(
             raise FileFormatError(
                 source, "", f"expected a column {name!r}, got columns {', '.join(header)}", line=numbers[0]
             )
-    rows: list[tuple[str, ...]] = []
-    for number, cells in zip(numbers[1:], parsed[1:], strict=True):
-        if len(cells) != len(header):
-            raise FileFormatError(source, "", f"expected {len(header)} cells, got {len(cells)}", line=number)
-        rows.append(tuple(map(str.strip, cells)))
-    return CsvTable(source, header, numbers[0], tuple(rows), tuple(numbers[1:]))
+    data = parsed[1:]
+    if any(width != len(header) for width in set(map(len, data))):  # the first such row named
+        for number, cells in zip(numbers[1:], data, strict=True):
+            if len(cells) != len(header):
+                raise FileFormatError(
+                    source, "", f"expected {len(header)} cells, got {len(cells)}", line=number
+                )
+    rows = tuple([tuple(map(str.strip, cells)) for cells in data])
+    return CsvTable(source, header, numbers[0], rows, tuple(numbers[1:]))
 
 
 def load_csv(

@@ -370,9 +370,8 @@ class _CsvFile:
     def texts(self, column: str) -> list[str]:
         """Return a column of non-empty strings."""
         cells = self.cells[column]
-        for row, cell in enumerate(cells):
-            if not cell:
-                self.fail_at(row, f"expected a non-empty {column} in column {column!r}, got ''")
+        if "" in cells:  # the first empty one named
+            self.fail_at(cells.index(""), f"expected a non-empty {column} in column {column!r}, got ''")
         return cells
 
     def at_least(self, column: str, values: NDArray[np.float64], *, positive: bool = False) -> None:
@@ -651,9 +650,10 @@ def _observation_columns(table: _CsvFile, units: Units, known: set[str]) -> Obse
     times = table.times(units, strict=False)
     table.no_clock_jump(times, held=False)
     ids = table.texts("landmark_id")
-    for row, ident in enumerate(ids):
-        if ident not in known:
-            table.fail_at(row, f"expected a landmark id listed in {LANDMARKS}, got {describe(ident)}")
+    if not known.issuperset(ids):  # the first row of an unknown one named
+        for row, ident in enumerate(ids):
+            if ident not in known:
+                table.fail_at(row, f"expected a landmark id listed in {LANDMARKS}, got {describe(ident)}")
     bearing = table.numbers("bearing", units)
     measured = table.numbers("range", units, optional=True)
     bearing_error = table.numbers("bearing_error", units, optional=True)
