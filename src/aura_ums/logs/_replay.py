@@ -954,6 +954,8 @@ def replay_log(
             # The reports the manager consumed are not read again (but for the last, which it
             # checks): a long log's replay keeps its memory, not every report since the start.
             board.forget_reports_before(max(board.released_reports, manager.consumed_reports - 1))
+            # Nor are this chunk's reports and observations: not held while the next chunk's are made.
+            made, chunk_working, chunk_envelope = [], [], None
         source.finish()
     result_trace = trace.build()
     state = None
