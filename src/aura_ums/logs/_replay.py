@@ -1210,11 +1210,14 @@ def _stream_chunks(stream: LogStream, start: float, stop: float, keep_rows: bool
             times, bearing, measured = times[keep], bearing[keep], measured[keep]
             bearing_error, range_error, line = bearing_error[keep], range_error[keep], line[keep]
             ids = [ids[index] for index in keep.tolist()]
+        bearings = bearing.tolist()
+        if not np.all((bearing > -math.pi) & (bearing <= math.pi)):  # else each is as _wrapped leaves it
+            bearings = [_wrapped(value) for value in bearings]
         pending.extend(
             zip(
                 times.tolist(),
                 ids,
-                [_wrapped(value) for value in bearing.tolist()],
+                bearings,
                 _given(measured),
                 _given(bearing_error),
                 _given(range_error),
