@@ -15,36 +15,39 @@ tree that refuses a log (more rows than it reads) is reported as failed.
     .venv/bin/python benchmarks/bench_long_log.py
     .venv/bin/python benchmarks/bench_long_log.py --rows 1000000 --frame-every 10 --src /tmp/old/src
 
-Measured on the 2-core development machine, 29 November 2026 about 03:32 UTC, idle (load
-average below 1.0): this tree, then f47bbb6 (the tree issue 19 was filed against, its
-kernels compiled by hand, ``--src``), then this tree again. "load" is ``open_log`` for this
-tree (one pass over ``groundtruth.csv``; the other files are parsed as the replay reads
-them, so their parsing is in the total) and ``load_log`` for f47bbb6:
+Measured on the 2-core development machine, 29 November 2026 about 09:39 UTC, shared
+(load average 0.57 to 0.84): this tree and 2ee5097 (the tree before that day's savings in
+reading, judging and posting; ``git archive`` of it with this tree's compiled kernel, built
+from the same C), one replay of each in turn, three of each, the medians. "load" is ``open_log``
+(one pass over ``groundtruth.csv``; the other files are parsed as the replay reads them,
+so their parsing is in the total):
 
 ===============================  ========  =====================  =====================  =====
-10^6 rows                        steps     this tree: load,       f47bbb6: load,         gain
+10^6 rows                        steps     this tree: load,       2ee5097: load,         gain
                                            update, total s; peak  update, total s; peak
 ===============================  ========  =====================  =====================  =====
-a frame every 100 rows           9,335     0.20, 0.54, 1.28; 80   7.61, 0.62, 9.66; 746  7.5x
-a frame every 10 rows            93,359    0.21, 4.11, 7.70; 86   9.11, 5.26, 28.72; 784 3.7x
+a frame every 100 rows           9,335     0.19, 0.57, 1.28; 84   0.21, 0.58, 1.46; 83   1.14x
+a frame every 10 rows            93,359    0.19, 4.11, 7.38; 89   0.20, 4.14, 7.66; 87   1.04x
 ===============================  ========  =====================  =====================  =====
 
 How to read it:
 
-- Times move by up to 2x with the machine's load, the older tree's most (it holds the whole
-  log: 750 to 810 MB, against 80 to 90 MB here). Compare trees only within one series.
-- The gain depends on the log's shape. Reading the log and recording the steps gained the
-  most; the manager's update per frame the least, so the more frames a log has per
-  odometry row, the smaller the gain.
+- Times move by up to 2x with the machine's load (another process's, on these 2 cores):
+  compare trees only within one series. Against f47bbb6, the tree issue 19 was filed
+  against (7.61, 0.62, 9.66 s; 746 MB at a frame every 100 rows), the earlier series in
+  this file's history measured 7.5x and 3.7x.
+- The gain depends on the log's shape. These savings are in reading the log (the ground
+  truth's and odometry's blocks, the observations' text), cutting the odometry into
+  reports, judging the truth and posting; the manager's update is as it was, so the more
+  frames a log has per odometry row, the smaller the gain.
 - The peak no longer holds the log. What still grows with the log (about 17 MB per 10^6
   rows) is the replay's record, the trace (84 bytes a step), and the allocator's heap
   around it.
-- At a frame every 10 rows the update is about 44 us a step, of which the compiled kernels
-  take about 11 us; the rest is Python around them (about 3.5 us around each growth, 3 us
-  around each reduction, 6 us of bookkeeping an update). At a frame every 100 rows the
-  update (0.54 s), reading the odometry (about 0.29 s) and opening the log (0.20 s) already
-  pass the 0.97 s that tenfold would allow: issue 19's tenfold gain needs the per-step
-  update compiled, not more small savings.
+- At a frame every 10 rows the update is about 44 us a step, most of it Python around the
+  compiled kernels (about 11 us of it, by the earlier series). At a frame every 100 rows
+  the update (0.57 s), opening the log (0.19 s) and reading the odometry (about 0.12 s)
+  already pass the 0.97 s that tenfold against f47bbb6 would allow: issue 19's tenfold
+  gain needs the per-step update compiled, not more small savings.
 
 Earlier series (27 and 28 November, before the compiled CSV reader and the per-step
 trimming) are in the repository's history of this file.
