@@ -518,8 +518,7 @@ def parse_csv(
     numbers: list[int] = []
     lines: list[str] = []
     for number, line in enumerate(body.splitlines(), start=1):
-        stripped = line.strip()  # _is_row, inline: a call a line cost a long file's reading
-        if stripped and stripped[0] != "#":
+        if _is_row(line):
             if len(lines) > most:
                 raise FileFormatError(source, "", f"expected at most {most} data rows, got more", line=number)
             numbers.append(number)
