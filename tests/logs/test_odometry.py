@@ -169,6 +169,14 @@ def test_motion_outside_the_record_is_zero() -> None:
     assert [r.command.run for r in reports] == [0.0, 0.5, 0.5, 0.0, 0.0]  # the last row only ends the record
 
 
+def test_a_turn_too_small_to_halve_stays_one_command() -> None:
+    # Half of 5e-324 rad is 0.0: split, the piece's halves would not sum to its turn (hypothesis).
+    (tiny,) = odometry_to_commands([0.0, 1.0], [0.5, 0.0], [5e-324, 0.0], max_interval=2.0)
+    assert (tiny.time, tiny.command.turn, tiny.command.run) == (1.0, 5e-324, 0.5)
+    halves = odometry_to_commands([0.0, 1.0], [0.5, 0.0], [1e-323, 0.0], max_interval=2.0)
+    assert [(r.command.turn, r.command.run) for r in halves] == [(5e-324, 0.5), (5e-324, 0.0)]
+
+
 def test_degenerate_spans_give_nothing() -> None:
     assert odometry_to_commands([3.0], [1.0], [1.0], [3.0, 4.0]) == ()
     assert odometry_to_commands([0.0, 1.0], [1.0, 0.0], [0.0, 0.0], start=0.5, end=0.5) == ()

@@ -269,7 +269,8 @@ def piece_commands(
     ([1.0, 1.0, 2.0, 3.0], [0.1, 0.1, 0.0, 0.4], [0.5, 0.0, 0.5, 0.0])
     """
     flipped = back > 0.0
-    split = flipped | ((ahead > 0.0) & (turn != 0.0))
+    # A turn too small to halve (a subnormal: half of 5e-324 is 0) stays one command, as no turn.
+    split = flipped | ((ahead > 0.0) & (turn / 2.0 != 0.0))
     if not np.any(split):
         return times, turn, ahead
     count = np.where(split, 2, 1)
