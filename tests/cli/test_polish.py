@@ -429,3 +429,24 @@ def test_resuming_a_state_saved_at_the_end_is_refused(tmp_path: Path, sample_rep
     again = tmp_path / "again.json"
     invoke(*replay, "--resume", end, "--save-state", again)
     assert again.exists()
+
+
+def test_a_state_saved_before_any_frame_is_not_exported_and_nothing_is_written(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    # --save-state takes a replay of no frame (the start map, resumable); --mcap cannot: it
+    # refused only after the state, the steps CSV and the figure were written.
+    folder, terrain = walk
+    out = tmp_path / "out"
+    out.mkdir()
+    early = ["replay", str(folder), "--terrain", str(terrain), "-q", "--until", "-5"]
+    outputs = ["--steps-csv", str(out / "s.csv"), "--plot", str(out), "--mcap", str(out / "r.mcap")]
+    result = runner.invoke(app, [*early, "--save-state", str(out / "s.json"), *outputs])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        "error: --mcap: expected a replay of at least one frame to export, got none "
+        "(--until -5 comes before the first frame)\n"
+    )
+    assert list(out.iterdir()) == []
+    invoke(*early, "--save-state", out / "s.json")  # without --mcap: the start map, saved
+    assert sorted(path.name for path in out.iterdir()) == ["s.json"]

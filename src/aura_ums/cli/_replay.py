@@ -597,6 +597,15 @@ def replay(
                     f"--resume: expected a state with frames left after it, got {resume}, saved at "
                     f"{saved.last_time:g} s{bounded}: nothing is left to replay"
                 )
+            if mcap_target is not None and not result.steps:
+                # A state saved before any frame has no step to export: refused before any
+                # output is written (the MCAP writer refused it after the others were).
+                raise fail(
+                    "--mcap: expected a replay of at least one frame to export, got none "
+                    f"(--until {until:g} comes before the first frame)"
+                    if until is not None
+                    else "--mcap: expected a replay of at least one frame to export, got none"
+                )
     except AuraUmsError as exc:
         message = str(exc)
         if resume is not None and message.startswith("resume: "):
