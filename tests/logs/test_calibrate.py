@@ -15,6 +15,7 @@ from aura_ums.logs import (
     RobotLog,
     SensorBounds,
     calibrate_logs,
+    fitted_for_anchor,
     load_noise,
     load_sensors,
     observation_errors,
@@ -94,6 +95,22 @@ def test_sensor_file_round_trips(tmp_path: Path) -> None:
 def _write(path: Path, text: str) -> Path:
     path.write_text(text)
     return path
+
+
+def test_the_sensor_file_says_which_growth_its_statistics_are_for(tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(1), duration=60.0)
+    for anchor in (False, True):
+        text = calibrate_logs([log], anchor=anchor).sensors_toml()
+        path = _write(tmp_path / f"{anchor}.toml", text)
+        assert fitted_for_anchor(path) is anchor
+        assert load_sensors(path)  # the key is read by both readers
+    older = _write(tmp_path / "older.toml", text.replace('growth = "anchor"\n', ""))
+    assert fitted_for_anchor(older) is None  # written before the files said
+    wrong = _write(tmp_path / "wrong.toml", text.replace('growth = "anchor"', 'growth = "sometimes"'))
+    with pytest.raises(
+        FileFormatError, match=r"wrong\.toml: growth: expected 'move' or 'anchor', got 'sometimes'"
+    ):
+        load_sensors(wrong)
 
 
 @pytest.mark.parametrize(

@@ -73,6 +73,8 @@ _NEAREST = 0.95
 _KIND = "aura-ums/sensor-calibration"
 #: How the sensors file's header names the growth the terrain statistics are for.
 _GROWTH_WORDS = {False: "move by move", True: "from an anchor (replay --anchor-growth)"}
+#: The sensors file's ``growth``: which growth the terrain statistics written with it are for.
+_GROWTH_KEYS = {False: "move", True: "anchor"}
 _T = TypeVar("_T")
 
 
@@ -278,6 +280,7 @@ class Calibration:
             "# Growth bound against the truth over each horizon (calibration logs):",
             *(f"# {line}" for line in self.report().splitlines()),
             f'format = "{_KIND}"',
+            f'growth = "{_GROWTH_KEYS[self.anchor]}"',
             "",
             "[motion]",
             *(f"{key} = {getattr(self.motion, key)!r}" for key in _MOTION_KEYS),
@@ -302,12 +305,15 @@ def sensors_path(terrain: str | Path) -> Path:
 def _read_sensors(path: str | Path) -> tuple[Fields, dict[str, object]]:
     document = load_toml(path, kind="sensor calibration TOML")
     reader = Fields(str(path))
-    expected, optional = {"format", "motion", "working", "envelope"}, {"noise"}
+    expected, optional = {"format", "motion", "working", "envelope"}, {"noise", "growth"}
     if not expected <= set(document) <= expected | optional:
         missing, extra = sorted(expected - set(document)), sorted(set(document) - expected - optional)
         raise reader.error("", f"expected keys {sorted(expected)}, got missing {missing}, unknown {extra}")
     if document["format"] != _KIND:
         raise reader.error("format", f"expected {_KIND!r}, got {reader.describe(document['format'])}")
+    if "growth" in document and document["growth"] not in _GROWTH_KEYS.values():
+        kinds = " or ".join(repr(kind) for kind in _GROWTH_KEYS.values())
+        raise reader.error("growth", f"expected {kinds}, got {reader.describe(document['growth'])}")
     return reader, document
 
 
@@ -383,6 +389,41 @@ def load_noise(path: str | Path) -> FilterNoise | None:
     if "noise" not in document:
         return None
     return _build(reader, document, "noise", _NOISE_KEYS, FilterNoise)
+
+
+def fitted_for_anchor(path: str | Path) -> bool | None:
+    """Whether a sensor calibration file's terrain statistics are for growth from an anchor.
+
+    :func:`calibrate_logs` fits the statistics either for growth move by move or for growth
+    from an anchor (``ManagerSettings.anchor_growth``), and the numbers of one are no bound
+    for the other: replayed from an anchor, statistics fitted move by move kept the truth
+    in under 1% of the frames of a synthetic log. The file says which (its ``growth``).
+
+    Returns
+    -------
+    bool or None
+        True for ``growth = "anchor"``, False for ``"move"``; None when the file does not
+        say (written before it did).
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`load_sensors`, and for a ``growth`` other than ``"move"`` or ``"anchor"``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from aura_ums.logs import synthetic_log
+    >>> calibration = calibrate_logs([synthetic_log(np.random.default_rng(1), duration=60.0)])
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "floor.sensors.toml"
+    ...     _ = path.write_text(calibration.sensors_toml())
+    ...     fitted_for_anchor(path)
+    False
+    """
+    _, document = _read_sensors(path)
+    growth = document.get("growth")
+    return None if growth is None else growth == _GROWTH_KEYS[True]
 
 
 # --- the fit ---------------------------------------------------------------------------
