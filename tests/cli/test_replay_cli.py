@@ -465,6 +465,9 @@ def test_compare_shows_figures_without_truth_as_n_a_never_nan(log_folder: Path, 
         ("--horizon", "1e308", "--horizon: expected seconds, each <= 86400 (a day), got [1e+308]"),
         # A move of 1 ns cut 20 s of log into 2e10 moves: a MemoryError traceback before.
         ("--move", "1e-9", "--move: expected at most 2000000 moves over the logs' "),
+        # 1e6 moves, but the check of the bounds grows a map over each second's next 20 s of them:
+        # 0.01 s moves and a 600 s horizon on a 13-minute log grew for hours before.
+        ("--move", "2e-5", "--move: expected at most 10,000,000 growths in the check of the bounds"),
         # was named --horizon, which the user never gave
         ("--move", "1e308", "--move: expected seconds <= 86400 (a day, the longest horizon), got 1e+308"),
         ("--move", "5", "--move: expected seconds <= the shortest horizon (1 s of the defaults 1, 2, 5"),

@@ -482,6 +482,11 @@ class _Moves:
 MAX_HORIZON = 86_400.0
 #: Most moves :func:`calibrate_logs` cuts its logs into (about 100 bytes each, per horizon).
 MAX_MOVES = 2_000_000
+#: Most growths of a point map :func:`calibrate_logs`'s check of its own bounds may take
+#: (:func:`horizon_checks`: tens of microseconds each, so minutes at most).
+MAX_CHECK_GROWTHS = 10_000_000
+#: Seconds between the starts of the windows :func:`horizon_checks` grows a map over.
+_CHECK_STRIDE = 1.0
 
 
 def _truth_span(log: RobotLog) -> float:
@@ -810,7 +815,7 @@ def horizon_checks(
     horizons: Sequence[float] = DEFAULT_HORIZONS,
     move: float = 0.5,
     sigmas: float = 3.0,
-    stride: float = 1.0,
+    stride: float = _CHECK_STRIDE,
     anchor: bool = False,
 ) -> tuple[HorizonCheck, ...]:
     """Check growth bounds against logs with ground truth over each horizon.
@@ -1073,6 +1078,15 @@ def calibrate_logs(
         raise InputError(
             f"move: expected at most {MAX_MOVES} moves over the logs' {seconds:g} s with ground truth, "
             f"got about {seconds / step:.3g} moves of {step:g} s"
+        )
+    # The check grows a map from each window's start over the longest horizon, move by move:
+    # a 600 s horizon of 0.01 s moves was about 5e7 growths, hours without a sign.
+    growths = seconds / _CHECK_STRIDE * min(max(spans), seconds) / step
+    if growths > MAX_CHECK_GROWTHS:
+        raise InputError(
+            f"move: expected at most {MAX_CHECK_GROWTHS:,} growths in the check of the bounds (a map grown "
+            f"from the true pose of every {_CHECK_STRIDE:g} s over the longest horizon, {max(spans):g} s), "
+            f"got about {growths:.3g} with moves of {step:g} s: longer moves, or a shorter longest horizon"
         )
     delay = _fit_delay(logs, np.arange(0.0, delay_limit + 1e-9, _DELAY_STEP), step)
     moves = [_moves(log, delay, step) for log in logs]
