@@ -194,10 +194,8 @@ def _linked_into(where: Path, folder: Path) -> bool:
             return False
         with os.scandir(folder) as entries:
             for entry in entries:
-                if entry.is_file():
-                    other = entry.stat()
-                    if (other.st_dev, other.st_ino) == (info.st_dev, info.st_ino):
-                        return True
+                if entry.is_file() and os.path.samestat(entry.stat(), info):
+                    return True
     except OSError:
         return False
     return False

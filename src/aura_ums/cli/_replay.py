@@ -55,6 +55,7 @@ from aura_ums.cli._outputs import (
     Target,
     check_outputs,
     placed,
+    resolved,
     safe_name,
     staged,
     write_text,
@@ -323,7 +324,7 @@ def calibrate(
         raise fail(f"--out: expected a file path, got {str(out)!r}")
     seen: dict[Path, Path] = {}
     for folder in log_dirs:
-        first = seen.setdefault(folder.resolve(), folder)
+        first = seen.setdefault(resolved(folder), folder)
         if first is not folder:  # its windows would count twice, as if two robots had run it
             raise fail(f"LOG_DIRS: expected distinct log folders, got {first} and {folder}, one folder")
     _check_truth_gap(max_truth_gap)
@@ -618,12 +619,8 @@ def replay(
             if mcap_target is not None and not result.steps:
                 # A state saved before any frame has no step to export: refused before any
                 # output is written (the MCAP writer refused it after the others were).
-                raise fail(
-                    "--mcap: expected a replay of at least one frame to export, got none "
-                    f"(--until {until:g} comes before the first frame)"
-                    if until is not None
-                    else "--mcap: expected a replay of at least one frame to export, got none"
-                )
+                early = "" if until is None else f" (--until {until:g} comes before the first frame)"
+                raise fail(f"--mcap: expected a replay of at least one frame to export, got none{early}")
     except AuraUmsError as exc:
         message = str(exc)
         if resume is not None and message.startswith("resume: "):
@@ -765,9 +762,8 @@ def compare(
     ]
     check_outputs([json_target], sources, overwrite=overwrite)
     for source in calibration_logs or ():
-        if (
-            source.resolve() == log_dir.resolve()
-        ):  # the filters would be fitted to the errors they are judged on
+        # The filters would be fitted to the errors they are judged on.
+        if resolved(source) == resolved(log_dir):
             raise fail(
                 f"--noise-from: expected calibration logs other than LOG_DIR, got {source}, which is LOG_DIR "
                 f"{log_dir}: noise fitted on the log compared on flatters the filters"

@@ -1409,21 +1409,16 @@ def _areas(vertices: Sequence[NDArray[np.float64]], rings: _Rings | None = None)
     The polygons of each vertex count are measured together: their coordinates relative to
     their first vertex (the same subtractions), in rows, and the two dot products of each
     row by one ``matmul`` of a row by a column, which numpy computes by the very BLAS dot
-    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers. With ``rings`` (of
-    ``vertices``), each group is gathered from its rows in one indexing.
+    ``polygon_area``'s ``np.dot`` calls on the same contiguous numbers. Each group is
+    gathered from the rows of ``rings`` (of ``vertices``; made here when not given).
     """
-    counts = (
-        np.fromiter(map(len, vertices), dtype=np.int64, count=len(vertices))
-        if rings is None
-        else rings.counts
-    )
+    if rings is None:
+        rings = _Rings(vertices)
+    counts = rings.counts
     areas = np.zeros(len(vertices), dtype=np.float64)  # a point or a segment: 0.0, as polygon_area
     for count in np.unique(counts[counts >= 3]).tolist():
         chosen = np.flatnonzero(counts == count)
-        if rings is None:
-            stack = np.stack([vertices[index] for index in chosen.tolist()])
-        else:  # the same numbers, (polygons, count, 2)
-            stack = rings.every[rings.first[chosen][:, None] + np.arange(count)]
+        stack = rings.every[rings.first[chosen][:, None] + np.arange(count)]  # (polygons, count, 2)
         relative = stack - stack[:, :1, :]
         x, y = np.ascontiguousarray(relative[:, :, 0]), np.ascontiguousarray(relative[:, :, 1])
         x_ahead = np.concatenate((x[:, 1:], x[:, :1]), axis=1)
@@ -1443,12 +1438,12 @@ def _surely_positive(
     give the reported areas), so a value is trusted only beyond a bound on its rounding; a
     polygon within it (a degenerate one, or nearly) is then judged by ``contains`` itself.
     """
-    counts = np.array([len(v) for v in vertices], dtype=np.int64) if rings is None else rings.counts
+    if rings is None:
+        rings = _Rings(vertices)
+    counts = rings.counts
     result = np.zeros(len(vertices))
     if not len(vertices) or counts.min() < 3:
         return np.array([polygon_area(v) > 0.0 for v in vertices], dtype=np.float64)
-    if rings is None:
-        rings = _Rings(vertices)
     every, first = rings.every, rings.first
     origin = np.repeat(every[first], counts, axis=0)  # each polygon's first vertex, as polygon_area
     relative = every - origin

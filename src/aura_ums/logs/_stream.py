@@ -26,7 +26,7 @@ from typing import BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import present, read_folder, regular_file
+from aura_ums._files import _is_row, present, read_folder, regular_file
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -246,9 +246,10 @@ def _file_span(path: Path, units: Units) -> tuple[float, float] | None:
     head_lines = head.decode("utf-8-sig", errors="replace").splitlines()
     if len(head) == _PROBE_BYTES:  # its last line may be cut short
         head_lines = head_lines[:-1]
-    rows = [line.strip() for line in head_lines if line.strip() and not line.lstrip().startswith("#")]
-    ends = [line.strip() for line in tail.decode("utf-8", errors="replace").splitlines()[1:]]
-    last_rows = [line for line in ends if line and not line.startswith("#")]
+    rows = [line.strip() for line in head_lines if _is_row(line)]
+    last_rows = [
+        line.strip() for line in tail.decode("utf-8", errors="replace").splitlines()[1:] if _is_row(line)
+    ]
     if len(rows) < 2 or not last_rows:
         return None
     names = [name.strip() for name in rows[0].split(",")]
@@ -334,6 +335,26 @@ def _wrapped_truth(blocks: Iterator[TruthColumns]) -> Iterator[TruthColumns]:
         yield time, x, y, heading
 
 
+def _read_past(
+    blocks: Iterator[tuple[Array, ...]], latest: float, held: tuple[Array, ...]
+) -> tuple[tuple[Array, ...], bool]:
+    """Return ``held`` joined with the blocks read up to the first one past ``latest``; whether they ended.
+
+    Columns of times first. The window is joined to the blocks once, not once per block
+    (each join copied it again).
+    """
+    parts = [held]
+    ended = True
+    for block in blocks:
+        parts.append(block)
+        if block[0][-1] > latest:
+            ended = False
+            break
+    if len(parts) == 1:
+        return held, ended
+    return tuple(np.concatenate(column) for column in zip(*parts, strict=True)), ended
+
+
 class TruthWindow:
     """The ground truth at increasing times, from its rows read block by block.
 
@@ -358,19 +379,9 @@ class TruthWindow:
 
         The window is joined to the blocks read once (a join per block copied it again each time).
         """
-        parts = [(self.time, self.x, self.y, self.unwrapped)]
-        while True:
-            try:
-                time, x, y, heading = next(self.blocks)
-            except StopIteration:
-                self.ended = True
-                break
-            parts.append((time, x, y, self._unwrapped(heading)))
-            if time[-1] > latest:
-                break
-        if len(parts) > 1:
-            joined = [np.concatenate(column) for column in zip(*parts, strict=True)]
-            self.time, self.x, self.y, self.unwrapped = joined
+        blocks = ((time, x, y, self._unwrapped(heading)) for time, x, y, heading in self.blocks)
+        joined, self.ended = _read_past(blocks, latest, (self.time, self.x, self.y, self.unwrapped))
+        self.time, self.x, self.y, self.unwrapped = joined
 
     def _unwrapped(self, heading: Array) -> Array:
         """Return a block's headings unwrapped, the corrections' running sum carried from the last block."""
@@ -470,28 +481,21 @@ class OdometryReports:
 
         The window is joined to the blocks read once (a join per block copied it again each time).
         """
-        parts = [(self.time, self.v, self.omega)]
-        while True:
-            try:
-                time, v, omega = next(self.blocks)
-            except StopIteration:
-                self.ended = True
-                break
-            reversing = v < 0.0
-            if self.reverse is ReverseMotion.ERROR and np.any(reversing):
-                row = int(np.argmax(reversing))
-                refused = ReversingError(self.read + row, float(v[row]))
-                if self.source is None:
-                    raise refused
-                raise reversed_at(self.source, refused)
-            self.read += len(time)
-            delayed = time + self.meta.delay_s
-            parts.append((delayed, v, omega))
-            if delayed[-1] > high:
-                break
-        if len(parts) > 1:
-            joined = [np.concatenate(column) for column in zip(*parts, strict=True)]
-            self.time, self.v, self.omega = joined
+        blocks = (self._delayed(time, v, omega) for time, v, omega in self.blocks)
+        joined, self.ended = _read_past(blocks, high, (self.time, self.v, self.omega))
+        self.time, self.v, self.omega = joined
+
+    def _delayed(self, time: Array, v: Array, omega: Array) -> tuple[Array, Array, Array]:
+        """Return a block read, its times delayed; refuse backing up unless told what to do with it."""
+        reversing = v < 0.0
+        if self.reverse is ReverseMotion.ERROR and np.any(reversing):
+            row = int(np.argmax(reversing))
+            refused = ReversingError(self.read + row, float(v[row]))
+            if self.source is None:
+                raise refused
+            raise reversed_at(self.source, refused)
+        self.read += len(time)
+        return time + self.meta.delay_s, v, omega
 
     def until(self, frames: Array) -> tuple[Array, Array, Array]:
         """Return the reports (times, turns, runs) after the previous call's last frame up to ``frames[-1]``.

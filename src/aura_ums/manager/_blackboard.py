@@ -147,12 +147,16 @@ class Blackboard:
         """
         if not isinstance(report, PositionReport):
             raise InputError(f"report: expected a PositionReport, got {type(report).__name__}")
+        self._check_after_last(report)
+        self._reports.append(report)
+
+    def _check_after_last(self, report: PositionReport) -> None:
+        """Refuse a report older than the last one posted."""
         if self._reports and report.time < self._reports[-1].time:
             raise InputError(
                 f"report.time: expected a time >= {self._reports[-1].time!r} (the last report's), "
                 f"got {report.time!r}"
             )
-        self._reports.append(report)
 
     def _post_in_order(self, reports: list[PositionReport]) -> None:
         """:meth:`post_report` of each of ``reports``, known to be reports in time order (a replay's).
@@ -162,11 +166,7 @@ class Blackboard:
         """
         if not reports:
             return
-        if self._reports and reports[0].time < self._reports[-1].time:
-            raise InputError(
-                f"report.time: expected a time >= {self._reports[-1].time!r} (the last report's), "
-                f"got {reports[0].time!r}"
-            )
+        self._check_after_last(reports[0])
         self._reports += reports
 
     def post_reports(self, reports: Iterable[PositionReport]) -> None:
