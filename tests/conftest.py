@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import errno
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 # Figures draw off screen however pytest is started (`make test` sets it too): an
 # interactive backend found on a developer's machine would open windows, or wait on them.
@@ -69,3 +72,49 @@ def point_map() -> ums.SpatialUncertaintyMap:
 def figure5_map(terrains: ums.TerrainTable) -> ums.SpatialUncertaintyMap:
     start = ums.SpatialUncertaintyMap.from_pose(ums.Pose(0.0, 0.0, 0.0), 0.0, 0.0)
     return start.grow(ums.TurnAndRun(math.radians(45), 30 * ums.FOOT), terrains["concrete"])
+
+
+class _FullDiskStream:
+    """A text stream over a real one that fails as a full disk does: ENOSPC on a write or on close.
+
+    ``where`` is ``"write"`` (every write after the first fails: the first is a header that
+    fits) or ``"close"`` (writes are buffered and the flush on close fails). The real
+    stream is closed either way, as Python's buffered files close their descriptor.
+    """
+
+    def __init__(self, stream: Any, where: str) -> None:
+        self._stream, self._where, self._writes = stream, where, 0
+
+    def write(self, text: str) -> int:
+        self._writes += 1
+        if self._where == "write" and self._writes > 1:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return int(self._stream.write(text))
+
+    def close(self) -> None:
+        self._stream.close()
+        if self._where == "close":
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    def __enter__(self) -> _FullDiskStream:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()
+
+
+@pytest.fixture
+def full_disk(monkeypatch: pytest.MonkeyPatch) -> Callable[[str, str], None]:
+    """Make files whose name holds ``part``, opened for writing, fail as on a full disk (see above)."""
+    opened = Path.open
+
+    def arm(part: str, where: str) -> None:
+        def opening(path: Path, mode: str = "r", *args: Any, **kwargs: Any) -> Any:
+            stream = opened(path, mode, *args, **kwargs)
+            if part in path.name and any(flag in mode for flag in "wxa"):
+                return _FullDiskStream(stream, where)
+            return stream
+
+        monkeypatch.setattr(Path, "open", opening)
+
+    return arm

@@ -15,12 +15,14 @@ from aura_ums._files import (
     MAX_BYTES,
     MAX_ROWS,
     Fields,
+    atomic_path,
     decode,
     describe,
     key_path,
     load_csv,
     load_json,
     load_toml,
+    make_folders,
     parse_csv,
     parse_json,
     parse_toml,
@@ -349,3 +351,31 @@ def test_a_folder_is_read_only_when_it_is_a_folder_this_process_may_enter(
     ):
         read_folder(locked, kind="log folder")
     locked.chmod(0o755)
+
+
+def test_a_failed_atomic_write_removes_the_folders_it_made_and_keeps_the_others(tmp_path: Path) -> None:
+    kept = tmp_path / "kept"
+    kept.mkdir()
+
+    def write_part(target: Path) -> None:
+        with atomic_path(target) as scratch:
+            scratch.write_text("part")
+            raise OSError(28, "No space left on device")
+
+    for target in (tmp_path / "new" / "deeper" / "a.json", kept / "a.json"):
+        with pytest.raises(OSError, match="No space left"):
+            write_part(target)
+    assert [path.name for path in tmp_path.iterdir()] == ["kept"]
+    assert list(kept.iterdir()) == []
+
+
+def test_make_folders_undoes_what_it_made_when_it_fails(tmp_path: Path) -> None:
+    # The parents are made first; then the last name is refused (too long for the file system).
+    with pytest.raises(OSError, match="File name too long"):
+        make_folders(tmp_path / "a" / "b" / ("x" * 300))
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "file").write_text("")
+    for below in (tmp_path / "file", tmp_path / "file" / "below"):
+        with pytest.raises(NotADirectoryError, match="Not a directory"):
+            make_folders(below)
+    assert [path.name for path in tmp_path.iterdir()] == ["file"]

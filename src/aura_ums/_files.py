@@ -23,6 +23,7 @@ command killed half-way) sees the old file or the whole new one, never a part.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import errno
 import io
@@ -1368,7 +1369,7 @@ def atomic_path(target: str | os.PathLike[str], *, replace: bool = True) -> Iter
     ('whole', 1)
     """
     final = Path(target)
-    final.parent.mkdir(parents=True, exist_ok=True)
+    made = make_folders(final.parent)
     scratch = scratch_path(final)
     try:
         yield scratch
@@ -1378,7 +1379,53 @@ def atomic_path(target: str | os.PathLike[str], *, replace: bool = True) -> Iter
             place_new(scratch, final)
     except BaseException:
         scratch.unlink(missing_ok=True)
+        remove_made(made)
         raise
+
+
+def make_folders(folder: Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; return the ones this call created, innermost first.
+
+    For an output that may yet fail: :func:`remove_made` takes them away again, so that a
+    failed write (a full disk, a Ctrl-C) leaves no empty folder where its output was to go.
+    When the creation itself fails, the folders it did create are removed before the
+    error is raised.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> base = Path(tempfile.mkdtemp())
+    >>> made = make_folders(base / "a" / "b")
+    >>> [path.relative_to(base).as_posix() for path in made]
+    ['a/b', 'a']
+    >>> make_folders(base / "a")          # there already: nothing made
+    []
+    >>> remove_made(made)
+    >>> list(base.iterdir())
+    []
+    """
+    if os.path.lexists(folder) and not folder.is_dir():
+        # mkdir would say "File exists", which reads as if the folder were there.
+        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(folder))
+    missing: list[Path] = []
+    at = folder
+    while not os.path.lexists(at) and at.parent != at:
+        missing.append(at)
+        at = at.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except BaseException:
+        remove_made(missing)
+        raise
+    return missing
+
+
+def remove_made(folders: Sequence[Path]) -> None:
+    """Remove the folders :func:`make_folders` created, innermost first, those still empty."""
+    for folder in folders:
+        # Not empty (another process wrote there meanwhile), or gone: it stays as it is.
+        with contextlib.suppress(OSError):
+            folder.rmdir()
 
 
 def place_new(scratch: Path, final: Path) -> None:

@@ -68,6 +68,9 @@ class FileFormatError(InputError):
     'map.geojson:1:9: expected valid JSON, got Expecting value'
     """
 
+    #: How the message of a file that could not be written begins; the reason follows.
+    UNWRITABLE = "expected a writable file, got "
+
     def __init__(
         self, path: str, where: str, message: str, *, line: int | None = None, column: int | None = None
     ) -> None:
@@ -82,6 +85,19 @@ class FileFormatError(InputError):
         if where:
             location += f": {where}"
         super().__init__(f"{location}: {message}")
+
+    @classmethod
+    def unwritable(cls, path: str, reason: OSError | str) -> FileFormatError:
+        """Return the error of a file that could not be written, for an ``OSError`` or a reason.
+
+        Examples
+        --------
+        >>> str(FileFormatError.unwritable("out/steps.csv", OSError(28, "No space left on device")))
+        'out/steps.csv: expected a writable file, got No space left on device'
+        """
+        if isinstance(reason, OSError):
+            reason = reason.strerror or str(reason)
+        return cls(path, "", f"{cls.UNWRITABLE}{reason}")
 
 
 class UnknownTerrainError(InputError, KeyError):

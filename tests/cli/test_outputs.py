@@ -706,3 +706,80 @@ def test_input_names_too_long_for_the_file_system_are_refused_cleanly(inputs: Pa
     refused(
         invoke(*bag, "--landmarks", tmp_path / long, inputs / "log", tmp_path / "out"), "got no such file"
     )
+
+
+# --- a full disk: the system refuses a write part-way through -----------------------------
+# Found on a 64 KiB tmpfs: a traceback from the MCAP writer, an empty folder left under the
+# name of --plot, and the per-step CSV's scratch file left beside its target.
+
+
+def failed_late(result: Result, *words: str) -> None:
+    """An output that failed after the results were printed: exit 2, the error on stderr, no traceback."""
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert "error: " in result.stderr
+    for word in words:
+        assert word in result.stderr, result.stderr
+
+
+@pytest.mark.parametrize("where", ["write", "close"])
+def test_a_full_disk_under_the_steps_csv_is_a_clean_error_leaving_nothing(
+    where: str, inputs: Path, tmp_path: Path, full_disk: Callable[[str, str], None]
+) -> None:
+    full_disk("steps.csv", where)
+    target = tmp_path / "out" / "steps.csv"
+    result = invoke("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--steps-csv", target)
+    refused(result, f"--steps-csv: expected a writable place, got {target}: No space left on device")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_full_disk_under_the_plot_leaves_no_folder_under_its_name(
+    inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import aura_ums.plot
+
+    def full(*_: object) -> None:  # what matplotlib's savefig raises on a full disk
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(aura_ums.plot, "draw_replay", full)
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    for folder in (tmp_path / "new" / "plots", kept):
+        result = invoke("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--plot", folder)
+        failed_late(result, f"--plot: expected a writable place, got {folder}: No space left on device")
+    # The folders made for the figure are gone; the one that was there stays, empty as it was.
+    assert [path.name for path in tmp_path.iterdir()] == ["kept"]
+    assert list(kept.iterdir()) == []
+
+
+def test_a_full_disk_under_the_mcap_is_a_clean_error_leaving_the_old_file(
+    inputs: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import foxglove
+
+    opened = foxglove.open_mcap
+    # The SDK's own words when its write or its closing flush fails (foxglove-sdk 0.30.3).
+    failure = "FoxgloveError: MCAP error: I/O error from writing, or reading a compression stream"
+
+    class FullDisk:
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            self._writer = opened(*args, **kwargs)
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self._writer, name)
+
+        def __enter__(self) -> FullDisk:
+            return self
+
+        def __exit__(self, *_: object) -> None:
+            self._writer.close()
+            raise RuntimeError(failure)
+
+    monkeypatch.setattr(foxglove, "open_mcap", FullDisk)
+    target = tmp_path / "replay.mcap"
+    target.write_bytes(b"the old file")
+    arguments = ("--terrain", inputs / "terrain.toml", "--mcap", target, "--overwrite")
+    result = invoke("replay", inputs / "log", *arguments)
+    failed_late(result, f"--mcap: expected a writable place, got {target}: {failure}")
+    assert target.read_bytes() == b"the old file"
+    assert [path.name for path in tmp_path.iterdir()] == ["replay.mcap"]

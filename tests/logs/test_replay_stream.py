@@ -5,6 +5,7 @@ from __future__ import annotations
 import gc
 import math
 import tracemalloc
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -117,6 +118,23 @@ def test_a_replay_that_fails_leaves_the_old_csv_and_no_scratch(tmp_path: Path) -
     assert target.read_text(encoding="utf-8") == "old\n"
     assert sorted(path.name for path in tmp_path.iterdir()) == ["folder", "steps.csv"]
     assert [path.name for path in onto_a_folder.iterdir()] == ["keep"]
+
+
+@pytest.mark.parametrize("where", ["write", "close"])
+def test_a_full_disk_leaves_no_csv_no_scratch_and_no_folder_made_for_it(
+    where: str, tmp_path: Path, full_disk: Callable[[str, str], None]
+) -> None:
+    # Found on a 64 KiB tmpfs: the flush on close failed and the scratch file stayed behind.
+    full_disk("steps.csv", where)
+    target = tmp_path / "new" / "deeper" / "steps.csv"
+    log = synthetic_log(np.random.default_rng(3), duration=10.0)
+    if where == "write":  # the write's own error, as the system raised it
+        with pytest.raises(OSError, match="No space left on device"):
+            replay_log(log, FLOOR, OPTIONS, steps_csv=target)
+    else:
+        with pytest.raises(FileFormatError, match=r"steps.csv: expected a writable file, got No space left"):
+            replay_log(log, FLOOR, OPTIONS, steps_csv=target)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:

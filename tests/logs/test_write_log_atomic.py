@@ -7,6 +7,8 @@ deterministic: the writing process kills itself from its own progress callback.
 
 from __future__ import annotations
 
+import errno
+import os
 import signal
 import subprocess
 import sys
@@ -16,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from aura_ums.errors import FileFormatError
 from aura_ums.logs import load_log, log_files_in, synthetic_log, write_log
 
 WRITE = textwrap.dedent(
@@ -77,3 +80,15 @@ def test_progress_counts_the_files_and_an_interrupt_leaves_nothing(tmp_path: Pat
         write_log(log, tmp_path / "a", overwrite=True, progress=stop)
     assert len(load_log(tmp_path / "a").observations) == len(log.observations)
     assert sorted(p.name for p in (tmp_path / "a").iterdir()) == sorted(log_files_in(tmp_path / "a"))
+
+
+def test_a_full_disk_leaves_no_folder_made_for_the_log(tmp_path: Path) -> None:
+    log = synthetic_log(np.random.default_rng(2), duration=10.0)
+
+    def full(done: int, total: int) -> None:  # as a write of the next file would fail
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    target = tmp_path / "new" / "deeper" / "log"
+    with pytest.raises(FileFormatError, match=r"log: expected a writable folder, got No space left"):
+        write_log(log, target, progress=full)
+    assert list(tmp_path.iterdir()) == []

@@ -526,8 +526,12 @@ def test_unreadable_files_are_file_format_errors(tmp_path: Path) -> None:
     binary.write_bytes(b"\xff\xfe\x00")
     with pytest.raises(FileFormatError, match="expected UTF-8 text"):
         MeadowMap.from_geojson(binary)
-    with pytest.raises(FileFormatError, match="expected a writable file"):
-        make_grid_world(1, 1).to_geojson(tmp_path / "no" / "such" / "folder.geojson")
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(FileFormatError, match="expected a writable file, got Not a directory"):
+        make_grid_world(1, 1).to_geojson(tmp_path / "a_file" / "map.geojson")
+    # A missing folder is made (as for every file aura-ums writes), and only the file lands there.
+    make_grid_world(1, 1).to_geojson(tmp_path / "no" / "such" / "folder.geojson")
+    assert [path.name for path in (tmp_path / "no" / "such").iterdir()] == ["folder.geojson"]
 
 
 def test_dict_documents_name_their_source() -> None:

@@ -31,9 +31,10 @@ from typing import Annotated, Any
 
 import typer
 
-from aura_ums._files import NAME_MAX, place_new, scratch_path, write_text_atomic
+from aura_ums._files import NAME_MAX, make_folders, place_new, remove_made, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
 from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN, announce
+from aura_ums.errors import FileFormatError
 
 #: The option every command that writes takes, with the same help everywhere.
 Overwrite = Annotated[
@@ -339,6 +340,14 @@ def placed(target: Target) -> Iterator[Path]:
         raise appeared(target, target.path) from None
     except OSError as exc:
         raise _unwritable(target, target.path, exc) from None
+    except FileFormatError as exc:
+        if exc.path != str(scratch):
+            raise
+        # The library could not write the scratch file (a full disk): the user named the output.
+        reason = exc.message.removeprefix(FileFormatError.UNWRITABLE)
+        if reason == exc.message:
+            raise fail(f"{target.option}: {target.path}: {reason}") from None
+        raise fail(f"{target.option}: expected a writable place, got {target.path}: {reason}") from None
     finally:
         with contextlib.suppress(OSError):  # gone, or its folder never was
             scratch.unlink()
@@ -354,12 +363,12 @@ def staged(target: Target) -> Iterator[Path]:
     """
     final = resolved(target.path)
     try:
-        final.mkdir(parents=True, exist_ok=True)
-        stage = scratch_path(final)
-        stage.mkdir()
+        made = make_folders(final)
     except OSError as exc:
         raise _unwritable(target, final, exc) from None
+    stage = scratch_path(final)
     try:
+        stage.mkdir()
         yield stage
         for path in sorted(p for p in stage.rglob("*") if p.is_file()):
             place = final / path.relative_to(stage)
@@ -369,12 +378,16 @@ def staged(target: Target) -> Iterator[Path]:
             else:
                 place_new(path, place)
             wrote(target.path / path.relative_to(stage))
-    except FileExistsError as exc:
-        raise appeared(target, Path(exc.filename or final)) from None
-    except OSError as exc:
-        raise _unwritable(target, final, exc) from None
-    finally:
+    except BaseException as exc:
         shutil.rmtree(stage, ignore_errors=True)
+        # A folder made for this output and still empty goes too: no empty folder under its name.
+        remove_made(made)
+        if isinstance(exc, FileExistsError):
+            raise appeared(target, Path(exc.filename or final)) from None
+        if isinstance(exc, OSError):
+            raise _unwritable(target, final, exc) from None
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
 
 
 def interruptible(command: Callable[..., None]) -> Callable[..., None]:

@@ -28,6 +28,9 @@ from aura_ums.world import MeadowMap
 if TYPE_CHECKING:
     from aura_ums.logs import WindowReport, WindowRow
 
+#: How the SDK's errors begin (foxglove-sdk 0.30 has no exception class of its own).
+_SDK_ERROR = "FoxgloveError"
+
 #: Reports ``(done, total)`` units of work after each one (the CLI draws it as a bar).
 Progress = Callable[[int, int], None]
 
@@ -49,7 +52,13 @@ def _mcap(path: Path, kind: str, name: str) -> Iterator[foxglove.Context]:
                 )
                 yield context
     except OSError as exc:
-        raise FileFormatError(str(path), "", f"expected a writable file, got {exc.strerror or exc}") from exc
+        raise FileFormatError.unwritable(str(path), exc) from exc
+    except RuntimeError as exc:
+        # The SDK reports its own I/O failures (a full disk while it writes or closes the
+        # file) as a RuntimeError naming itself; any other RuntimeError is not ours to word.
+        if not str(exc).startswith(_SDK_ERROR):
+            raise
+        raise FileFormatError.unwritable(str(path), str(exc)) from exc
 
 
 def _report(progress: Progress | None, done: int, total: int) -> None:

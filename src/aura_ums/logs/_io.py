@@ -34,11 +34,13 @@ from aura_ums._files import (
     describe,
     key_path,
     load_toml,
+    make_folders,
     parse_csv,
     present,
     read_csv_floats,
     read_folder,
     read_text,
+    remove_made,
     scratch_path,
 )
 from aura_ums._validate import (
@@ -1058,13 +1060,14 @@ def write_log(
         else:
             _write_fresh(base, files, progress)
     except OSError as exc:
-        raise FileFormatError(str(base), "", f"expected a writable folder, got {exc}") from exc
+        reason = exc.strerror or exc
+        raise FileFormatError(str(base), "", f"expected a writable folder, got {reason}") from exc
     return base
 
 
 def _write_fresh(base: Path, files: Mapping[str, str], progress: Callable[[int, int], None] | None) -> None:
     """Write a whole new folder under a scratch name, then rename it onto ``base`` (absent or empty)."""
-    base.parent.mkdir(parents=True, exist_ok=True)
+    made = make_folders(base.parent)
     scratch = scratch_path(base)
     try:
         scratch.mkdir()
@@ -1076,6 +1079,7 @@ def _write_fresh(base: Path, files: Mapping[str, str], progress: Callable[[int, 
         os.replace(scratch, base)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
+        remove_made(made)  # no empty folders left where the log was to go
         raise
 
 

@@ -17,7 +17,7 @@ from typing import TextIO, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import scratch_path
+from aura_ums._files import make_folders, remove_made, scratch_path
 from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
@@ -1528,20 +1528,20 @@ class _StepsCsv:
         self.target = None if target is None else Path(target)
         self.scratch: Path | None = None
         self.stream: TextIO | None = None
+        self.made: list[Path] = []
 
     def __enter__(self) -> _StepsCsv:
         if self.target is not None:
             target = self.target
             self.scratch = scratch_path(target)
             try:
-                target.parent.mkdir(parents=True, exist_ok=True)
+                self.made = make_folders(target.parent)
                 # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay).
                 self.stream = self.scratch.open("x", encoding="utf-8", newline="")
                 self.stream.write(STEPS_CSV_HEADER + "\n")
             except OSError as exc:
-                raise FileFormatError(
-                    str(target), "", f"expected a writable file, got {exc.strerror or exc}"
-                ) from None
+                self._discard()
+                raise self._unwritable(exc) from None
         return self
 
     def write(self, trace: ReplayTrace) -> None:
@@ -1551,17 +1551,31 @@ class _StepsCsv:
     def __exit__(self, kind: object, error: object, traceback: object) -> None:
         if self.stream is None or self.scratch is None or self.target is None:
             return
-        self.stream.close()
-        if error is not None:
-            self.scratch.unlink(missing_ok=True)
-            return
         try:
-            os.replace(self.scratch, self.target)
+            # Closing writes the last buffered lines: on a full disk it fails as a write does.
+            self.stream.close()
+            if error is None:
+                os.replace(self.scratch, self.target)
+                return
         except OSError as exc:
+            self._discard()
+            if error is None:
+                raise self._unwritable(exc) from None
+            # The error already on its way (maybe this same one, from a write) says more.
+            return
+        self._discard()
+
+    def _discard(self) -> None:
+        """Remove the scratch file (its stream closed, or never opened) and the folders made for it."""
+        if self.stream is not None:
+            with contextlib.suppress(OSError):
+                self.stream.close()
+        if self.scratch is not None:
             self.scratch.unlink(missing_ok=True)
-            raise FileFormatError(
-                str(self.target), "", f"expected a writable file, got {exc.strerror or exc}"
-            ) from None
+        remove_made(self.made)
+
+    def _unwritable(self, exc: OSError) -> FileFormatError:
+        return FileFormatError.unwritable(str(self.target), exc)
 
 
 def _digest(frames: Mapping[float, list[LogObservation]], times: np.ndarray) -> str:

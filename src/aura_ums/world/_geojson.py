@@ -15,7 +15,7 @@ from typing import NoReturn
 
 import numpy as np
 
-from aura_ums._files import Fields, describe, load_json, regular_file
+from aura_ums._files import Fields, describe, load_json, regular_file, write_text_atomic
 from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, POSITION_UNCERTAINTY, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
@@ -399,6 +399,6 @@ def write_geojson(meadow_map: MeadowMap, path: str | Path) -> None:
     lines.append("  ]")
     lines.append("}")
     try:
-        Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+        write_text_atomic(path, "\n".join(lines) + "\n")
     except OSError as exc:
-        raise FileFormatError(str(path), "", f"expected a writable file, got {exc.strerror}") from exc
+        raise FileFormatError.unwritable(str(path), exc) from exc

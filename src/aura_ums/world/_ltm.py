@@ -514,7 +514,14 @@ expected the id of a landmark feature, got 'pole'
     def to_geojson(self, path: str | Path) -> None:
         """Write the map to a GeoJSON file that :meth:`from_geojson` reads back exactly.
 
-        One feature per line; floats are written with ``repr`` precision.
+        One feature per line; floats are written with ``repr`` precision. The file is
+        written atomically (its folder made when missing): a failed write, on a full disk
+        say, leaves the old file, or none.
+
+        Raises
+        ------
+        FileFormatError
+            When the file cannot be written, with the system's reason.
         """
         from aura_ums.world._geojson import write_geojson
 
