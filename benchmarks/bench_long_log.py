@@ -48,6 +48,12 @@ How to read it:
   the update (0.57 s), opening the log (0.19 s) and reading the odometry (about 0.12 s)
   already pass the 0.97 s that tenfold against f47bbb6 would allow: issue 19's tenfold
   gain needs the per-step update compiled, not more small savings.
+- A frame every row (10^6 rows, 932,437 steps; ``--rows 1000000 --frame-every 1``), one
+  run of each on 29 November about 11:12 UTC, load about 1: this tree 0.43, 45.0, 78.0 s
+  and 232 MB; f47bbb6 19.3, 70.7, 248 s and 2,799 MB: 3.2x. Here every step costs: 84 us
+  a step in all, 48 of them the manager's update and 36 the rest of the replay (posting,
+  judging, the trace and the CSV). Tenfold at this shape would need 27 us a step in all,
+  so not only the update but the replay's whole step loop compiled.
 
 Earlier series (27 and 28 November, before the compiled CSV reader and the per-step
 trimming) are in the repository's history of this file.

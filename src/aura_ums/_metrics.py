@@ -14,7 +14,6 @@ import json
 import math
 import numbers
 import os
-import secrets
 import types
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import InitVar, dataclass, field
@@ -684,25 +683,19 @@ class Metrics(Mapping[str, "MetricValue"]):
         """Write :meth:`to_json` to ``path`` atomically and return the path.
 
         The text goes to a temporary file in the target folder (created when missing),
-        which then replaces ``path``: a reader sees the old file or the whole new one.
+        which then replaces ``path``: a reader sees the old file or the whole new one, and
+        a failed write leaves neither a temporary file nor a folder made for it.
 
         Raises
         ------
         OSError
             When the folder cannot be created or written.
         """
+        # Imported here: reading metrics (the CLI's start-up) does not need the file layer's numpy.
+        from aura_ums._files import write_text_atomic
+
         target = Path(path)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        text = self.to_json()
-        # Not tempfile.mkstemp: its 0600 mode would stay on the result; "x" honours the umask.
-        scratch = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
-        try:
-            with scratch.open("x", encoding="utf-8") as stream:
-                stream.write(text)
-            os.replace(scratch, target)
-        except BaseException:
-            scratch.unlink(missing_ok=True)
-            raise
+        write_text_atomic(target, self.to_json())
         return target
 
     def lines(self) -> tuple[str, ...]:

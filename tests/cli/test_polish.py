@@ -5,7 +5,10 @@ from __future__ import annotations
 import io
 import itertools
 import json
+import os
 import shutil
+import subprocess
+import sys
 from importlib.metadata import version
 from pathlib import Path
 
@@ -49,6 +52,29 @@ def invoke(*arguments: object) -> Result:
 def test_version_is_the_installed_one() -> None:
     result = invoke("--version")
     assert result.stdout == f"aura-ums {version('aura-ums')}\n"
+
+
+@pytest.mark.parametrize(
+    "arguments", [["replay", "--help"], ["replay", "SAMPLE", "-q", "--terrain", "TERRAIN"]]
+)
+def test_a_stream_that_cannot_encode_every_character_gets_them_escaped(
+    arguments: list[str], tmp_path: Path
+) -> None:
+    # The help's ellipsis raised UnicodeEncodeError on an ASCII stdout: a traceback, exit 1.
+    terrain = floor_terrain(tmp_path / "terrain.toml")
+    given = [str(SAMPLE) if a == "SAMPLE" else str(terrain) if a == "TERRAIN" else a for a in arguments]
+    script = "from aura_ums.cli import main; main()"
+    done = subprocess.run(
+        [sys.executable, "-c", script, *given],
+        capture_output=True,
+        env={**os.environ, "PYTHONIOENCODING": "ascii", "COLUMNS": "80"},
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr.decode("ascii", "replace")
+    assert b"Traceback" not in done.stderr
+    assert done.stdout
+    assert done.stdout.isascii()
 
 
 @pytest.mark.parametrize("command", ["simulate", "replay", "compare", "calibrate", "import mrclam", "demo"])

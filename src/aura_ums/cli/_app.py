@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import stat
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -291,4 +293,19 @@ app.command(cls=PlainCommand)(interruptible(compare))
 
 def main() -> None:
     """Entry point of the ``aura-ums`` console script."""
+    _tolerant_streams()
     app()
+
+
+def _tolerant_streams() -> None:
+    """Let stdout and stderr show what their encoding cannot, escaped, instead of failing.
+
+    The help and the tables hold a few characters beyond ASCII (an ellipsis, a micro
+    sign); on a stream that cannot encode them (``PYTHONIOENCODING=ascii``, an old
+    console's code page) printing raised UnicodeEncodeError, a traceback, after the
+    command had done its work. A UTF-8 stream is left exactly as it is.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "").lower().replace("-", "")
+        if encoding != "utf8" and isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
