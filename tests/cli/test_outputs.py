@@ -783,3 +783,33 @@ def test_a_full_disk_under_the_mcap_is_a_clean_error_leaving_the_old_file(
     failed_late(result, f"--mcap: expected a writable place, got {target}: {failure}")
     assert target.read_bytes() == b"the old file"
     assert [path.name for path in tmp_path.iterdir()] == ["replay.mcap"]
+
+
+@pytest.mark.skipif(
+    not Path("/dev/full").exists(), reason="needs /dev/full (Linux), a device that is always full"
+)
+@pytest.mark.parametrize("arguments", [["--version"], ["replay", "LOG", "--terrain", "TERRAIN", "--quiet"]])
+def test_a_stdout_that_takes_nothing_is_a_clean_error(arguments: list[str], inputs: Path) -> None:
+    # The results printed onto a full device raised OSError: a traceback, exit 1.
+    import subprocess
+    import sys
+
+    names = {"LOG": str(inputs / "log"), "TERRAIN": str(inputs / "terrain.toml")}
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "from aura_ums.cli import main; main()",
+                *(names.get(a, a) for a in arguments),
+            ],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            check=False,
+            timeout=120,
+        )
+    assert done.returncode == 2, done.stderr
+    assert (
+        done.stderr == "error: stdout: expected a place to print the results, got No space left on device\n"
+    )

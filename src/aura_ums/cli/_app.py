@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import os
 import stat
 import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.console import Console
 
 from aura_ums.cli._campaign import (
     DEFAULTS,
@@ -294,7 +296,38 @@ app.command(cls=PlainCommand)(interruptible(compare))
 def main() -> None:
     """Entry point of the ``aura-ums`` console script."""
     _tolerant_streams()
-    app()
+    try:
+        app()
+    except OSError as exc:
+        # Every output file's failure is worded where it is written; stdout's own (a full
+        # disk, a device that takes nothing) is told by where it was raised.
+        if not _raised_writing_stdout(exc):
+            raise
+        _drop_stdout()
+        # Past typer's own handling: its Exit would not become an exit status here.
+        refusal = fail(f"stdout: expected a place to print the results, got {exc.strerror or exc}")
+        raise SystemExit(refusal.exit_code) from None
+
+
+def _raised_writing_stdout(exc: BaseException) -> bool:
+    """Whether ``exc`` came from a console writing to stdout (rich's write of its buffer)."""
+    innermost = exc.__traceback__
+    if innermost is None:
+        return False
+    while innermost.tb_next is not None:
+        innermost = innermost.tb_next
+    writer = innermost.tb_frame.f_locals.get("self")
+    return isinstance(writer, Console) and writer.file is sys.stdout
+
+
+def _drop_stdout() -> None:
+    """Send what is left for stdout nowhere: the interpreter's last flush would fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def _tolerant_streams() -> None:
