@@ -813,3 +813,27 @@ def test_a_stdout_that_takes_nothing_is_a_clean_error(arguments: list[str], inpu
     assert (
         done.stderr == "error: stdout: expected a place to print the results, got No space left on device\n"
     )
+
+
+def test_memory_refused_by_the_system_is_a_clean_error() -> None:
+    # Under a tight `ulimit -v` a replay of an MRCLAM log raised MemoryError: a traceback, exit 1.
+    import subprocess
+    import sys
+
+    script = (
+        "import aura_ums.cli._app as cli\n"
+        "def exhausted():\n"
+        "    held = [bytearray(10**6) for _ in range(20)]  # what the frames keep until they are left\n"
+        "    raise MemoryError\n"
+        "cli.app = exhausted\n"
+        "cli.main()\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=False, timeout=60
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(
+        "error: memory: expected what this command needs, got a refusal from the system"
+    )
+    assert "ulimit -v" in done.stderr
+    assert "Traceback" not in done.stderr

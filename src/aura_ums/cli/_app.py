@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import os
 import stat
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NoReturn
 
 import typer
 from rich.console import Console
@@ -296,6 +297,7 @@ app.command(cls=PlainCommand)(interruptible(compare))
 def main() -> None:
     """Entry point of the ``aura-ums`` console script."""
     _tolerant_streams()
+    out_of_memory = False
     try:
         app()
     except OSError as exc:
@@ -307,6 +309,32 @@ def main() -> None:
         # Past typer's own handling: its Exit would not become an exit status here.
         refusal = fail(f"stdout: expected a place to print the results, got {exc.strerror or exc}")
         raise SystemExit(refusal.exit_code) from None
+    except MemoryError:
+        # Said below, once this block is left: the exception holds the frames that hold the
+        # arrays, and printing needs memory too.
+        out_of_memory = True
+    if out_of_memory:
+        _say_out_of_memory()
+
+
+#: Counts that would exhaust memory are refused from an estimate before any work; this is
+#: the system refusing memory all the same (a tight ``ulimit -v``, a crowded machine).
+_OUT_OF_MEMORY = (
+    "error: memory: expected what this command needs, got a refusal from the system (MemoryError); "
+    "files already written stay whole, nothing else was written. Raise the process's memory limit "
+    "(ulimit -v) or free memory, then run it again\n"
+)
+
+
+def _say_out_of_memory() -> NoReturn:
+    """Say on stderr that memory ran out (plainly: rich's rendering needs memory) and exit 2."""
+    try:
+        sys.stderr.write(_OUT_OF_MEMORY)
+        sys.stderr.flush()
+    except (MemoryError, OSError, ValueError):
+        with contextlib.suppress(OSError):
+            os.write(2, _OUT_OF_MEMORY.encode("ascii", "replace"))
+    raise SystemExit(2)
 
 
 def _raised_writing_stdout(exc: BaseException) -> bool:
