@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from aura_ums._files import parse_csv, parse_csv_floats, read_csv_floats, read_text
+from aura_ums._files import CsvFloats, csv_blocks, parse_csv, parse_csv_floats, read_csv_floats, read_text
 from aura_ums.errors import FileFormatError
 
 COLUMNS = ("time", "v", "omega")
@@ -108,3 +108,23 @@ def test_files_it_cannot_read_go_to_the_reader_whose_message_names_them(tmp_path
     rows.write_bytes(b"time,v,omega\n1,2,3\n4,5,6\n7,8,9\n")
     assert read_csv_floats(rows, columns=COLUMNS, max_rows=2, block_bytes=16) is None
     assert read_csv_floats(rows, columns=COLUMNS, max_rows=3, block_bytes=16) is not None
+
+
+@pytest.mark.parametrize("change", ["cut short", "written on"])
+def test_a_file_that_changes_while_it_is_read_is_refused_not_read_twice(change: str, tmp_path: Path) -> None:
+    # A replay whose odometry.csv was cut short under it went on without the rest, exit 0.
+    path = tmp_path / "odometry.csv"
+    path.write_text("time,v,omega\n" + "".join(f"{i},0.5,0.01\n" for i in range(2000)))
+    size = path.stat().st_size
+    blocks = csv_blocks(path, columns=COLUMNS, numeric=True, block_bytes=4096)
+    first = next(blocks)
+    assert isinstance(first, CsvFloats)
+    assert first.values[0].tolist() == [0.0, 0.5, 0.01]
+    with path.open("r+b") as stream:
+        if change == "cut short":
+            stream.truncate(size // 2 + 3)  # mid-row, as a cut file ends
+        else:
+            stream.seek(0, 2)
+            stream.write(b"2000,0.5,0.01\n")
+    with pytest.raises(FileFormatError, match=r"odometry.csv: expected the file as it was when it was open"):
+        list(blocks)

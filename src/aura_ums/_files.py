@@ -898,10 +898,11 @@ def csv_blocks(
         raise CsvFallbackError from None
     with handle:
         try:
-            if os.fstat(handle.fileno()).st_size > limit:
-                raise CsvFallbackError
+            opened = os.fstat(handle.fileno())
         except OSError:
             raise CsvFallbackError from None
+        if opened.st_size > limit:
+            raise CsvFallbackError
         header_text: str | None = None
         rows = 0
         lines_before = 0  # lines of the file before the block
@@ -912,6 +913,8 @@ def csv_blocks(
                 chunk = handle.read(block_bytes)
             except OSError:
                 raise CsvFallbackError from None
+            if not chunk:
+                _unchanged(handle, opened, source)
             data = carry + chunk
             if chunk:
                 cut = data.rfind(b"\n") + 1
@@ -968,6 +971,27 @@ def csv_blocks(
                     yield CsvTable(source, found.header, found.header_line, found.rows, tuple(lines.tolist()))
             if not chunk:
                 return
+
+
+def _unchanged(handle: io.BufferedReader, opened: os.stat_result, source: str) -> None:
+    """Refuse a file that changed between its opening and the end of its reading.
+
+    Read block by block, a file cut short (or written on) meanwhile would give rows from
+    two versions of it, its last one perhaps cut mid-number, and no error: a replay went on
+    without the odometry's end and lost the truth with exit 0. Not a fallback: reading the
+    whole file again would read the changed one.
+    """
+    try:
+        now = os.fstat(handle.fileno())
+    except OSError:
+        return
+    if (now.st_size, now.st_mtime_ns) != (opened.st_size, opened.st_mtime_ns):
+        raise FileFormatError(
+            source,
+            "",
+            f"expected the file as it was when it was opened ({opened.st_size} bytes), got one changed "
+            f"while it was read ({now.st_size} bytes now); read it again once nothing writes to it",
+        )
 
 
 def _decoded(block: bytes) -> str:
