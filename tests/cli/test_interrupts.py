@@ -219,3 +219,29 @@ def test_a_ctrl_c_after_the_command_keeps_its_exit_status(moment: str) -> None:
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("aura-ums ")
     assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("stop", ["SIGTERM", "SIGHUP"])
+def test_a_request_to_stop_is_met_as_a_ctrl_c_with_its_own_exit_code(
+    stop: str, inputs: Path, tmp_path: Path
+) -> None:
+    # SIGTERM (kill, timeout, a cancelled CI job) ended the process by the signal, said
+    # nothing and left the per-step CSV's scratch file behind.
+    from tests.logs.log_helpers import long_odometry_log
+
+    log = write_log(long_odometry_log(300_000), tmp_path / "long")
+    out = tmp_path / "out"
+    out.mkdir()
+    cli = Path(sys.executable).with_name("aura-ums")
+    command = [str(cli), "replay", str(log), "--terrain", str(inputs / "terrain.toml"), "--quiet"]
+    command += ["--steps-csv", str(out / "steps.csv"), "--metrics-json", str(out / "metrics.json")]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    waited = time.monotonic()
+    while not any(out.iterdir()) and process.poll() is None and time.monotonic() - waited < 60:
+        time.sleep(0.01)  # until the replay writes its scratch CSV: well inside the command
+    process.send_signal(getattr(signal, stop))
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 128 + getattr(signal, stop), stderr
+    assert "Traceback" not in stderr
+    assert f"error: terminated ({stop}): nothing was written" in stderr
+    assert list(out.iterdir()) == []

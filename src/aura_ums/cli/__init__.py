@@ -8,7 +8,7 @@ the command line itself are still loading.
 from __future__ import annotations
 
 from aura_ums import TYPE_CHECKING
-from aura_ums.cli._interrupt import INTERRUPTED, say_interrupted
+from aura_ums.cli._interrupt import INTERRUPTED, TERMINATION_SIGNALS, exit_code, say_interrupted
 
 if TYPE_CHECKING:
     from types import FrameType
@@ -30,10 +30,11 @@ def main() -> None:
         from aura_ums.cli._app import main as run
 
         run()
-    except KeyboardInterrupt:
-        _finish_on_interrupt(INTERRUPTED)
-        say_interrupted()
-        raise SystemExit(INTERRUPTED) from None
+    except KeyboardInterrupt as stop:  # a Ctrl-C, or a Terminated (SIGTERM, SIGHUP)
+        code = exit_code(stop)
+        _finish_on_interrupt(code)
+        say_interrupted(stop)
+        raise SystemExit(code) from None
     except SystemExit as exc:
         _finish_on_interrupt(_status(exc.code))
         if exc.code == INTERRUPTED:  # typer's own answer to a Ctrl-C while it reads the arguments
@@ -73,6 +74,10 @@ def _finish_on_interrupt(status: int) -> None:
 
     with contextlib.suppress(ValueError):  # not the main thread: an embedding caller's signals
         signal.signal(signal.SIGINT, finish)
+        for name in TERMINATION_SIGNALS:  # a request to stop, now: the same
+            number = getattr(signal, name, None)
+            if number is not None and getattr(signal.getsignal(number), "stops_the_command", False):
+                signal.signal(number, finish)
         # Python puts back the default action of SIGINT after the exit functions, before it
         # tears the modules down, unless it is ignored: a Ctrl-C in that last stretch would
         # end the process by the signal. By then nothing is left that a Ctrl-C could stop.

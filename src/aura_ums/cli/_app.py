@@ -51,6 +51,7 @@ from aura_ums.cli._interop import (
     rosbag_command,
     write_simulation_mcap_option,
 )
+from aura_ums.cli._interrupt import TERMINATION_SIGNALS, Terminated
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, staged, write_text
 from aura_ums.cli._replay import calibrate, compare, replay
@@ -297,6 +298,7 @@ app.command(cls=PlainCommand)(interruptible(compare))
 def main() -> None:
     """Entry point of the ``aura-ums`` console script."""
     _tolerant_streams()
+    _stop_as_on_ctrl_c()
     out_of_memory = False
     try:
         app()
@@ -335,6 +337,28 @@ def _say_out_of_memory() -> NoReturn:
         with contextlib.suppress(OSError):
             os.write(2, _OUT_OF_MEMORY.encode("ascii", "replace"))
     raise SystemExit(2)
+
+
+def _stop_as_on_ctrl_c() -> None:
+    """Make SIGTERM and SIGHUP stop the command as a Ctrl-C does (:class:`Terminated`).
+
+    By default they end the process at once: `timeout`, `kill`, a CI runner cancelling a
+    job or a closed terminal left a command's scratch files behind, said nothing, and
+    ended it by the signal. A signal someone chose to ignore (``nohup``) stays ignored.
+    """
+    import signal
+
+    def stop(signum: int, frame: object) -> None:
+        raise Terminated(signum, signal.Signals(signum).name)
+
+    stop.stops_the_command = True  # type: ignore[attr-defined]  # told apart at the end (cli.main)
+    for name in TERMINATION_SIGNALS:
+        number = getattr(signal, name, None)
+        if number is None:  # not on this system (SIGHUP on Windows)
+            continue
+        with contextlib.suppress(ValueError, OSError):  # not the main thread: the caller's signals
+            if signal.getsignal(number) is signal.SIG_DFL:
+                signal.signal(number, stop)
 
 
 def _raised_writing_stdout(exc: BaseException) -> bool:

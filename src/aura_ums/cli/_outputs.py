@@ -33,7 +33,7 @@ import typer
 
 from aura_ums._files import NAME_MAX, make_folders, place_new, remove_made, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
-from aura_ums.cli._interrupt import INTERRUPTED, NOTHING_WRITTEN, announce
+from aura_ums.cli._interrupt import NOTHING_WRITTEN, announce, exit_code, stopped
 from aura_ums.errors import FileFormatError
 
 #: The option every command that writes takes, with the same help everywhere.
@@ -399,15 +399,15 @@ def interruptible(command: Callable[..., None]) -> Callable[..., None]:
         _replacing[0] = False
         try:
             command(*args, **kwargs)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as stop:  # a Ctrl-C, or a Terminated (SIGTERM, SIGHUP)
             if _written:
                 done = ", ".join(str(path) for path in _written)
-                message = f"interrupted: only {done} written whole; nothing else was written"
+                message = f"{stopped(stop)}: only {done} written whole; nothing else was written"
             else:
-                message = NOTHING_WRITTEN
+                message = NOTHING_WRITTEN.replace("interrupted", stopped(stop), 1)
             err_console.print(f"[red]error:[/red] {_escape(message)}", highlight=False)
             announce()
-            raise typer.Exit(code=INTERRUPTED) from None
+            raise typer.Exit(code=exit_code(stop)) from None
 
     return run
 
