@@ -837,3 +837,17 @@ def test_memory_refused_by_the_system_is_a_clean_error() -> None:
     )
     assert "ulimit -v" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_an_output_that_is_a_looping_link_is_refused_before_the_computation(
+    inputs: Path, tmp_path: Path
+) -> None:
+    # It passed the checks, then the final rename refused it "as appeared while this command ran".
+    loop = tmp_path / "loop.json"
+    loop.symlink_to(loop.name)
+    given = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", loop)
+    refused(invoke(*given), f"--metrics-json: expected a new file, got {loop}, a symbolic link that loops")
+    assert loop.is_symlink()
+    assert invoke(*given, "--overwrite").exit_code == 0
+    assert not loop.is_symlink()
+    assert loop.read_text().startswith("{")

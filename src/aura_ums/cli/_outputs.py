@@ -248,6 +248,13 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
             f"{target.option}: expected a new file, got {target.path}, which exists "
             "(pass --overwrite to replace it)"
         )
+    if os.path.lexists(where) and not where.exists() and not overwrite:
+        # Resolved as far as it goes, a link that loops is still a name that is taken: the
+        # final rename would refuse it, after the computation, as if it had just appeared.
+        raise fail(
+            f"{target.option}: expected a new file, got {target.path}, a symbolic link that loops "
+            "(pass --overwrite to replace the link with the file)"
+        )
 
 
 def _followed(path: Path) -> os.stat_result | None:
