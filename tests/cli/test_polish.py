@@ -77,6 +77,22 @@ def test_a_stream_that_cannot_encode_every_character_gets_them_escaped(
     assert done.stdout.isascii()
 
 
+def test_a_misspelt_matplotlib_backend_in_the_environment_does_not_stop_a_figure(tmp_path: Path) -> None:
+    # MPLBACKEND=nonexistent made `import matplotlib` raise: a ValueError traceback from --plot.
+    terrain = floor_terrain(tmp_path / "terrain.toml")
+    arguments = ["replay", str(SAMPLE), "-q", "--terrain", str(terrain), "--plot", str(tmp_path / "plots")]
+    done = subprocess.run(
+        [sys.executable, "-c", "from aura_ums.cli import main; main()", *arguments],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "MPLBACKEND": "nonexistent"},
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert [path.suffix for path in (tmp_path / "plots").iterdir()] == [".png"]
+
+
 @pytest.mark.parametrize("command", ["simulate", "replay", "compare", "calibrate", "import mrclam", "demo"])
 def test_help_shows_flags_and_brackets_as_written(command: str) -> None:
     result = runner.invoke(app, [*command.split(), "--help"], env={"COLUMNS": "200"})

@@ -299,6 +299,10 @@ def main() -> None:
     """Entry point of the ``aura-ums`` console script."""
     _tolerant_streams()
     _stop_as_on_ctrl_c()
+    # The command line only writes figure files (through Agg canvases), never shows one: a
+    # backend named in the environment is never needed, and a misspelt one made matplotlib's
+    # import fail (a ValueError traceback from --plot, figures and demo).
+    os.environ["MPLBACKEND"] = "agg"
     out_of_memory = False
     try:
         app()
