@@ -25,7 +25,7 @@ from aura_ums.campaign import (
     run_seeds,
     simulate_campaign,
 )
-from aura_ums.errors import InputError, MissingDependencyError, RunLostError
+from aura_ums.errors import AuraUmsError, InputError, MissingDependencyError, RunLostError
 from aura_ums.geometry import ImageWindow
 from aura_ums.logs import ReplayOptions, calibrate_logs, synthetic_log, write_log
 from aura_ums.manager import MapProfile
@@ -300,3 +300,17 @@ def test_a_restart_after_which_no_worker_returns_fails_the_campaign_by_name() ->
         engine._time_out(client, runs, 1.0)  # type: ignore[arg-type]
     assert client.restarted == ["tcp://stuck"]
     assert runs.retried == {0}
+
+
+def test_local_workers_that_cannot_start_are_named_not_a_traceback() -> None:
+    # A Dask setting the workers cannot read (DASK_DISTRIBUTED__WORKER__MEMORY__TARGET=abc in
+    # the environment) was "RuntimeError: Nanny failed to start." through a traceback.
+    import dask
+
+    with (
+        dask.config.set({"distributed.worker.memory.target": "abc"}),
+        pytest.raises(
+            AuraUmsError, match=r"^workers: expected 2 local Dask workers to start, got RuntimeError"
+        ),
+    ):
+        run_campaign(abs, [1], CampaignSettings(workers=2))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from aura_ums.campaign._settings import CampaignSettings
-from aura_ums.errors import InputError, MissingDependencyError, RunLostError
+from aura_ums.errors import AuraUmsError, InputError, MissingDependencyError, RunLostError
 
 if TYPE_CHECKING:
     from distributed import Client, Future
@@ -203,16 +203,29 @@ def _client(settings: CampaignSettings) -> Iterator[Client]:
         # Loopback only; no dashboard; the workers' log lines stay out of the terminal: a task's
         # error comes back to the caller, who words it (a worker's 'Compute Failed' and a
         # traceback printed before the clean message was noise).
-        cluster = LocalCluster(
-            n_workers=settings.workers,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=None,
-            silence_logs=logging.CRITICAL,
-            # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
-            scheduler_kwargs={"allowed_failures": 0, "dashboard": False, "dashboard_address": "127.0.0.1:0"},
-        )
+        try:
+            cluster = LocalCluster(
+                n_workers=settings.workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=logging.CRITICAL,
+                # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
+                scheduler_kwargs={
+                    "allowed_failures": 0,
+                    "dashboard": False,
+                    "dashboard_address": "127.0.0.1:0",
+                },
+            )
+        except (RuntimeError, OSError, ValueError, TypeError, TimeoutError) as exc:
+            # "Nanny failed to start", from a worker that could not: a Dask setting it read
+            # (DASK_... in the environment, a configuration file) or the machine refusing it.
+            raise AuraUmsError(
+                f"workers: expected {settings.workers} local Dask workers to start, got "
+                f"{type(exc).__name__}: {exc} (look at Dask's settings: DASK_* variables in the "
+                "environment, files in ~/.config/dask)"
+            ) from None
         with cluster, Client(cluster, set_as_default=False) as client:
             yield client
 
