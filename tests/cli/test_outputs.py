@@ -851,3 +851,35 @@ def test_an_output_that_is_a_looping_link_is_refused_before_the_computation(
     assert invoke(*given, "--overwrite").exit_code == 0
     assert not loop.is_symlink()
     assert loop.read_text().startswith("{")
+
+
+def test_a_deleted_current_folder_is_said_not_a_traceback(inputs: Path, tmp_path: Path) -> None:
+    # os.getcwd() raised FileNotFoundError from the first relative path resolved.
+    import subprocess
+    import sys
+
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    script = "import os; os.rmdir(os.getcwd()); from aura_ums.cli import main; main()"
+    given = [
+        "replay",
+        str(inputs / "log"),
+        "--terrain",
+        str(inputs / "terrain.toml"),
+        "--metrics-json",
+        "m.json",
+    ]
+    done = subprocess.run(
+        [sys.executable, "-c", script, *given],
+        cwd=gone,
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr
+    assert done.stderr.startswith(
+        "warning: relative paths cannot be found: a current folder that was deleted"
+    )
+    assert "error: m.json: expected a path from an existing current folder" in done.stderr

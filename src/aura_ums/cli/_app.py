@@ -31,6 +31,7 @@ from aura_ums.cli._common import (
     SettingOptions,
     check_seed,
     console,
+    err_console,
     fail,
     folder_argument,
     manager_options,
@@ -53,7 +54,16 @@ from aura_ums.cli._interop import (
 )
 from aura_ums.cli._interrupt import TERMINATION_SIGNALS, Terminated
 from aura_ums.cli._logs import import_app
-from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, interruptible, staged, write_text
+from aura_ums.cli._outputs import (
+    CWD_GONE,
+    Overwrite,
+    Source,
+    Target,
+    check_outputs,
+    interruptible,
+    staged,
+    write_text,
+)
 from aura_ums.cli._replay import calibrate, compare, replay
 from aura_ums.sim import PerceptionMode
 
@@ -303,6 +313,7 @@ def main() -> None:
     # backend named in the environment is never needed, and a misspelt one made matplotlib's
     # import fail (a ValueError traceback from --plot, figures and demo).
     os.environ["MPLBACKEND"] = "agg"
+    _warn_if_the_current_folder_is_gone()
     out_of_memory = False
     try:
         app()
@@ -341,6 +352,18 @@ def _say_out_of_memory() -> NoReturn:
         with contextlib.suppress(OSError):
             os.write(2, _OUT_OF_MEMORY.encode("ascii", "replace"))
     raise SystemExit(2)
+
+
+def _warn_if_the_current_folder_is_gone() -> None:
+    """Say why relative paths will not be found when the shell's current folder was deleted."""
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        err_console.print(
+            f"warning: relative paths cannot be found: {CWD_GONE}",
+            highlight=False,
+            markup=False,
+        )
 
 
 def _stop_as_on_ctrl_c() -> None:

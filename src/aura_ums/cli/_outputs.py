@@ -94,8 +94,19 @@ class Target:
 
 
 def resolved(path: Path) -> Path:
-    """Return ``path`` absolute with every symlink resolved (the missing tail kept as is)."""
-    return Path(os.path.realpath(path.expanduser()))
+    """Return ``path`` absolute with every symlink resolved (the missing tail kept as is).
+
+    A relative path in a current folder that was deleted (the shell still in it) exits 2
+    saying so, where ``os.getcwd`` raised FileNotFoundError through a traceback.
+    """
+    try:
+        return Path(os.path.realpath(path.expanduser()))
+    except FileNotFoundError:
+        raise fail(f"{path}: expected a path from an existing current folder, got {CWD_GONE}") from None
+
+
+#: Why a relative path cannot be found when the current folder is gone.
+CWD_GONE = "a current folder that was deleted; cd to an existing folder, or give absolute paths"
 
 
 def safe_name(text: str, default: str = "log") -> str:
