@@ -303,6 +303,15 @@ def test_compare_takes_the_filters_noise_from_the_calibration_never_the_log(
     assert itself.stderr.startswith(
         f"error: --noise-from: expected calibration logs other than LOG_DIR, got {again}, which is LOG_DIR"
     )
+    # nor twice from one calibration log: pooled, its errors would count twice
+    other = tmp_path / "other"
+    shutil.copytree(log_folder, other)
+    twice = runner.invoke(app, [*args, "--noise-from", str(other), "--noise-from", f"{other}/"])
+    assert twice.exit_code == 2
+    assert (
+        twice.stderr
+        == f"error: --noise-from: expected distinct log folders, got {other} and {other}, one folder\n"
+    )
 
 
 def test_reversing_is_replayable_from_the_command_line(tmp_path: Path) -> None:

@@ -7,6 +7,7 @@ import dataclasses
 import enum
 import inspect
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -322,11 +323,8 @@ def calibrate(
 
     if not out.name:
         raise fail(f"--out: expected a file path, got {str(out)!r}")
-    seen: dict[Path, Path] = {}
-    for folder in log_dirs:
-        first = seen.setdefault(resolved(folder), folder)
-        if first is not folder:  # its windows would count twice, as if two robots had run it
-            raise fail(f"LOG_DIRS: expected distinct log folders, got {first} and {folder}, one folder")
+    # Each folder's windows would count twice, as if two robots had run it.
+    _distinct("LOG_DIRS", log_dirs)
     _check_truth_gap(max_truth_gap)
     out_target = Target("--out", out)
     sensors_target = Target(
@@ -692,6 +690,15 @@ def _open(folder: Path, max_truth_gap: float | None) -> LogStream:
     return open_log(folder) if max_truth_gap is None else open_log(folder, max_gap=max_truth_gap)
 
 
+def _distinct(option: str, folders: Sequence[Path]) -> None:
+    """Refuse (exit 2) a log folder given twice (by any path to it) where the logs are pooled."""
+    seen: dict[Path, Path] = {}
+    for folder in folders:
+        first = seen.setdefault(resolved(folder), folder)
+        if first is not folder:
+            raise fail(f"{option}: expected distinct log folders, got {first} and {folder}, one folder")
+
+
 def _draw(result: ReplayResult, target: Target) -> None:
     """Draw the replay figure into a scratch folder and move it onto ``target`` (named safely)."""
     import dataclasses
@@ -761,6 +768,7 @@ def compare(
         *(Source("--noise-from", p, folder=True) for p in calibration_logs or ()),
     ]
     check_outputs([json_target], sources, overwrite=overwrite)
+    _distinct("--noise-from", calibration_logs or [])  # pooled: a folder given twice counts twice
     for source in calibration_logs or ():
         # The filters would be fitted to the errors they are judged on.
         if resolved(source) == resolved(log_dir):
