@@ -634,6 +634,9 @@ _MOST_INDENTED = 10_000
 #: ``(rows, columns)`` array, or None when it cannot (see :func:`parse_float_rows`).
 RowsParser: TypeAlias = Callable[[bytes, int, int], NDArray[np.float64] | None]
 
+#: What tells two versions of one file apart: its size, bytes, and modification time, ns.
+FileVersion: TypeAlias = tuple[int, int]
+
 
 def parse_csv_floats(
     text: str | bytes,
@@ -833,6 +836,7 @@ def csv_blocks(
     max_bytes: int | None = None,
     block_bytes: int = CSV_BLOCK_BYTES,
     parse_rows: RowsParser | None = None,
+    version: FileVersion | None = None,
 ) -> Iterator[CsvFloats | CsvTable]:
     r"""Read a CSV file ``block_bytes`` at a time and yield each block's rows as they are read.
 
@@ -856,6 +860,10 @@ def csv_blocks(
         Bytes read at a time, >= 1.
     parse_rows : callable or None
         Reads each block's data rows (:data:`RowsParser`); None: :func:`parse_float_rows`.
+    version : FileVersion or None
+        The file as it was seen before (:func:`file_version`, when its log was opened):
+        a file changed since is refused as soon as it is opened. Either way a file that
+        changes while it is read is refused when its end is reached.
 
     Yields
     ------
@@ -901,6 +909,13 @@ def csv_blocks(
             opened = os.fstat(handle.fileno())
         except OSError:
             raise CsvFallbackError from None
+        if version is not None and _version_of(opened) != version:
+            raise FileFormatError(
+                source,
+                "",
+                f"expected the file as it was when its log was opened ({version[0]} bytes), got one "
+                f"changed since ({opened.st_size} bytes now); open the log again",
+            )
         if opened.st_size > limit:
             raise CsvFallbackError
         header_text: str | None = None
@@ -973,6 +988,18 @@ def csv_blocks(
                 return
 
 
+def file_version(path: str | os.PathLike[str]) -> FileVersion | None:
+    """Return the file's :data:`FileVersion` now, or None when it cannot be looked at."""
+    try:
+        return _version_of(os.stat(path))
+    except OSError:
+        return None
+
+
+def _version_of(status: os.stat_result) -> FileVersion:
+    return status.st_size, status.st_mtime_ns
+
+
 def _unchanged(handle: io.BufferedReader, opened: os.stat_result, source: str) -> None:
     """Refuse a file that changed between its opening and the end of its reading.
 
@@ -985,7 +1012,7 @@ def _unchanged(handle: io.BufferedReader, opened: os.stat_result, source: str) -
         now = os.fstat(handle.fileno())
     except OSError:
         return
-    if (now.st_size, now.st_mtime_ns) != (opened.st_size, opened.st_mtime_ns):
+    if _version_of(now) != _version_of(opened):
         raise FileFormatError(
             source,
             "",

@@ -168,6 +168,24 @@ def test_a_bad_row_far_in_a_file_fails_the_replay_with_load_logs_message(
     assert f":{row + 1}:" in str(expected.value)
 
 
+@pytest.mark.parametrize("name", ["observations.csv", "odometry.csv", "groundtruth.csv"])
+def test_a_file_changed_after_its_log_was_opened_is_refused_when_read(
+    name: str, folder: Path, tmp_path: Path
+) -> None:
+    # Its spans (and the truth's extent) were checked on the version open_log saw.
+    changed = tmp_path / "changed"
+    changed.mkdir()
+    for path in folder.iterdir():
+        (changed / path.name).write_bytes(path.read_bytes())
+    stream = open_log(changed)
+    if name == "groundtruth.csv":  # read again by the replay only without its scratch copy
+        stream = dataclasses.replace(stream, truth_scratch=None)
+    text = (changed / name).read_text()
+    (changed / name).write_text(text[: len(text) // 2].rsplit("\n", 1)[0] + "\n")
+    with pytest.raises(FileFormatError, match=f"{name}: expected the file as it was when its log was opened"):
+        replay_log(stream, FLOOR, OPTIONS)
+
+
 @pytest.mark.parametrize(
     ("name", "shift"), [("observations.csv", 2 * 86_400.0), ("odometry.csv", -30 * 86_400.0)]
 )

@@ -29,6 +29,7 @@ from aura_ums._files import (
     CsvFloats,
     CsvTable,
     Fields,
+    FileVersion,
     atomic_path,
     csv_blocks,
     describe,
@@ -260,7 +261,12 @@ class _CsvFile:
 
     @classmethod
     def blocks(
-        cls, path: Path, columns: Mapping[str, str], required: Sequence[str], block_bytes: int
+        cls,
+        path: Path,
+        columns: Mapping[str, str],
+        required: Sequence[str],
+        block_bytes: int,
+        version: FileVersion | None = None,
     ) -> Iterator[_CsvFile]:
         """Yield the file's rows block by block (:func:`csv_blocks`), each block a table of its own.
 
@@ -280,6 +286,7 @@ class _CsvFile:
                 max_bytes=LOG_CSV_MAX_BYTES,
                 block_bytes=block_bytes,
                 parse_rows=_native.parse_float_rows,
+                version=version,
             ):
                 table = cls(path, columns, required, block)
                 if len(table):
@@ -689,7 +696,11 @@ def _read_observations(path: Path, units: Units, known: set[str]) -> tuple[LogOb
 
 
 def observation_blocks(
-    path: Path, units: Units, known: set[str], block_bytes: int = STREAM_BLOCK_BYTES
+    path: Path,
+    units: Units,
+    known: set[str],
+    block_bytes: int = STREAM_BLOCK_BYTES,
+    version: FileVersion | None = None,
 ) -> Iterator[ObservationColumns]:
     """Yield the checked columns of ``observations.csv`` block by block (:meth:`_CsvFile.blocks`).
 
@@ -702,7 +713,9 @@ def observation_blocks(
     def whole() -> None:
         _read_observations(path, units, known)
 
-    tables = _CsvFile.blocks(path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"), block_bytes)
+    tables = _CsvFile.blocks(
+        path, _OBSERVATION_COLUMNS, ("time", "landmark_id", "bearing"), block_bytes, version
+    )
     yield from _checked_blocks(
         tables, lambda table: _observation_columns(table, units, known), whole, strict=False, need_rows=False
     )
@@ -787,7 +800,7 @@ def reversed_at(path: Path, refused: ReversingError) -> FileFormatError:
 
 
 def odometry_blocks(
-    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES
+    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES, version: FileVersion | None = None
 ) -> Iterator[OdometryColumns]:
     """Yield the checked time (s), v (m/s) and omega (rad/s) of ``odometry.csv`` block by block.
 
@@ -799,7 +812,7 @@ def odometry_blocks(
     def whole() -> None:
         _read_odometry(path, units)
 
-    tables = _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"), block_bytes)
+    tables = _CsvFile.blocks(path, _ODOMETRY_COLUMNS, ("time", "v", "omega"), block_bytes, version)
     yield from _checked_blocks(
         tables, lambda table: _odometry_columns(table, units), whole, strict=True, need_rows=True
     )
@@ -834,7 +847,7 @@ def _groundtruth_columns(table: _CsvFile, units: Units) -> TruthColumns:
 
 
 def groundtruth_blocks(
-    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES
+    path: Path, units: Units, block_bytes: int = STREAM_BLOCK_BYTES, version: FileVersion | None = None
 ) -> Iterator[TruthColumns]:
     """Yield the checked time (s), x, y (m) and heading (rad) of ``groundtruth.csv`` block by block.
 
@@ -846,7 +859,7 @@ def groundtruth_blocks(
     def whole() -> None:
         _read_groundtruth(path, units)
 
-    tables = _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"), block_bytes)
+    tables = _CsvFile.blocks(path, _GROUNDTRUTH_COLUMNS, ("time", "x", "y", "heading"), block_bytes, version)
     yield from _checked_blocks(
         tables, lambda table: _groundtruth_columns(table, units), whole, strict=True, need_rows=True
     )

@@ -18,15 +18,15 @@ import os
 import tempfile
 import threading
 import weakref
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import _is_row, present, read_folder, regular_file
+from aura_ums._files import FileVersion, _is_row, file_version, present, read_folder, regular_file
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -111,6 +111,10 @@ class LogStream:
         The ground truth as :func:`open_log` read and checked it (time, x, y, wrapped
         heading: four float64 a row), in a scratch file removed with the stream, so the
         replay does not parse ``groundtruth.csv`` twice; None: parse it again.
+    versions : mapping of str to (int, int)
+        Each CSV file's size and modification time when :func:`open_log` opened the log,
+        by file name: a file changed since (its spans and extent checked on another
+        version) is refused when the replay comes to read it.
     max_gap : float
         Seconds: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
     block_bytes : int
@@ -126,15 +130,20 @@ class LogStream:
     max_gap: float = DEFAULT_MAX_TRUTH_GAP
     block_bytes: int = STREAM_BLOCK_BYTES
     truth_scratch: ScratchFile | None = None
+    versions: Mapping[str, FileVersion] = field(default_factory=dict)
 
     def observation_blocks(self) -> Iterator[ObservationColumns]:
         """Yield ``observations.csv``'s checked columns block by block (time, id, bearing, ...)."""
         known = {landmark.id for landmark in self.landmarks}
-        return observation_blocks(self.path / OBSERVATIONS, self.units, known, self.block_bytes)
+        return observation_blocks(
+            self.path / OBSERVATIONS, self.units, known, self.block_bytes, self.versions.get(OBSERVATIONS)
+        )
 
     def odometry_blocks(self) -> Iterator[OdometryColumns]:
         """Yield ``odometry.csv``'s checked time, v, omega block by block (at least one block)."""
-        return odometry_blocks(self.path / ODOMETRY, self.units, self.block_bytes)
+        return odometry_blocks(
+            self.path / ODOMETRY, self.units, self.block_bytes, self.versions.get(ODOMETRY)
+        )
 
     def groundtruth_blocks(self) -> Iterator[TruthColumns]:
         """Yield the ground truth's checked time, x, y, heading (wrapped to (-pi, pi]) block by block."""
@@ -146,7 +155,11 @@ class LogStream:
                     return
                 offset += block.nbytes
                 yield block[:, 0].copy(), block[:, 1].copy(), block[:, 2].copy(), block[:, 3].copy()
-        yield from _wrapped_truth(groundtruth_blocks(self.path / GROUNDTRUTH, self.units, self.block_bytes))
+        yield from _wrapped_truth(
+            groundtruth_blocks(
+                self.path / GROUNDTRUTH, self.units, self.block_bytes, self.versions.get(GROUNDTRUTH)
+            )
+        )
 
     def load(self) -> RobotLog:
         """Read the whole log (:func:`~aura_ums.logs.load_log`), for what needs it all at once."""
@@ -209,6 +222,8 @@ def open_log(
     gap = _max_gap(max_gap, "max_gap")
     if isinstance(block_bytes, bool) or not isinstance(block_bytes, int) or block_bytes < 1:
         raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
+    # Before any is read: what open_log checks (spans, extent) holds for these versions only.
+    versions = {name: v for name in (OBSERVATIONS, ODOMETRY, GROUNDTRUTH) if (v := file_version(base / name))}
     meta, units = _MetaReader(base / META).read(base.name)
     landmarks = _read_landmarks(base / LANDMARKS, units)
     has_odometry, has_commands = present(base / ODOMETRY), present(base / COMMANDS)
@@ -220,7 +235,7 @@ def open_log(
     box, scratch = None, None
     if present(base / GROUNDTRUTH):
         box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
-    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch)
+    return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch, versions)
 
 
 #: Bytes read at each end of a file to find its first and last time.
