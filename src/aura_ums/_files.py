@@ -909,13 +909,10 @@ def csv_blocks(
             opened = os.fstat(handle.fileno())
         except OSError:
             raise CsvFallbackError from None
-        if version is not None and _version_of(opened) != version:
-            raise FileFormatError(
-                source,
-                "",
-                f"expected the file as it was when its log was opened ({version[0]} bytes), got one "
-                f"changed since ({opened.st_size} bytes now); open the log again",
-            )
+        # The version every later look must find: the one the log was opened on, else this one.
+        expected = _version_of(opened) if version is None else version
+        if version is not None:
+            _unchanged(opened, expected, source, _SINCE_OPENED)
         if opened.st_size > limit:
             raise CsvFallbackError
         header_text: str | None = None
@@ -929,7 +926,9 @@ def csv_blocks(
             except OSError:
                 raise CsvFallbackError from None
             if not chunk:
-                _unchanged(handle, opened, source)
+                with contextlib.suppress(OSError):  # nothing to compare: the reading stands
+                    now = os.fstat(handle.fileno())
+                    _unchanged(now, expected, source, _WHILE_READ)
             data = carry + chunk
             if chunk:
                 cut = data.rfind(b"\n") + 1
@@ -1000,24 +999,25 @@ def _version_of(status: os.stat_result) -> FileVersion:
     return status.st_size, status.st_mtime_ns
 
 
-def _unchanged(handle: io.BufferedReader, opened: os.stat_result, source: str) -> None:
-    """Refuse a file that changed between its opening and the end of its reading.
+#: How a change is told (compared with, when, what to do): after the log was opened, or during the reading.
+_SINCE_OPENED = ("when its log was opened", "since", "open the log again")
+_WHILE_READ = ("when it was opened", "while it was read", "read it again once nothing writes to it")
+
+
+def _unchanged(now: os.stat_result, expected: FileVersion, source: str, told: tuple[str, str, str]) -> None:
+    """Refuse a file whose size or modification time is no longer ``expected``.
 
     Read block by block, a file cut short (or written on) meanwhile would give rows from
     two versions of it, its last one perhaps cut mid-number, and no error: a replay went on
     without the odometry's end and lost the truth with exit 0. Not a fallback: reading the
     whole file again would read the changed one.
     """
-    try:
-        now = os.fstat(handle.fileno())
-    except OSError:
-        return
-    if _version_of(now) != _version_of(opened):
+    if _version_of(now) != expected:
         raise FileFormatError(
             source,
             "",
-            f"expected the file as it was when it was opened ({opened.st_size} bytes), got one changed "
-            f"while it was read ({now.st_size} bytes now); read it again once nothing writes to it",
+            f"expected the file as it was {told[0]} ({expected[0]} bytes), got one changed {told[1]} "
+            f"({now.st_size} bytes now); {told[2]}",
         )
 
 

@@ -42,6 +42,11 @@ def stopped(stop: KeyboardInterrupt) -> str:
     return f"terminated ({stop.name})" if isinstance(stop, Terminated) else "interrupted"
 
 
+def nothing_written(stop: KeyboardInterrupt | None = None) -> str:
+    """Return the message when a Ctrl-C (or ``stop``) came before anything was written."""
+    return NOTHING_WRITTEN if stop is None else NOTHING_WRITTEN.replace("interrupted", stopped(stop), 1)
+
+
 def announce() -> None:
     """Record that the command said on stderr what a Ctrl-C left written."""
     _announced[0] = True
@@ -50,6 +55,5 @@ def announce() -> None:
 def say_interrupted(stop: KeyboardInterrupt | None = None) -> None:
     """Say, once, that a Ctrl-C (or ``stop``) ended the command before anything was written."""
     if not _announced[0]:
-        message = NOTHING_WRITTEN if stop is None else NOTHING_WRITTEN.replace("interrupted", stopped(stop))
-        sys.stderr.write(f"error: {message}\n")
+        sys.stderr.write(f"error: {nothing_written(stop)}\n")
         _announced[0] = True

@@ -33,7 +33,7 @@ import typer
 
 from aura_ums._files import NAME_MAX, make_folders, place_new, remove_made, scratch_path, write_text_atomic
 from aura_ums.cli._common import err_console, fail
-from aura_ums.cli._interrupt import NOTHING_WRITTEN, announce, exit_code, stopped
+from aura_ums.cli._interrupt import announce, exit_code, nothing_written, stopped
 from aura_ums.errors import FileFormatError
 
 #: The option every command that writes takes, with the same help everywhere.
@@ -386,18 +386,20 @@ def staged(target: Target) -> Iterator[Path]:
         raise _unwritable(target, final, exc) from None
     stage = scratch_path(final)
     try:
-        stage.mkdir()
-        yield stage
-        for path in sorted(p for p in stage.rglob("*") if p.is_file()):
-            place = final / path.relative_to(stage)
-            place.parent.mkdir(parents=True, exist_ok=True)
-            if _replacing[0]:
-                os.replace(path, place)
-            else:
-                place_new(path, place)
-            wrote(target.path / path.relative_to(stage))
+        try:
+            stage.mkdir()
+            yield stage
+            for path in sorted(p for p in stage.rglob("*") if p.is_file()):
+                place = final / path.relative_to(stage)
+                place.parent.mkdir(parents=True, exist_ok=True)
+                if _replacing[0]:
+                    os.replace(path, place)
+                else:
+                    place_new(path, place)
+                wrote(target.path / path.relative_to(stage))
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
     except BaseException as exc:
-        shutil.rmtree(stage, ignore_errors=True)
         # A folder made for this output and still empty goes too: no empty folder under its name.
         remove_made(made)
         if isinstance(exc, FileExistsError):
@@ -405,7 +407,6 @@ def staged(target: Target) -> Iterator[Path]:
         if isinstance(exc, OSError):
             raise _unwritable(target, final, exc) from None
         raise
-    shutil.rmtree(stage, ignore_errors=True)
 
 
 def interruptible(command: Callable[..., None]) -> Callable[..., None]:
@@ -422,7 +423,7 @@ def interruptible(command: Callable[..., None]) -> Callable[..., None]:
                 done = ", ".join(str(path) for path in _written)
                 message = f"{stopped(stop)}: only {done} written whole; nothing else was written"
             else:
-                message = NOTHING_WRITTEN.replace("interrupted", stopped(stop), 1)
+                message = nothing_written(stop)
             err_console.print(f"[red]error:[/red] {_escape(message)}", highlight=False)
             announce()
             raise typer.Exit(code=exit_code(stop)) from None

@@ -17,7 +17,7 @@ from typing import TextIO, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import make_folders, remove_made, scratch_path
+from aura_ums._files import atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
@@ -1522,60 +1522,45 @@ def _contains(
 
 
 class _StepsCsv:
-    """The per-step CSV, written block by block into a scratch file renamed onto the target at the end."""
+    """The per-step CSV, written block by block through :func:`atomic_path`: whole, or not at all."""
 
     def __init__(self, target: str | os.PathLike[str] | None) -> None:
         self.target = None if target is None else Path(target)
-        self.scratch: Path | None = None
         self.stream: TextIO | None = None
-        self.made: list[Path] = []
+        # The scratch file (and any folder made for it) and its stream, closed in that order's reverse.
+        self._held = contextlib.ExitStack()
 
     def __enter__(self) -> _StepsCsv:
         if self.target is not None:
-            target = self.target
-            self.scratch = scratch_path(target)
             try:
-                self.made = make_folders(target.parent)
+                scratch = self._held.enter_context(atomic_path(self.target))
                 # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay).
-                self.stream = self.scratch.open("x", encoding="utf-8", newline="")
+                self.stream = self._held.enter_context(scratch.open("x", encoding="utf-8", newline=""))
                 self.stream.write(STEPS_CSV_HEADER + "\n")
             except OSError as exc:
-                self._discard()
-                raise self._unwritable(exc) from None
+                with contextlib.suppress(OSError):
+                    self._held.__exit__(type(exc), exc, exc.__traceback__)
+                raise FileFormatError.unwritable(str(self.target), exc) from None
         return self
 
     def write(self, trace: ReplayTrace) -> None:
         if self.stream is not None and len(trace):
             self.stream.write("".join(line + "\n" for line in trace.csv_lines()))
 
-    def __exit__(self, kind: object, error: object, traceback: object) -> None:
-        if self.stream is None or self.scratch is None or self.target is None:
-            return
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: types.TracebackType | None,
+    ) -> None:
         try:
-            # Closing writes the last buffered lines: on a full disk it fails as a write does.
-            self.stream.close()
-            if error is None:
-                os.replace(self.scratch, self.target)
-                return
+            # Closing writes the last buffered lines (on a full disk it fails as a write does),
+            # then the scratch file is renamed onto the target, or removed on any error.
+            self._held.__exit__(kind, error, traceback)
         except OSError as exc:
-            self._discard()
             if error is None:
-                raise self._unwritable(exc) from None
-            # The error already on its way (maybe this same one, from a write) says more.
-            return
-        self._discard()
-
-    def _discard(self) -> None:
-        """Remove the scratch file (its stream closed, or never opened) and the folders made for it."""
-        if self.stream is not None:
-            with contextlib.suppress(OSError):
-                self.stream.close()
-        if self.scratch is not None:
-            self.scratch.unlink(missing_ok=True)
-        remove_made(self.made)
-
-    def _unwritable(self, exc: OSError) -> FileFormatError:
-        return FileFormatError.unwritable(str(self.target), exc)
+                raise FileFormatError.unwritable(str(self.target), exc) from None
+            # Otherwise the error already on its way (maybe this same one, from a write) says more.
 
 
 def _digest(frames: Mapping[float, list[LogObservation]], times: np.ndarray) -> str:

@@ -234,7 +234,7 @@ def open_log(
     _check_clocks(base, units, commands)
     box, scratch = None, None
     if present(base / GROUNDTRUTH):
-        box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes)
+        box, scratch = _read_truth(base / GROUNDTRUTH, units, block_bytes, versions.get(GROUNDTRUTH))
     return LogStream(meta, landmarks, base, units, commands, box, gap, block_bytes, scratch, versions)
 
 
@@ -301,7 +301,7 @@ def _check_clocks(base: Path, units: Units, commands: tuple[PositionReport, ...]
 
 
 def _read_truth(
-    path: Path, units: Units, block_bytes: int
+    path: Path, units: Units, block_bytes: int, version: FileVersion | None
 ) -> tuple[tuple[float, float, float, float], ScratchFile | None]:
     """Check the whole ground truth block by block: its extent, and the scratch copy of its rows."""
     low, high = np.full(2, np.inf), np.full(2, -np.inf)
@@ -309,7 +309,7 @@ def _read_truth(
     with contextlib.suppress(OSError):  # no scratch file: the replay parses the file again
         handle = tempfile.TemporaryFile(prefix="aura-ums-truth-", suffix=".f8")  # noqa: SIM115
     try:
-        for block in _wrapped_truth(groundtruth_blocks(path, units, block_bytes)):
+        for block in _wrapped_truth(groundtruth_blocks(path, units, block_bytes, version)):
             _, x, y, _ = block
             low = np.minimum(low, (x.min(), y.min()))
             high = np.maximum(high, (x.max(), y.max()))
