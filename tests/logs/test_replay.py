@@ -109,6 +109,9 @@ def test_replay_rejects_bad_arguments(clean_log: RobotLog) -> None:
         ReplayOptions(settings={"sigmas": 3.0})  # type: ignore[arg-type]
     with pytest.raises(InputError, match=r"ReplayOptions\.max_interval: expected a positive number"):
         ReplayOptions(max_interval=0.0)
+    # A string for the enum is refused by name, not an AttributeError while wording the message.
+    with pytest.raises(InputError, match=r"ReplayOptions\.landmark_class: expected .*, got 'II' \(str\)$"):
+        ReplayOptions(landmark_class="II")  # type: ignore[arg-type]
     no_start = dataclasses.replace(clean_log, groundtruth=None)
     with pytest.raises(InputError, match=r"expected a \[start\] pose in meta.toml or a groundtruth.csv"):
         replay_log(no_start, FLOOR)

@@ -400,6 +400,20 @@ def test_a_different_blackboard_is_refused() -> None:
         manager.update(board_with((1.0, STRIDE), (5.0, STRIDE)), now=6.0)
 
 
+def test_an_update_to_before_the_maps_time_is_refused_and_changes_nothing() -> None:
+    """A clock that went back is told, not answered with the map as it was."""
+    manager = manager_for()
+    board = board_with((1.0, STRIDE), (2.0, STRIDE))
+    grown = manager.update(board, now=2.0).map
+    with pytest.raises(
+        InputError, match=r"^now: expected a time at or after the map's \(2\.0 s, .*\), got 1\.5$"
+    ):
+        manager.update(board, now=1.5)
+    assert manager.map is grown
+    assert manager.map_time == 2.0
+    assert manager.update(board, now=2.0).map is grown  # the same time again is no change
+
+
 def test_bad_arguments_are_refused() -> None:
     with pytest.raises(InputError, match="initial_map: expected a SpatialUncertaintyMap, got Pose"):
         UncertaintyMapManager(START, WORLD, TABLE)  # type: ignore[arg-type]
@@ -753,17 +767,15 @@ def test_a_run_from_an_estimate_outside_every_meadow_grows_on_the_nearest_terrai
     assert manager.grown_reports == 1
 
 
-def test_a_terrain_missing_from_the_table_fails_every_update_of_a_one_meadow_map() -> None:
-    """The one meadow's terrain is looked up when first grown on; a missing one is never remembered."""
+def test_a_terrain_missing_from_the_table_is_refused_when_the_manager_is_made() -> None:
+    """Not at the first run through that meadow, in the middle of a live run: naming the meadow."""
     only = Meadow("only", box(0, -5, 20, 5), "marsh", tuple(landmark.id for landmark in LANDMARKS))
     world = MeadowMap([only], [record(landmark) for landmark in LANDMARKS])  # no table to check against
-    manager = UncertaintyMapManager(start_map(), world, TABLE)
-    board = Blackboard()
-    board.post_report(PositionReport(1.0, TurnAndRun(0.0, 0.5)))
-    for _ in range(2):
-        with pytest.raises(UnknownTerrainError, match="got 'marsh'"):
-            manager.update(board, now=1.0)
-        assert manager.consumed_reports == 0
+    with pytest.raises(
+        UnknownTerrainError,
+        match=r"^table: expected the terrain 'marsh' of the meadow 'only' of meadow_map, got ",
+    ):
+        UncertaintyMapManager(start_map(), world, TABLE)
 
 
 def test_a_one_meadow_manager_grows_as_the_map_does_on_its_terrain() -> None:

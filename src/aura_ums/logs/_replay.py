@@ -111,10 +111,14 @@ class ReplayOptions:
     'II'
     >>> ReplayOptions(settings=ManagerSettings(robust=False)).settings.robust
     False
-    >>> ReplayOptions(landmark_class=LandmarkClass.GROUND_LINE)
+    >>> ReplayOptions(landmark_class=LandmarkClass.GROUND_LINE)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: ReplayOptions.landmark_class: expected Class I or II, got GROUND_LINE
+    aura_ums.errors.InputError: ReplayOptions.landmark_class: expected ... (Class II), got GROUND_LINE
+    >>> ReplayOptions(landmark_class="II")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: ReplayOptions.landmark_class: expected ..., got 'II' (str)
     """
 
     settings: ManagerSettings = field(default_factory=ManagerSettings)
@@ -131,9 +135,15 @@ class ReplayOptions:
             raise InputError(
                 f"ReplayOptions.settings: expected ManagerSettings, got {type(self.settings).__name__}"
             )
-        if self.landmark_class not in _REPLAY_CLASSES:
+        if not isinstance(self.landmark_class, LandmarkClass) or self.landmark_class not in _REPLAY_CLASSES:
+            got = (
+                self.landmark_class.name
+                if isinstance(self.landmark_class, LandmarkClass)
+                else f"{self.landmark_class!r} ({type(self.landmark_class).__name__})"
+            )
             raise InputError(
-                f"ReplayOptions.landmark_class: expected Class I or II, got {self.landmark_class.name}"
+                "ReplayOptions.landmark_class: expected LandmarkClass.VERTICAL_LINE (Class I) or "
+                f"LandmarkClass.POINT (Class II), got {got}"
             )
         object.__setattr__(
             self, "max_interval", positive_float(self.max_interval, "ReplayOptions.max_interval")

@@ -331,6 +331,9 @@ class UncertaintyMapManager:
     ------
     InputError
         For an argument of the wrong type.
+    UnknownTerrainError
+        When ``table`` lacks the terrain of a meadow of ``meadow_map`` (refused here, not
+        at the first run through that meadow).
 
     Examples
     --------
@@ -415,6 +418,8 @@ class UncertaintyMapManager:
             settings = ManagerSettings()
         elif not isinstance(settings, ManagerSettings):
             raise InputError(f"settings: expected ManagerSettings or None, got {type(settings).__name__}")
+        for meadow in meadow_map.meadows:
+            table.require(meadow.terrain, where="table", whose=f"the meadow {meadow.id!r} of meadow_map")
         self._meadow_map = meadow_map
         self._table = table
         self._only_terrain: TerrainStats | None = None
@@ -616,8 +621,11 @@ class UncertaintyMapManager:
         InputError
             For a bad argument (an ``envelope`` that does not pair with the drained
             observations); for a blackboard that is not the one this manager has been
-            reading (fewer reports than consumed, or a different last consumed report); when
-            a run meets no meadow of the meadow map (from :func:`~aura_ums.world.grow_through`).
+            reading (fewer reports than consumed, or a different last consumed report); for a
+            ``now`` before :attr:`map_time` (the map cannot go back in time). A
+            run that meets no meadow (it leaves the mapped free space; the meadow map knows no
+            walls) is not refused: it grows on the terrain of the meadow nearest the map's
+            most probable pose.
 
         Examples
         --------
@@ -639,6 +647,12 @@ class UncertaintyMapManager:
         if isinstance(missed_in_a_row, bool) or not isinstance(missed_in_a_row, int) or missed_in_a_row < 0:
             raise InputError(f"missed_in_a_row: expected a non-negative integer, got {missed_in_a_row!r}")
         self._check_blackboard(blackboard)
+        if self._map_time is not None and time < self._map_time:
+            # The map already holds the motion up to its last report: it cannot be brought back.
+            raise InputError(
+                f"now: expected a time at or after the map's ({self._map_time!r} s, its last position "
+                f"report grown), got {time!r}"
+            )
 
         identified = blackboard.identified
         pending = identified.peek(time)
