@@ -30,6 +30,7 @@ if TYPE_CHECKING:
         Camera,
         CameraIntrinsics,
         CameraMount,
+        load_calibration_bounds,
         load_camera,
         load_opencv_calibration,
     )
@@ -134,6 +135,7 @@ __all__ = [
     "UnknownTerrainError",
     "VerticalLineLandmark",
     "__version__",
+    "load_calibration_bounds",
     "load_camera",
     "load_opencv_calibration",
     "observe_ground_line",
@@ -154,6 +156,7 @@ _HOMES: dict[str, str] = {
     "Camera": "aura_ums.camera",
     "CameraIntrinsics": "aura_ums.camera",
     "CameraMount": "aura_ums.camera",
+    "load_calibration_bounds": "aura_ums.camera",
     "load_camera": "aura_ums.camera",
     "load_opencv_calibration": "aura_ums.camera",
     "AuraUmsError": "aura_ums.errors",

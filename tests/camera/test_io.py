@@ -124,7 +124,11 @@ def edit(old: str, new: str) -> str:
         (edit("-0.002]", "-0.002, 0.0, 0.1, 0.0, 0.0]"), "distortion", "beyond k3 .* to be zero"),
         (edit("distortion = [", "distortion = 3 #"), "distortion", "distortion: expected a list of numbers"),
         (edit("tilt = 0.1", "tilt = 0.1\ntilt_deg = 5.0"), "tilt_deg", "expected tilt or tilt_deg, got both"),
-        (edit("tilt = 0.1", "tilt_deg = 95.0"), "tilt", r"\[mount\] tilt: expected \|tilt\| < pi/2"),
+        (
+            edit("tilt = 0.1", "tilt_deg = 95.0"),
+            "tilt",
+            r"\[mount\] tilt_deg: expected a number in \(-1\.5708, 1\.5708\) rad, got 95\.0 \(1\.65806 rad\)",
+        ),
         (
             edit("fx = 3.0", "fx = -3.0"),
             "fx",

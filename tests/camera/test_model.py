@@ -162,3 +162,26 @@ def test_a_mount_built_in_code_has_the_camera_files_ranges(arguments: dict[str, 
     with pytest.raises(InputError, match=message):
         CameraMount(**arguments)
     assert CameraMount(100.0, forward=-100.0, left=100.0).height == 100.0
+
+
+@pytest.mark.parametrize("length", [4, 5, 8, 12, 14])
+def test_intrinsics_take_every_length_of_opencvs_distortion_vector(length: int) -> None:
+    """As a camera file does: the vector of any of OpenCV's lengths, kept as (k1, k2, p1, p2, k3)."""
+    vector = [-0.1, 0.01, 0.001, -0.002, 0.003, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0][:length]
+    k = CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=vector)  # type: ignore[arg-type]
+    assert k.distortion == (-0.1, 0.01, 0.001, -0.002, 0.003 if length > 4 else 0.0)
+
+
+def test_intrinsics_refuse_distortion_aura_ums_does_not_model() -> None:
+    with pytest.raises(
+        InputError, match=r"^CameraIntrinsics\.distortion: expected 4, 5, 8, 12 or 14 .*, got 3$"
+    ):
+        CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(0.1, 0.0, 0.0))  # type: ignore[arg-type]
+    with pytest.raises(
+        InputError, match=r"expected the coefficients beyond k3 .* to be zero .*, got \[0\.5, 0\.0, 0\.0\]"
+    ):
+        CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(0.1, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0))  # type: ignore[arg-type]
+    with pytest.raises(
+        InputError, match=r"^CameraIntrinsics\.distortion\[1\]: expected a number in \[-1000, 1000\]"
+    ):
+        CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(0.1, 2000.0, 0.0, 0.0))  # type: ignore[arg-type]

@@ -40,14 +40,13 @@ from numpy.typing import NDArray
 
 from aura_ums._files import Fields, describe, load_toml, parse_json, read_text
 from aura_ums._validate import ANGLE, DISTORTION, FOCAL_LENGTH, IMAGE_SIDE, PIXEL, SENSOR_OFFSET, Range
-from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount
+from aura_ums.camera._model import Camera, CameraIntrinsics, CameraMount, opencv_distortion
 from aura_ums.camera._observe import CalibrationBounds
 from aura_ums.errors import FileFormatError, InputError
 
 Array = NDArray[np.float64]
 
 #: Distortion vector lengths OpenCV writes (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx, ty]]]]).
-_DISTORTION_LENGTHS = (4, 5, 8, 12, 14)
 
 _INTRINSIC_KEYS = ("fx", "fy", "cx", "cy", "width", "height", "distortion")
 _ANGLES = ("pan", "tilt")
@@ -71,7 +70,8 @@ KEY_RANGES: dict[str, dict[str, Range]] = {
         "forward": MOUNT_OFFSET,
         "left": MOUNT_OFFSET,
         "pan": ANGLE,
-        "tilt": ANGLE,
+        # CameraMount's own limit: at +-pi/2 the optical axis is vertical, the horizon out of view.
+        "tilt": Range(-math.pi / 2, math.pi / 2, "rad", low_open=True, high_open=True),
     },
     "calibration_bounds": {
         "fx": Range(0.0, FOCAL_LENGTH.high, "px"),
@@ -109,24 +109,12 @@ def _side(value: object, source: str, where: str) -> int:
 
 
 def _distortion(values: Array, source: str, where: str) -> tuple[float, float, float, float, float]:
-    """OpenCV's distortion vector as (k1, k2, p1, p2, k3); the thin-prism/tilt terms must be zero."""
-    if values.size not in _DISTORTION_LENGTHS:
-        raise FileFormatError(
-            source, where, f"expected 4, 5, 8, 12 or 14 distortion coefficients, got {values.size}"
-        )
-    if values.size > 5 and np.any(values[5:] != 0.0):
-        raise FileFormatError(
-            source,
-            where,
-            "expected the coefficients beyond k3 (k4-k6, s1-s4, tau) to be zero (aura-ums models k1, k2, "
-            f"p1, p2, k3 only), got {values[5:].tolist()}",
-        )
-    bounds = KEY_RANGES["intrinsics"]["distortion"]
-    for index, value in enumerate(values[:5].tolist()):
-        if not bounds.contains(value):
-            raise FileFormatError(source, f"{where}[{index}]", f"expected {bounds.text()}, got {value!r}")
-    k = [float(v) for v in values[:5]] + [0.0] * (5 - min(values.size, 5))
-    return (k[0], k[1], k[2], k[3], k[4])
+    """OpenCV's distortion vector as (k1, k2, p1, p2, k3) (:func:`opencv_distortion`), the file named."""
+    try:
+        return opencv_distortion(values, where)
+    except InputError as exc:
+        located, _, message = str(exc).partition(": ")
+        raise FileFormatError(source, located, message) from None
 
 
 def _reraise(source: str, where: str, exc: InputError) -> FileFormatError:

@@ -64,6 +64,28 @@ def distort(
     return xd, yd
 
 
+#: The lengths of OpenCV's distortion vector: (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1-s4[, taux, tauy]]]]).
+DISTORTION_LENGTHS = (4, 5, 8, 12, 14)
+
+
+def opencv_distortion(values: Array, where: str) -> tuple[float, float, float, float, float]:
+    """Return OpenCV's distortion vector as (k1, k2, p1, p2, k3); refuse terms aura-ums does not model.
+
+    ``values`` are finite floats (any shape: flattened); ``where`` names them in messages.
+    """
+    flat = values.reshape(-1)
+    if flat.size not in DISTORTION_LENGTHS:
+        raise InputError(f"{where}: expected 4, 5, 8, 12 or 14 distortion coefficients, got {flat.size}")
+    if flat.size > 5 and np.any(flat[5:] != 0.0):
+        raise InputError(
+            f"{where}: expected the coefficients beyond k3 (k4-k6, s1-s4, tau) to be zero (aura-ums models "
+            f"k1, k2, p1, p2, k3 only), got {flat[5:].tolist()}"
+        )
+    k = [DISTORTION.check(float(c), f"{where}[{index}]") for index, c in enumerate(flat[:5].tolist())]
+    k += [0.0] * (5 - len(k))
+    return (k[0], k[1], k[2], k[3], k[4])
+
+
 @dataclass(frozen=True, slots=True)
 class CameraIntrinsics:
     """Pinhole intrinsics, in pixels, with optional OpenCV distortion.
@@ -76,9 +98,19 @@ class CameraIntrinsics:
         Principal point, pixels ((0, 0) is the centre of the top-left pixel), in [-1e5, 1e5].
     width, height : int
         Image size, pixels, in [1, 20000].
-    distortion : tuple of 5 floats, optional
-        OpenCV coefficients (k1, k2, p1, p2, k3), each in [-1000, 1000]; None for an ideal
-        pinhole.
+    distortion : sequence of 4, 5, 8, 12 or 14 floats, optional
+        OpenCV's distortion vector (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1-s4[, taux, tauy]]]]),
+        each in [-1000, 1000], kept as (k1, k2, p1, p2, k3) (k3 = 0 when absent); the terms
+        beyond k3 must be zero. None for an ideal pinhole.
+
+    Examples
+    --------
+    >>> CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(-0.1, 0.01, 0.0, 0.0)).distortion
+    (-0.1, 0.01, 0.0, 0.0, 0.0)
+    >>> CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(0.1, 0.0, 0.0))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: CameraIntrinsics.distortion: expected 4, 5, 8, 12 or 14 ..., got 3
     """
 
     fx: float
@@ -109,17 +141,10 @@ class CameraIntrinsics:
                 )
             object.__setattr__(self, name, int(value))
         if self.distortion is not None:
-            coefficients = float_array(self.distortion, "CameraIntrinsics.distortion")
-            if coefficients.shape != (5,):
-                raise InputError(
-                    f"CameraIntrinsics.distortion: expected 5 coefficients (k1, k2, p1, p2, k3), "
-                    f"got shape {coefficients.shape}"
-                )
-            k1, k2, p1, p2, k3 = (
-                DISTORTION.check(float(c), f"CameraIntrinsics.distortion[{index}]")
-                for index, c in enumerate(coefficients)
+            distortion = float_array(self.distortion, "CameraIntrinsics.distortion")
+            object.__setattr__(
+                self, "distortion", opencv_distortion(distortion, "CameraIntrinsics.distortion")
             )
-            object.__setattr__(self, "distortion", (k1, k2, p1, p2, k3))
 
     def matrix(self) -> Array:
         """Return the 3x3 camera matrix K."""

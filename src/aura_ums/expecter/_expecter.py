@@ -91,7 +91,12 @@ class Expecter:
     Parameters
     ----------
     camera : Camera
-        The calibrated camera on its mount; its pan, tilt and offset stay fixed.
+        The calibrated camera on its mount; its pan, tilt and offset stay fixed. The windows
+        hold for this camera as it is: the errors its calibration may have
+        (:class:`~aura_ums.camera.CalibrationBounds`) are not in them. For a camera that may be
+        off by its bounds, widen the ``margin`` of :meth:`window` by their effect in pixels
+        (about ``fx`` times the pan bound across, ``fy`` times the tilt bound up and down,
+        plus the bounds on ``cx`` and ``cy``).
 
     Examples
     --------
