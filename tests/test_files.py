@@ -379,3 +379,16 @@ def test_make_folders_undoes_what_it_made_when_it_fails(tmp_path: Path) -> None:
         with pytest.raises(NotADirectoryError, match="Not a directory"):
             make_folders(below)
     assert [path.name for path in tmp_path.iterdir()] == ["file"]
+
+
+@pytest.mark.parametrize(("separator", "name"), [("\t", "tabs"), (";", "semicolons"), ("|", "vertical bars")])
+def test_a_csv_separated_otherwise_is_named_so_not_as_an_unknown_column(separator: str, name: str) -> None:
+    text = f"# odometry\ntime{separator}v{separator}omega\n0.0{separator}1.0{separator}0.0\n"
+    with pytest.raises(
+        FileFormatError,
+        match=rf"^odometry\.csv:2: expected comma-separated values, got a header separated by {name}$",
+    ):
+        _files.parse_csv(text, "odometry.csv", columns=("time", "v", "omega"))
+    # A header cell that only looks so (not every part a known column) stays an unknown column.
+    with pytest.raises(FileFormatError, match=r"got unknown column 'time;speed'"):
+        _files.parse_csv("time;speed,v\n", "odometry.csv", columns=("time", "v", "omega"))

@@ -465,6 +465,19 @@ class CsvTable:
         return {name: list(cells) for name, cells in zip(self.header, transposed, strict=True)}
 
 
+#: Separators of CSV-like files that are not commas, by name: told apart from an unknown column.
+_OTHER_SEPARATORS = {"\t": "tabs", ";": "semicolons", "|": "vertical bars"}
+
+
+def _other_separator(cell: str, columns: Sequence[str]) -> str | None:
+    """Name the separator that splits a header cell into known columns (a file not comma-separated)."""
+    for separator, name in _OTHER_SEPARATORS.items():
+        parts = [part.strip() for part in cell.split(separator)]
+        if len(parts) > 1 and all(part in columns for part in parts):
+            return name
+    return None
+
+
 def parse_csv(
     text: str,
     source: str,
@@ -538,6 +551,14 @@ def parse_csv(
     header = tuple(name.strip().removeprefix(_BOM).strip() for name in parsed[0])
     for index, name in enumerate(header):
         if name not in columns:
+            separator = _other_separator(name, columns)
+            if separator is not None:
+                raise FileFormatError(
+                    source,
+                    "",
+                    f"expected comma-separated values, got a header separated by {separator}",
+                    line=numbers[0],
+                )
             raise FileFormatError(
                 source,
                 "",

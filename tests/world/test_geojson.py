@@ -289,7 +289,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "meadow with a 3-d position",
         geometry(0, {"type": "Polygon", "coordinates": [[[0, 0, 5], [4, 0], [4, 2], [0, 0]]]}),
         "features[0] (id 'walk') geometry.coordinates[0][0]",
-        "expected an [x, y] position in metres, got an array",
+        "expected an [x, y] position in metres (2 values, no altitude), got 3 values",
     ),
     (
         "meadow with a string coordinate",

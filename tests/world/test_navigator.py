@@ -18,6 +18,7 @@ from aura_ums import (
     TurnAndRun,
     UnknownTerrainError,
 )
+from aura_ums.errors import OutsideMapError
 from aura_ums.world import (
     Meadow,
     MeadowMap,
@@ -353,3 +354,18 @@ def test_run_clipping_matches_shapely_intersections(name: str) -> None:
             assert b == pytest.approx(d, abs=1e-9)
         compared += len(ours)
     assert compared > 50  # the runs do cross meadows
+
+
+def test_a_run_off_the_map_is_worded_for_the_function_called() -> None:
+    """commands_for and grow_through name their own arguments, not split_run's."""
+    world = make_grid_world(1, 3)
+    far = Pose(50.0, 50.0, 0.0)
+    with pytest.raises(
+        OutsideMapError, match=r"^pose, command: expected a run that meets a meadow, got one from \(50"
+    ):
+        commands_for(world, far, TurnAndRun(0.0, 1.0), TerrainTable.default())
+    start = SpatialUncertaintyMap.from_pose(far, 0.1, 0.01)
+    with pytest.raises(
+        OutsideMapError, match=r"^uncertainty_map \(its most probable pose\), command: expected a run"
+    ):
+        grow_through(start, world, TurnAndRun(0.0, 1.0), TerrainTable.default())

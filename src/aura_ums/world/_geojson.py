@@ -204,7 +204,9 @@ class _Reader:
 
     def position(self, where: str, value: object) -> tuple[float, float]:
         if not isinstance(value, list) or len(value) != 2:
-            self.fail(where, f"expected an [x, y] position in metres, got {_kind(value)}")
+            # GIS tools often write a third value (an altitude): say how many there are.
+            got = f"{len(value)} values" if isinstance(value, list) else _kind(value)
+            self.fail(where, f"expected an [x, y] position in metres (2 values, no altitude), got {got}")
         return (
             self.fields.ranged(value[0], where, COORDINATE),
             self.fields.ranged(value[1], where, COORDINATE),

@@ -302,15 +302,10 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
         if meadow is not None:
             return [RunPiece(length, meadow.terrain, meadow.id)]
         if length == 0.0:
-            raise InputError(
-                f"start: expected a point inside a meadow for a zero-length run, got {_xy(origin)}"
-            )
+            raise _outside_every_meadow("start, heading, distance", origin, angle, length)
     spans = _run_spans(meadow_map, float(origin[0]), float(origin[1]), angle, length)
     if not spans:
-        raise OutsideMapError(
-            f"start, heading, distance: expected a run that meets a meadow, got one from "
-            f"{_xy(origin)} of {length!r} m at heading {angle!r} outside every meadow"
-        )
+        raise _outside_every_meadow("start, heading, distance", origin, angle, length)
     cuts = sorted({0.0, length, *(lo for lo, _, _ in spans), *(hi for _, hi, _ in spans)})
     owners: list[int | None] = []
     for lo, hi in pairwise(cuts):
@@ -412,8 +407,8 @@ def commands_for(
     ------
     UnknownTerrainError
         When a meadow's terrain is not in ``table``.
-    InputError
-        When the run meets no meadow.
+    OutsideMapError
+        When the run meets no meadow (or a run of length 0 starts outside every meadow).
 
     Examples
     --------
@@ -433,10 +428,48 @@ def commands_for(
         raise InputError(f"pose: expected a Pose, got {type(pose).__name__}")
     if not isinstance(command, TurnAndRun):
         raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-    pieces = split_run(meadow_map, (pose.x, pose.y), pose.heading + command.turn, command.run)
+    pieces = _split_for("pose, command", meadow_map, pose, command)
+    return _steps(pieces, command, table)
+
+
+def _steps(
+    pieces: list[RunPiece], command: TurnAndRun, table: TerrainTable
+) -> list[tuple[TurnAndRun, TerrainStats]]:
+    """Return the growth steps of a command's run pieces: the turn with the first, then each run."""
     steps = [(TurnAndRun(command.turn, pieces[0].distance), table[pieces[0].terrain])]
     steps.extend((TurnAndRun(0.0, piece.distance), table[piece.terrain]) for piece in pieces[1:])
     return steps
+
+
+def _outside_every_meadow(names: str, origin: NDArray[np.float64], angle: float, length: float) -> InputError:
+    """Return the error of a run that meets no meadow, worded for the arguments ``names`` it came from.
+
+    A run of length 0 names the first of them only (its start: no heading or distance matters),
+    and is an :class:`InputError` (there is no run to grow elsewhere); a longer one an
+    :class:`OutsideMapError`.
+    """
+    if length == 0.0:
+        start = names.split(", ")[0]
+        return InputError(
+            f"{start}: expected a point inside a meadow for a zero-length run, got {_xy(origin)}"
+        )
+    return OutsideMapError(
+        f"{names}: expected a run that meets a meadow, got one from {_xy(origin)} of {length!r} m at "
+        f"heading {angle!r} outside every meadow"
+    )
+
+
+def _split_for(names: str, meadow_map: MeadowMap, pose: Pose, command: TurnAndRun) -> list[RunPiece]:
+    """:func:`split_run` of a command from a pose, a run off the map worded for the caller's ``names``."""
+    if not isinstance(meadow_map, MeadowMap):
+        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+    heading, origin = pose.heading + command.turn, np.array([pose.x, pose.y])
+    if command.run == 0.0 and meadow_map.meadow_at(pose.x, pose.y) is None:
+        raise _outside_every_meadow(names, origin, heading, command.run)
+    try:
+        return split_run(meadow_map, (pose.x, pose.y), heading, command.run)
+    except OutsideMapError:
+        raise _outside_every_meadow(names, origin, heading, command.run) from None
 
 
 def grow_through(
@@ -454,6 +487,13 @@ def grow_through(
     :meth:`~aura_ums.uncertainty.SpatialUncertaintyMap.grow` with ``sigmas`` and
     ``max_vertices`` (whose defaults are that method's).
 
+    Raises
+    ------
+    UnknownTerrainError
+        When a meadow's terrain is not in ``table``.
+    OutsideMapError
+        When the run from the map's most probable pose meets no meadow.
+
     Examples
     --------
     >>> from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
@@ -462,12 +502,22 @@ def grow_through(
     >>> grown = grow_through(start, make_grid_world(1, 3), TurnAndRun(0.0, 10.0), TerrainTable.default())
     >>> bool(grown.area > start.area)
     True
+    >>> far = SpatialUncertaintyMap.from_pose(Pose(50.0, 50.0, 0.0), 0.1, 0.01)   # off the map
+    >>> table = TerrainTable.default()
+    >>> grow_through(far, make_grid_world(1, 3), TurnAndRun(0.0, 1.0), table)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.OutsideMapError: uncertainty_map (its most probable pose), command: expected a run ...
     """
     if not isinstance(uncertainty_map, SpatialUncertaintyMap):
         raise InputError(
             f"uncertainty_map: expected a SpatialUncertaintyMap, got {type(uncertainty_map).__name__}"
         )
     result = uncertainty_map
-    for step, terrain in commands_for(meadow_map, uncertainty_map.most_probable_pose(), command, table):
+    pose = uncertainty_map.most_probable_pose()
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+    pieces = _split_for("uncertainty_map (its most probable pose), command", meadow_map, pose, command)
+    for step, terrain in _steps(pieces, command, table):
         result = result.grow(step, terrain, sigmas=sigmas, max_vertices=max_vertices)
     return result
