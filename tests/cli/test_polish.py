@@ -492,3 +492,18 @@ def test_a_state_saved_before_any_frame_is_not_exported_and_nothing_is_written(
     assert list(out.iterdir()) == []
     invoke(*early, "--save-state", out / "s.json")  # without --mcap: the start map, saved
     assert sorted(path.name for path in out.iterdir()) == ["s.json"]
+
+
+def test_the_camera_files_calibration_bounds_widen_the_windows(
+    tmp_path: Path, sample_replay: list[str]
+) -> None:
+    """replay --camera reads the file's [calibration_bounds]: windows for every camera within them."""
+    exact = EXAMPLES / "virtual_camera_60deg.toml"
+    loose = tmp_path / "loose.toml"
+    loose.write_text(exact.read_text() + "\n[calibration_bounds]\ncx = 4.0\npan_deg = 0.5\ntilt_deg = 0.5\n")
+    widths = []
+    for index, camera in enumerate((exact, loose)):
+        metrics = tmp_path / f"m{index}.json"
+        invoke(*sample_replay, "--until", "10", "--camera", camera, "--metrics-json", metrics)
+        widths.append(json.loads(metrics.read_text())["median_window_width_frac"])
+    assert widths[1] > widths[0]

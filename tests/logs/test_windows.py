@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from aura_ums.camera import load_camera
+from aura_ums.camera import CalibrationBounds, load_camera
 from aura_ums.errors import InputError
 from aura_ums.logs import (
     Calibration,
@@ -117,6 +117,20 @@ def test_the_replay_is_the_same_with_windows(clean_log: RobotLog, landmark_class
         assert (a.inside, a.accepted, a.rejected, a.state) == (b.inside, b.accepted, b.rejected, b.state)
     observed = sum(len([o for o in clean_log.observations if o.time == s.time]) for s in plain.steps)
     assert len(report.rows) == len(WindowReport.methods) * observed
+
+
+def test_windows_under_calibration_bounds_are_wider_and_the_replay_the_same(clean_log: RobotLog) -> None:
+    """Every method's window holds for every camera within the bounds; the maps do not change."""
+    options = ReplayOptions(landmark_class=LandmarkClass.POINT)
+    exact_result, exact = replay_windows(clean_log, FLOOR, CAMERA, options)
+    bounds = CalibrationBounds(cx=3.0, cy=3.0, pan=math.radians(0.5), tilt=math.radians(0.5))
+    loose_result, loose = replay_windows(clean_log, FLOOR, CAMERA, options, calibration_bounds=bounds)
+    assert loose_result.trace.area_m2.tobytes() == exact_result.trace.area_m2.tobytes()
+    for method in WindowReport.methods:
+        pairs = list(zip(exact.judged(method), loose.judged(method), strict=True))
+        assert pairs
+        assert all(wide.width_frac >= narrow.width_frac for narrow, wide in pairs)
+        assert any(wide.width_frac > narrow.width_frac for narrow, wide in pairs)
 
 
 def test_csv_rows_match_the_metrics(clean_log: RobotLog) -> None:

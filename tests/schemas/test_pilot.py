@@ -92,6 +92,9 @@ def test_pilot_uses_or_builds_its_expecter() -> None:
     assert Pilot(CAMERA).expecter == Expecter(CAMERA)
     mine = Expecter(CAMERA)
     assert Pilot(CAMERA, expecter=mine).expecter is mine
+    # The calibration bounds its observations allow for, its windows allow for too.
+    bounds = CalibrationBounds(cx=2.0, pan=0.01)
+    assert Pilot(CAMERA, bounds=bounds).expecter == Expecter(CAMERA, bounds)
 
 
 def test_pilot_validates_its_inputs(sidewalk_stm: ShortTermMemory) -> None:

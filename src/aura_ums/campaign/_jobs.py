@@ -18,7 +18,7 @@ from typing import TypeVar
 import numpy as np
 
 from aura_ums._metrics import Metrics
-from aura_ums.camera import Camera
+from aura_ums.camera import CalibrationBounds, Camera
 from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
 from aura_ums.errors import InputError
@@ -247,6 +247,8 @@ class LogReplay:
         Stop after the last frame at or before this log time, s.
     table_file : str
         Where ``table`` was read (the terrain TOML), named when it lacks a log's terrain.
+    calibration_bounds : CalibrationBounds or None
+        How far the true camera may be from ``camera`` (windows for every camera within them).
 
     Examples
     --------
@@ -266,6 +268,7 @@ class LogReplay:
     load: LoadLog = LoadLog()
     until: float | None = None
     table_file: str = "table"
+    calibration_bounds: CalibrationBounds | None = None
 
     def __call__(self, folder: str | os.PathLike[str]) -> Metrics:
         """Replay the log in ``folder`` and return its metrics (with the windows', given a camera).
@@ -291,6 +294,7 @@ class LogReplay:
             margin=self.window_margin,
             keep_maps=False,
             until=self.until,
+            calibration_bounds=self.calibration_bounds,
         )
         _require_steps(result, self.until, folder)
         return Metrics({**result.metrics(), **windows.metrics()})

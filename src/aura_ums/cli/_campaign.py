@@ -17,7 +17,7 @@ from aura_ums.cli._common import console, fail, none_or_float, progress_bar, ref
 from aura_ums.cli._outputs import Target, write_text
 
 if TYPE_CHECKING:
-    from aura_ums.camera import Camera
+    from aura_ums.camera import CalibrationBounds, Camera
     from aura_ums.logs import ReplayOptions
     from aura_ums.uncertainty import TerrainTable
 
@@ -116,6 +116,7 @@ def replay_logs(
     *,
     table_file: Path,
     camera: Camera | None,
+    calibration_bounds: CalibrationBounds | None,
     window_margin: float,
     max_truth_gap: float | None,
     until: float | None,
@@ -131,7 +132,16 @@ def replay_logs(
     from aura_ums.campaign import LoadLog, LogReplay, run_campaign
     from aura_ums.errors import AuraUmsError
 
-    job = LogReplay(table, options, camera, window_margin, LoadLog(max_truth_gap), until, str(table_file))
+    job = LogReplay(
+        table,
+        options,
+        camera,
+        window_margin,
+        LoadLog(max_truth_gap),
+        until,
+        str(table_file),
+        calibration_bounds,
+    )
     try:
         with progress_bar("replay: logs", quiet=quiet, total=len(log_dirs)) as advance:
             campaign = run_campaign(job, log_dirs, settings, progress=advance)

@@ -498,7 +498,7 @@ def replay(
     one log's steps, maps and state, and --live, need one LOG_DIR.
     """
     from aura_ums import Metrics
-    from aura_ums.camera import load_camera
+    from aura_ums.camera import load_calibration_bounds, load_camera
     from aura_ums.campaign import LoadLog
     from aura_ums.errors import AuraUmsError
     from aura_ums.logs import ReplayState, RobotLog, replay_log, replay_windows
@@ -535,9 +535,12 @@ def replay(
             many = TerrainTable.from_toml(terrain)
             options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
             lens = None if camera is None else load_camera(camera)
+            # The windows hold for every camera within the file's [calibration_bounds] (none: exact).
+            lens_bounds = None if camera is None else load_calibration_bounds(camera)
         except AuraUmsError as exc:
             raise fail(str(exc)) from None
-        replay_logs(log_dirs, many, options, table_file=terrain, camera=lens, window_margin=window_margin,
+        replay_logs(log_dirs, many, options, table_file=terrain, camera=lens, calibration_bounds=lens_bounds,
+                    window_margin=window_margin,
                     max_truth_gap=max_truth_gap, until=until, json_target=json_target,
                     settings=campaign_options, quiet=quiet)  # fmt: skip
         return
@@ -578,6 +581,7 @@ def replay(
         # A map per step only for the outputs that draw them: a long log's replay stays lean.
         keep_maps = plot is not None or mcap is not None
         lens = None if camera is None else load_camera(camera)
+        lens_bounds = None if camera is None else load_calibration_bounds(camera)
         watch = (
             live_replay(
                 log, options, lens, live=live, host=live_host, port=live_port, rate=live_rate, wait=live_wait
@@ -604,6 +608,7 @@ def replay(
                     log, table, lens, options, margin=window_margin, keep_maps=keep_maps,
                     steps_csv=steps_path, progress=advance, until=until, resume=saved,
                     save_state=save_state is not None, after_step=None if view is None else view.step,
+                    calibration_bounds=lens_bounds,
                 )  # fmt: skip
             # Inside the outputs' block, so no empty steps CSV is left under its name.
             if resume is None and save_state is None:

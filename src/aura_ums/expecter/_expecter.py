@@ -34,6 +34,18 @@ the extremes of a projection over a convex set are attained at its extreme point
 those are actual poses (a vertex of the map with an end of the wedge, or a point of the
 landmark's own set).
 
+With calibration bounds (``Expecter(camera, calibration_bounds)``) the window holds for every camera
+within them. The true camera differs from the nominal one by its height (within
+``bounds.height``) and by a rotation about its optical centre: pan and tilt errors, a rotation
+of angle at most ``rho = pan + tilt`` (the angle between two rotations is a metric invariant on
+both sides, so the pan and tilt errors add whatever the order of the mount's rotations).
+Seen through the nominal camera, that rotation moves a landmark point ``q`` about the optical
+centre ``c`` by at most ``2 sin(rho / 2) |q - c|``: the window is the nominal window of the
+landmark with its position uncertainty and its heights widened by that much (``|q - c|`` at
+most the farthest the landmark can be from the camera over the map), and its heights by the
+height bound too. The intrinsics' bounds then widen the pixels: ``u = fx x + cx`` is
+monotone in ``fx`` and ``cx`` for each ``x``, so the extremes are at the bounds' ends.
+
 A heading-sliced map (``SpatialUncertaintyMap.is_sliced``) is a union of such product
 sets, one per slice: its window is the bounding window of the slices' windows, each made as
 above from the slice's polygon and interval, so it holds every projection too, and a slice
@@ -54,7 +66,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums import _native
-from aura_ums.camera import NEAR_PLANE, Camera
+from aura_ums.camera import NEAR_PLANE, CalibrationBounds, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter._distortion import distorted_range
 from aura_ums.expecter._window import margin_pixels
@@ -80,6 +92,8 @@ _CUT_PLANE = 0.5 * NEAR_PLANE
 #: Relative and absolute slack (pixels) added to every bound, far above rounding error.
 _RELATIVE_SLACK = 1e-9
 _ABSOLUTE_SLACK = 1e-7
+#: The bounds of an exact calibration (an Expecter given them keeps no bounds).
+_EXACT = CalibrationBounds()
 #: Distortion bounds are refined until within this many pixels of an attained value.
 _DISTORTION_TOLERANCE_PIXELS = 1e-3
 
@@ -91,12 +105,12 @@ class Expecter:
     Parameters
     ----------
     camera : Camera
-        The calibrated camera on its mount; its pan, tilt and offset stay fixed. The windows
-        hold for this camera as it is: the errors its calibration may have
-        (:class:`~aura_ums.camera.CalibrationBounds`) are not in them. For a camera that may be
-        off by its bounds, widen the ``margin`` of :meth:`window` by their effect in pixels
-        (about ``fx`` times the pan bound across, ``fy`` times the tilt bound up and down,
-        plus the bounds on ``cx`` and ``cy``).
+        The calibrated camera on its mount; its pan, tilt and offset stay fixed.
+    calibration_bounds : CalibrationBounds or None
+        How far the true camera may be from ``camera`` (``[calibration_bounds]`` of a camera
+        file: :func:`~aura_ums.camera.load_calibration_bounds`); the windows then hold for
+        every camera within them (see the module notes), and are wider. None (or all zero):
+        the camera is exact. Its ``fx`` and ``fy`` bounds must be below the camera's own.
 
     Examples
     --------
@@ -115,14 +129,40 @@ class Expecter:
     True
     >>> expecter.window(unsure, PointLandmark("behind", -10.0, 0.0, 2.0)) is None
     True
+
+    A camera whose pan and tilt are known to half a degree, its principal point to 2 pixels:
+    the window holds for every such camera, so it is wider.
+
+    >>> from aura_ums.camera import CalibrationBounds
+    >>> half_degree = math.radians(0.5)
+    >>> loose = Expecter(camera, CalibrationBounds(cx=2.0, cy=2.0, pan=half_degree, tilt=half_degree))
+    >>> wide = loose.bounds(known, corner)
+    >>> round(wide.u_min, 1), round(wide.u_max, 1)   # the corner's 0.18 m at 10 m (pan + tilt: 1 deg), +-2 px
+    (309.2, 330.8)
     """
 
     camera: Camera
+    calibration_bounds: CalibrationBounds | None = None
     _rotation: tuple[float, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.camera, Camera):
             raise InputError(f"camera: expected a Camera, got {type(self.camera).__name__}")
+        calibration = self.calibration_bounds
+        if calibration is not None:
+            if not isinstance(calibration, CalibrationBounds):
+                got = type(calibration).__name__
+                raise InputError(f"calibration_bounds: expected CalibrationBounds or None, got {got}")
+            k = self.camera.intrinsics
+            for name, focal in (("fx", k.fx), ("fy", k.fy)):
+                bound = getattr(calibration, name)
+                if bound >= focal:
+                    raise InputError(
+                        f"calibration_bounds.{name}: expected a bound below the camera's {name} "
+                        f"({focal!r} px), got {bound!r}"
+                    )
+            if calibration == _EXACT:  # an exact calibration: the windows of no bounds, computed so
+                object.__setattr__(self, "calibration_bounds", None)
         rotation = tuple(float(value) for value in self.camera.mount.rotation().ravel())
         object.__setattr__(self, "_rotation", rotation)
 
@@ -203,28 +243,79 @@ def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) 
     camera = expecter.camera
     mount, k = camera.mount, camera.intrinsics
     rises = tuple(height - mount.height for height in heights)
+    uncertainty = landmark.position_uncertainty
+    bounds = expecter.calibration_bounds
+    if bounds is not None:
+        spread = _rotation_spread(map, ends, uncertainty, rises, camera, bounds)
+        uncertainty += spread
+        rises = (min(rises) - bounds.height - spread, max(rises) + bounds.height + spread)
     if map.is_sliced:
-        found = _sliced_points(expecter, map, ends, landmark.position_uncertainty, rises)
+        found = _sliced_points(expecter, map, ends, uncertainty, rises)
     else:
         wedge = map.wedge
         found = _points(
-            expecter, map.polygon.vertices, ends, landmark.position_uncertainty,
+            expecter, map.polygon.vertices, ends, uncertainty,
             wedge.is_full_circle, wedge.center - wedge.cw, wedge.width, rises,
         )  # fmt: skip
     if found is None:
         return None
     if k.distortion is None:
-        return _pixel_window(k.fx, k.fy, k.cx, k.cy, found.x_min, found.y_min, found.x_max, found.y_max)
-    tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
-    lower, upper = distorted_range(found.points, k.distortion, tolerance)
+        if bounds is None:
+            return _pixel_window(k.fx, k.fy, k.cx, k.cy, found.x_min, found.y_min, found.x_max, found.y_max)
+        lower, upper = np.array([found.x_min, found.y_min]), np.array([found.x_max, found.y_max])
+    else:
+        tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
+        lower, upper = distorted_range(found.points, k.distortion, tolerance)
     with np.errstate(over="ignore", invalid="ignore"):
-        u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
-        v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
+        if bounds is None:
+            u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
+            v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
+        else:
+            u = _pixel_range(k.fx, bounds.fx, k.cx, bounds.cx, lower[0], upper[0])
+            v = _pixel_range(k.fy, bounds.fy, k.cy, bounds.cy, lower[1], upper[1])
     return ImageWindow(
         _outward(float(u[0]), -1.0),
         _outward(float(v[0]), -1.0),
         _outward(float(u[1]), 1.0),
         _outward(float(v[1]), 1.0),
+    )
+
+
+def _rotation_spread(
+    map: SpatialUncertaintyMap,
+    ends: tuple[tuple[float, float], ...],
+    uncertainty: float,
+    rises: tuple[float, ...],
+    camera: Camera,
+    bounds: CalibrationBounds,
+) -> float:
+    """Metres a landmark point may seem moved by the mount's pan and tilt errors (module notes).
+
+    ``2 sin(rho / 2)`` times the farthest the landmark can be from the optical centre: over
+    the map's polygon (the hull of its slices), the landmark's ground set and the camera's
+    offset across, its heights (the camera's height error included) up and down.
+    """
+    rho = min(bounds.pan + bounds.tilt, math.pi)
+    if rho == 0.0:
+        return 0.0
+    vertices = map.polygon.vertices
+    across = (
+        max(float(np.max(np.hypot(vertices[:, 0] - x, vertices[:, 1] - y))) for x, y in ends)
+        + uncertainty
+        + math.hypot(camera.mount.forward, camera.mount.left)
+    )
+    up = max(abs(rise) for rise in rises) + bounds.height
+    return 2.0 * math.sin(rho / 2.0) * math.hypot(across, up)
+
+
+def _pixel_range(
+    focal: float, focal_bound: float, centre: float, centre_bound: float, low: float, high: float
+) -> tuple[float, float]:
+    """Return the least and most of ``focal x + centre``: x in [low, high], focal and centre in bounds."""
+    least, most = focal - focal_bound, focal + focal_bound  # both > 0 (checked by the Expecter)
+    return (
+        min(least * low, most * low) - centre_bound + centre,
+        max(least * high, most * high) + centre_bound + centre,
     )
 
 

@@ -35,7 +35,7 @@ import numpy as np
 from aura_ums._metrics import Metrics
 from aura_ums._validate import finite_float
 from aura_ums.baselines import ExtendedKalmanFilter
-from aura_ums.camera import Camera
+from aura_ums.camera import CalibrationBounds, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_window, gaussian_window, margin_pixels
 from aura_ums.logs._calibrate import SensorBounds
@@ -300,6 +300,7 @@ def replay_windows(
     resume: ReplayState | None = None,
     save_state: bool = False,
     after_step: Callable[[ReplayStep, tuple[WindowRow, ...]], None] | None = None,
+    calibration_bounds: CalibrationBounds | None = None,
 ) -> tuple[ReplayResult, WindowReport]:
     """Replay a log and judge, for each real observation, the image windows of four methods.
 
@@ -337,6 +338,10 @@ def replay_windows(
     after_step : callable or None
         As for :func:`replay_log`, called as ``after_step(step, rows)`` with the step's
         window rows too (one per observation of the frame and method).
+    calibration_bounds : CalibrationBounds or None
+        How far the true camera may be from ``camera`` (a camera file's
+        ``[calibration_bounds]``): every method's windows then hold for every camera within
+        them (:class:`~aura_ums.expecter.Expecter`). None: the camera is exact.
 
     Returns
     -------
@@ -390,7 +395,8 @@ def replay_windows(
 
     if after_step is not None and not callable(after_step):
         raise InputError(f"after_step: expected a callable or None, got {type(after_step).__name__}")
-    judge = _Judge(log, table, camera, opts, pixels, box_sigmas, b_sd, r_sd, bounds)
+    expecter = Expecter(camera, calibration_bounds)
+    judge = _Judge(log, table, expecter, opts, pixels, box_sigmas, b_sd, r_sd, bounds)
     forward = None if after_step is None else _with_rows(after_step, judge)
     result = replay_log(
         log, table, opts, before_frame=judge, keep_maps=keep_maps, steps_csv=steps_csv, progress=progress,
@@ -420,7 +426,7 @@ class _Judge:
         self,
         log: RobotLog,
         table: TerrainTable,
-        camera: Camera,
+        expecter: Expecter,
         options: ReplayOptions,
         margin: float,
         sigmas: float,
@@ -443,8 +449,8 @@ class _Judge:
             lm.id: _judged_landmark(meadows.landmark(lm.id).landmark) for lm in moved.landmarks
         }
         self._sensor = moved.meta.sensor_offset
-        self._camera = camera
-        self._expecter = Expecter(camera)
+        self._camera = expecter.camera
+        self._expecter = expecter
         self._margin = margin
         self._sigmas = sigmas
         self.rows: list[WindowRow] = []

@@ -35,7 +35,8 @@ class Pilot:
     camera : Camera
         The camera the schemas observe with.
     expecter : Expecter or None
-        The Expecter process; None builds one for ``camera``. Its camera must be ``camera``.
+        The Expecter process; None builds one for ``camera`` and ``bounds`` (its windows hold
+        for every camera within them). Its camera must be ``camera``.
     lost_frames, tracking_margin, pixel_error, bounds
         Passed to every schema (see :class:`FindLandmarkSchema`).
 
@@ -71,19 +72,20 @@ class Pilot:
     def __post_init__(self) -> None:
         if not isinstance(self.camera, Camera):
             raise InputError(f"camera: expected a Camera, got {type(self.camera).__name__}")
+        margin, error = check_tracking_settings(
+            self.lost_frames, self.tracking_margin, self.pixel_error, self.bounds
+        )
+        object.__setattr__(self, "tracking_margin", margin)
+        object.__setattr__(self, "pixel_error", error)
         if self.expecter is None:
-            object.__setattr__(self, "expecter", Expecter(self.camera))
+            # Its windows hold for every camera within the bounds its observations allow for.
+            object.__setattr__(self, "expecter", Expecter(self.camera, self.bounds))
         elif not isinstance(self.expecter, Expecter):
             raise InputError(f"expecter: expected an Expecter or None, got {type(self.expecter).__name__}")
         elif self.expecter.camera != self.camera:
             raise InputError(
                 f"expecter: expected an Expecter for the pilot's camera, got one for {self.expecter.camera!r}"
             )
-        margin, error = check_tracking_settings(
-            self.lost_frames, self.tracking_margin, self.pixel_error, self.bounds
-        )
-        object.__setattr__(self, "tracking_margin", margin)
-        object.__setattr__(self, "pixel_error", error)
 
     def schemas_for_leg(self, stm: ShortTermMemory) -> tuple[FindLandmarkSchema, ...]:
         """Return one slot-filled find-landmark schema per candidate landmark of ``stm``, in its order.
