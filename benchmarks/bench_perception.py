@@ -1,6 +1,8 @@
 """Benchmark perception: milliseconds on a full York Urban frame and on a 160 x 120 window.
 
-Run: ``.venv/bin/python benchmarks/bench_perception.py [path/to/york_urban]``.
+Run: ``.venv/bin/python benchmarks/bench_perception.py [path/to/york_urban]``. Without the
+argument it reads ``../shared/data/york_urban`` beside the repository, and skips (saying so)
+when that folder is not there.
 
 For each detector, the median time of ``find`` on a full 640 x 480 frame and on a
 160 x 120 window (the centre of the frame), over the first 5 images, each repeated;
@@ -54,6 +56,10 @@ def median_ms(
 
 def main() -> None:
     folder = Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_DATA
+    if len(sys.argv) == 1 and not folder.is_dir():
+        # make bench runs every benchmark: one whose data is elsewhere says so and lets the rest run.
+        print(f"York Urban images not found at {folder}: skipped (pass their folder as the argument)")
+        return
     images = [item.image for item in load_york_urban(folder, york_urban_names(folder)[:5])]
     detectors: dict[str, Finder] = {
         "FLF tuned pi/2, numpy": FastLineFinder(VERTICAL).find,
