@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import inspect
 import json
 import pkgutil
 import subprocess
@@ -101,3 +102,21 @@ def test_a_subpackage_is_an_attribute_of_the_top_level_and_an_unknown_name_is_no
     assert aura_ums.geometry is importlib.import_module("aura_ums.geometry")
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         _ = aura_ums.no_such_name  # type: ignore[attr-defined]
+
+
+def _public_objects() -> list[tuple[str, object]]:
+    """Every class and function a public module exports (``__all__``), by its public name."""
+    found: list[tuple[str, object]] = []
+    for name in PUBLIC:
+        module = importlib.import_module(name)
+        for attr in public_all(name):
+            value = getattr(module, attr)
+            if inspect.isclass(value) or inspect.isfunction(value):
+                found.append((f"{name}.{attr}", value))
+    return found
+
+
+def test_every_public_class_and_function_shows_an_example() -> None:
+    """Style rule 8: a runnable Examples section (run by pytest's doctests) on each public name."""
+    bare = [name for name, value in _public_objects() if ">>>" not in (inspect.getdoc(value) or "")]
+    assert not bare, f"no example in the docstrings of {bare}"

@@ -21,23 +21,72 @@ __all__ = [
 
 
 class AuraUmsError(Exception):
-    """Base class of every error raised on purpose by aura-ums."""
+    """Base class of every error raised on purpose by aura-ums.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import BearingObservation
+    >>> try:
+    ...     BearingObservation("pole_1", 0.0, 0.3, -0.01)
+    ... except AuraUmsError as exc:   # catches every error aura-ums raises on purpose
+    ...     print(type(exc).__name__, "-", exc)
+    InputError - bearing_error: expected a non-negative number, got -0.01
+    >>> issubclass(RunLostError, AuraUmsError), issubclass(AuraUmsError, ValueError)
+    (True, False)
+    """
 
 
 class InputError(AuraUmsError, ValueError):
-    """An argument or a value given to aura-ums is not what it expects."""
+    """An argument or a value given to aura-ums is not what it expects.
+
+    Examples
+    --------
+    >>> from aura_ums.camera import CameraMount
+    >>> try:
+    ...     CameraMount(height=-0.5)
+    ... except ValueError as exc:   # an InputError is a ValueError too
+    ...     print(type(exc).__name__, "-", exc)
+    InputError - CameraMount.height: expected a height >= 0 m above the ground, got -0.5
+    """
 
 
 class OutsideMapError(InputError):
-    """A position or a run lies outside every meadow of the meadow map."""
+    """A position or a run lies outside every meadow of the meadow map.
+
+    Examples
+    --------
+    >>> from aura_ums.world import make_grid_world, split_run
+    >>> split_run(make_grid_world(1, 2), (100.0, 100.0), 0.0, 5.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.OutsideMapError: start, heading, distance: expected a run that meets a meadow, got ...
+    >>> issubclass(OutsideMapError, InputError)
+    True
+    """
 
 
 class MissingDependencyError(AuraUmsError, ImportError):
-    """An optional dependency (an extra such as ``opencv``) is needed but not installed."""
+    """An optional dependency (an extra such as ``opencv``) is needed but not installed.
+
+    Examples
+    --------
+    >>> try:
+    ...     raise MissingDependencyError("a campaign needs the package 'dask'; install aura-ums[dask]")
+    ... except ImportError as exc:   # an ImportError too, not a ValueError
+    ...     print(exc)
+    a campaign needs the package 'dask'; install aura-ums[dask]
+    """
 
 
 class RunLostError(AuraUmsError):
-    """A run of a campaign was lost (its worker died or it timed out) more often than its retries allow."""
+    """A run of a campaign was lost (its worker died or it timed out) more often than its retries allow.
+
+    Examples
+    --------
+    >>> lost = RunLostError("run 3: expected it to finish within 2 retries, got it lost 3 times")
+    >>> isinstance(lost, AuraUmsError), isinstance(lost, ValueError)   # not the caller's input
+    (True, False)
+    """
 
 
 class FileFormatError(InputError):
@@ -104,6 +153,17 @@ class UnknownTerrainError(InputError, KeyError):
     """A name (a terrain, a meadow) is not in the table it was looked up in.
 
     It is a :class:`KeyError` too, so ``Mapping.get`` and ``in`` work as usual.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import TerrainTable
+    >>> table = TerrainTable.default()
+    >>> table["lava"]
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.UnknownTerrainError: terrain: expected one of concrete, grass, gravel, tile, got 'lava'
+    >>> "lava" in table, table.get("lava")   # a KeyError: the Mapping methods still work
+    (False, None)
     """
 
     def __str__(self) -> str:

@@ -82,6 +82,19 @@ class MotionBounds(NamedTuple):
         Largest skitter displacement during the turn, metres.
     drift_max : float
         Largest heading change during the run, radians, either side.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import TerrainTable
+    >>> concrete = TerrainTable.default()["concrete"]
+    >>> b = motion_bounds(concrete, 0.5, 2.0, 3.0)
+    >>> b.turn_min <= b.turn_mean <= b.turn_max, b.chord_min <= b.run_min <= b.run_mean <= b.run_max
+    (True, True)
+    >>> round(b.turn_min, 3), b.turn_max, b.run_max   # never beyond the command itself
+    (0.445, 0.5, 2.0)
+    >>> left, right = motion_bounds(concrete, -0.5, 2.0, 3.0)[:2]   # a clockwise turn: still ordered
+    >>> left, round(right, 3)
+    (-0.5, -0.445)
     """
 
     turn_min: float

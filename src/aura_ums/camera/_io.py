@@ -276,7 +276,7 @@ def load_camera(path: str | Path) -> Camera:
 
 
 def load_calibration_bounds(path: str | Path) -> CalibrationBounds:
-    """Read the ``[calibration_bounds]`` table of a TOML camera file (all zero when absent).
+    r"""Read the ``[calibration_bounds]`` table of a TOML camera file (all zero when absent).
 
     Keys: ``fx``, ``fy``, ``cx``, ``cy`` (pixels), ``pan``/``tilt`` (radians) or
     ``pan_deg``/``tilt_deg`` (degrees), ``height`` (metres); each optional, default 0.
@@ -296,6 +296,24 @@ def load_calibration_bounds(path: str | Path) -> CalibrationBounds:
     ------
     FileFormatError
         As :func:`load_camera`.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> text = camera_to_toml(Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0)))
+    >>> _ = (folder / "cam.toml").write_text(text + "[calibration_bounds]\nfx = 3.0\npan_deg = 0.5\n")
+    >>> bounds = load_calibration_bounds(folder / "cam.toml")
+    >>> bounds.fx, round(bounds.pan, 6), bounds.tilt   # degrees read as radians; absent keys are 0
+    (3.0, 0.008727, 0.0)
+    >>> _ = (folder / "plain.toml").write_text(text)
+    >>> load_calibration_bounds(folder / "plain.toml") == CalibrationBounds()   # no table: all zero
+    True
+    >>> _ = (folder / "bad.toml").write_text(text + "[calibration_bounds]\nfx = -1.0\n")
+    >>> load_calibration_bounds(folder / "bad.toml")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...bad.toml: [calibration_bounds] fx: expected a number in ..., got -1.0
     """
     return _parse_toml(path)[1]
 
@@ -314,6 +332,26 @@ def camera_to_toml(camera: Camera, bounds: CalibrationBounds | None = None) -> s
     -------
     str
         The TOML document (angles in radians).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> camera = Camera(CameraIntrinsics(500, 500, 320, 240, 640, 480), CameraMount(1.0, tilt=0.1))
+    >>> text = camera_to_toml(camera, CalibrationBounds(fx=3.0))
+    >>> print(text.split("[mount]")[1].split("[calibration_bounds]")[0].strip())
+    height = 1.0
+    forward = 0.0
+    left = 0.0
+    pan = 0.0
+    tilt = 0.1
+    >>> file = pathlib.Path(tempfile.mkdtemp()) / "cam.toml"
+    >>> _ = file.write_text(text)
+    >>> load_camera(file) == camera, load_calibration_bounds(file).fx   # read back exactly
+    (True, 3.0)
+    >>> camera_to_toml(camera.mount)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: camera: expected Camera, got CameraMount
     """
     if not isinstance(camera, Camera):
         raise InputError(f"camera: expected Camera, got {type(camera).__name__}")

@@ -55,7 +55,16 @@ def robot_from_camera_rotation(pan: float, tilt: float) -> Array:
 def distort(
     x: Array, y: Array, coefficients: tuple[float, float, float, float, float]
 ) -> tuple[Array, Array]:
-    """Apply OpenCV's radial-tangential distortion (k1, k2, p1, p2, k3) to normalized coordinates."""
+    """Apply OpenCV's radial-tangential distortion (k1, k2, p1, p2, k3) to normalized coordinates.
+
+    Examples
+    --------
+    >>> x, y = np.array([0.0, 0.5]), np.array([0.0, 0.0])
+    >>> [v.tolist() for v in distort(x, y, (-0.1, 0.0, 0.0, 0.0, 0.0))]   # barrel: the edge moves in
+    [[0.0, 0.4875], [0.0, 0.0]]
+    >>> [v.tolist() for v in distort(x, y, (0.0, 0.0, 0.0, 0.0, 0.0))]    # all zero: unchanged
+    [[0.0, 0.5], [0.0, 0.0]]
+    """
     k1, k2, p1, p2, k3 = coefficients
     r2 = x * x + y * y
     radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
@@ -166,6 +175,16 @@ class CameraMount:
         Radians, counter-clockwise positive (towards the robot's left), in [-1000, 1000].
     tilt : float
         Radians, positive when the optical axis points below the horizon; |tilt| < pi/2.
+
+    Examples
+    --------
+    >>> mount = CameraMount(1.2, forward=0.3, tilt=math.radians(5.0))
+    >>> mount.sensor_offset, mount.rotation()[:, 2].round(4).tolist()   # optical axis: a little down
+    ((0.3, 0.0), [0.9962, 0.0, -0.0872])
+    >>> CameraMount(1.2, tilt=math.pi / 2)   # looking straight down: no horizon in view
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: CameraMount.tilt: expected |tilt| < pi/2, got 1.5707963267948966
     """
 
     height: float

@@ -58,6 +58,15 @@ class Campaign(Generic[_R]):
         counted once however many retries it took; 0 for a serial campaign.
     retried_items : tuple of int
         Their indices, ascending.
+
+    Examples
+    --------
+    >>> run_campaign(abs, [-1, 2, -3])
+    Campaign(values=(1, 2, 3), retried=0, retried_items=())
+    >>> Campaign((1, 2, 3), retried=1, retried_items=(2,)).retried_items   # item 2 ran twice on Dask
+    (2,)
+    >>> run_campaign(abs, [])                      # no items: no runs, nothing retried
+    Campaign(values=(), retried=0, retried_items=())
     """
 
     values: tuple[_R, ...]

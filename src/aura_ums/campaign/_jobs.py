@@ -74,6 +74,19 @@ class SimulationRun:
         Reduce the map by landmarks (False: growth only).
     perception : PerceptionMode
         Where perception runs (:func:`~aura_ums.sim.run_scenario`'s ``perception``).
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> run = SimulationRun(Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml")))
+    >>> (seed,) = run_seeds(1, 1)
+    >>> result = run(seed)
+    >>> len(result.records), run(seed).final_map.area == result.final_map.area   # the same seed, the same run
+    (4, True)
+    >>> run(1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: seed: expected a numpy.random.SeedSequence, got int
     """
 
     scenario: Scenario
@@ -105,6 +118,17 @@ class SimulationBatch:
     ----------
     run : SimulationRun
         One run of the scenario.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> run = SimulationRun(Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml")))
+    >>> (seed,) = run_seeds(1, 1)
+    >>> first, second = SimulationBatch(run)((seed, seed))     # each run as alone: the same run twice
+    >>> len(first.records), first.final_map.area == second.final_map.area
+    (4, True)
+    >>> SimulationBatch(run)(())                   # an empty batch: no run
+    ()
     """
 
     run: SimulationRun
@@ -211,6 +235,19 @@ class LoadLog:
         Longest interval, s, between ground-truth rows interpolated across
         (:meth:`GroundTruth.with_max_gap <aura_ums.logs.GroundTruth.with_max_gap>`);
         None: the log's own.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from aura_ums.logs import synthetic_log, write_log
+    >>> folder = write_log(synthetic_log(np.random.default_rng(0), duration=5.0), tempfile.mkdtemp() + "/log")
+    >>> log = LoadLog()(folder)
+    >>> log.meta.name, log.groundtruth.max_gap, LoadLog(max_truth_gap=2.0)(folder).groundtruth.max_gap
+    ('synthetic', 0.5, 2.0)
+    >>> LoadLog()(folder / "missing")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: .../missing: expected a log folder, got no such folder
     """
 
     max_truth_gap: float | None = None

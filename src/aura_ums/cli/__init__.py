@@ -20,11 +20,22 @@ __all__ = ["app", "main"]
 
 
 def main() -> None:
-    """Run the ``aura-ums`` command line (the console script's entry point).
+    r"""Run the ``aura-ums`` command line (the console script's entry point).
 
     A Ctrl-C before a command starts (while the libraries load, or while the arguments
     are read) exits with code 130 and says so on stderr, as one during a command does,
-    instead of a traceback or nothing.
+    instead of a traceback or nothing. It runs the command line of ``sys.argv`` in this
+    process and exits with its status (:doc:`/cli`: 0, or 2 for a refusal named on stderr).
+
+    Examples
+    --------
+    >>> import subprocess, sys
+    >>> run = [sys.executable, "-c", "from aura_ums.cli import main; main()"]
+    >>> subprocess.run([*run, "--version"], capture_output=True, text=True).stdout.startswith("aura-ums ")
+    True
+    >>> refused = subprocess.run([*run, "replay", "no/log", "--terrain", "t"], capture_output=True, text=True)
+    >>> refused.returncode, refused.stderr
+    (2, 'error: no/log: expected a log folder, got no such folder\n')
     """
     try:
         from aura_ums.cli._app import main as run

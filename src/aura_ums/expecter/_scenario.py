@@ -22,7 +22,18 @@ from aura_ums.uncertainty import PointLandmark, SpatialUncertaintyMap
 
 @dataclass(frozen=True, slots=True)
 class Figure4Scenario:
-    """Camera, elongated map and the two landmarks of the Figure 4 scenario."""
+    """Camera, elongated map and the two landmarks of the Figure 4 scenario.
+
+    Examples
+    --------
+    >>> s = figure4_scenario(vertices=8)
+    >>> s.camera.intrinsics.width, s.map.polygon.vertex_count, [lm.symbol for lm in s.landmarks]
+    (640, 8, ['manhole cover', 'sign corner'])
+    >>> s.map = None                                      # a value: it cannot change
+    Traceback (most recent call last):
+    ...
+    dataclasses.FrozenInstanceError: cannot assign to field 'map'
+    """
 
     camera: Camera
     map: SpatialUncertaintyMap

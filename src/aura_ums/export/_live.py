@@ -157,6 +157,17 @@ class LiveSimulation(_LiveView):
     each run of a Monte Carlo in turn: a run whose first frame (index 0) follows another
     run's frames is placed on the time line one second after them (log times only grow),
     and its ``/metrics`` carry its run number.
+
+    Examples
+    --------
+    >>> [name for name in vars(LiveSimulation) if not name.startswith("_")]    # its own; the rest shared
+    ['run', 'frame']
+    >>> sorted(name for name in vars(_LiveView) if not name.startswith("_"))
+    ['close', 'port', 'published', 'url', 'wait_for_client', 'wait_while_watched']
+    >>> serve_simulation("scenarios/paper_sidewalk.toml")     # a path, not a Scenario: no server starts
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: scenario: expected a Scenario, got str
     """
 
     def __init__(self, server: LiveServer, channels: SimulationChannels) -> None:
@@ -190,6 +201,17 @@ class LiveReplay(_LiveView):
 
     Pass :meth:`step` as ``after_step`` to :func:`aura_ums.logs.replay_log` or to
     :func:`aura_ums.logs.replay_windows` (which hands it each step's window rows too).
+
+    Examples
+    --------
+    >>> [name for name in vars(LiveReplay) if not name.startswith("_")]    # its own; the rest shared
+    ['step']
+    >>> issubclass(LiveReplay, _LiveView), hasattr(LiveReplay, "__enter__")   # a context manager
+    (True, True)
+    >>> serve_replay("runs/log")                 # a folder, not a RobotLog: no server starts
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: log: expected a RobotLog, got str
     """
 
     def __init__(self, server: LiveServer, channels: ReplayChannels) -> None:

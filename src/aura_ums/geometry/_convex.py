@@ -412,6 +412,18 @@ def outer_arc(radius: float, start: float, stop: float, step: float = ARC_STEP) 
     The arc is centred on the origin; ``0 < stop - start < 2*pi``. The returned
     polyline runs from the arc's start point through tangent intersections to its
     end point, so the region between it and the origin contains the arc.
+
+    Examples
+    --------
+    >>> quarter = outer_arc(1.0, 0.0, math.pi / 2)   # 8 steps of pi/16: ends and 8 tangent corners
+    >>> len(quarter), quarter[0].tolist(), quarter[-1].round(12).tolist()
+    (10, [1.0, 0.0], [0.0, 1.0])
+    >>> bool(np.all(np.hypot(quarter[:, 0], quarter[:, 1]) >= 1.0))   # nothing inside the arc
+    True
+    >>> outer_arc(1.0, 0.0, 1.0, step=1.0).round(4).tolist()   # one step: a single corner
+    [[1.0, 0.0], [1.0, 0.5463], [0.5403, 0.8415]]
+    >>> outer_arc(0.0, 0.0, 0.1).tolist()   # a zero radius: the origin, three times
+    [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
     """
     width = stop - start
     count = max(1, math.ceil(width / step))

@@ -163,6 +163,17 @@ class MotionCalibration:
     run_scale, turn_scale : float
         Factors, > 0, that make recorded runs and turns bounds of the actual ones (the
         growth model never moves farther or turns more than commanded).
+
+    Examples
+    --------
+    >>> MotionCalibration()
+    MotionCalibration(delay_s=0.0, run_scale=1.0, turn_scale=1.0)
+    >>> MotionCalibration(delay_s=0.1, run_scale=1.05).run_scale
+    1.05
+    >>> MotionCalibration(delay_s=-0.1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: MotionCalibration.delay_s: expected a number >= 0, got -0.1
     """
 
     delay_s: float = 0.0
@@ -238,6 +249,20 @@ class Calibration:
     anchor : bool
         Whether :attr:`stats` are for growth from an anchor (``ManagerSettings.anchor_growth``)
         rather than move by move.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=10.0)
+    >>> calibration = calibrate_logs([log], horizons=(1.0, 2.0, 30.0))
+    >>> calibration.terrain, list(calibration.terrain_table()), calibration.observations
+    ('floor', ['floor'], 35)
+    >>> calibration.report().splitlines()[0]
+    'horizon s  windows  inside  heading q0.99 rad  bound rad  position q0.99 m  bound m'
+    >>> calibration.report().splitlines()[-1]       # longer than the log: no window, NaN figures
+    '       30        0     nan             nan        nan            nan      nan'
+    >>> calibration.sensors_toml().splitlines()[8:10]
+    ['format = "aura-ums/sensor-calibration"', 'growth = "move"']
     """
 
     terrain: str
@@ -356,6 +381,23 @@ def load_sensors(path: str | Path) -> tuple[MotionCalibration, SensorBounds, Sen
     FileFormatError
         Naming the file and table for a missing file, bad TOML, a missing or unknown key,
         or a value out of range (in the optional ``[noise]`` table too).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=10.0)
+    >>> calibration = calibrate_logs([log], horizons=(1.0,))
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "floor.sensors.toml"
+    ...     _ = path.write_text(calibration.sensors_toml())
+    ...     motion, working, envelope = load_sensors(path)
+    >>> motion == calibration.motion, working == calibration.working, envelope == calibration.envelope
+    (True, True, True)
+    >>> load_sensors("missing.sensors.toml")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: missing.sensors.toml: expected an existing ... file, got no such file
     """
     reader, document = _read_sensors(path)
     if "noise" in document:
@@ -384,6 +426,22 @@ def load_noise(path: str | Path) -> FilterNoise | None:
     ------
     FileFormatError
         As :func:`load_sensors`, and for a bad ``[noise]`` table.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=10.0)
+    >>> calibration = calibrate_logs([log], horizons=(1.0,))
+    >>> text = calibration.sensors_toml()
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "floor.sensors.toml"
+    ...     _ = path.write_text(text)
+    ...     noise = load_noise(path)
+    ...     _ = path.write_text(text.split("[noise]")[0])     # as written before the table existed
+    ...     old = load_noise(path)
+    >>> noise == calibration.noise, old is None
+    (True, True)
     """
     reader, document = _read_sensors(path)
     if "noise" not in document:
@@ -795,6 +853,16 @@ class HorizonCheck:
         centre, metres.
     position_bound : float
         Median distance from the grown map's centre to its farthest vertex, metres.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=10.0)
+    >>> first, too_long = calibrate_logs([log], horizons=(1.0, 30.0)).checks
+    >>> first.horizon, first.windows, 0.0 <= first.containment <= 1.0
+    (1.0, 9, True)
+    >>> too_long.windows, math.isnan(too_long.containment)     # longer than the log: nothing checked
+    (0, True)
     """
 
     horizon: float
@@ -1176,6 +1244,18 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
         Measured minus true bearing, wrapped to (-pi, pi], radians.
     range_errors : ndarray, shape (k,)
         ``(measured - true) / measured`` for the observations with a range (k <= n).
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=10.0)
+    >>> bearing, relative = observation_errors([log])
+    >>> bearing.size, relative.size
+    (35, 35)
+    >>> bool(np.abs(bearing).max() <= log.meta.bearing_error)     # within the log's own bound
+    True
+    >>> observation_errors([])                                    # no log: no error
+    (array([], dtype=float64), array([], dtype=float64))
     """
     bearing, error, measured = _observation_errors(logs)
     return bearing, error / measured

@@ -191,6 +191,17 @@ class ReplayStep:
         Whether ``truth`` is inside the envelope map (None without truth or envelope).
     excluded : int
         Observations the relaxed intersection excluded at this step (``relaxed_q > 0``).
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> step = replay_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]})).steps[0]
+    >>> step.time, step.inside, step.accepted, step.rejected, step.state
+    (0.3, True, 1, 0, <ManagerState.NOMINAL: 'nominal'>)
+    >>> blind = ReplayStep(1.0, step.map, None, None, 0, 0, 0.0, ManagerState.NOMINAL)  # no truth
+    >>> blind.inside, ReplayTrace.of_steps([blind]).inside.tolist()     # not judged: -1 in a trace
+    (None, [-1])
     """
 
     time: float
@@ -238,6 +249,20 @@ class ReplayTrace:
         Whether the working map was re-seeded from the envelope at the step.
     excluded : ndarray of int64, shape (n,)
         Observations the relaxed intersection excluded at the step (``relaxed_q > 0``).
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> table = TerrainTable({"floor": TerrainTable.default()["tile"]})
+    >>> trace = replay_log(log, table, keep_maps=False).trace
+    >>> len(trace), trace.inside.tolist().count(1), trace.states()[0].value
+    (16, 16, 'nominal')
+    >>> trace.truth_pose(0) == Pose(*trace.truth[0])
+    True
+    >>> blank = ReplayTrace.empty(1)                  # nothing filled in: no truth, not judged
+    >>> blank.truth_pose(0), blank.csv_lines()
+    (None, ['0.0,,0.0,0.0,0,0,0.000,nominal,0'])
     """
 
     time: NDArray[np.float64]
@@ -379,6 +404,21 @@ class ReplayResult:
         The replay's start, s: the motion's first time, or the ground truth's first row
         when that is later (NaN when not known). A replay whose frames all come before it
         has no step.
+
+    Examples
+    --------
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> table = TerrainTable({"floor": TerrainTable.default()["tile"]})
+    >>> result = replay_log(log, table)
+    >>> len(result.trace), result.containment_rate, result.relocalizations, result.start_time
+    (16, 1.0, 0, 0.0)
+    >>> len(result.steps) == len(result.maps) == result.metrics()["steps"]
+    True
+    >>> replay_log(log, table, keep_maps=False).steps  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: ReplayResult.steps: expected ... (keep_maps=True), got one without ...
     """
 
     log: RobotLog | LogStream
@@ -598,6 +638,20 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
     grown by ``margin`` metres. Landmarks become :class:`~aura_ums.uncertainty.VerticalLineLandmark`
     (Class I, heights from the row or the meta) or :class:`~aura_ums.uncertainty.PointLandmark`
     (Class II, at the row's mid height).
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from aura_ums.logs import synthetic_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> world = log_meadow_map(log, LandmarkClass.POINT)
+    >>> world.bounds, world.meadows[0].terrain, len(world.landmarks)
+    ((-12.5, -12.5, 12.5, 12.5), 'floor', 8)
+    >>> world.landmark("L1").landmark
+    PointLandmark(id='L1', x=-6.0, y=-6.0, z=1.0, symbol='pole', position_uncertainty=0.01)
+    >>> bare = dataclasses.replace(log, landmarks=(), observations=(), groundtruth=None)
+    >>> log_meadow_map(bare, LandmarkClass.POINT).bounds          # nothing to hold: around the origin
+    (-6.0, -6.0, 6.0, 6.0)
     """
     truth = log.groundtruth
     box = None
@@ -656,6 +710,20 @@ def observation_for(
     rows without a range (returns a bearing observation, which the manager rejects as of
     the wrong class and counts). ``sensor_offset`` (forward, left; metres) is where the
     sensor sits in the robot frame (the log's ``meta.sensor_offset``).
+
+    Examples
+    --------
+    >>> bounds = SensorBounds(0.05, 0.0, 0.1, 0.1)
+    >>> row = LogObservation(2.5, "pole", 0.25, range=4.0)
+    >>> seen = observation_for(row, LandmarkClass.POINT, bounds)
+    >>> type(seen).__name__, seen.bearing_error, seen.range_min, seen.range_max
+    ('RangeBearingObservation', 0.05, 3.6, 4.4)
+    >>> wide = observation_for(row, LandmarkClass.POINT, bounds, factor=2.0)
+    >>> wide.bearing_error, wide.range_min, wide.range_max
+    (0.1, 3.2, 4.8)
+    >>> no_range = LogObservation(2.5, "pole", 0.25)      # Class II: left bearing-only, then rejected
+    >>> type(observation_for(no_range, LandmarkClass.POINT, bounds)).__name__
+    'BearingObservation'
     """
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:

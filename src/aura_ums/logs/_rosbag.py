@@ -464,6 +464,18 @@ def import_rosbag(
     ------
     MissingDependencyError, InputError, FileFormatError
         As :func:`read_rosbag` and :func:`write_log`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> out = Path(tempfile.mkdtemp()) / "log"
+    >>> import_rosbag("no_such_bag", out, odom_topic="/odom", observations_topic="/landmarks",
+    ...               landmarks=())                                      # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: no_such_bag: expected a ROS bag (...), got no such file or folder
+    >>> out.exists()                                   # refused before anything is written
+    False
     """
     log = read_rosbag(
         bag_path,

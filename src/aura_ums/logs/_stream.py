@@ -119,6 +119,21 @@ class LogStream:
         Seconds: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
     block_bytes : int
         Bytes read of a CSV file at a time.
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from aura_ums.logs import synthetic_log, write_log
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> stream = open_log(write_log(log, tempfile.mkdtemp() + "/log"), block_bytes=200)
+    >>> stream.meta.name, len(stream.landmarks), len(stream.commands)   # commands.csv: read whole
+    ('synthetic', 8, 50)
+    >>> rows = [len(block[0]) for block in stream.observation_blocks()]   # 200 bytes at a time
+    >>> len(rows) > 1, sum(rows), len(stream.load().observations)
+    (True, 18, 18)
+    >>> blind = open_log(write_log(dataclasses.replace(log, groundtruth=None), tempfile.mkdtemp() + "/log"))
+    >>> blind.truth_box, blind.truth_scratch                             # no ground truth
+    (None, None)
     """
 
     meta: LogMeta

@@ -129,6 +129,23 @@ class WindowRow:
     width_frac, area_frac : float
         The window's width over the image's, and its area over the image's (0 without a
         window).
+
+    Examples
+    --------
+    >>> from aura_ums.camera import CameraIntrinsics, CameraMount
+    >>> from aura_ums.logs import synthetic_log
+    >>> camera = Camera(CameraIntrinsics(554.26, 554.26, 319.5, 239.5, 640, 480), CameraMount(0.3))
+    >>> log = synthetic_log(np.random.default_rng(0), duration=5.0)
+    >>> _, report = replay_windows(log, TerrainTable({"floor": TerrainTable.default()["tile"]}), camera)
+    >>> row = report.rows[0]
+    >>> row.landmark_id, row.landmark_class.value, row.method, row.in_view, row.inside, row.truth_inside
+    ('L5', 'I', 'aura-ums', True, True, True)
+    >>> 0.0 < row.width_frac < 0.1, math.isnan(row.measured_v)          # Class I: judged by column
+    (True, True)
+    >>> unseen = WindowRow(1.0, "L1", LandmarkClass.VERTICAL_LINE, "disk model", None, math.nan, math.nan,
+    ...                    False, None, None, 0.0, 0.0)                  # no window: cannot be in view
+    >>> WindowReport(camera, 0.0, (unseen,)).judged("disk model")          # so not judged
+    ()
     """
 
     time: float

@@ -61,7 +61,23 @@ class _Anchor:
 
 
 class ManagerState(enum.Enum):
-    """Whether the robot knows where it is (:attr:`NOMINAL`) or has declared itself lost."""
+    """Whether the robot knows where it is (:attr:`NOMINAL`) or has declared itself lost.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose, TerrainTable
+    >>> from aura_ums.world import make_grid_world
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+    >>> manager = UncertaintyMapManager(start, make_grid_world(1, 3), TerrainTable.default())
+    >>> manager.update(Blackboard(), now=1.0).state   # a small map, no landmark missed
+    <ManagerState.NOMINAL: 'nominal'>
+    >>> ManagerState("lost")
+    <ManagerState.LOST: 'lost'>
+    >>> ManagerState("found")
+    Traceback (most recent call last):
+    ...
+    ValueError: 'found' is not a valid ManagerState
+    """
 
     #: Landmarks are being found and the map is small enough to be useful.
     NOMINAL = "nominal"
@@ -165,6 +181,24 @@ class ManagerStep:
         The map after the update of the relaxed intersection's primary branch (see
         :attr:`UncertaintyMapManager.focus_map`); None with ``relaxed_q = 0``, where it is
         ``map`` itself (read :attr:`focus`).
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import BearingObservation, Pose, TerrainTable, TurnAndRun
+    >>> from aura_ums.world import make_grid_world
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+    >>> manager = UncertaintyMapManager(start, make_grid_world(1, 3), TerrainTable.default())
+    >>> board = Blackboard()
+    >>> step = manager.update(board, now=1.0)   # nothing posted: the start map itself
+    >>> step.map is start, step.outcomes, step.grown_reports, step.focus is step.map
+    (True, (), 0, True)
+    >>> board.post_report(PositionReport(2.0, TurnAndRun(0.0, 2.0)))
+    >>> board.identified.post(BearingObservation("pole_9_9", 2.0, 0.0, 0.01))   # not in the map
+    >>> step = manager.update(board, now=2.0, missed_in_a_row=3)
+    >>> step.time, step.grown_reports, step.accepted, step.rejected[0].reason.value
+    (2.0, 1, (), 'unknown landmark id')
+    >>> step.state, step.lost_reason
+    (<ManagerState.LOST: 'lost'>, '3 frames in a row with predicted landmarks not found >= missed_limit 3')
     """
 
     time: float

@@ -148,6 +148,22 @@ def read_gray_image(path: str | PathLike[str]) -> NDArray[np.uint8]:
     ------
     FileFormatError
         When the file is missing or is not a readable image.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> import matplotlib.image
+    >>> path = Path(tempfile.mkdtemp()) / "step.png"
+    >>> pixels = np.zeros((4, 6), dtype=np.uint8)
+    >>> pixels[:, 3:] = 200                                  # a vertical step edge
+    >>> matplotlib.image.imsave(path, pixels, cmap="gray", vmin=0, vmax=255)   # RGBA PNG
+    >>> gray = read_gray_image(path)
+    >>> gray.dtype, gray.shape, gray[0].tolist()
+    (dtype('uint8'), (4, 6), [0, 0, 0, 200, 200, 200])
+    >>> read_gray_image(path.with_name("missing.png"))      # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...missing.png: expected a readable image file, got [Errno 2] No such ...
     """
     import matplotlib.image  # deferred: only loaders need it
 

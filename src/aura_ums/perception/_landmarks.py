@@ -43,6 +43,15 @@ class LineEvidence:
         ``(x1, y1, x2, y2)``, full-image pixels.
     point : tuple of float or None
         ``(u, v)``: its midpoint, full-image pixels.
+
+    Examples
+    --------
+    >>> found = LineEvidence(960.0, (50.0, 10.0, 51.0, 90.0), (50.5, 50.0))
+    >>> found.found, found.column
+    (True, 50.5)
+    >>> nothing = LineEvidence(0.0, None, None)               # no line fits
+    >>> nothing.found, nothing.column
+    (False, None)
     """
 
     value: float
@@ -76,6 +85,16 @@ class CornerEvidence:
         the point.
     intersection : tuple of float or None
         ``(u, v)`` of that intersection, full-image pixels.
+
+    Examples
+    --------
+    >>> corner = CornerEvidence(400.0, (12.0, 11.0), True, (10.0, 10.0))
+    >>> corner.point, corner.supported, corner.intersection
+    ((12.0, 11.0), True, (10.0, 10.0))
+    >>> CornerEvidence(900.0, (30.0, 30.0), False, None).intersection is None   # a point alone
+    True
+    >>> evaluate_corner(np.zeros((0, 3)))                     # no interest point at all
+    CornerEvidence(value=0.0, point=None, supported=False, intersection=None)
     """
 
     value: float

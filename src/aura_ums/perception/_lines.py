@@ -49,6 +49,17 @@ class LineBackend(enum.Enum):
     """Which library computes gradients and connected components for :class:`FastLineFinder`.
 
     Both give the same segments (up to float rounding); OpenCV is faster on large images.
+
+    Examples
+    --------
+    >>> [backend.value for backend in LineBackend]
+    ['numpy', 'opencv']
+    >>> FastLineFinder(backend=LineBackend("numpy")).backend
+    <LineBackend.NUMPY: 'numpy'>
+    >>> FastLineFinder(backend="numpy")                    # the name alone is refused
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: backend: expected a LineBackend, got 'numpy'
     """
 
     #: numpy differences and :func:`scipy.ndimage.label`: always available.

@@ -65,6 +65,16 @@ class Region:
         ``(u, v)``: mean pixel position, full-image pixels.
     bright : bool
         True when its pixels are above the threshold, False when at or below it.
+
+    Examples
+    --------
+    >>> image = np.zeros((20, 30), dtype=np.uint8)
+    >>> image[5:10, 8:20] = 180                       # a bright 12 x 5 block
+    >>> block = RegionSegmenter(threshold=90.0).find(image)[1]
+    >>> block.area, block.mean_intensity, block.bbox, block.centroid, block.bright
+    (60, 180.0, (8, 5, 19, 9), (13.5, 7.0), True)
+    >>> RegionSegmenter().find(np.zeros((0, 5)))      # an empty image has no region
+    ()
     """
 
     area: int

@@ -18,6 +18,16 @@ def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
     The angle of ``(x2 - x1, y2 - y1)`` in pixel coordinates (u right, v down), modulo
     pi: 0 is horizontal, pi/2 vertical; a segment going down and to the right has an
     angle in ``(0, pi/2)`` (clockwise on the screen).
+
+    Examples
+    --------
+    >>> segments = np.array([[0.0, 0.0, 10.0, 0.0], [5.0, 0.0, 5.0, 8.0], [0.0, 0.0, 4.0, 4.0]])
+    >>> segment_orientation(segments).round(4).tolist()   # horizontal, vertical, down-right
+    [0.0, 1.5708, 0.7854]
+    >>> float(segment_orientation(np.array([[10.0, 0.0, 0.0, 0.0]]))[0])   # either way round
+    0.0
+    >>> segment_orientation(np.zeros((0, 4)))              # no segment
+    array([], dtype=float64)
     """
     angle = np.arctan2(segments[:, 3] - segments[:, 1], segments[:, 2] - segments[:, 0])
     return np.asarray(np.mod(angle, math.pi), dtype=np.float64)

@@ -63,7 +63,29 @@ class TableRow:
 
 
 def experiment_table(scenario: Scenario, result: RunResult) -> list[TableRow]:
-    """Return the table rows of a run: map before/after, windows of polygon vs disk model, containment."""
+    """Return the table rows of a run: map before/after, windows of polygon vs disk model, containment.
+
+    Examples
+    --------
+    The windows are computed again from each frame's map before pruning, for the landmarks
+    the frame searched (only their ids are read from the record):
+
+    >>> from aura_ums.manager import ManagerState
+    >>> scenario = paper_scenario()
+    >>> start = scenario.initial_map()
+    >>> frame = FrameRecord(
+    ...     0, 0.0, None, True, scenario.start.pose, True, start, start,
+    ...     (("lamppost_107", ImageWindow(0, 0, 1, 1)),), ("lamppost_107",), ("lamppost_107",), 1, (),
+    ...     ManagerState.NOMINAL, 3.0,
+    ... )
+    >>> [row] = experiment_table(scenario, RunResult(scenario.name, (frame,), start, True, None, 1, 1))
+    >>> row.distance_ft, round(row.area_before, 3), round(row.wedge_before_deg, 1), row.recognized
+    (0.0, 0.296, 6.0, ('lamppost_107',))
+    >>> row.window_polygon < row.window_disk                  # the polygon's window is the smaller
+    True
+    >>> experiment_table(scenario, RunResult(scenario.name, (), start, False, None, 0, 0))   # no frame
+    []
+    """
     expecter = Expecter(scenario.camera)
     rows = []
     distance = 0.0
@@ -271,6 +293,20 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
     InputError
         When ``runs`` is not an integer in [1, 100,000] (``Scenario.check_runs``), before
         anything is written.
+
+    Examples
+    --------
+    The report runs the closed loop many times (minutes; ``aura-ums demo`` writes it);
+    a count of runs out of range is refused before any work:
+
+    >>> import tempfile
+    >>> out = Path(tempfile.mkdtemp()) / "report"
+    >>> write_experiment_report(out, runs=0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: runs: expected an integer in [1, 100000], got 0
+    >>> out.exists()
+    False
     """
     from aura_ums.plot._growth import write_growth_report
 

@@ -34,6 +34,19 @@ def draw_replay(result: ReplayResult, folder: str | Path, *, maps_drawn: int = 1
     -------
     Path
         The PNG written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from aura_ums.logs import replay_log, synthetic_log
+    >>> from aura_ums.uncertainty import TerrainTable
+    >>> log = synthetic_log(np.random.default_rng(3), duration=3.0)     # ten frames
+    >>> result = replay_log(log, TerrainTable({"floor": TerrainTable.default()["tile"]}))
+    >>> folder = Path(tempfile.mkdtemp()) / "replay"                    # created when missing
+    >>> draw_replay(result, folder, maps_drawn=0).name    # no map on the left: landmarks and truth
+    'synthetic_replay.png'
+    >>> sorted(path.name for path in folder.iterdir())
+    ['synthetic_replay.png']
     """
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)

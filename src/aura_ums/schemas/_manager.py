@@ -37,6 +37,18 @@ class StepReport:
     ambiguous : tuple of str
         Ids whose identification was withheld: it lay where another mapped landmark of the
         same kind may appear (see :meth:`SchemaManager.step`).
+
+    Examples
+    --------
+    >>> window = ImageWindow(300, 100, 340, 260)
+    >>> searched = SchemaReport("pole", SchemaStatus(SchemaState.DISCOVERING), window, 0.0, False, None, None)
+    >>> step = StepReport(1.0, (searched,), (), ("pole",), (), 1)
+    >>> step.predicted, step.found, step.report("pole").value
+    (('pole',), (), 0.0)
+    >>> step.report("lamppost")                          # no schema looks for it
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: landmark_id: expected one of pole, got 'lamppost'
     """
 
     time: float
@@ -85,6 +97,16 @@ class SchemaManagerState:
     counters : tuple of int
         frames, predicted_total, missed_total, missed_frames, posted_total, consecutive_missed,
         ambiguous_total.
+
+    Examples
+    --------
+    >>> SchemaManager().export_state()                  # no schema, no frame yet
+    SchemaManagerState(statuses=(), last_time=None, counters=(0, 0, 0, 0, 0, 0, 0))
+    >>> saved = SchemaManagerState((("pole", SchemaStatus()),), 1.0, (1, 1, 1, 1, 0, 1, 0))
+    >>> SchemaManager().restore_state(saved)            # a manager without that schema
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: state: expected statuses for [], got ['pole']
     """
 
     statuses: tuple[tuple[str, SchemaStatus], ...]

@@ -18,6 +18,17 @@ class SchemaState(enum.Enum):
     frame to frame; ``SUSPECT`` on the frame a tracked landmark is given up (it stopped
     matching): the map may be partially invalid. A suspect schema discovers again on the
     next frame.
+
+    Examples
+    --------
+    >>> [state.value for state in SchemaState]
+    ['hibernating', 'discovering', 'tracking', 'suspect']
+    >>> SchemaState("tracking")
+    <SchemaState.TRACKING: 'tracking'>
+    >>> SchemaState("lost")                               # not a schema's state
+    Traceback (most recent call last):
+    ...
+    ValueError: 'lost' is not a valid SchemaState
     """
 
     HIBERNATING = "hibernating"
@@ -45,6 +56,16 @@ class Detection:
         ``(u1, v1, u2, v2)`` of the line found, pixels; None for a point or a region.
     pose : Pose
         The map's most probable pose in that frame (the reference for predicting motion).
+
+    Examples
+    --------
+    >>> box = ImageWindow(50, 10, 51, 90)
+    >>> line = Detection(2.0, 960.0, (50.5, 50.0), box, (50, 10, 51, 90), Pose(0, 0, 0))
+    >>> line.point, line.box.height
+    ((50.5, 50.0), 80.0)
+    >>> corner = Detection(2.0, 400.0, (12.0, 11.0), ImageWindow(12, 11, 12, 11), None, Pose(0, 0, 0))
+    >>> corner.segment is None, corner.box.area                # a point: no segment, an empty box
+    (True, 0.0)
     """
 
     time: float
@@ -116,6 +137,16 @@ class SchemaReport:
         The focus map's window (:attr:`Frame.focus`), searched before the guaranteed one
         while discovering; :attr:`window` is then this window when it held the match, the
         guaranteed one when not. None when no focus window was searched.
+
+    Examples
+    --------
+    >>> window = ImageWindow(300, 100, 340, 260)
+    >>> searched = SchemaReport("pole", SchemaStatus(SchemaState.DISCOVERING), window, 0.0, False, None, None)
+    >>> searched.state, searched.predicted, searched.missed      # a window, nothing in it
+    (<SchemaState.DISCOVERING: 'discovering'>, True, True)
+    >>> asleep = SchemaReport("pole", SchemaStatus(), None, None, False, None, None)
+    >>> asleep.state, asleep.predicted, asleep.missed           # hibernating: no window at all
+    (<SchemaState.HIBERNATING: 'hibernating'>, False, False)
     """
 
     landmark_id: str

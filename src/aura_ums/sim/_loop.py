@@ -74,7 +74,19 @@ _WRONG_TURN = 3.0
 
 
 class PerceptionMode(enum.Enum):
-    """Where perception runs: in the Expecter's windows, or on the whole image (the baseline)."""
+    """Where perception runs: in the Expecter's windows, or on the whole image (the baseline).
+
+    Examples
+    --------
+    >>> [mode.value for mode in PerceptionMode]
+    ['windows', 'full_frame', 'focus_first']
+    >>> PerceptionMode("full_frame")
+    <PerceptionMode.FULL_FRAME: 'full_frame'>
+    >>> PerceptionMode("everywhere")
+    Traceback (most recent call last):
+    ...
+    ValueError: 'everywhere' is not a valid PerceptionMode
+    """
 
     #: In the Expecter's windows from the map (the guaranteed ones).
     WINDOWS = "windows"
@@ -134,6 +146,22 @@ class FrameRecord:
     ambiguous : int
         Landmarks found in the frame but not posted: each lay where another mapped landmark
         of the same kind may appear (:attr:`~aura_ums.schemas.StepReport.ambiguous`).
+
+    Examples
+    --------
+    >>> grown = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.3, 0.05)
+    >>> pruned = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.2, 0.02)
+    >>> searched = (("pole", ImageWindow(300, 100, 340, 260)),)
+    >>> record = FrameRecord(
+    ...     0, 0.0, None, True, Pose(0.1, 0, 0), True, grown, pruned,
+    ...     searched, ("pole",), ("pole",), 1, (), ManagerState.NOMINAL, 4.2,
+    ... )
+    >>> round(record.area_before, 3), round(record.area, 3), record.wedge_width_before, record.wedge_width
+    (0.286, 0.127, 0.1, 0.04)
+    >>> start = FrameRecord(0, 0.0, None, True, Pose(0, 0, 0), True, grown, grown, (), (), (), 0, (),
+    ...                     ManagerState.NOMINAL, 0.8)
+    >>> start.area == start.area_before, start.detections       # nothing searched, nothing found
+    (True, ())
     """
 
     index: int
@@ -184,6 +212,18 @@ class LoopState:
     The manager and blackboard are their exact JSON (:meth:`UncertaintyMapManager.to_json`,
     :meth:`Blackboard.to_json`); the schema manager's statuses and counters are immutable
     values; the random generators are their ``bit_generator.state``.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> scenario = Scenario.from_toml(pathlib.Path("scenarios/paper_sidewalk.toml"))
+    >>> state = run_scenario(scenario, np.random.default_rng(1), stop_after=1).saved   # one frame only
+    >>> state.scenario, state.next_index, state.perception, len(state.records)
+    ('paper_sidewalk', 1, <PerceptionMode.WINDOWS: 'windows'>, 1)
+    >>> run_scenario(scenario, np.random.default_rng(1), resume_from="frame 1")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: resume_from: expected a LoopState, got str
     """
 
     scenario: str
@@ -223,6 +263,17 @@ class RunResult:
         Landmark windows searched, and matches in them, over the run.
     images : tuple of ndarray
         The images of the frames, when asked for (``keep_images``); else empty.
+
+    Examples
+    --------
+    >>> grown = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.3, 0.05)
+    >>> frame = FrameRecord(0, 0.0, None, True, Pose(0, 0, 0), True, grown, grown, (), (), (), 0, (),
+    ...                     ManagerState.NOMINAL, 0.8)
+    >>> result = RunResult("demo", (frame,), grown, True, None, 0, 0)
+    >>> result.containment_rate, result.ever_lost, round(result.median_area, 3)
+    (1.0, False, 0.286)
+    >>> result.detection_rate                         # no window searched: undefined
+    nan
     """
 
     scenario: str

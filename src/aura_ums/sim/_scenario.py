@@ -184,6 +184,17 @@ class StartState:
         Metres, >= 0: the true position is within this distance.
     heading_halfwidth : float
         Radians, >= 0: the true heading is within this angle of ``pose.heading``.
+
+    Examples
+    --------
+    >>> StartState(Pose(0.0, 0.0, 0.0), 0.3, 0.05)
+    StartState(pose=Pose(x=0.0, y=0.0, heading=0.0), position_radius=0.3, heading_halfwidth=0.05)
+    >>> StartState(Pose(0.0, 0.0, 0.0), 0, 0).position_radius   # a start known exactly
+    0.0
+    >>> StartState(Pose(0.0, 0.0, 0.0), -0.3, 0.05)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: StartState.position_radius: expected a non-negative number, got -0.3
     """
 
     pose: Pose
@@ -219,6 +230,15 @@ class RenderSettings:
         Metres: Class I poles' radius, Class III strips' width.
     building_width, building_depth, building_base : float
         Metres: size of the box drawn at each Class II landmark and the height of its floor.
+
+    Examples
+    --------
+    >>> settings = RenderSettings()
+    >>> settings.noise, settings.clutter, settings.pole_radius
+    (2.0, 0, 0.12)
+    >>> clean = dataclasses.replace(RenderSettings(), noise=0.0)    # noise-free images
+    >>> clean.noise, clean.clutter
+    (0.0, 0)
     """
 
     noise: float = 2.0
@@ -247,6 +267,16 @@ class SimulatedFrame:
         What the camera saw (read-only).
     distance : float
         Commanded run from the start to this frame, metres.
+
+    Examples
+    --------
+    >>> image = np.zeros((48, 64), dtype=np.uint8)
+    >>> first = SimulatedFrame(0, None, Pose(0.0, 0.0, 0.0), image, 0.0)   # the start frame
+    >>> first.command is None, first.distance, first.image.shape
+    (True, 0.0, (48, 64))
+    >>> later = SimulatedFrame(1, TurnAndRun(0.0, 2.0), Pose(2.0, 0.0, 0.0), image, 2.0)
+    >>> later.command.run == later.distance
+    True
     """
 
     index: int

@@ -221,6 +221,16 @@ class GroundPatch:
         A simple polygon, metres, n >= 3 (stored read-only).
     shade : float
         Gray level.
+
+    Examples
+    --------
+    >>> lawn = GroundPatch([(0, 0), (4, 0), (4, 3), (0, 3)], 95)
+    >>> lawn.polygon.shape, lawn.shade, lawn.polygon.flags.writeable
+    ((4, 2), 95.0, False)
+    >>> GroundPatch([(0, 0), (4, 0)], 95)                 # two points bound no area
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: GroundPatch.polygon: expected at least 3 points, got 2
     """
 
     polygon: NDArray[np.float64]
@@ -246,6 +256,16 @@ class GroundStripe:
         Gray level.
     id : str
         The landmark it shows, or ``""``.
+
+    Examples
+    --------
+    >>> edge = GroundStripe((0.0, -1.5), (4.0, -1.5), 0.2, 60, id="path_edge")
+    >>> edge.polygon().tolist()                           # its four corners, 0.1 m either side
+    [[0.0, -1.6], [4.0, -1.6], [4.0, -1.4], [0.0, -1.4]]
+    >>> GroundStripe((1, 2), (1, 2), 0.1, 60)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: GroundStripe.end: expected a point distinct from start, got [1.0, 2.0]
     """
 
     start: NDArray[np.float64]

@@ -31,6 +31,19 @@ class ContainmentResult:
         Sampled poses checked, summed over every step.
     per_step : tuple of float
         Fraction inside after each command.
+
+    Examples
+    --------
+    >>> ContainmentResult(inside=297, total=300, per_step=(1.0, 0.99, 0.98)).rate
+    0.99
+    >>> ContainmentResult(0, 0, ()).rate   # nothing checked: nothing escaped
+    1.0
+    >>> from aura_ums.uncertainty import Pose, TerrainTable
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.0, 0.0)
+    >>> moves = [(TurnAndRun(0.5, 3.0), TerrainTable.default()["grass"])] * 2
+    >>> result = simulate_containment(start, moves, np.random.default_rng(1), poses=20, truncate=3.0)
+    >>> result.inside == result.total, result.per_step
+    (True, (1.0, 1.0))
     """
 
     inside: int
@@ -118,6 +131,19 @@ class TightnessResult:
         Area of the convex hull of the sampled true positions, m^2.
     samples : ndarray, shape (n, 3)
         The sampled true poses.
+
+    Examples
+    --------
+    >>> TightnessResult(map_area=12.0, sample_hull_area=10.0, samples=np.zeros((0, 3))).ratio
+    1.2
+    >>> TightnessResult(0.5, 0.0, np.zeros((1, 3))).ratio   # the samples span no area
+    inf
+    >>> from aura_ums.uncertainty import Pose, TerrainTable
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.0, 0.0)
+    >>> still = growth_tightness(start, TurnAndRun(0.0, 0.0), TerrainTable.default()["tile"],
+    ...                          np.random.default_rng(0), samples=50)
+    >>> still.map_area, still.sample_hull_area, still.ratio, still.samples.shape   # no motion
+    (0.0, 0.0, 1.0, (50, 3))
     """
 
     map_area: float

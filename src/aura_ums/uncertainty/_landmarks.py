@@ -22,7 +22,19 @@ from aura_ums.errors import InputError
 
 
 class LandmarkClass(enum.Enum):
-    """The paper's three landmark classes."""
+    """The paper's three landmark classes.
+
+    Examples
+    --------
+    >>> LandmarkClass("II"), LandmarkClass.GROUND_LINE.value
+    (<LandmarkClass.POINT: 'II'>, 'III')
+    >>> PointLandmark("corner_3", 5.0, 2.0, 3.5).landmark_class is LandmarkClass.POINT
+    True
+    >>> LandmarkClass("IV")
+    Traceback (most recent call last):
+    ...
+    ValueError: 'IV' is not a valid LandmarkClass
+    """
 
     #: Class I: a vertical line (pole, door edge, building side); gives a bearing ray.
     VERTICAL_LINE = "I"
@@ -106,6 +118,16 @@ class PointLandmark:
         Symbolic class.
     position_uncertainty : float
         Radius (m) of the disk (in x, y) in which the point truly lies, >= 0.
+
+    Examples
+    --------
+    >>> corner = PointLandmark("building_corner_3", 5.0, 2.0, 3.5, symbol="building corner")
+    >>> corner.landmark_class, corner.position.tolist()
+    (<LandmarkClass.POINT: 'II'>, [5.0, 2.0])
+    >>> PointLandmark("corner_4", 5.0, 2.0, 3.5, position_uncertainty=-0.1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: corner_4.position_uncertainty: expected a number in [0, 1000] m, got -0.1
     """
 
     id: str
@@ -150,6 +172,16 @@ class GroundLineLandmark:
         Symbolic class.
     position_uncertainty : float
         Distance (m) by which the true line may lie off the mapped one, >= 0.
+
+    Examples
+    --------
+    >>> edge = GroundLineLandmark("sidewalk_left_edge", (0, 1), (0, 11), symbol="sidewalk edge")
+    >>> edge.start.tolist(), edge.length, round(edge.direction, 4), edge.landmark_class
+    ([0.0, 1.0], 10.0, 1.5708, <LandmarkClass.GROUND_LINE: 'III'>)
+    >>> GroundLineLandmark("dot", (2, 3), (2, 3))   # a line needs two distinct ends
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: dot.end: expected a point distinct from start, got [2.0, 3.0]
     """
 
     id: str
@@ -263,6 +295,16 @@ class BearingObservation:
         Bound on the bearing's error, radians, >= 0.
     sensor_offset : tuple of float
         Where the sensor sits on the robot (forward, left), metres.
+
+    Examples
+    --------
+    >>> seen = BearingObservation("lamppost_107", 12.5, 0.3, 0.01, sensor_offset=(0.2, 0.0))
+    >>> seen.landmark_class, seen.sensor_offset
+    (<LandmarkClass.VERTICAL_LINE: 'I'>, (0.2, 0.0))
+    >>> BearingObservation("lamppost_107", 12.5, 0.3, -0.01)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: bearing_error: expected a non-negative number, got -0.01
     """
 
     landmark_id: str
@@ -309,6 +351,16 @@ class RangeBearingObservation:
     """A Class II observation: bearing within +-``bearing_error`` and range in [range_min, range_max].
 
     ``range`` is the horizontal distance (m) from the sensor to the landmark's (x, y).
+
+    Examples
+    --------
+    >>> seen = RangeBearingObservation("building_corner_3", 4.0, -0.2, 0.02, 4.5, 5.0)
+    >>> seen.landmark_class, seen.range_max - seen.range_min
+    (<LandmarkClass.POINT: 'II'>, 0.5)
+    >>> RangeBearingObservation("building_corner_3", 4.0, -0.2, 0.02, 5.0, 4.5)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: range_max: expected >= range_min (5.0), got 4.5
     """
 
     landmark_id: str
@@ -388,6 +440,16 @@ class GroundLineObservation:
     ``offset`` is the signed distance (m) from the sensor to the line, positive when
     the sensor is to the left of start -> end, within +-``offset_error``; ``angle`` is
     the direction start -> end relative to the heading (rad), within +-``angle_error``.
+
+    Examples
+    --------
+    >>> seen = GroundLineObservation("sidewalk_left_edge", 3.0, 1.2, 0.05, -0.1, 0.02)
+    >>> seen.landmark_class, seen.offset, seen.angle
+    (<LandmarkClass.GROUND_LINE: 'III'>, 1.2, -0.1)
+    >>> GroundLineObservation("sidewalk_left_edge", 3.0, 1.2, 0.05, float("nan"), 0.02)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: angle: expected a finite number, got nan
     """
 
     landmark_id: str

@@ -53,6 +53,18 @@ class PerceptualStrategy(enum.Enum):
 
     The strategy decides how much context (margin) the window needs around the place
     where the landmark is guaranteed to appear (the paper's Figure 8).
+
+    Examples
+    --------
+    >>> PerceptualStrategy("interest_operator")   # as a map file's ``strategy`` names it
+    <PerceptualStrategy.INTEREST_OPERATOR: 'interest_operator'>
+    >>> from aura_ums.world import sample_world
+    >>> sample_world("paper_sidewalk").landmark("lamppost_107").strategy
+    <PerceptualStrategy.LINE_FINDER: 'line_finder'>
+    >>> PerceptualStrategy("hough")
+    Traceback (most recent call last):
+    ...
+    ValueError: 'hough' is not a valid PerceptualStrategy
     """
 
     #: Fast line finder: fits lines to gradient runs; needs long context on each side.

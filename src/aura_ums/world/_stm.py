@@ -41,6 +41,23 @@ class ShortTermMemory:
         The candidate landmarks, without repeats.
     nearby : float
         The distance (m) within which meadows were instantiated.
+
+    Examples
+    --------
+    >>> from aura_ums.world import make_grid_world
+    >>> world = make_grid_world(1, 6, cell=5.0)
+    >>> stm = ShortTermMemory.for_leg(world, (2.5, 2.5), (7.5, 2.5), nearby=0.0)
+    >>> stm.leg, stm.traversed
+    (((2.5, 2.5), (7.5, 2.5)), ('cell_0_0', 'cell_0_1'))
+    >>> stm.meadow_ids, stm.landmark_ids   # the adjacent cell_0_2 too, and the poles seen from them
+    (('cell_0_0', 'cell_0_1', 'cell_0_2'), ('pole_0_0', 'pole_0_2'))
+    >>> turn = ShortTermMemory.for_leg(world, (2.5, 2.5), (2.5, 2.5), nearby=0.0)   # a turn in place
+    >>> turn.traversed, turn.meadow_ids
+    (('cell_0_0',), ('cell_0_0', 'cell_0_1'))
+    >>> ShortTermMemory(stm.leg, stm.meadows, ("cell_0_5",), stm.landmarks, 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: traversed: expected ids of the instantiated meadows, got 'cell_0_5'
     """
 
     leg: tuple[Point, Point]
