@@ -472,3 +472,16 @@ def test_a_flow_sequence_cut_after_a_comma_is_a_clean_error(tmp_path: Path) -> N
     path = write(tmp_path, "cut.yml", "%YAML:1.0\n]: [1,\n")
     with pytest.raises(FileFormatError, match=r"cut\.yml:2: expected a value, got ''"):
         load_opencv_calibration(path, MOUNT)
+
+
+def test_a_focal_bound_not_below_the_focal_length_is_refused_by_the_file(tmp_path: Path) -> None:
+    """Named with the file when read, not at the first observation that uses it."""
+    camera = Camera(CameraIntrinsics(500, 400, 320, 240, 640, 480), CameraMount(1.0))
+    path = write(tmp_path, "loose.toml", camera_to_toml(camera, CalibrationBounds(fy=400.0)))
+    for read in (load_camera, load_calibration_bounds):
+        with pytest.raises(
+            FileFormatError,
+            match=r"loose\.toml: \[calibration_bounds\] fy: expected a bound below \[intrinsics\] fy "
+            r"\(400\.0 px\), got 400\.0$",
+        ):
+            read(path)

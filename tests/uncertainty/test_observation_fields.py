@@ -12,6 +12,7 @@ import pytest
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     BearingObservation,
+    GroundLineLandmark,
     GroundLineObservation,
     Observation,
     RangeBearingObservation,
@@ -50,3 +51,19 @@ def test_bad_common_fields_are_refused(
 ) -> None:
     with pytest.raises(InputError, match=match):
         make(ident, time, offset)
+
+
+def test_a_point_of_three_numbers_is_named_as_such() -> None:
+    """Not as an (n, 2) array: the message says what one point is."""
+    with pytest.raises(
+        InputError, match=r"^e\.start: expected an \(x, y\) point in metres, got shape \(3,\)$"
+    ):
+        GroundLineLandmark("e", (1.0, 1.0, 2.0), (1.0, 1.0))
+    with pytest.raises(
+        InputError, match=r"^sensor_offset: expected \(forward, left\) metres, got shape \(3,\)$"
+    ):
+        BearingObservation("p", 0.0, 0.1, 0.01, sensor_offset=(1.0, 2.0, 3.0))  # type: ignore[arg-type]
+    assert GroundLineLandmark("e", [[0.0, 0.0]], (1.0, 0.0)).start.tolist() == [
+        0.0,
+        0.0,
+    ]  # (1, 2) still works

@@ -212,6 +212,14 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         bounds = CalibrationBounds(**bound_values)
     except InputError as exc:
         raise _reraise(source, "[calibration_bounds]", exc) from None
+    for key, focal in (("fx", intrinsics.fx), ("fy", intrinsics.fy)):
+        # A focal length that may be zero or negative bounds nothing: refused here, not at first use.
+        if getattr(bounds, key) >= focal:
+            raise FileFormatError(
+                source,
+                f"[calibration_bounds] {key}",
+                f"expected a bound below [intrinsics] {key} ({focal!r} px), got {getattr(bounds, key)!r}",
+            )
     return Camera(intrinsics, mount), bounds
 
 

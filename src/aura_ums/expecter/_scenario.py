@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from aura_ums._validate import integer_at_least
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import PointLandmark, SpatialUncertaintyMap
@@ -48,7 +49,12 @@ def figure4_scenario(vertices: int = 16) -> Figure4Scenario:
     >>> s = figure4_scenario()
     >>> s.map.polygon.vertex_count, [lm.id for lm in s.landmarks]
     (16, ['landmark_1', 'landmark_2'])
+    >>> figure4_scenario(2)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: vertices: expected an integer >= 3, got 2
     """
+    vertices = integer_at_least(vertices, "vertices", 3)
     camera = Camera(
         CameraIntrinsics(400.0, 400.0, 319.5, 239.5, 640, 480),
         CameraMount(height=1.2, forward=0.2, tilt=math.radians(8.0)),

@@ -14,6 +14,7 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from aura_ums.errors import InputError
 from aura_ums.geometry._angles import TWO_PI
 
 #: Default angular step of the outer polygon of an arc, radians. The polygon's
@@ -406,6 +407,10 @@ def outer_disk(center: Array, radius: float, sides: int = 16) -> Array:
     return np.column_stack([center[0] + reach * np.cos(angles), center[1] + reach * np.sin(angles)])
 
 
+#: Radians: the widest piece of an outer arc (a wider ``step`` is cut to it).
+_WIDEST_ARC_PIECE = math.pi / 2
+
+
 def outer_arc(radius: float, start: float, stop: float, step: float = ARC_STEP) -> Array:
     """Return points, counter-clockwise from ``start`` to ``stop``, of an outer polygon of an arc.
 
@@ -424,9 +429,18 @@ def outer_arc(radius: float, start: float, stop: float, step: float = ARC_STEP) 
     [[1.0, 0.0], [1.0, 0.5463], [0.5403, 0.8415]]
     >>> outer_arc(0.0, 0.0, 0.1).tolist()   # a zero radius: the origin, three times
     [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    >>> len(outer_arc(1.0, 0.0, 3.5, step=4.0))   # a step wider than pi/2 is cut: 3 corners
+    5
+    >>> outer_arc(1.0, 0.0, 1.0, step=0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: step: expected a positive number, got 0.0
     """
+    if not step > 0.0:  # also NaN
+        raise InputError(f"step: expected a positive number, got {step!r}")
     width = stop - start
-    count = max(1, math.ceil(width / step))
+    # A piece's corner lies at radius / cos(piece / 2): past pi it would be behind the origin.
+    count = max(1, math.ceil(width / min(step, _WIDEST_ARC_PIECE)))
     half = width / (2 * count)
     reach = radius / math.cos(half)
     # Few points: plain floats beat numpy's per-call overhead here.

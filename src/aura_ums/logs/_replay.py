@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from aura_ums._files import atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
-from aura_ums._validate import finite_float, positive_float
+from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, edge_distances, polygon_area, wedges_contain
@@ -135,16 +135,7 @@ class ReplayOptions:
             raise InputError(
                 f"ReplayOptions.settings: expected ManagerSettings, got {type(self.settings).__name__}"
             )
-        if not isinstance(self.landmark_class, LandmarkClass) or self.landmark_class not in _REPLAY_CLASSES:
-            got = (
-                self.landmark_class.name
-                if isinstance(self.landmark_class, LandmarkClass)
-                else f"{self.landmark_class!r} ({type(self.landmark_class).__name__})"
-            )
-            raise InputError(
-                "ReplayOptions.landmark_class: expected LandmarkClass.VERTICAL_LINE (Class I) or "
-                f"LandmarkClass.POINT (Class II), got {got}"
-            )
+        _require_replay_class(self.landmark_class, "ReplayOptions.landmark_class")
         object.__setattr__(
             self, "max_interval", positive_float(self.max_interval, "ReplayOptions.max_interval")
         )
@@ -631,13 +622,27 @@ def _truth_start(meta: LogMeta, start: float, pose: NDArray[np.float64], max_gap
     return Pose(x, y, heading)
 
 
+def _require_replay_class(landmark_class: object, name: str = "landmark_class") -> None:
+    """Refuse a class a replay cannot turn log rows into (Class III: ground lines), naming ``name``."""
+    if not isinstance(landmark_class, LandmarkClass) or landmark_class not in _REPLAY_CLASSES:
+        got = (
+            landmark_class.name
+            if isinstance(landmark_class, LandmarkClass)
+            else f"{landmark_class!r} ({type(landmark_class).__name__})"
+        )
+        raise InputError(
+            f"{name}: expected LandmarkClass.VERTICAL_LINE (Class I) or LandmarkClass.POINT (Class II), "
+            f"got {got}"
+        )
+
+
 def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: float = 5.0) -> MeadowMap:
     """Return a meadow map for replaying ``log``: one meadow of its terrain, its landmarks.
 
     The meadow is the bounding box of the landmarks, the start and the ground truth,
-    grown by ``margin`` metres. Landmarks become :class:`~aura_ums.uncertainty.VerticalLineLandmark`
-    (Class I, heights from the row or the meta) or :class:`~aura_ums.uncertainty.PointLandmark`
-    (Class II, at the row's mid height).
+    grown by ``margin`` metres (>= 0) and 1 m more. Landmarks become
+    :class:`~aura_ums.uncertainty.VerticalLineLandmark` (Class I, heights from the row or the
+    meta) or :class:`~aura_ums.uncertainty.PointLandmark` (Class II, at the row's mid height).
 
     Examples
     --------
@@ -652,7 +657,13 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
     >>> bare = dataclasses.replace(log, landmarks=(), observations=(), groundtruth=None)
     >>> log_meadow_map(bare, LandmarkClass.POINT).bounds          # nothing to hold: around the origin
     (-6.0, -6.0, 6.0, 6.0)
+    >>> log_meadow_map(log, LandmarkClass.POINT, margin=-10.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: margin: expected a non-negative number, got -10.0
     """
+    _require_replay_class(landmark_class)
+    margin = nonnegative_float(margin, "margin")
     truth = log.groundtruth
     box = None
     if truth is not None:
@@ -724,7 +735,14 @@ def observation_for(
     >>> no_range = LogObservation(2.5, "pole", 0.25)      # Class II: left bearing-only, then rejected
     >>> type(observation_for(no_range, LandmarkClass.POINT, bounds)).__name__
     'BearingObservation'
+    >>> observation_for(row, LandmarkClass.POINT, bounds, factor=0.5)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: factor: expected a number >= 1, got 0.5
     """
+    _require_replay_class(landmark_class)
+    if factor != 1.0 and not (math.isfinite(factor) and factor >= 1.0):  # also NaN
+        raise InputError(f"factor: expected a number >= 1, got {factor!r}")
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:
         return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, sensor_offset)

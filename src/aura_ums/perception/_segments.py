@@ -8,11 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from aura_ums._validate import float_array
 from aura_ums.errors import InputError
 from aura_ums.geometry import angle_difference
 
 
-def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
+def segment_orientation(segments: ArrayLike) -> NDArray[np.float64]:
     """Return the direction of each segment ``(n, 4)`` in ``[0, pi)``, radians.
 
     The angle of ``(x2 - x1, y2 - y1)`` in pixel coordinates (u right, v down), modulo
@@ -28,8 +29,17 @@ def segment_orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
     0.0
     >>> segment_orientation(np.zeros((0, 4)))              # no segment
     array([], dtype=float64)
+    >>> segment_orientation([0.0, 0.0, 1.0, 1.0])
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: segments: expected an (n, 4) array of x1, y1, x2, y2 pixels, got shape (4,)
     """
-    angle = np.arctan2(segments[:, 3] - segments[:, 1], segments[:, 2] - segments[:, 0])
+    array = float_array(segments, "segments")
+    if array.ndim != 2 or array.shape[1] != 4:
+        raise InputError(
+            f"segments: expected an (n, 4) array of x1, y1, x2, y2 pixels, got shape {array.shape}"
+        )
+    angle = np.arctan2(array[:, 3] - array[:, 1], array[:, 2] - array[:, 0])
     return np.asarray(np.mod(angle, math.pi), dtype=np.float64)
 
 

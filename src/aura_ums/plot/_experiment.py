@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from aura_ums._metrics import Metrics
+from aura_ums._validate import integer_at_least
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_window
 from aura_ums.plot._draw import draw_map
 from aura_ums.schemas import FindLandmarkSchema
@@ -313,6 +314,7 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
     base = scenarios_folder()
     paper = paper_scenario()
     paper.check_runs(runs)  # before any work: a count out of range is refused with its estimate
+    seed = integer_at_least(seed, "seed", 0)
     folder = Path(out)
     summary = write_growth_report(folder, seed=seed)
     figures = folder / "figures"

@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from aura_ums._validate import integer_at_least
 from aura_ums.plot._draw import draw_compass, draw_map, draw_samples
 from aura_ums.uncertainty import (
     FOOT,
@@ -149,9 +150,10 @@ def draw_growth_figures(out: str | Path, *, seed: int = 0, terrain: str = PAPER_
     ...
     aura_ums.errors.UnknownTerrainError: terrain: expected one of concrete, grass, gravel, tile, got 'moon'
     """
+    seed = integer_at_least(seed, "seed", 0)
+    stats = TerrainTable.default()[terrain]
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    stats = TerrainTable.default()[terrain]
     rng = np.random.default_rng(seed)
     return [figure5(folder, rng, stats), figure6(folder, rng, stats), figure7(folder, rng, stats)]
 
@@ -166,18 +168,19 @@ def draw_all_figures(out: str | Path, *, seed: int = 0) -> list[Path]:
 
     Examples
     --------
-    Drawing every figure takes about a second; a negative seed is refused (by numpy's
-    generator) before anything is drawn:
+    Drawing every figure takes about a second; a negative seed is refused before anything
+    is drawn:
 
     >>> import tempfile
     >>> draw_all_figures(tempfile.mkdtemp(), seed=-1)
     Traceback (most recent call last):
     ...
-    ValueError: expected non-negative integer
+    aura_ums.errors.InputError: seed: expected an integer >= 0, got -1
     """
     from aura_ums.plot._expecter import draw_expecter_figures
     from aura_ums.plot._reduction import draw_path_figure
 
+    seed = integer_at_least(seed, "seed", 0)
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     written = [draw_path_figure(folder, np.random.default_rng(seed))]
@@ -231,18 +234,18 @@ def write_growth_report(out: str | Path, *, seed: int = 0) -> Path:
     Examples
     --------
     The report takes a few seconds (``aura-ums demo`` writes it, then adds the experiment);
-    a negative seed is refused (by numpy's generator) before any figure is drawn or the
-    summary written:
+    a negative seed is refused before any figure is drawn or the summary written:
 
     >>> import tempfile
     >>> out = Path(tempfile.mkdtemp())
     >>> write_growth_report(out, seed=-1)
     Traceback (most recent call last):
     ...
-    ValueError: expected non-negative integer
+    aura_ums.errors.InputError: seed: expected an integer >= 0, got -1
     >>> (out / "summary.md").exists()
     False
     """
+    seed = integer_at_least(seed, "seed", 0)
     folder = Path(out)
     figures = draw_all_figures(folder / "figures", seed=seed)
     table = TerrainTable.default()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from aura_ums.errors import InputError
 from aura_ums.plot._draw import draw_map, draw_samples
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -101,7 +103,7 @@ def run_down_path(
     return result
 
 
-def draw_path_figure(out: Path, rng: np.random.Generator) -> Path:
+def draw_path_figure(out: str | os.PathLike[str], rng: np.random.Generator) -> Path:
     """Figure 3: disk model versus convex polygon down a path whose edge is seen.
 
     Examples
@@ -112,11 +114,15 @@ def draw_path_figure(out: Path, rng: np.random.Generator) -> Path:
     'figure3_disk_vs_polygon.png'
     >>> sorted(path.name for path in folder.iterdir())
     ['figure3_disk_vs_polygon.png']
+    >>> draw_path_figure(str(folder), np.random.default_rng(0)).parent == folder   # a str works too
+    True
     >>> draw_path_figure(folder, None)
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: rng: expected a numpy.random.Generator, got NoneType
     """
+    if not isinstance(out, (str, os.PathLike)):
+        raise InputError(f"out: expected a folder path, got {type(out).__name__}")
     steps = run_down_path(rng)
     figure = Figure(figsize=(12, 4.2))
     axes = figure.add_subplot()
@@ -147,6 +153,6 @@ def draw_path_figure(out: Path, rng: np.random.Generator) -> Path:
         fontsize=10,
     )
     figure.tight_layout()
-    path = out / "figure3_disk_vs_polygon.png"
+    path = Path(out) / "figure3_disk_vs_polygon.png"
     figure.savefig(path, dpi=130)
     return path

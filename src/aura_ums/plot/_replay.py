@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
+from aura_ums._validate import integer_at_least
+from aura_ums.errors import InputError
 from aura_ums.plot._draw import draw_map
 
 if TYPE_CHECKING:
@@ -47,7 +49,16 @@ def draw_replay(result: ReplayResult, folder: str | Path, *, maps_drawn: int = 1
     'synthetic_replay.png'
     >>> sorted(path.name for path in folder.iterdir())
     ['synthetic_replay.png']
+    >>> draw_replay(result, folder, maps_drawn=-3)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: maps_drawn: expected an integer >= 0, got -3
     """
+    from aura_ums.logs import ReplayResult
+
+    if not isinstance(result, ReplayResult):
+        raise InputError(f"result: expected a ReplayResult, got {type(result).__name__}")
+    maps_drawn = integer_at_least(maps_drawn, "maps_drawn", 0)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     figure = Figure(figsize=(12, 5.5))

@@ -274,6 +274,9 @@ class RunResult:
     (1.0, False, 0.286)
     >>> result.detection_rate                         # no window searched: undefined
     nan
+    >>> empty = RunResult("none", (), grown, False, None, 0, 0)   # no frame: every rate undefined
+    >>> empty.containment_rate, empty.median_area
+    (nan, nan)
     """
 
     scenario: str
@@ -287,8 +290,8 @@ class RunResult:
 
     @property
     def containment_rate(self) -> float:
-        """Fraction of frames whose true pose is inside the map after the frame."""
-        return sum(r.inside for r in self.records) / max(1, len(self.records))
+        """Fraction of frames whose true pose is inside the map after the frame (nan without frames)."""
+        return sum(r.inside for r in self.records) / len(self.records) if self.records else math.nan
 
     @property
     def detection_rate(self) -> float:
@@ -297,18 +300,18 @@ class RunResult:
 
     @property
     def median_area(self) -> float:
-        """Median map area after each frame, m^2."""
-        return statistics.median(r.area for r in self.records)
+        """Median map area after each frame, m^2 (nan without frames)."""
+        return statistics.median(r.area for r in self.records) if self.records else math.nan
 
     @property
     def median_wedge_width(self) -> float:
-        """Median wedge width after each frame, radians."""
-        return statistics.median(r.wedge_width for r in self.records)
+        """Median wedge width after each frame, radians (nan without frames)."""
+        return statistics.median(r.wedge_width for r in self.records) if self.records else math.nan
 
     @property
     def median_frame_ms(self) -> float:
-        """Median milliseconds per frame of the loop."""
-        return statistics.median(r.frame_ms for r in self.records)
+        """Median milliseconds per frame of the loop (nan without frames)."""
+        return statistics.median(r.frame_ms for r in self.records) if self.records else math.nan
 
     @property
     def rejected(self) -> int:

@@ -239,6 +239,10 @@ class RenderSettings:
     >>> clean = dataclasses.replace(RenderSettings(), noise=0.0)    # noise-free images
     >>> clean.noise, clean.clutter
     (0.0, 0)
+    >>> RenderSettings(noise=-4.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: RenderSettings.noise: expected a number in [0, 255] gray levels, got -4.0
     """
 
     noise: float = 2.0
@@ -249,6 +253,21 @@ class RenderSettings:
     building_width: float = 15.0
     building_depth: float = 10.0
     building_base: float = 0.0
+
+    def __post_init__(self) -> None:
+        # The scenario file's ranges (KEY_RANGES), for settings built in code too.
+        for key in _RENDER_KEYS:
+            value, where, bounds = getattr(self, key), f"RenderSettings.{key}", KEY_RANGES[key]
+            if key in ("clutter", "clutter_lines"):
+                if (
+                    isinstance(value, bool)
+                    or not isinstance(value, (int, np.integer))
+                    or not bounds.contains(float(value))
+                ):
+                    raise InputError(f"{where}: expected an integer in {bounds.interval()}, got {value!r}")
+                object.__setattr__(self, key, int(value))
+            else:
+                object.__setattr__(self, key, bounds.check(value, where))
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,8 +14,8 @@ from aura_ums._validate import (
     HEIGHT,
     POSITION_UNCERTAINTY,
     finite_float,
+    float_array,
     nonnegative_float,
-    points_array,
     read_only,
 )
 from aura_ums.errors import InputError
@@ -199,10 +199,8 @@ class GroundLineLandmark:
         position_uncertainty: float = 0.0,
     ) -> None:
         ident = _identifier(id, "id")
-        a = points_array(start, f"{ident}.start", min_rows=1)
-        b = points_array(end, f"{ident}.end", min_rows=1)
-        if a.shape != (1, 2) or b.shape != (1, 2):
-            raise InputError(f"{ident}: expected start and end as single (x, y) points")
+        a = _one_point(start, f"{ident}.start", "an (x, y) point in metres")
+        b = _one_point(end, f"{ident}.end", "an (x, y) point in metres")
         for name, point in (("start", a), ("end", b)):
             if not (COORDINATE.contains(float(point[0, 0])) and COORDINATE.contains(float(point[0, 1]))):
                 raise InputError(
@@ -261,10 +259,16 @@ def _sensor_offset(value: ArrayLike, name: str) -> tuple[float, float]:
         if type(forward) is float and type(left) is float and math.isfinite(forward + left):
             # The common case (the default (0.0, 0.0)): no array built, twice per log row.
             return (forward, left)
-    offset = points_array(value, name, min_rows=1)
-    if offset.shape != (1, 2):
-        raise InputError(f"{name}: expected (forward, left) metres, got shape {offset.shape}")
+    offset = _one_point(value, name, "(forward, left) metres")
     return (float(offset[0, 0]), float(offset[0, 1]))
+
+
+def _one_point(value: ArrayLike, name: str, what: str) -> NDArray[np.float64]:
+    """Return one point given as two numbers, as a (1, 2) array; refuse any other shape, naming ``what``."""
+    point = float_array(value, name)
+    if point.shape not in ((2,), (1, 2)):
+        raise InputError(f"{name}: expected {what}, got shape {point.shape}")
+    return point.reshape(1, 2)
 
 
 _COMMON = ("landmark_id", "time", "sensor_offset")

@@ -54,6 +54,10 @@ class ShortTermMemory:
     >>> turn = ShortTermMemory.for_leg(world, (2.5, 2.5), (2.5, 2.5), nearby=0.0)   # a turn in place
     >>> turn.traversed, turn.meadow_ids
     (('cell_0_0',), ('cell_0_0', 'cell_0_1'))
+    >>> ShortTermMemory("junk", (), (), (), 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: leg: expected the leg's (start, end), two (x, y) points, got 'junk'
     >>> ShortTermMemory(stm.leg, stm.meadows, ("cell_0_5",), stm.landmarks, 0.0)
     Traceback (most recent call last):
     ...
@@ -67,6 +71,10 @@ class ShortTermMemory:
     nearby: float
 
     def __post_init__(self) -> None:
+        if not isinstance(self.leg, (tuple, list)) or len(self.leg) != 2:
+            raise InputError(f"leg: expected the leg's (start, end), two (x, y) points, got {self.leg!r}")
+        start, end = (_point(point, f"leg[{index}]") for index, point in enumerate(self.leg))
+        object.__setattr__(self, "leg", ((float(start[0]), float(start[1])), (float(end[0]), float(end[1]))))
         object.__setattr__(self, "meadows", _typed(self.meadows, Meadow, "meadows"))
         object.__setattr__(self, "landmarks", _typed(self.landmarks, LandmarkRecord, "landmarks"))
         object.__setattr__(self, "traversed", tuple(self.traversed))
