@@ -218,7 +218,24 @@ def regular_file(path: str | os.PathLike[str]) -> bool:
     return stat.S_ISREG(path_mode(path))
 
 
-def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
+def as_path(value: object, name: str) -> Path:
+    """Return ``value`` as a Path, refusing anything but a str or a path-like object, naming ``name``.
+
+    Examples
+    --------
+    >>> as_path("runs/log", "folder").as_posix()
+    'runs/log'
+    >>> as_path(None, "folder")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: folder: expected a path (str or os.PathLike), got NoneType
+    """
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{name}: expected a path (str or os.PathLike), got {type(value).__name__}")
+    return Path(value)
+
+
+def read_folder(path: str | os.PathLike[str], *, kind: str, name: str = "folder") -> Path:
     """Return ``path`` as a folder whose files can be read, or refuse it naming why.
 
     The one check of every folder a reader takes (a log, a dataset): a path that is
@@ -241,7 +258,7 @@ def read_folder(path: str | os.PathLike[str], *, kind: str) -> Path:
     ...
     aura_ums.errors.FileFormatError: /nowhere: expected a log folder, got no such folder
     """
-    folder = Path(path)
+    folder = as_path(path, name)
     try:
         mode = os.stat(folder).st_mode
     except (FileNotFoundError, NotADirectoryError):

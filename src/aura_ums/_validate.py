@@ -11,14 +11,19 @@ numeric field against one, and the docs pages of the file formats list them.
 
 from __future__ import annotations
 
+import enum
 import math
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import NoReturn, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums.errors import InputError
+
+_T = TypeVar("_T")
 
 
 def finite_float(value: object, name: str) -> float:
@@ -54,6 +59,62 @@ def integer_at_least(value: object, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
     return value
+
+
+def _refuse_choice(kind: type[enum.Enum], value: object) -> NoReturn:
+    choices = ", ".join(repr(member.value) for member in kind)
+    raise InputError(f"{kind.__name__}: expected one of {choices}, got {value!r}")
+
+
+class Choice(enum.Enum):
+    """An enum of fixed choices: looked up by an unknown value, it raises :class:`InputError`.
+
+    (Python's own ValueError is not an :class:`~aura_ums.errors.AuraUmsError`.)
+
+    Examples
+    --------
+    >>> class Side(Choice):
+    ...     LEFT = "left"
+    ...     RIGHT = "right"
+    >>> Side("left") is Side.LEFT
+    True
+    >>> Side("up")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: Side: expected one of 'left', 'right', got 'up'
+    """
+
+    @classmethod
+    def _missing_(cls, value: object) -> NoReturn:
+        _refuse_choice(cls, value)
+
+
+class StrChoice(enum.StrEnum):
+    """:class:`Choice` whose members are strings too (``enum.StrEnum``)."""
+
+    @classmethod
+    def _missing_(cls, value: object) -> NoReturn:
+        _refuse_choice(cls, value)
+
+
+def items_of(value: Iterable[_T], name: str, what: str) -> tuple[_T, ...]:
+    """Return the items of an iterable that is not a string, or raise naming ``name`` and ``what``.
+
+    For collections given to a constructor: ``tuple(None)`` would raise a TypeError from inside.
+
+    Examples
+    --------
+    >>> items_of([1, 2], "ids", "a sequence of ids")
+    (1, 2)
+    >>> items_of(None, "meadows", "a sequence of Meadow")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: meadows: expected a sequence of Meadow, got NoneType
+    """
+    checked: object = value  # typed as iterable; given anything at run time
+    if isinstance(checked, (str, bytes)) or not isinstance(checked, Iterable):
+        raise InputError(f"{name}: expected {what}, got {type(checked).__name__}")
+    return tuple(value)
 
 
 def check_rng(rng: object, name: str = "rng") -> None:

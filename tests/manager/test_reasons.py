@@ -52,7 +52,7 @@ def test_reasons_are_their_texts_wherever_a_string_is_expected() -> None:
         json.dumps({RejectReason.CLASS_MISMATCH: 1})
         == '{"observation class differs from the landmark\'s": 1}'
     )
-    with pytest.raises(ValueError, match="'stale' is not a valid RejectReason"):
+    with pytest.raises(InputError, match=r"^RejectReason: expected one of .*, got 'stale'$"):
         RejectReason("stale")
 
 

@@ -24,7 +24,7 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import Fields, key_path, load_toml
+from aura_ums._files import Fields, as_path, key_path, load_toml
 from aura_ums._validate import (
     ANGLE_ERROR,
     DELAY,
@@ -33,6 +33,7 @@ from aura_ums._validate import (
     SIGMAS,
     Range,
     finite_float,
+    items_of,
     positive_float,
 )
 from aura_ums.errors import InputError
@@ -324,7 +325,7 @@ def sensors_path(terrain: str | Path) -> Path:
     >>> sensors_path("runs/calib/terrain.toml").as_posix()
     'runs/calib/terrain.sensors.toml'
     """
-    return Path(terrain).with_suffix(".sensors.toml")
+    return as_path(terrain, "terrain").with_suffix(".sensors.toml")
 
 
 def _read_sensors(path: str | Path) -> tuple[Fields, dict[str, object]]:
@@ -1108,9 +1109,11 @@ def calibrate_logs(
     ...
     aura_ums.errors.InputError: logs: expected at least one log with ground truth, got none
     """
-    logs = list(logs)
+    logs = list(items_of(logs, "logs", "a sequence of RobotLog"))
     if not logs:
         raise InputError("logs: expected at least one log with ground truth, got none")
+    if not isinstance(anchor, bool):
+        raise InputError(f"anchor: expected True or False, got {anchor!r}")
     for log in logs:
         if not isinstance(log, RobotLog):
             raise InputError(f"logs: expected RobotLog values, got {type(log).__name__}")
@@ -1126,7 +1129,9 @@ def calibrate_logs(
     if step > MAX_HORIZON:
         longest = f"{MAX_HORIZON:g} (a day, the longest horizon)"
         raise InputError(f"move: expected seconds <= {longest}, got {step!r}")
-    spans = tuple(finite_float(h, "horizons") for h in horizons)
+    spans = tuple(
+        finite_float(h, "horizons") for h in items_of(horizons, "horizons", "a sequence of seconds")
+    )
     if not spans or min(spans) < step:
         raise InputError(f"horizons: expected seconds, each >= move ({step!r}), got {list(spans)}")
     if max(spans) > MAX_HORIZON:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, positive_float
 from aura_ums.baselines import CodacLocalizer, Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
@@ -119,7 +119,15 @@ def filter_settings(log: RobotLog, *, bearing_sd: float, range_sd_fraction: floa
     ...                            bearing_sd=0.006, range_sd_fraction=0.012)
     >>> sorted(settings), settings["range_sd"]
     (['bearing_sd', 'heading_sd', 'position_sd', 'range_sd', 'range_sd_fraction'], 0.01)
+    >>> filter_settings("log", bearing_sd=0.006, range_sd_fraction=0.012)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: log: expected a RobotLog, got str
     """
+    if not isinstance(log, RobotLog):
+        raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
+    bearing_sd = positive_float(bearing_sd, "bearing_sd")
+    range_sd_fraction = positive_float(range_sd_fraction, "range_sd_fraction")
     return {
         "position_sd": max(log.meta.start_radius / 3.0, 1e-3),
         "heading_sd": max(log.meta.start_heading_halfwidth / 3.0, 1e-3),
@@ -232,6 +240,8 @@ def compare_on_log(
     if log.groundtruth is None:
         raise InputError(f"log {log.meta.name!r}: expected ground truth to compare against, got none")
     opts = ReplayOptions() if options is None else options
+    if not isinstance(opts, ReplayOptions):
+        raise InputError(f"options: expected ReplayOptions or None, got {type(opts).__name__}")
     b_sd = finite_float(bearing_sd, "bearing_sd")
     r_sd = finite_float(range_sd_fraction, "range_sd_fraction")
     if not b_sd > 0.0 or not r_sd > 0.0:

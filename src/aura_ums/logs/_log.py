@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import enum
 import itertools
 import math
 from collections.abc import Iterable, Mapping, Sequence
@@ -13,7 +12,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import ROW_GAP, finite_float, float_array, integer_at_least, read_only
+from aura_ums._validate import ROW_GAP, Choice, finite_float, float_array, integer_at_least, read_only
 from aura_ums.errors import InputError, UnknownLandmarkError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, reports_of
@@ -26,7 +25,7 @@ from aura_ums.uncertainty import Pose, TurnAndRun
 DEFAULT_MAX_TRUTH_GAP = 0.5
 
 
-class ObservationKind(enum.Enum):
+class ObservationKind(Choice):
     """What a log observation measured: a bearing only, or a range and a bearing.
 
     Examples

@@ -225,7 +225,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     ):
         raise InputError(f"robot: expected a robot number from 1 to 5, got {robot!r}")
     robot = int(robot)
-    folder = read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder")
+    folder = read_folder(dataset_dir, kind="UTIAS MRCLAM dataset folder", name="dataset_dir")
     prefix = f"Robot{robot}_"
     if not present(folder / f"{prefix}Measurement.dat"):
         found = sorted({path.name.split("_")[0] for path in folder.glob("Robot*_*.dat")})

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, float_array
+from aura_ums._validate import Choice, finite_float, float_array
 from aura_ums.errors import InputError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import TurnAndRun
@@ -42,7 +41,7 @@ class ReversingError(InputError):
         self.value = value
 
 
-class ReverseMotion(enum.Enum):
+class ReverseMotion(Choice):
     """What :func:`odometry_to_commands` does with negative forward velocities.
 
     The turn-and-run model has no reverse gear.

@@ -17,7 +17,7 @@ from typing import TextIO, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._files import atomic_path
+from aura_ums._files import as_path, atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import finite_float, nonnegative_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
@@ -662,6 +662,8 @@ def log_meadow_map(log: RobotLog, landmark_class: LandmarkClass, *, margin: floa
     ...
     aura_ums.errors.InputError: margin: expected a non-negative number, got -10.0
     """
+    if not isinstance(log, RobotLog):
+        raise InputError(f"log: expected a RobotLog, got {type(log).__name__}")
     _require_replay_class(landmark_class)
     margin = nonnegative_float(margin, "margin")
     truth = log.groundtruth
@@ -740,9 +742,15 @@ def observation_for(
     ...
     aura_ums.errors.InputError: factor: expected a number >= 1, got 0.5
     """
+    if not isinstance(row, LogObservation):
+        raise InputError(f"row: expected a LogObservation, got {type(row).__name__}")
+    if not isinstance(bounds, SensorBounds):
+        raise InputError(f"bounds: expected SensorBounds, got {type(bounds).__name__}")
     _require_replay_class(landmark_class)
-    if factor != 1.0 and not (math.isfinite(factor) and factor >= 1.0):  # also NaN
-        raise InputError(f"factor: expected a number >= 1, got {factor!r}")
+    if factor != 1.0:
+        factor = finite_float(factor, "factor")
+        if factor < 1.0:
+            raise InputError(f"factor: expected a number >= 1, got {factor!r}")
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:
         return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, sensor_offset)
@@ -912,6 +920,10 @@ def replay_log(
         raise InputError(f"progress: expected a callable or None, got {type(progress).__name__}")
     if after_step is not None and not callable(after_step):
         raise InputError(f"after_step: expected a callable or None, got {type(after_step).__name__}")
+    if before_frame is not None and not callable(before_frame):
+        raise InputError(f"before_frame: expected a callable or None, got {type(before_frame).__name__}")
+    if steps_csv is not None:
+        as_path(steps_csv, "steps_csv")
     stop = math.inf if until is None else finite_float(until, "until")
     if resume is not None and not isinstance(resume, ReplayState):
         raise InputError(f"resume: expected a ReplayState or None, got {type(resume).__name__}")

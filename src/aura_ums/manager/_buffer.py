@@ -6,7 +6,7 @@ import bisect
 import operator
 from collections.abc import Iterable, Sequence
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import finite_float, items_of
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     BearingObservation,
@@ -75,7 +75,7 @@ or GroundLineObservation, got str
             raise InputError(
                 f"observations: expected an iterable of observations, got one {type(observations).__name__}"
             )
-        for observation in observations:
+        for observation in items_of(observations, "observations", "an iterable of observations"):
             self.post(observation)
 
     def post(self, observation: Observation) -> None:

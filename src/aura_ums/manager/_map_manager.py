@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
-import enum
 import math
 import operator
 import types
@@ -15,7 +14,7 @@ from typing import Any
 
 import shapely
 
-from aura_ums._validate import finite_float
+from aura_ums._validate import Choice, finite_float
 from aura_ums.errors import FileFormatError, InputError, OutsideMapError, UnknownLandmarkError
 from aura_ums.manager import _relaxed
 from aura_ums.manager._blackboard import Blackboard, PositionReport
@@ -60,7 +59,7 @@ class _Anchor:
     composite: Composite
 
 
-class ManagerState(enum.Enum):
+class ManagerState(Choice):
     """Whether the robot knows where it is (:attr:`NOMINAL`) or has declared itself lost.
 
     Examples
@@ -76,7 +75,7 @@ class ManagerState(enum.Enum):
     >>> ManagerState("found")
     Traceback (most recent call last):
     ...
-    ValueError: 'found' is not a valid ManagerState
+    aura_ums.errors.InputError: ManagerState: expected one of 'nominal', 'lost', got 'found'
     """
 
     #: Landmarks are being found and the map is small enough to be useful.

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import enum
+from aura_ums._validate import StrChoice
 
 
-class RejectReason(enum.StrEnum):
+class RejectReason(StrChoice):
     """Why an observation did not reduce the map.
 
     The first three are checks the manager makes before any reduction; the next five are
@@ -24,10 +24,10 @@ class RejectReason(enum.StrEnum):
     (False, True)
     >>> RejectReason("unknown landmark id")          # from its value, as saved
     <RejectReason.UNKNOWN_LANDMARK: 'unknown landmark id'>
-    >>> RejectReason("no such reason")
+    >>> RejectReason("no such reason")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: 'no such reason' is not a valid RejectReason
+    aura_ums.errors.InputError: RejectReason: expected one of ..., got 'no such reason'
     """
 
     #: The observation is older than the map (the map was grown past its time).

@@ -9,7 +9,6 @@ range or a help text is written here and nowhere else.
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
 import numbers
 import textwrap
@@ -18,7 +17,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-from aura_ums._validate import SIGMAS
+from aura_ums._validate import SIGMAS, Choice
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import cell_count
 
@@ -605,7 +604,7 @@ def _document() -> str:
 ManagerSettings.__doc__ = _document()
 
 
-class MapProfile(enum.Enum):
+class MapProfile(Choice):
     """How the manager represents the map: the three trade-offs measured on real logs.
 
     Each profile sets :attr:`fields` and leaves every other setting as it was. Measured

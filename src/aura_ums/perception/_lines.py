@@ -27,7 +27,6 @@ both polarities in one call. A window's search costs little beyond its pixels.
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -35,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import BLUR, finite_float, nonnegative_float, positive_float
+from aura_ums._validate import BLUR, Choice, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
@@ -45,7 +44,7 @@ from aura_ums.perception._segments import LineSegments, orientation_difference
 _EIGHT = np.ones((3, 3), dtype=bool)
 
 
-class LineBackend(enum.Enum):
+class LineBackend(Choice):
     """Which library computes gradients and connected components for :class:`FastLineFinder`.
 
     Both give the same segments (up to float rounding); OpenCV is faster on large images.

@@ -11,6 +11,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon as PolygonPatch
 from matplotlib.patches import Rectangle
 
+from aura_ums._files import as_path
+from aura_ums._validate import integer_at_least
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_map, figure4_scenario
 from aura_ums.uncertainty import PointLandmark, SpatialUncertaintyMap
 
@@ -46,7 +48,8 @@ def draw_expecter_figures(out_dir: str | Path, *, seed: int = 0) -> list[Path]:
     ...     [p.name for p in draw_expecter_figures(folder)]
     ['figure4_top_view.png', 'figure4_windows.png']
     """
-    folder = Path(out_dir)
+    seed = integer_at_least(seed, "seed", 0)
+    folder = as_path(out_dir, "out_dir")
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
     scenario = figure4_scenario()

@@ -6,6 +6,7 @@ import types
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from aura_ums._validate import items_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.manager import IdentifiedLandmarkBuffer
@@ -223,7 +224,7 @@ class SchemaManager:
             raise InputError(
                 "schemas: expected an iterable of FindLandmarkSchema, got one FindLandmarkSchema"
             )
-        new = list(schemas)
+        new = list(items_of(schemas, "schemas", "an iterable of FindLandmarkSchema"))
         seen = set(self._status)
         for position, schema in enumerate(new):
             if not isinstance(schema, FindLandmarkSchema):

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
+from aura_ums._validate import Choice
 from aura_ums.expecter import ImageWindow
 from aura_ums.uncertainty import Observation, Pose
 
 
-class SchemaState(enum.Enum):
+class SchemaState(Choice):
     """Where a find-landmark schema instantiation is in its life cycle (the paper's SI states).
 
     ``HIBERNATING`` until the robot may be within the landmark's activation range;
@@ -25,10 +25,10 @@ class SchemaState(enum.Enum):
     ['hibernating', 'discovering', 'tracking', 'suspect']
     >>> SchemaState("tracking")
     <SchemaState.TRACKING: 'tracking'>
-    >>> SchemaState("lost")                               # not a schema's state
+    >>> SchemaState("lost")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: 'lost' is not a valid SchemaState
+    aura_ums.errors.InputError: SchemaState: expected one of ..., got 'lost'
     """
 
     HIBERNATING = "hibernating"

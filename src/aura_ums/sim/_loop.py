@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
-import enum
 import math
 import statistics
 import time as _time
@@ -40,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import check_rng
+from aura_ums._validate import Choice, check_rng
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
 from aura_ums.geometry import wrap_angle
@@ -73,7 +72,7 @@ _LOOK_PATTERN = (1.0, -2.0, 1.0)
 _WRONG_TURN = 3.0
 
 
-class PerceptionMode(enum.Enum):
+class PerceptionMode(Choice):
     """Where perception runs: in the Expecter's windows, or on the whole image (the baseline).
 
     Examples
@@ -82,10 +81,10 @@ class PerceptionMode(enum.Enum):
     ['windows', 'full_frame', 'focus_first']
     >>> PerceptionMode("full_frame")
     <PerceptionMode.FULL_FRAME: 'full_frame'>
-    >>> PerceptionMode("everywhere")
+    >>> PerceptionMode("everywhere")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: 'everywhere' is not a valid PerceptionMode
+    aura_ums.errors.InputError: PerceptionMode: expected one of ..., got 'everywhere'
     """
 
     #: In the Expecter's windows from the map (the guaranteed ones).

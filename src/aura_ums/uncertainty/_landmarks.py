@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass
 
@@ -13,6 +12,7 @@ from aura_ums._validate import (
     COORDINATE,
     HEIGHT,
     POSITION_UNCERTAINTY,
+    Choice,
     finite_float,
     float_array,
     nonnegative_float,
@@ -21,7 +21,7 @@ from aura_ums._validate import (
 from aura_ums.errors import InputError
 
 
-class LandmarkClass(enum.Enum):
+class LandmarkClass(Choice):
     """The paper's three landmark classes.
 
     Examples
@@ -33,7 +33,7 @@ class LandmarkClass(enum.Enum):
     >>> LandmarkClass("IV")
     Traceback (most recent call last):
     ...
-    ValueError: 'IV' is not a valid LandmarkClass
+    aura_ums.errors.InputError: LandmarkClass: expected one of 'I', 'II', 'III', got 'IV'
     """
 
     #: Class I: a vertical line (pole, door edge, building side); gives a bearing ray.
@@ -47,6 +47,13 @@ class LandmarkClass(enum.Enum):
 def _identifier(value: object, name: str) -> str:
     if not isinstance(value, str) or not value:
         raise InputError(f"{name}: expected a non-empty string, got {value!r}")
+    return value
+
+
+def _symbol(value: object, name: str) -> str:
+    """Return the landmark's symbol (a description, possibly empty), refusing anything but a string."""
+    if not isinstance(value, str):
+        raise InputError(f"{name}: expected a string, got {type(value).__name__}")
     return value
 
 
@@ -83,6 +90,7 @@ class VerticalLineLandmark:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "id", _identifier(self.id, "id"))
+        object.__setattr__(self, "symbol", _symbol(self.symbol, f"{self.id}.symbol"))
         for name, bounds in (("x", COORDINATE), ("y", COORDINATE), ("z_bottom", HEIGHT), ("z_top", HEIGHT)):
             object.__setattr__(self, name, bounds.check(getattr(self, name), f"{self.id}.{name}"))
         if self.z_top < self.z_bottom:
@@ -139,6 +147,7 @@ class PointLandmark:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "id", _identifier(self.id, "id"))
+        object.__setattr__(self, "symbol", _symbol(self.symbol, f"{self.id}.symbol"))
         for name, bounds in (("x", COORDINATE), ("y", COORDINATE), ("z", HEIGHT)):
             object.__setattr__(self, name, bounds.check(getattr(self, name), f"{self.id}.{name}"))
         object.__setattr__(
@@ -211,7 +220,7 @@ class GroundLineLandmark:
         object.__setattr__(self, "id", ident)
         object.__setattr__(self, "start", read_only(a[0].copy()))
         object.__setattr__(self, "end", read_only(b[0].copy()))
-        object.__setattr__(self, "symbol", symbol)
+        object.__setattr__(self, "symbol", _symbol(symbol, f"{ident}.symbol"))
         object.__setattr__(
             self,
             "position_uncertainty",

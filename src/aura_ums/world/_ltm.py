@@ -8,7 +8,6 @@ passes from one to the other through that segment, the *portal*.
 
 from __future__ import annotations
 
-import enum
 import math
 import types
 from collections.abc import Iterable, Mapping, Sequence
@@ -20,7 +19,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, points_array, read_only
+from aura_ums._validate import Choice, finite_float, items_of, points_array, read_only
 from aura_ums.errors import InputError, UnknownLandmarkError, UnknownTerrainError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.uncertainty import (
@@ -48,7 +47,7 @@ _OVERLAP_TOLERANCE = 1e-6
 _LANDMARK_TYPES = (VerticalLineLandmark, PointLandmark, GroundLineLandmark)
 
 
-class PerceptualStrategy(enum.Enum):
+class PerceptualStrategy(Choice):
     """The perceptual algorithm a find-landmark schema runs inside its window.
 
     The strategy decides how much context (margin) the window needs around the place
@@ -61,10 +60,10 @@ class PerceptualStrategy(enum.Enum):
     >>> from aura_ums.world import sample_world
     >>> sample_world("paper_sidewalk").landmark("lamppost_107").strategy
     <PerceptualStrategy.LINE_FINDER: 'line_finder'>
-    >>> PerceptualStrategy("hough")
+    >>> PerceptualStrategy("hough")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: 'hough' is not a valid PerceptualStrategy
+    aura_ums.errors.InputError: PerceptualStrategy: expected one of ..., got 'hough'
     """
 
     #: Fast line finder: fits lines to gradient runs; needs long context on each side.
@@ -375,8 +374,8 @@ class MeadowMap:
         terrain_table: TerrainTable | None,
         terrain_table_file: str | None,
     ) -> None:
-        meadow_tuple = tuple(meadows)
-        landmark_tuple = tuple(landmarks)
+        meadow_tuple = items_of(meadows, "meadows", "a sequence of Meadow")
+        landmark_tuple = items_of(landmarks, "landmarks", "a sequence of LandmarkRecord")
         if not meadow_tuple:
             raise InputError("meadows: expected at least one meadow, got none")
         for index, meadow in enumerate(meadow_tuple):

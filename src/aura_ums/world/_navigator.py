@@ -18,7 +18,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, points_array, read_only
+from aura_ums._validate import finite_float, items_of, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError, OutsideMapError
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
 from aura_ums.world._ltm import MeadowMap
@@ -70,7 +70,7 @@ class Route:
 
     def __init__(self, waypoints: ArrayLike, meadow_ids: tuple[str, ...] | list[str]) -> None:
         points = points_array(waypoints, "waypoints", min_rows=1)
-        ids = tuple(meadow_ids)
+        ids = items_of(meadow_ids, "meadow_ids", "a sequence of meadow ids")
         expected = max(len(points) - 1, 1)
         if len(ids) != expected:
             raise InputError(f"meadow_ids: expected {expected} ids (one per leg), got {len(ids)}")

@@ -10,7 +10,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from aura_ums._validate import nonnegative_float
+from aura_ums._validate import items_of, nonnegative_float
 from aura_ums.errors import InputError
 from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap
 from aura_ums.world._navigator import RUN_TOLERANCE, _point
@@ -170,7 +170,7 @@ class ShortTermMemory:
 
 def _typed(items: Iterable[object], kind: type[_T], name: str) -> tuple[_T, ...]:
     result: list[_T] = []
-    for position, item in enumerate(items):
+    for position, item in enumerate(items_of(items, name, f"a sequence of {kind.__name__}")):
         if not isinstance(item, kind):
             raise InputError(f"{name}[{position}]: expected a {kind.__name__}, got {type(item).__name__}")
         result.append(item)

@@ -1,0 +1,110 @@
+"""Bad arguments to the library's public API: an AuraUmsError naming the argument, never from inside.
+
+Each case was found by a sweep of every public class and function with wrong-typed and
+out-of-range values, and raised a TypeError, AttributeError or numpy error from deep inside
+(or was accepted) before.
+"""
+
+# mypy: disable-error-code="arg-type"
+# (the arguments are wrong on purpose)
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from aura_ums.errors import AuraUmsError, InputError
+from aura_ums.logs import (
+    LogObservation,
+    ReplayOptions,
+    SensorBounds,
+    calibrate_logs,
+    compare_on_log,
+    filter_settings,
+    load_log,
+    log_meadow_map,
+    observation_for,
+    open_log,
+    replay_log,
+    synthetic_log,
+)
+from aura_ums.manager import IdentifiedLandmarkBuffer, MapProfile, RejectReason
+from aura_ums.schemas import SchemaManager
+from aura_ums.uncertainty import GroundLineLandmark, LandmarkClass, PointLandmark, TerrainTable
+from aura_ums.world import MeadowMap, Route
+
+LOG = synthetic_log(np.random.default_rng(1), duration=5.0)
+FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
+ROW = LogObservation(2.5, "pole", 0.25, range=4.0)
+BOUNDS = SensorBounds(0.05, 0.0, 0.1, 0.1)
+RNG = np.random.default_rng(0)
+
+CASES: list[tuple[str, Callable[[], Any], str]] = [
+    ("symbol", lambda: PointLandmark("c", 5.0, 2.0, 3.5, symbol=object()), r"^c\.symbol: expected a string"),
+    (
+        "symbol",
+        lambda: GroundLineLandmark("e", (0, 0), (1, 0), symbol=None),
+        r"^e\.symbol: expected a string",
+    ),
+    ("meadows", lambda: MeadowMap(None, ()), r"^meadows: expected a sequence of Meadow, got NoneType$"),
+    ("observations", lambda: IdentifiedLandmarkBuffer(5), r"^observations: expected an iterable"),
+    ("schemas", lambda: SchemaManager(None), r"^schemas: expected an iterable of FindLandmarkSchema"),
+    ("meadow_ids", lambda: Route([[0, 0], [1, 1]], None), r"^meadow_ids: expected a sequence of meadow ids"),
+    ("folder", lambda: load_log(None), r"^folder: expected a path \(str or os\.PathLike\), got NoneType$"),
+    ("folder", lambda: open_log(0), r"^folder: expected a path \(str or os\.PathLike\), got int$"),
+    ("before_frame", lambda: replay_log(LOG, FLOOR, before_frame="x"), r"^before_frame: expected a callable"),
+    ("steps_csv", lambda: replay_log(LOG, FLOOR, steps_csv=0), r"^steps_csv: expected a path"),
+    ("logs", lambda: calibrate_logs(None), r"^logs: expected a sequence of RobotLog, got NoneType$"),
+    (
+        "anchor",
+        lambda: calibrate_logs([LOG], anchor=float("nan")),
+        r"^anchor: expected True or False, got nan$",
+    ),
+    ("horizons", lambda: calibrate_logs([LOG], horizons=None), r"^horizons: expected a sequence of seconds"),
+    (
+        "log",
+        lambda: filter_settings("x", bearing_sd=0.01, range_sd_fraction=0.01),
+        r"^log: expected a RobotLog",
+    ),
+    (
+        "bearing_sd",
+        lambda: filter_settings(LOG, bearing_sd=float("nan"), range_sd_fraction=0.01),
+        r"^bearing_sd: expected a finite number, got nan$",
+    ),
+    (
+        "options",
+        lambda: compare_on_log(LOG, FLOOR, "x", bearing_sd=0.01, range_sd_fraction=0.01, rng=RNG),
+        r"^options: expected ReplayOptions or None",
+    ),
+    ("log", lambda: log_meadow_map("x", LandmarkClass.POINT), r"^log: expected a RobotLog, got str$"),
+    ("row", lambda: observation_for("x", LandmarkClass.POINT, BOUNDS), r"^row: expected a LogObservation"),
+    ("bounds", lambda: observation_for(ROW, LandmarkClass.POINT, None), r"^bounds: expected SensorBounds"),
+    (
+        "factor",
+        lambda: observation_for(ROW, LandmarkClass.POINT, BOUNDS, factor=None),
+        r"^factor: expected a",
+    ),
+    ("landmark_class", lambda: ReplayOptions(landmark_class="II"), r"landmark_class: expected .*, got 'II'"),
+    (
+        "LandmarkClass",
+        lambda: LandmarkClass("x"),
+        r"^LandmarkClass: expected one of 'I', 'II', 'III', got 'x'$",
+    ),
+    (
+        "MapProfile",
+        lambda: MapProfile("fast"),
+        r"^MapProfile: expected one of 'product', 'sliced', 'relaxed'",
+    ),
+    ("RejectReason", lambda: RejectReason("stale"), r"^RejectReason: expected one of .*, got 'stale'$"),
+]
+
+
+@pytest.mark.parametrize(("name", "call", "message"), CASES, ids=[f"{i}-{c[0]}" for i, c in enumerate(CASES)])
+def test_a_bad_argument_is_refused_by_name(name: str, call: Callable[[], Any], message: str) -> None:
+    with pytest.raises(InputError, match=message) as raised:
+        call()
+    assert isinstance(raised.value, (AuraUmsError, ValueError))
+    assert name in str(raised.value)
