@@ -33,14 +33,29 @@ from aura_ums.logs import (
 )
 from aura_ums.manager import IdentifiedLandmarkBuffer, MapProfile, RejectReason
 from aura_ums.schemas import SchemaManager
-from aura_ums.uncertainty import GroundLineLandmark, LandmarkClass, PointLandmark, TerrainTable
-from aura_ums.world import MeadowMap, Route
+from aura_ums.uncertainty import (
+    Composite,
+    GroundLineLandmark,
+    LandmarkClass,
+    PointLandmark,
+    Pose,
+    SpatialUncertaintyMap,
+    TerrainTable,
+    TurnAndRun,
+    anchor_bounds,
+    intersect_maps,
+    union_of_maps,
+)
+from aura_ums.world import MeadowMap, Route, commands_for, grow_through, make_grid_world
 
 LOG = synthetic_log(np.random.default_rng(1), duration=5.0)
 FLOOR = TerrainTable({"floor": TerrainTable.default()["tile"]})
 ROW = LogObservation(2.5, "pole", 0.25, range=4.0)
 BOUNDS = SensorBounds(0.05, 0.0, 0.1, 0.1)
 RNG = np.random.default_rng(0)
+WORLD = make_grid_world(1, 2)
+START = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+TILE = TerrainTable.default()["tile"]
 
 CASES: list[tuple[str, Callable[[], Any], str]] = [
     ("symbol", lambda: PointLandmark("c", 5.0, 2.0, 3.5, symbol=object()), r"^c\.symbol: expected a string"),
@@ -88,6 +103,35 @@ CASES: list[tuple[str, Callable[[], Any], str]] = [
         r"^factor: expected a",
     ),
     ("landmark_class", lambda: ReplayOptions(landmark_class="II"), r"landmark_class: expected .*, got 'II'"),
+    (
+        "table",
+        lambda: commands_for(WORLD, Pose(2.5, 2.5, 0.0), TurnAndRun(0.0, 1.0), None),
+        r"^table: expected a",
+    ),
+    (
+        "table",
+        lambda: grow_through(START, WORLD, TurnAndRun(0.0, 1.0), None),
+        r"^table: expected a TerrainTable",
+    ),
+    ("rng", lambda: make_grid_world(1, 2, rng="x"), r"^rng: expected a numpy\.random\.Generator, got str$"),
+    (
+        "remove",
+        lambda: make_grid_world(1, 2, remove=5),
+        r"^remove: expected a sequence of \(row, col\) cells",
+    ),
+    ("maps", lambda: union_of_maps(None), r"^maps: expected a sequence of SpatialUncertaintyMap"),
+    (
+        "others",
+        lambda: intersect_maps(START, None, 64),
+        r"^others: expected a sequence of SpatialUncertaintyMap",
+    ),
+    ("max_vertices", lambda: intersect_maps(START, [START], object()), r"^max_vertices: expected an integer"),
+    (
+        "terrain",
+        lambda: anchor_bounds(None, Composite(), 3.0),
+        r"^terrain: expected TerrainStats, got NoneType$",
+    ),
+    ("sigmas", lambda: anchor_bounds(TILE, Composite(), float("nan")), r"^sigmas: expected a finite number"),
     (
         "LandmarkClass",
         lambda: LandmarkClass("x"),

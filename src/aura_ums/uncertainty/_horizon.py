@@ -39,6 +39,8 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import clamp_into
+from aura_ums._validate import SIGMAS, items_of, vertex_cap
+from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs, nearest_on_polygon
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._motion import TurnAndRun
@@ -120,6 +122,8 @@ def anchor_bounds(terrain: TerrainStats, composite: Composite, sigmas: float) ->
     >>> anchor_bounds(stats, Composite(), 3.0)            # no move: no growth, however large L0
     (0.0, 0.0)
     """
+    _check_anchor_arguments(terrain, composite)
+    sigmas = SIGMAS.check(sigmas, "sigmas")
     if composite.is_still:
         return 0.0, 0.0
     reach = composite.path + terrain.translation_inertial_loss
@@ -128,6 +132,13 @@ def anchor_bounds(terrain: TerrainStats, composite: Composite, sigmas: float) ->
         terrain.skitter + sigmas * terrain.skitter_sd
     )
     return heading, position
+
+
+def _check_anchor_arguments(terrain: object, composite: object) -> None:
+    if not isinstance(terrain, TerrainStats):
+        raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+    if not isinstance(composite, Composite):
+        raise InputError(f"composite: expected a Composite, got {type(composite).__name__}")
 
 
 def grow_from_anchor(
@@ -173,6 +184,11 @@ def grow_from_anchor(
     >>> grow_from_anchor(start, Composite(), stats, 3.0, 64) is start   # no move
     True
     """
+    _check_anchor_arguments(terrain, composite)
+    if not isinstance(anchor, SpatialUncertaintyMap):
+        raise InputError(f"anchor: expected a SpatialUncertaintyMap, got {type(anchor).__name__}")
+    sigmas = SIGMAS.check(sigmas, "sigmas")
+    max_vertices = vertex_cap(max_vertices)
     if composite.is_still:
         return anchor
     heading_bound, position_bound = anchor_bounds(terrain, composite, sigmas)
@@ -232,6 +248,13 @@ def intersect_maps(
     >>> intersect_maps(a, [far], 64) is a          # nothing in common: the first map
     True
     """
+    if not isinstance(first, SpatialUncertaintyMap):
+        raise InputError(f"first: expected a SpatialUncertaintyMap, got {type(first).__name__}")
+    others = items_of(others, "others", "a sequence of SpatialUncertaintyMap")
+    for index, other in enumerate(others):
+        if not isinstance(other, SpatialUncertaintyMap):
+            raise InputError(f"others[{index}]: expected a SpatialUncertaintyMap, got {type(other).__name__}")
+    max_vertices = vertex_cap(max_vertices)
     result = first
     for other in others:
         if other is result:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._validate import items_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
@@ -70,7 +71,7 @@ def union_of_maps(
     """
     if isinstance(max_vertices, bool) or not isinstance(max_vertices, int) or max_vertices < 3:
         raise InputError(f"max_vertices: expected an integer >= 3, got {max_vertices!r}")
-    items = list(maps)
+    items = list(items_of(maps, "maps", "a sequence of SpatialUncertaintyMap"))
     if not items:
         raise InputError("maps: expected at least one SpatialUncertaintyMap, got none")
     for position, item in enumerate(items):

@@ -426,6 +426,8 @@ def commands_for(
     """
     if not isinstance(pose, Pose):
         raise InputError(f"pose: expected a Pose, got {type(pose).__name__}")
+    if not isinstance(table, TerrainTable):
+        raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
     if not isinstance(command, TurnAndRun):
         raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
     pieces = _split_for("pose, command", meadow_map, pose, command)
@@ -515,6 +517,8 @@ def grow_through(
         )
     result = uncertainty_map
     pose = uncertainty_map.most_probable_pose()
+    if not isinstance(table, TerrainTable):
+        raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
     if not isinstance(command, TurnAndRun):
         raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
     pieces = _split_for("uncertainty_map (its most probable pose), command", meadow_map, pose, command)

@@ -8,7 +8,7 @@ from importlib import resources
 
 import numpy as np
 
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import check_rng, finite_float, integer_at_least, items_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import TerrainTable, VerticalLineLandmark
@@ -97,7 +97,9 @@ def make_grid_world(
     side = finite_float(cell, "cell")
     if side <= 0.0:
         raise InputError(f"cell: expected a positive number, got {side!r}")
-    holes = {(int(r), int(c)) for r, c in remove}
+    if rng is not None:
+        check_rng(rng)
+    holes = {(int(r), int(c)) for r, c in items_of(remove, "remove", "a sequence of (row, col) cells")}
     names = sorted(TerrainTable.default())
     meadows: list[Meadow] = []
     poles: dict[str, tuple[int, int]] = {}
