@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from aura_ums.baselines import chi2_quantile
+from aura_ums.campaign import batches
 from aura_ums.errors import AuraUmsError, InputError
 from aura_ums.logs import (
     LogObservation,
@@ -33,6 +35,7 @@ from aura_ums.logs import (
 )
 from aura_ums.manager import IdentifiedLandmarkBuffer, MapProfile, RejectReason
 from aura_ums.schemas import SchemaManager
+from aura_ums.sim import Scene
 from aura_ums.uncertainty import (
     Composite,
     GroundLineLandmark,
@@ -132,6 +135,13 @@ CASES: list[tuple[str, Callable[[], Any], str]] = [
         r"^terrain: expected TerrainStats, got NoneType$",
     ),
     ("sigmas", lambda: anchor_bounds(TILE, Composite(), float("nan")), r"^sigmas: expected a finite number"),
+    ("poles", lambda: Scene(poles=None), r"^Scene\.poles: expected a sequence of Pole, got NoneType$"),
+    ("count", lambda: batches((1, 2), None), r"^count: expected an integer >= 1, got None$"),
+    (
+        "probability",
+        lambda: chi2_quantile(float("nan"), 2),
+        r"^probability: expected a finite number, got nan$",
+    ),
     (
         "LandmarkClass",
         lambda: LandmarkClass("x"),

@@ -81,7 +81,14 @@ def chi2_quantile(probability: float, dof: int) -> float:
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: dof: expected 1 or 2, got 3
+    >>> chi2_quantile(float("nan"), 2)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: probability: expected a finite number, got nan
     """
+    probability = finite_float(probability, "probability")
+    if not 0.0 < probability < 1.0:
+        raise InputError(f"probability: expected a number in (0, 1), got {probability!r}")
     if dof == 1:
         return _STANDARD_NORMAL.inv_cdf(0.5 + 0.5 * probability) ** 2
     if dof == 2:

@@ -18,6 +18,7 @@ from typing import TypeVar
 import numpy as np
 
 from aura_ums._metrics import Metrics
+from aura_ums._validate import integer_at_least, items_of
 from aura_ums.camera import CalibrationBounds, Camera
 from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
@@ -147,7 +148,13 @@ def batches(items: tuple[_Item, ...], count: int) -> list[tuple[_Item, ...]]:
     [(1, 2), (3, 4, 5)]
     >>> batches((1, 2), 5)          # never an empty batch
     [(1,), (2,)]
+    >>> batches((1, 2), 0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: count: expected an integer >= 1, got 0
     """
+    items = tuple(items_of(items, "items", "a sequence of items"))
+    count = integer_at_least(count, "count", 1)
     parts = max(1, min(count, len(items)))
     ends = [len(items) * k // parts for k in range(parts + 1)]
     return [items[ends[k] : ends[k + 1]] for k in range(parts)]

@@ -69,6 +69,7 @@ from aura_ums._validate import (
     START_RADIUS,
     Range,
     finite_float,
+    items_of,
     nonnegative_float,
     read_only,
 )
@@ -473,7 +474,7 @@ class Scenario:
             value = getattr(self, name)
             if not isinstance(value, kind):
                 raise InputError(f"Scenario.{name}: expected a {kind.__name__}, got {type(value).__name__}")
-        commands = tuple(self.commands)
+        commands = items_of(self.commands, "Scenario.commands", "a sequence of TurnAndRun")
         for index, command in enumerate(commands):
             if not isinstance(command, TurnAndRun):
                 raise InputError(f"Scenario.commands[{index}]: expected a TurnAndRun, got {command!r}")

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import (
     finite_float,
     integer_at_least,
+    items_of,
     nonnegative_float,
     points_array,
     positive_float,
@@ -169,7 +170,7 @@ class Building:
             object.__setattr__(self, name, finite_float(getattr(self, name), f"Building.{name}"))
         if not self.z_top > self.z_bottom:
             raise InputError(f"Building.z_top: expected > z_bottom ({self.z_bottom}), got {self.z_top}")
-        if len(self.shades) != 2:
+        if not isinstance(self.shades, (tuple, list)) or len(self.shades) != 2:
             raise InputError(f"Building.shades: expected two gray levels, got {self.shades!r}")
         bright, dark = (_shade(s, "Building.shades") for s in self.shades)
         object.__setattr__(self, "shades", (bright, dark))
@@ -408,7 +409,7 @@ class Scene:
             ("patches", GroundPatch),
             ("stripes", GroundStripe),
         ):
-            items = tuple(getattr(self, name))
+            items = items_of(getattr(self, name), f"Scene.{name}", f"a sequence of {kind.__name__}")
             for index, item in enumerate(items):
                 if not isinstance(item, kind):
                     raise InputError(f"Scene.{name}[{index}]: expected a {kind.__name__}, got {item!r}")
