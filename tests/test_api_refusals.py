@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from aura_ums.baselines import chi2_quantile
+from aura_ums.baselines import chi2_quantile, motion_moments
 from aura_ums.campaign import batches
 from aura_ums.errors import AuraUmsError, InputError
 from aura_ums.logs import (
@@ -34,8 +34,9 @@ from aura_ums.logs import (
     synthetic_log,
 )
 from aura_ums.manager import IdentifiedLandmarkBuffer, MapProfile, RejectReason
+from aura_ums.plot import experiment_table, run_down_path
 from aura_ums.schemas import SchemaManager
-from aura_ums.sim import Scene
+from aura_ums.sim import Scene, ground_texture, landmark_points, random_clutter, waypoints_array
 from aura_ums.uncertainty import (
     Composite,
     GroundLineLandmark,
@@ -135,6 +136,21 @@ CASES: list[tuple[str, Callable[[], Any], str]] = [
         r"^terrain: expected TerrainStats, got NoneType$",
     ),
     ("sigmas", lambda: anchor_bounds(TILE, Composite(), float("nan")), r"^sigmas: expected a finite number"),
+    ("rng", lambda: ground_texture(None), r"^rng: expected a numpy\.random\.Generator, got NoneType$"),
+    (
+        "rng",
+        lambda: random_clutter((0.0, 0.0, 1.0, 1.0), 2, None),
+        r"^rng: expected a numpy\.random\.Generator",
+    ),
+    (
+        "landmark",
+        lambda: landmark_points(None),
+        r"^landmark: expected a VerticalLineLandmark or PointLandmark",
+    ),
+    ("scenario", lambda: waypoints_array(None), r"^scenario: expected a Scenario, got NoneType$"),
+    ("terrain", lambda: motion_moments(None, TurnAndRun(0.0, 1.0)), r"^terrain: expected TerrainStats"),
+    ("steps", lambda: run_down_path(RNG, steps=None), r"^steps: expected an integer >= 0, got None$"),
+    ("scenario", lambda: experiment_table(None, None), r"^scenario: expected a Scenario, got NoneType$"),
     ("poles", lambda: Scene(poles=None), r"^Scene\.poles: expected a sequence of Pole, got NoneType$"),
     ("count", lambda: batches((1, 2), None), r"^count: expected an integer >= 1, got None$"),
     (

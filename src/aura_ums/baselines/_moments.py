@@ -132,6 +132,10 @@ def motion_moments(terrain: TerrainStats, command: TurnAndRun) -> MotionMoments:
     >>> motion_moments(TerrainTable.default()["grass"], TurnAndRun(0.0, 0.0))   # no motion at all
     MotionMoments(turn_mean=0.0, turn_var=0.0, run_mean=0.0, run_var=0.0, drift_var=0.0, skitter_var=0.0)
     """
+    if not isinstance(terrain, TerrainStats):
+        raise InputError(f"terrain: expected TerrainStats, got {type(terrain).__name__}")
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
     turn, run = command.turn, command.run
     if turn != 0.0:
         fraction_mean, fraction_var = clipped_normal_moments(

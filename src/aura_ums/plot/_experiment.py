@@ -13,6 +13,7 @@ from matplotlib.patches import Rectangle
 
 from aura_ums._metrics import Metrics
 from aura_ums._validate import integer_at_least
+from aura_ums.errors import InputError
 from aura_ums.expecter import Expecter, ImageWindow, disk_model_window
 from aura_ums.plot._draw import draw_map
 from aura_ums.schemas import FindLandmarkSchema
@@ -87,6 +88,10 @@ def experiment_table(scenario: Scenario, result: RunResult) -> list[TableRow]:
     >>> experiment_table(scenario, RunResult(scenario.name, (), start, False, None, 0, 0))   # no frame
     []
     """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    if not isinstance(result, RunResult):
+        raise InputError(f"result: expected a RunResult, got {type(result).__name__}")
     expecter = Expecter(scenario.camera)
     rows = []
     distance = 0.0

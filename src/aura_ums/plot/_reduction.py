@@ -11,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from aura_ums._validate import check_rng, integer_at_least, positive_float
 from aura_ums.errors import InputError
 from aura_ums.plot._draw import draw_map, draw_samples
 from aura_ums.uncertainty import (
@@ -75,11 +76,14 @@ def run_down_path(
     ...
     aura_ums.errors.UnknownTerrainError: terrain: expected one of concrete, grass, gravel, tile, got 'moon'
     """
+    check_rng(rng)
+    steps = integer_at_least(steps, "steps", 0)
+    length = positive_float(step_length, "step_length")
     stats = TerrainTable.default()[terrain]
     truth = Pose(0.0, 0.0, 0.0)
     current = SpatialUncertaintyMap.from_pose(truth, 0.3, math.radians(3))
     result = []
-    command = TurnAndRun(0.0, step_length)
+    command = TurnAndRun(0.0, length)
     for index in range(steps):
         moved = stats.sample_motions(truth.as_array(), command, rng, truncate=3.0)[0]
         truth = Pose(float(moved[0]), float(moved[1]), float(moved[2]))

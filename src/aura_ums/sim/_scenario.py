@@ -1099,6 +1099,8 @@ def waypoints_array(scenario: Scenario) -> NDArray[np.float64]:
     >>> waypoints_array(s).round(6).tolist()
     [[0.0, 0.0], [2.0, 0.0], [2.0, 0.5]]
     """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
     x, y, heading = scenario.start.pose.x, scenario.start.pose.y, scenario.start.pose.heading
     points = [(x, y)]
     for command in scenario.commands:

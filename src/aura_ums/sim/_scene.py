@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import (
+    check_rng,
     finite_float,
     integer_at_least,
     items_of,
@@ -313,6 +314,7 @@ def ground_texture(
 
     if isinstance(size, bool) or not isinstance(size, int) or size < 4 or size & (size - 1):
         raise InputError(f"size: expected a power of two >= 4, got {size!r}")
+    check_rng(rng)
     noise = rng.standard_normal((size, size))
     smooth = ndimage.gaussian_filter(noise, nonnegative_float(smoothing, "smoothing"), mode="wrap")
     smooth = (smooth - smooth.mean()) / max(float(smooth.std()), 1e-12)
@@ -345,6 +347,7 @@ def random_clutter(
     ...
     aura_ums.errors.InputError: count: expected an integer >= 0, got -1
     """
+    check_rng(rng)
     integer_at_least(count, "count", 0)
     x0, y0, x1, y1 = (finite_float(v, "bounds") for v in bounds)
     centre = np.column_stack([rng.uniform(x0, x1, count), rng.uniform(y0, y1, count)])
@@ -559,5 +562,9 @@ def landmark_points(landmark: VerticalLineLandmark | PointLandmark) -> NDArray[n
     """
     if isinstance(landmark, PointLandmark):
         return np.array([[landmark.x, landmark.y, landmark.z]])
+    if not isinstance(landmark, VerticalLineLandmark):
+        raise InputError(
+            f"landmark: expected a VerticalLineLandmark or PointLandmark, got {type(landmark).__name__}"
+        )
     zs = [landmark.z_bottom, 0.5 * (landmark.z_bottom + landmark.z_top), landmark.z_top]
     return np.array([[landmark.x, landmark.y, z] for z in zs])
