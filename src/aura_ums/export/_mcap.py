@@ -247,6 +247,16 @@ def mcap_channels(path: str | Path) -> dict[str, str]:
     Examples
     --------
     >>> import pathlib, tempfile
+    >>> from mcap.writer import Writer                  # the foxglove extra's MCAP writer
+    >>> good = pathlib.Path(tempfile.mkdtemp()) / "one.mcap"
+    >>> with good.open("wb") as stream:
+    ...     writer = Writer(stream)
+    ...     writer.start()
+    ...     schema = writer.register_schema("demo.Point", "jsonschema", b"{}")
+    ...     _ = writer.register_channel("/point", "json", schema)
+    ...     writer.finish()
+    >>> mcap_channels(good)
+    {'/point': 'demo.Point'}
     >>> bad = pathlib.Path(tempfile.mkdtemp()) / "not.mcap"
     >>> _ = bad.write_bytes(b"hello")
     >>> mcap_channels(bad)                       # doctest: +ELLIPSIS

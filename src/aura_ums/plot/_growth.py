@@ -145,6 +145,8 @@ def draw_growth_figures(out: str | Path, *, seed: int = 0, terrain: str = PAPER_
     default table is refused before anything is drawn:
 
     >>> import tempfile
+    >>> [path.name for path in draw_growth_figures(tempfile.mkdtemp(), seed=1)]
+    ['figure5_point_transform.png', 'figure6_heading_wedge.png', 'figure7_map_transform.png']
     >>> draw_growth_figures(tempfile.mkdtemp(), terrain="moon")
     Traceback (most recent call last):
     ...
