@@ -145,8 +145,7 @@ def read_bytes(path: str | os.PathLike[str], *, kind: str, max_bytes: int | None
     aura_ums.errors.FileFormatError: .../a.toml: expected a TOML file of at most 4 bytes, got a larger one
     """
     limit = _limit(max_bytes, MAX_BYTES)
-    if not isinstance(path, (str, os.PathLike)):
-        raise InputError(f"path: expected a {kind} file's path (str or path-like), got {type(path).__name__}")
+    as_path(path, "path", f"a {kind} file's path (str or path-like)")
     source = str(path)
     try:
         mode = os.stat(path).st_mode
@@ -218,8 +217,8 @@ def regular_file(path: str | os.PathLike[str]) -> bool:
     return stat.S_ISREG(path_mode(path))
 
 
-def as_path(value: object, name: str) -> Path:
-    """Return ``value`` as a Path, refusing anything but a str or a path-like object, naming ``name``.
+def as_path(value: object, name: str, what: str = "a path (str or os.PathLike)") -> Path:
+    """Return ``value`` as a Path, refusing anything but a str or path-like object (``name``: ``what``).
 
     Examples
     --------
@@ -231,7 +230,7 @@ def as_path(value: object, name: str) -> Path:
     aura_ums.errors.InputError: folder: expected a path (str or os.PathLike), got NoneType
     """
     if not isinstance(value, (str, os.PathLike)):
-        raise InputError(f"{name}: expected a path (str or os.PathLike), got {type(value).__name__}")
+        raise InputError(f"{name}: expected {what}, got {type(value).__name__}")
     return Path(value)
 
 

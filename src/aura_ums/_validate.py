@@ -16,7 +16,7 @@ import math
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import NoReturn, TypeVar
+from typing import NoReturn, TypeVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -115,6 +115,25 @@ def items_of(value: Iterable[_T], name: str, what: str) -> tuple[_T, ...]:
     if isinstance(checked, (str, bytes)) or not isinstance(checked, Iterable):
         raise InputError(f"{name}: expected {what}, got {type(checked).__name__}")
     return tuple(value)
+
+
+def sequence_of(value: Iterable[object], kind: type[_T], name: str) -> tuple[_T, ...]:
+    """Return the items of an iterable (not a string), each a ``kind``, or raise naming ``name`` and the item.
+
+    Examples
+    --------
+    >>> sequence_of([1, 2], int, "ids")
+    (1, 2)
+    >>> sequence_of([1, "2"], int, "ids")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: ids[1]: expected a int, got str
+    """
+    items = items_of(value, name, f"a sequence of {kind.__name__}")
+    for index, item in enumerate(items):
+        if not isinstance(item, kind):
+            raise InputError(f"{name}[{index}]: expected a {kind.__name__}, got {type(item).__name__}")
+    return cast(tuple[_T, ...], items)
 
 
 def check_rng(rng: object, name: str = "rng") -> None:

@@ -266,13 +266,11 @@ def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) 
     else:
         tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
         lower, upper = distorted_range(found.points, k.distortion, tolerance)
+    # Zero bounds leave focal x + centre as it is, bit for bit (x - 0.0 is x).
+    within = _EXACT if bounds is None else bounds
     with np.errstate(over="ignore", invalid="ignore"):
-        if bounds is None:
-            u = (k.fx * lower[0] + k.cx, k.fx * upper[0] + k.cx)
-            v = (k.fy * lower[1] + k.cy, k.fy * upper[1] + k.cy)
-        else:
-            u = _pixel_range(k.fx, bounds.fx, k.cx, bounds.cx, lower[0], upper[0])
-            v = _pixel_range(k.fy, bounds.fy, k.cy, bounds.cy, lower[1], upper[1])
+        u = _pixel_range(k.fx, within.fx, k.cx, within.cx, lower[0], upper[0])
+        v = _pixel_range(k.fy, within.fy, k.cy, within.cy, lower[1], upper[1])
     return ImageWindow(
         _outward(float(u[0]), -1.0),
         _outward(float(v[0]), -1.0),

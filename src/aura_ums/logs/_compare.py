@@ -17,9 +17,9 @@ from aura_ums.logs._log import RobotLog
 from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
+    _observation_for,
     frames_after,
     meta_bounds,
-    observation_for,
     position_reports_for,
     replay_log,
     replay_start,
@@ -312,8 +312,8 @@ def compare_on_log(
                 (observation, landmarks[row.landmark_id])
                 for row in frames[frame_time]
                 if isinstance(
-                    observation := observation_for(
-                        row, opts.landmark_class, bounds, sensor_offset=log.meta.sensor_offset
+                    observation := _observation_for(
+                        row, opts.landmark_class, bounds, 1.0, log.meta.sensor_offset
                     ),
                     (BearingObservation, RangeBearingObservation),
                 )

@@ -4,15 +4,22 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import ROW_GAP, Choice, finite_float, float_array, integer_at_least, read_only
+from aura_ums._validate import (
+    ROW_GAP,
+    Choice,
+    finite_float,
+    float_array,
+    integer_at_least,
+    read_only,
+    sequence_of,
+)
 from aura_ums.errors import InputError, UnknownLandmarkError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._odometry import ReverseMotion, odometry_report_arrays, reports_of
@@ -527,16 +534,6 @@ def _max_gap(value: object, name: str) -> float:
     return float(value)
 
 
-def _tuple_of(value: object, kind: type, name: str) -> tuple[object, ...]:
-    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
-        raise InputError(f"{name}: expected a sequence of {kind.__name__}, got {type(value).__name__}")
-    items = tuple(value)
-    for index, item in enumerate(items):
-        if not isinstance(item, kind):
-            raise InputError(f"{name}[{index}]: expected a {kind.__name__}, got {type(item).__name__}")
-    return items
-
-
 def unaligned_spans(spans: Sequence[tuple[str, float, float]]) -> str | None:
     """Return why records of one run disagree in their clocks, or None.
 
@@ -614,13 +611,8 @@ class RobotLog:
     def __post_init__(self) -> None:
         if not isinstance(self.meta, LogMeta):
             raise InputError(f"RobotLog.meta: expected a LogMeta, got {type(self.meta).__name__}")
-        landmarks = cast(
-            tuple[LogLandmark, ...], _tuple_of(self.landmarks, LogLandmark, "RobotLog.landmarks")
-        )
-        observations = cast(
-            tuple[LogObservation, ...],
-            _tuple_of(self.observations, LogObservation, "RobotLog.observations"),
-        )
+        landmarks = sequence_of(self.landmarks, LogLandmark, "RobotLog.landmarks")
+        observations = sequence_of(self.observations, LogObservation, "RobotLog.observations")
         object.__setattr__(self, "landmarks", landmarks)
         object.__setattr__(self, "observations", observations)
         by_id: dict[str, LogLandmark] = {}
@@ -652,9 +644,7 @@ class RobotLog:
                 f"RobotLog.odometry: expected an Odometry or None, got {type(self.odometry).__name__}"
             )
         if self.commands is not None:
-            commands = cast(
-                tuple[PositionReport, ...], _tuple_of(self.commands, PositionReport, "RobotLog.commands")
-            )
+            commands = sequence_of(self.commands, PositionReport, "RobotLog.commands")
             for index in range(1, len(commands)):
                 before, after = commands[index - 1], commands[index]
                 if after.time <= before.time:

@@ -751,6 +751,17 @@ def observation_for(
         factor = finite_float(factor, "factor")
         if factor < 1.0:
             raise InputError(f"factor: expected a number >= 1, got {factor!r}")
+    return _observation_for(row, landmark_class, bounds, factor, sensor_offset)
+
+
+def _observation_for(
+    row: LogObservation,
+    landmark_class: LandmarkClass,
+    bounds: SensorBounds,
+    factor: float,
+    sensor_offset: tuple[float, float],
+) -> Observation:
+    """:func:`observation_for` of checked arguments: a replay's own rows, class and bounds, row by row."""
     bearing_error = (bounds.bearing_error if row.bearing_error is None else row.bearing_error) * factor
     if landmark_class is LandmarkClass.VERTICAL_LINE or row.range is None:
         return BearingObservation(row.landmark_id, row.time, row.bearing, bearing_error, sensor_offset)

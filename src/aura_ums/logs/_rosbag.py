@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from aura_ums._files import present
+from aura_ums._files import as_path, present
 from aura_ums._validate import ROW_GAP
 from aura_ums.errors import AuraUmsError, FileFormatError, InputError, MissingDependencyError
 from aura_ums.logs._io import (
@@ -384,9 +384,7 @@ def read_rosbag(
     truth = None if groundtruth_topic is None else _topic(groundtruth_topic, "groundtruth_topic")
     if meta is not None and not isinstance(meta, LogMeta):
         raise InputError(f"meta: expected a LogMeta or None, got {type(meta).__name__}")
-    if not isinstance(bag_path, (str, os.PathLike)):
-        raise InputError(f"bag_path: expected a path, got {type(bag_path).__name__}")
-    path = Path(bag_path)
+    path = as_path(bag_path, "bag_path", "a path")
     if not present(path):
         raise FileFormatError(
             str(path),

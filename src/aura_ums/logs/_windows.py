@@ -45,9 +45,9 @@ from aura_ums.logs._replay import (
     ReplayOptions,
     ReplayResult,
     ReplayStep,
+    _observation_for,
     log_meadow_map,
     meta_bounds,
-    observation_for,
     position_reports_for,
     replay_log,
     replay_start,
@@ -507,7 +507,7 @@ class _Judge:
             for method, window in zip(WINDOW_METHODS, windows, strict=True):
                 self.rows.append(self._row(time, row.landmark_id, method, window, measured, true_pixel))
         for row in rows:
-            observation = observation_for(row, self._class, self._bounds, sensor_offset=self._sensor)
+            observation = _observation_for(row, self._class, self._bounds, 1.0, self._sensor)
             if isinstance(observation, (BearingObservation, RangeBearingObservation)):
                 landmark = self._landmarks[row.landmark_id]
                 ekf.update(observation, (landmark.x, landmark.y))

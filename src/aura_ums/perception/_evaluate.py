@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.perception._segments import orientation_difference, segment_orientation
+from aura_ums.perception._segments import _orientation, orientation_difference
 
 _CHUNK = 2048
 
@@ -120,7 +120,7 @@ def _matched(
     a = segments[:, :2]
     d = segments[:, 2:] - a
     dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-12)
-    seg_angle = segment_orientation(segments)
+    seg_angle = _orientation(segments)
     found = 0
     for lo in range(0, points.shape[0], _CHUNK):
         p = points[lo : lo + _CHUNK]
@@ -189,10 +189,6 @@ def segment_recall_precision(
         raise InputError(f"step: expected a positive number, got {step!r}")
     truth_points, truth_owner = sample_points(truth, step)
     found_points, found_owner = sample_points(found, step)
-    recalled = _matched(
-        truth_points, segment_orientation(truth)[truth_owner], found, distance, angle_tolerance
-    )
-    precise = _matched(
-        found_points, segment_orientation(found)[found_owner], against, distance, angle_tolerance
-    )
+    recalled = _matched(truth_points, _orientation(truth)[truth_owner], found, distance, angle_tolerance)
+    precise = _matched(found_points, _orientation(found)[found_owner], against, distance, angle_tolerance)
     return RecallPrecision(recalled, int(truth_points.shape[0]), precise, int(found_points.shape[0]))

@@ -39,7 +39,12 @@ def segment_orientation(segments: ArrayLike) -> NDArray[np.float64]:
         raise InputError(
             f"segments: expected an (n, 4) array of x1, y1, x2, y2 pixels, got shape {array.shape}"
         )
-    angle = np.arctan2(array[:, 3] - array[:, 1], array[:, 2] - array[:, 0])
+    return _orientation(array)
+
+
+def _orientation(segments: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`segment_orientation` of a checked ``(n, 4)`` float array (a detector's, or checked data)."""
+    angle = np.arctan2(segments[:, 3] - segments[:, 1], segments[:, 2] - segments[:, 0])
     return np.asarray(np.mod(angle, math.pi), dtype=np.float64)
 
 
@@ -150,7 +155,7 @@ class LineSegments:
     @property
     def orientation(self) -> NDArray[np.float64]:
         """Direction of each segment, radians in ``[0, pi)`` (see :func:`segment_orientation`)."""
-        return segment_orientation(self.segments)
+        return _orientation(self.segments)
 
     @property
     def midpoints(self) -> NDArray[np.float64]:

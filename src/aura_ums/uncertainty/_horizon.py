@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import clamp_into
-from aura_ums._validate import SIGMAS, items_of, vertex_cap
+from aura_ums._validate import SIGMAS, sequence_of, vertex_cap
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs, nearest_on_polygon
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -123,7 +123,11 @@ def anchor_bounds(terrain: TerrainStats, composite: Composite, sigmas: float) ->
     (0.0, 0.0)
     """
     _check_anchor_arguments(terrain, composite)
-    sigmas = SIGMAS.check(sigmas, "sigmas")
+    return _anchor_bounds(terrain, composite, SIGMAS.check(sigmas, "sigmas"))
+
+
+def _anchor_bounds(terrain: TerrainStats, composite: Composite, sigmas: float) -> tuple[float, float]:
+    """:func:`anchor_bounds` of checked arguments (:func:`grow_from_anchor` checked them)."""
     if composite.is_still:
         return 0.0, 0.0
     reach = composite.path + terrain.translation_inertial_loss
@@ -191,7 +195,7 @@ def grow_from_anchor(
     max_vertices = vertex_cap(max_vertices)
     if composite.is_still:
         return anchor
-    heading_bound, position_bound = anchor_bounds(terrain, composite, sigmas)
+    heading_bound, position_bound = _anchor_bounds(terrain, composite, sigmas)
     chord = math.hypot(composite.x, composite.y)
     direction = math.atan2(composite.y, composite.x) if chord > 0.0 else 0.0
     grown = anchor._grow_many((TurnAndRun(direction, chord),), TerrainStats.zero(), sigmas, max_vertices)
@@ -250,10 +254,7 @@ def intersect_maps(
     """
     if not isinstance(first, SpatialUncertaintyMap):
         raise InputError(f"first: expected a SpatialUncertaintyMap, got {type(first).__name__}")
-    others = items_of(others, "others", "a sequence of SpatialUncertaintyMap")
-    for index, other in enumerate(others):
-        if not isinstance(other, SpatialUncertaintyMap):
-            raise InputError(f"others[{index}]: expected a SpatialUncertaintyMap, got {type(other).__name__}")
+    others = sequence_of(others, SpatialUncertaintyMap, "others")
     max_vertices = vertex_cap(max_vertices)
     result = first
     for other in others:

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import items_of
+from aura_ums._validate import sequence_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
@@ -71,12 +71,9 @@ def union_of_maps(
     """
     if isinstance(max_vertices, bool) or not isinstance(max_vertices, int) or max_vertices < 3:
         raise InputError(f"max_vertices: expected an integer >= 3, got {max_vertices!r}")
-    items = list(items_of(maps, "maps", "a sequence of SpatialUncertaintyMap"))
+    items = sequence_of(maps, SpatialUncertaintyMap, "maps")
     if not items:
         raise InputError("maps: expected at least one SpatialUncertaintyMap, got none")
-    for position, item in enumerate(items):
-        if not isinstance(item, SpatialUncertaintyMap):
-            raise InputError(f"maps[{position}]: expected a SpatialUncertaintyMap, got {type(item).__name__}")
     primary = items[0]
     if len(items) == 1:
         return primary

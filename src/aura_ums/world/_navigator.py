@@ -296,16 +296,23 @@ def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance:
     origin = _point(start, "start")
     angle = finite_float(heading, "heading")
     length = nonnegative_float(distance, "distance")
+    return _split(meadow_map, origin, angle, length, "start, heading, distance")
+
+
+def _split(
+    meadow_map: MeadowMap, origin: NDArray[np.float64], angle: float, length: float, names: str
+) -> list[RunPiece]:
+    """:func:`split_run` of checked arguments; a run off the map is refused naming the caller's ``names``."""
     if length <= RUN_TOLERANCE:
         # Too short to cut by meadow boundaries: one piece on the start meadow's terrain.
         meadow = meadow_map.meadow_at(float(origin[0]), float(origin[1]))
         if meadow is not None:
             return [RunPiece(length, meadow.terrain, meadow.id)]
         if length == 0.0:
-            raise _outside_every_meadow("start, heading, distance", origin, angle, length)
+            raise _outside_every_meadow(names, origin, angle, length)
     spans = _run_spans(meadow_map, float(origin[0]), float(origin[1]), angle, length)
     if not spans:
-        raise _outside_every_meadow("start, heading, distance", origin, angle, length)
+        raise _outside_every_meadow(names, origin, angle, length)
     cuts = sorted({0.0, length, *(lo for lo, _, _ in spans), *(hi for _, hi, _ in spans)})
     owners: list[int | None] = []
     for lo, hi in pairwise(cuts):
@@ -465,13 +472,7 @@ def _split_for(names: str, meadow_map: MeadowMap, pose: Pose, command: TurnAndRu
     """:func:`split_run` of a command from a pose, a run off the map worded for the caller's ``names``."""
     if not isinstance(meadow_map, MeadowMap):
         raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
-    heading, origin = pose.heading + command.turn, np.array([pose.x, pose.y])
-    if command.run == 0.0 and meadow_map.meadow_at(pose.x, pose.y) is None:
-        raise _outside_every_meadow(names, origin, heading, command.run)
-    try:
-        return split_run(meadow_map, (pose.x, pose.y), heading, command.run)
-    except OutsideMapError:
-        raise _outside_every_meadow(names, origin, heading, command.run) from None
+    return _split(meadow_map, np.array([pose.x, pose.y]), pose.heading + command.turn, command.run, names)
 
 
 def grow_through(

@@ -2,21 +2,18 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from aura_ums._validate import items_of, nonnegative_float
+from aura_ums._validate import nonnegative_float, sequence_of
 from aura_ums.errors import InputError
 from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap
 from aura_ums.world._navigator import RUN_TOLERANCE, _point
 
 Point = tuple[float, float]
-_T = TypeVar("_T")
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,8 +72,8 @@ class ShortTermMemory:
             raise InputError(f"leg: expected the leg's (start, end), two (x, y) points, got {self.leg!r}")
         start, end = (_point(point, f"leg[{index}]") for index, point in enumerate(self.leg))
         object.__setattr__(self, "leg", ((float(start[0]), float(start[1])), (float(end[0]), float(end[1]))))
-        object.__setattr__(self, "meadows", _typed(self.meadows, Meadow, "meadows"))
-        object.__setattr__(self, "landmarks", _typed(self.landmarks, LandmarkRecord, "landmarks"))
+        object.__setattr__(self, "meadows", sequence_of(self.meadows, Meadow, "meadows"))
+        object.__setattr__(self, "landmarks", sequence_of(self.landmarks, LandmarkRecord, "landmarks"))
         object.__setattr__(self, "traversed", tuple(self.traversed))
         ids = {m.id for m in self.meadows}
         for ident in self.traversed:
@@ -166,12 +163,3 @@ class ShortTermMemory:
     def landmark_ids(self) -> tuple[str, ...]:
         """Ids of the candidate landmarks, in order."""
         return tuple(r.id for r in self.landmarks)
-
-
-def _typed(items: Iterable[object], kind: type[_T], name: str) -> tuple[_T, ...]:
-    result: list[_T] = []
-    for position, item in enumerate(items_of(items, name, f"a sequence of {kind.__name__}")):
-        if not isinstance(item, kind):
-            raise InputError(f"{name}[{position}]: expected a {kind.__name__}, got {type(item).__name__}")
-        result.append(item)
-    return tuple(result)
