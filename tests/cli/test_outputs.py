@@ -883,3 +883,23 @@ def test_a_deleted_current_folder_is_said_not_a_traceback(inputs: Path, tmp_path
         "warning: relative paths cannot be found: a current folder that was deleted"
     )
     assert "error: m.json: expected a path from an existing current folder" in done.stderr
+
+
+def test_the_write_probe_is_removed_when_a_stop_lands_while_it_exists(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A Ctrl-C (or SIGTERM) between making the probe file and removing it left it behind."""
+    from aura_ums.cli import _outputs
+
+    opened = Path.open
+
+    def open_then_stop(self: Path, *args: Any, **kwargs: Any) -> Any:
+        handle = opened(self, *args, **kwargs)
+        handle.close()
+        raise KeyboardInterrupt  # the signal, as the handler raises it, right after the file exists
+
+    monkeypatch.setattr(Path, "open", open_then_stop)
+    with pytest.raises(KeyboardInterrupt, match=r"^$"):
+        _outputs._writable(_outputs.Target("--metrics-json", tmp_path / "m.json"), tmp_path / "m.json")
+    monkeypatch.undo()
+    assert list(tmp_path.iterdir()) == []

@@ -302,8 +302,10 @@ def _writable(target: Target, where: Path) -> None:
         )
     probe = scratch_path(folder / "write-probe")
     try:
-        probe.open("x").close()
-        probe.unlink()
+        try:
+            probe.open("x").close()
+        finally:  # also when a Ctrl-C or SIGTERM lands between making the probe and removing it
+            probe.unlink(missing_ok=True)
     except OSError as exc:
         raise _unwritable(target, folder, exc) from None
 
