@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from aura_ums.baselines import chi2_quantile, motion_moments
-from aura_ums.campaign import batches
+from aura_ums.campaign import LoadLog, batches
 from aura_ums.errors import AuraUmsError, InputError
 from aura_ums.logs import (
     LogObservation,
@@ -76,6 +76,11 @@ CASES: list[tuple[str, Callable[[], Any], str]] = [
     ("folder", lambda: open_log(0), r"^folder: expected a path \(str or os\.PathLike\), got int$"),
     ("before_frame", lambda: replay_log(LOG, FLOOR, before_frame="x"), r"^before_frame: expected a callable"),
     ("steps_csv", lambda: replay_log(LOG, FLOOR, steps_csv=0), r"^steps_csv: expected a path"),
+    (
+        "max_truth_gap",
+        lambda: LoadLog(max_truth_gap=-1.0),
+        r"^LoadLog\.max_truth_gap: expected a positive number of seconds \(or inf\), got -1\.0$",
+    ),
     ("logs", lambda: calibrate_logs(None), r"^logs: expected a sequence of RobotLog, got NoneType$"),
     (
         "anchor",

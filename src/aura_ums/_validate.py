@@ -54,6 +54,13 @@ def nonnegative_float(value: object, name: str) -> float:
     return result
 
 
+def gap_seconds(value: object, name: str) -> float:
+    """Return ``value``, a longest interpolated interval (s, > 0, or ``math.inf``), as a float."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0.0:
+        raise InputError(f"{name}: expected a positive number of seconds (or inf), got {value!r}")
+    return float(value)
+
+
 def integer_at_least(value: object, name: str, minimum: int) -> int:
     """Return ``value`` if it is an integer (not a bool) >= ``minimum``, or raise naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:

@@ -18,7 +18,7 @@ from typing import TypeVar
 import numpy as np
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import integer_at_least, items_of
+from aura_ums._validate import gap_seconds, integer_at_least, items_of
 from aura_ums.camera import CalibrationBounds, Camera
 from aura_ums.campaign._engine import Campaign, run_campaign, settings_or_serial
 from aura_ums.campaign._settings import CampaignSettings
@@ -255,9 +255,19 @@ class LoadLog:
     Traceback (most recent call last):
     ...
     aura_ums.errors.FileFormatError: .../missing: expected a log folder, got no such folder
+    >>> LoadLog(max_truth_gap=-1.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: LoadLog.max_truth_gap: expected a positive number of seconds ..., got -1.0
     """
 
     max_truth_gap: float | None = None
+
+    def __post_init__(self) -> None:
+        # Checked here, not on the worker: a campaign learns of a bad gap before it starts.
+        if self.max_truth_gap is not None:
+            gap = gap_seconds(self.max_truth_gap, "LoadLog.max_truth_gap")
+            object.__setattr__(self, "max_truth_gap", gap)
 
     def __call__(self, folder: str | os.PathLike[str]) -> RobotLog:
         """Read ``folder`` (on the worker: the path must be readable there)."""

@@ -16,6 +16,7 @@ from aura_ums._validate import (
     Choice,
     finite_float,
     float_array,
+    gap_seconds,
     integer_at_least,
     read_only,
     sequence_of,
@@ -474,7 +475,7 @@ class GroundTruth:
     ) -> None:
         for name, value in (("time", time), ("x", x), ("y", y), ("heading", heading)):
             object.__setattr__(self, name, _series(value, f"GroundTruth.{name}"))
-        object.__setattr__(self, "max_gap", _max_gap(max_gap, "GroundTruth.max_gap"))
+        object.__setattr__(self, "max_gap", gap_seconds(max_gap, "GroundTruth.max_gap"))
         _same_length("GroundTruth", time=self.time, x=self.x, y=self.y, heading=self.heading)
         _increasing(self.time, "GroundTruth.time")
         outside = (self.heading <= -math.pi) | (self.heading > math.pi)
@@ -526,12 +527,6 @@ class GroundTruth:
     def with_max_gap(self, max_gap: float) -> GroundTruth:
         """Return this record with another :attr:`max_gap` (seconds, > 0, or ``math.inf``)."""
         return GroundTruth(self.time, self.x, self.y, self.heading, max_gap=max_gap)
-
-
-def _max_gap(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0.0:
-        raise InputError(f"{name}: expected a positive number of seconds (or inf), got {value!r}")
-    return float(value)
 
 
 def unaligned_spans(spans: Sequence[tuple[str, float, float]]) -> str | None:

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._files import FileVersion, _is_row, file_version, present, read_folder, regular_file
+from aura_ums._validate import gap_seconds
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import wrap_angle
 from aura_ums.logs._io import (
@@ -55,7 +56,6 @@ from aura_ums.logs._log import (
     LogLandmark,
     LogMeta,
     RobotLog,
-    _max_gap,
     unaligned_spans,
 )
 from aura_ums.logs._odometry import ReverseMotion, ReversingError, piece_commands, report_times
@@ -234,7 +234,7 @@ def open_log(
     aura_ums.errors.FileFormatError: .../missing: expected a log folder, got no such folder
     """
     base = read_folder(folder, kind="log folder")
-    gap = _max_gap(max_gap, "max_gap")
+    gap = gap_seconds(max_gap, "max_gap")
     if isinstance(block_bytes, bool) or not isinstance(block_bytes, int) or block_bytes < 1:
         raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
     # Before any is read: what open_log checks (spans, extent) holds for these versions only.
