@@ -79,6 +79,33 @@ def test_class_two_is_tighter_than_class_one(clean_log: RobotLog) -> None:
     assert two.median_area_m2 < one.median_area_m2
 
 
+def test_a_class_two_replay_uses_rows_without_a_range_as_bearings(clean_log: RobotLog) -> None:
+    # Every other row loses its range: a bearing to the point, not an observation of another class.
+    rows = tuple(
+        dataclasses.replace(row, range=None) if i % 2 else row for i, row in enumerate(clean_log.observations)
+    )
+    mixed = replay_log(
+        dataclasses.replace(clean_log, observations=rows),
+        FLOOR,
+        ReplayOptions(landmark_class=LandmarkClass.POINT),
+    )
+    metrics = mixed.metrics()
+    assert (metrics["inconsistent_observations"], metrics["rejected_by_reason"]) == (0, {})
+    assert metrics["accepted_observations"] == len(rows)
+    assert all(step.inside for step in mixed.steps)
+    # The bearings bite: on the same frames, tighter than with bearings too loose to tell anything.
+    loose = tuple(
+        row if row.range is not None else dataclasses.replace(row, bearing_error=3.0) for row in rows
+    )
+    blind = replay_log(
+        dataclasses.replace(clean_log, observations=loose),
+        FLOOR,
+        ReplayOptions(landmark_class=LandmarkClass.POINT),
+    )
+    assert len(blind.steps) == len(mixed.steps)
+    assert mixed.median_area_m2 < 0.95 * blind.median_area_m2
+
+
 def test_observation_for_uses_row_bounds_first() -> None:
     from aura_ums.logs import LogObservation
 

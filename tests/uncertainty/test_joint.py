@@ -281,8 +281,16 @@ def test_bad_arguments_are_named(kwargs: dict[str, object], match: str) -> None:
 def test_a_pair_of_mismatched_classes_is_refused() -> None:
     prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, math.pi)
     corner = PointLandmark("a", 5.0, 0.0, 2.0)
-    with pytest.raises(InputError, match="for a BearingObservation, got PointLandmark"):
-        reduce_jointly(prior, [(BearingObservation("a", 0.0, 0.0, 0.01), corner)] * 2)
+    with pytest.raises(InputError, match="for a RangeBearingObservation, got VerticalLineLandmark"):
+        reduce_jointly(prior, [(RangeBearingObservation("a", 0.0, 0.0, 0.01, 4.0, 6.0), _line(corner))] * 2)
+    # A bearing may name a point: the bearing to the vertical line through it.
+    joint = reduce_jointly(prior, [(BearingObservation("a", 0.0, 0.0, 0.01), corner)] * 2)
+    assert joint.map.wedge.width < 0.5 * prior.wedge.width
+    assert joint.map.contains(Pose(0.0, 0.0, 0.0))
+
+
+def _line(corner: PointLandmark) -> VerticalLineLandmark:
+    return VerticalLineLandmark(corner.id, corner.x, corner.y, 0.0, corner.z)
 
 
 @settings(max_examples=60, deadline=None)

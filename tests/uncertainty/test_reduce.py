@@ -147,6 +147,18 @@ def class_one_cases(rng: np.random.Generator, prior: SpatialUncertaintyMap, pose
     return [(BearingObservation("pole", 0.0, float(b), bound, offset), landmark) for b in bearing]
 
 
+def bearing_to_point_cases(
+    rng: np.random.Generator, prior: SpatialUncertaintyMap, poses: Array
+) -> list[Case]:
+    """Class I cases naming a point landmark instead (a sighting whose range was not measured)."""
+    cases = class_one_cases(rng, prior, poses)
+    pole = cases[0][1]
+    assert isinstance(pole, VerticalLineLandmark)
+    height = float(rng.uniform(0.0, 5.0))
+    corner = PointLandmark("pole", pole.x, pole.y, height, "", pole.position_uncertainty)
+    return [(observation, corner) for observation, _ in cases]
+
+
 def class_two_cases(rng: np.random.Generator, prior: SpatialUncertaintyMap, poses: Array) -> list[Case]:
     count = len(poses)
     position = random_landmark_position(rng, prior)
@@ -202,7 +214,9 @@ def class_three_cases(rng: np.random.Generator, prior: SpatialUncertaintyMap, po
 
 
 @pytest.mark.parametrize(
-    "make_cases", [class_one_cases, class_two_cases, class_three_cases], ids=["I", "II", "III"]
+    "make_cases",
+    [class_one_cases, bearing_to_point_cases, class_two_cases, class_three_cases],
+    ids=["I", "I-of-II", "II", "III"],
 )
 def test_every_true_pose_is_kept(rng: np.random.Generator, make_cases: MakeCase) -> None:
     priors, per_prior = 250, 40
@@ -541,9 +555,10 @@ def test_reduction_is_a_frozen_value() -> None:
     [
         (
             BearingObservation("pole", 0.0, 0.0, 0.1),
-            PointLandmark("pole", 1.0, 1.0, 1.0),
-            "expected a VerticalLine",
+            GroundLineLandmark("pole", (0.0, 1.0), (1.0, 1.0)),
+            "expected a VerticalLineLandmark or PointLandmark for a BearingObservation, got GroundLine",
         ),
+        (BearingObservation("pole", 0.0, 0.0, 0.1), PointLandmark("pole", 1.0, 1.0, 1.0), None),
         (
             RangeBearingObservation("c", 0.0, 0.0, 0.1, 1.0, 2.0),
             VerticalLineLandmark("c", 1.0, 1.0, 0.0, 1.0),
@@ -568,6 +583,20 @@ def test_mismatched_observation_and_landmark_are_refused(
         return
     with pytest.raises(InputError, match=message):
         prior.reduce(observation, landmark)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("slice_width", [None, math.radians(2.0)])
+def test_a_bearing_to_a_point_reduces_as_to_the_vertical_line_through_it(slice_width: float | None) -> None:
+    prior = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.3), 1.5, 0.4)
+    if slice_width is not None:
+        prior = prior.with_slices(slice_width)
+    seen = BearingObservation("c", 0.0, 0.2, 0.05, (0.1, 0.0))
+    by_point = prior.reduce(seen, PointLandmark("c", 8.0, 3.0, 2.5, "corner", 0.2))
+    by_line = prior.reduce(seen, VerticalLineLandmark("c", 8.0, 3.0, 0.0, 2.5, "corner", 0.2))
+    assert by_point.consistent
+    assert by_point.wedge_after.width < 0.7 * by_point.wedge_before.width  # it bites
+    np.testing.assert_array_equal(by_point.map.polygon.vertices, by_line.map.polygon.vertices)
+    assert by_point.map.wedge == by_line.map.wedge
 
 
 def test_bad_vertex_cap_is_refused() -> None:

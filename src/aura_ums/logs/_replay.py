@@ -719,10 +719,11 @@ def observation_for(
     """Turn a log row into a bounded observation of the replay's landmark class.
 
     The row's own ``bearing_error`` / ``range_error`` (absolute, metres) take precedence
-    over ``bounds``; ``factor`` (>= 1) widens whichever is used. A Class II replay skips
-    rows without a range (returns a bearing observation, which the manager rejects as of
-    the wrong class and counts). ``sensor_offset`` (forward, left; metres) is where the
-    sensor sits in the robot frame (the log's ``meta.sensor_offset``).
+    over ``bounds``; ``factor`` (>= 1) widens whichever is used. A row without a range
+    gives a bearing observation in a Class II replay too: a bearing to the point landmark
+    (:meth:`LandmarkClass.observes <aura_ums.uncertainty.LandmarkClass.observes>`).
+    ``sensor_offset`` (forward, left; metres) is where the sensor sits in the robot frame
+    (the log's ``meta.sensor_offset``).
 
     Examples
     --------
@@ -734,7 +735,7 @@ def observation_for(
     >>> wide = observation_for(row, LandmarkClass.POINT, bounds, factor=2.0)
     >>> wide.bearing_error, wide.range_min, wide.range_max
     (0.1, 3.2, 4.8)
-    >>> no_range = LogObservation(2.5, "pole", 0.25)      # Class II: left bearing-only, then rejected
+    >>> no_range = LogObservation(2.5, "pole", 0.25)      # Class II: a bearing to the point
     >>> type(observation_for(no_range, LandmarkClass.POINT, bounds)).__name__
     'BearingObservation'
     >>> observation_for(row, LandmarkClass.POINT, bounds, factor=0.5)

@@ -995,7 +995,7 @@ class UncertaintyMapManager:
                 landmark = self._meadow_map.landmark(observation.landmark_id).landmark
             except UnknownLandmarkError:
                 continue
-            if observation.landmark_class is not landmark.landmark_class:
+            if not observation.landmark_class.observes(landmark.landmark_class):
                 continue
             found = current._reduce_checked(observation, landmark, self._max_vertices)
             if not isinstance(found, str):
@@ -1210,7 +1210,7 @@ class UncertaintyMapManager:
             except UnknownLandmarkError:
                 return RejectReason.UNKNOWN_LANDMARK
             self._landmarks[observation.landmark_id] = landmark
-        if observation.landmark_class is not landmark.landmark_class:
+        if not observation.landmark_class.observes(landmark.landmark_class):
             return RejectReason.CLASS_MISMATCH
         return landmark
 

@@ -34,7 +34,7 @@ class RejectReason(StrChoice):
     STALE = "observation older than the map's time"
     #: The meadow map has no landmark with the observation's id.
     UNKNOWN_LANDMARK = "unknown landmark id"
-    #: The observation is not of the class of the landmark it names.
+    #: The observation cannot name a landmark of that class (``LandmarkClass.observes``).
     CLASS_MISMATCH = "observation class differs from the landmark's"
     #: No position of the map is consistent with the observation (Class I and II).
     NO_POSITION = "no position of the map is consistent with the observation"

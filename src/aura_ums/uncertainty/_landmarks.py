@@ -43,6 +43,23 @@ class LandmarkClass(Choice):
     #: Class III: a line on the ground (path edge); gives offset and relative angle.
     GROUND_LINE = "III"
 
+    def observes(self, landmark_class: LandmarkClass) -> bool:
+        """Tell whether an observation of this class can name a landmark of ``landmark_class``.
+
+        Each class observes its own. A bearing (Class I) also observes a point (Class II):
+        it needs only the landmark's ground position, and the bearing to a point is the
+        bearing to the vertical line through it (a sighting whose range was not measured).
+
+        Examples
+        --------
+        >>> LandmarkClass.VERTICAL_LINE.observes(LandmarkClass.POINT)
+        True
+        >>> LandmarkClass.POINT.observes(LandmarkClass.VERTICAL_LINE)  # a range needs a point
+        False
+        """
+        bearing_to_point = self is LandmarkClass.VERTICAL_LINE and landmark_class is LandmarkClass.POINT
+        return landmark_class is self or bearing_to_point
+
 
 def _identifier(value: object, name: str) -> str:
     if not isinstance(value, str) or not value:

@@ -102,23 +102,24 @@ def arc_wedge(arc: tuple[float, float], center: float) -> HeadingWedge:
 
 # --- the map-level entry point ------------------------------------------------------
 
-_PAIRS: dict[type, type] = {
-    BearingObservation: VerticalLineLandmark,
-    RangeBearingObservation: PointLandmark,
-    GroundLineObservation: GroundLineLandmark,
+#: The observation types, and the landmark types each can name (LandmarkClass.observes).
+_PAIRS: dict[type, tuple[type, ...]] = {
+    BearingObservation: (VerticalLineLandmark, PointLandmark),
+    RangeBearingObservation: (PointLandmark,),
+    GroundLineObservation: (GroundLineLandmark,),
 }
 
 
 def check_pair(observation: object, landmark: object) -> None:
-    """Raise :class:`InputError` unless the observation and landmark are of one class and id."""
+    """Raise :class:`InputError` unless the observation can name the landmark, by class and id."""
     expected = _PAIRS.get(type(observation))
     if expected is None:
         names = ", ".join(kind.__name__ for kind in _PAIRS)
         raise InputError(f"observation: expected one of {names}, got {type(observation).__name__}")
     if not isinstance(landmark, expected):
+        names = " or ".join(kind.__name__ for kind in expected)
         raise InputError(
-            f"landmark: expected a {expected.__name__} for a {type(observation).__name__}, "
-            f"got {type(landmark).__name__}"
+            f"landmark: expected a {names} for a {type(observation).__name__}, got {type(landmark).__name__}"
         )
     observed_id = cast(Observation, observation).landmark_id
     landmark_id = cast(Landmark, landmark).id
