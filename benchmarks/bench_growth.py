@@ -1,4 +1,4 @@
-"""Speed of one `grow` against filterpy's EKF predict step, and numpy vs shapely hot paths.
+"""Speed of one `grow` against filterpy's EKF predict step, growth through meadows, numpy vs shapely.
 
 Run: `make bench` or `.venv/bin/python benchmarks/bench_growth.py`. Prints medians (µs)
 and ratios measured in the same run. Nothing here is asserted: speed is reported.
@@ -16,9 +16,10 @@ import numpy as np
 import shapely
 from filterpy.kalman import ExtendedKalmanFilter
 
-from aura_ums import HeadingWedge, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+from aura_ums import HeadingWedge, Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
 from aura_ums.geometry import convex_hull, minkowski_sum, regular_polygon
 from aura_ums.geometry._convex import points_in_convex
+from aura_ums.world import commands_for, grow_through, make_grid_world
 
 
 def median_us(function: Callable[[], object], repeat: int = 2000) -> float:
@@ -94,6 +95,32 @@ def main() -> None:
     print(f"{'operation':64s} {'median µs':>10s} {'/ EKF':>8s}")
     for name, value in rows:
         print(f"{name:64s} {value:10.1f} {value / ekf_us:8.2f}")
+
+    # Growth through meadows: grow_through bounds every pose's run; the paper's split by the
+    # most probable pose's run (commands_for, one grow per piece) is the baseline.
+    world, table = make_grid_world(5, 5, cell=5.0), TerrainTable.default()
+    cases = [
+        ("inside a meadow, 0.05 m report", (12.5, 12.5), TurnAndRun(0.01, 0.05)),
+        ("0.2 m from a boundary, 0.5 m report", (14.7, 12.5), TurnAndRun(0.01, 0.5)),
+        ("a 3 m run across a boundary", (12.5, 12.5), TurnAndRun(0.0, 3.0)),
+    ]
+    print()
+    print("## Growth through meadows (median µs): grow_through vs the paper's split")
+    print(f"{'case':40s} {'grow_through':>12s} {'paper split':>12s} {'ratio':>8s}")
+    for name, (x, y), step in cases:
+        begin = SpatialUncertaintyMap.from_pose(Pose(x, y, 0.3), 0.3, 0.05)
+
+        def paper_split(
+            begin: SpatialUncertaintyMap = begin, step: TurnAndRun = step
+        ) -> SpatialUncertaintyMap:
+            grown = begin
+            for piece, stats in commands_for(world, begin.most_probable_pose(), step, table):
+                grown = grown.grow(piece, stats)
+            return grown
+
+        ours = median_us(functools.partial(grow_through, begin, world, step, table), 1000)
+        theirs = median_us(paper_split, 1000)
+        print(f"{name:40s} {ours:12.1f} {theirs:12.1f} {ours / theirs:8.2f}")
 
     # numpy vs shapely on the geometry hot paths
     rng = np.random.default_rng(0)

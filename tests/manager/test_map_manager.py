@@ -40,7 +40,7 @@ from aura_ums.uncertainty import (
     VerticalLineLandmark,
     reduce_jointly,
 )
-from aura_ums.world import RUN_TOLERANCE, LandmarkRecord, Meadow, MeadowMap, grow_through
+from aura_ums.world import RUN_TOLERANCE, LandmarkRecord, Meadow, MeadowMap, grow_through, outer_terrain
 
 TABLE = TerrainTable.default()
 POLE_NORTH = VerticalLineLandmark("pole_north", 8.0, 6.0, 0.0, 4.0)
@@ -378,15 +378,20 @@ def test_lost_by_missed_predictions_persists_until_a_landmark_is_found() -> None
 # --- robustness --------------------------------------------------------------------------
 
 
-def test_an_update_that_fails_changes_nothing() -> None:
-    outside = SpatialUncertaintyMap.from_pose(Pose(50.0, 50.0, 0.0), 0.1, 0.01)
-    manager = manager_for(outside)
+def test_an_update_that_fails_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    start = start_map()
+    manager = manager_for(start)
     board = board_with(
         (1.0, TurnAndRun(0.5, 0.0)), observations=(BearingObservation("pole_north", 1.0, 0.0, 0.1),)
     )
-    with pytest.raises(InputError, match="expected a point inside a meadow"):
+
+    def failing(*args: object, **kwargs: object) -> SpatialUncertaintyMap:
+        raise InputError("growth: expected to fail here, got a test")
+
+    monkeypatch.setattr("aura_ums.manager._map_manager.grow_through", failing)
+    with pytest.raises(InputError, match="expected to fail here"):
         manager.update(board, now=1.0)
-    assert manager.map is outside
+    assert manager.map is start
     assert (manager.consumed_reports, manager.map_time, manager.grown_reports) == (0, None, 0)
     assert len(board.identified) == 1
 
@@ -754,16 +759,21 @@ def test_the_map_contains_the_true_pose_after_any_run(
             assert len(step.map.polygon.vertices) <= most
 
 
-def test_a_run_from_an_estimate_outside_every_meadow_grows_on_the_nearest_terrain() -> None:
-    # The estimate grazes the edge of mapped free space and its run leaves the map: the
-    # manager grows on the nearest meadow's terrain instead of giving up on the report.
+def test_a_run_from_an_estimate_outside_every_meadow_grows_on_every_terrain_it_may_be_on() -> None:
+    # The estimate lies beyond reach of mapped free space (the meadow map knows no walls):
+    # a robot outside every meadow moves on the terrain of the meadow it was last in, which
+    # the manager cannot know, so it grows on the outer terrain of all of them, not give up.
     outside = SpatialUncertaintyMap.from_pose(Pose(2.0, 10.5, math.pi / 2), 0.1, 0.01)
     manager = UncertaintyMapManager(outside, WORLD, TABLE)
     board = Blackboard()
     board.post_report(PositionReport(1.0, TurnAndRun(0.0, 2.0)))
     step = manager.update(board, now=1.0)
-    expected = outside.grow(TurnAndRun(0.0, 2.0), TABLE["concrete"])  # "west" is the nearest meadow
+    every = outer_terrain([TABLE["concrete"], TABLE["gravel"]], 1, TurnAndRun(0.0, 2.0), 3.0)
+    expected = outside.grow(TurnAndRun(0.0, 2.0), every)
     assert np.array_equal(step.map.polygon.vertices, expected.polygon.vertices)
+    for name in ("concrete", "gravel"):
+        one = outside.grow(TurnAndRun(0.0, 2.0), TABLE[name])
+        assert step.map.polygon.contains(one.polygon.vertices).all(), name
     assert manager.grown_reports == 1
 
 

@@ -21,7 +21,7 @@ from aura_ums.plot._experiment import (
     position_counts_sentences,
     position_sentences,
 )
-from aura_ums.sim import RunResult, Scenario, run_scenario
+from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
 from aura_ums.world import sample_world
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -248,17 +248,21 @@ def test_the_truth_stays_inside_while_at_most_q_of_n_identifications_are_wrong(
     # line finder sometimes takes it: a wrong identification every reduction agrees with.
     # The relaxed intersection's guarantee: the truth stays inside whenever at most q of any
     # N consecutive identifications are wrong (with the gate alone, 0.9675 of 400 frames).
+    # Since growth across meadows bounds every pose's run (not only the most probable one's),
+    # the map at position 4 is wider, the far edge usually lies in the corner's window too,
+    # and the schema withholds such ambiguous identifications: these runs post none wrong.
+    # The guarantee with wrong ones posted: tests/sim/test_inject.py.
     paper, results = paper_runs
     settings = paper.settings
-    tolerated = 0
+    covered = 0
     for result in results:
         records = result.records
         wrong = [ident in misidentified(paper, record) for record in records for ident in record.posted]
         if at_most_q_of_any_n(wrong, settings.relaxed_q, settings.relaxed_window):
             assert all(record.inside for record in result.records), [r.posted for r in result.records]
-            tolerated += any(wrong)
-    # Runs with a wrong identification the guarantee covers: not a vacuous check.
-    assert tolerated >= 1
+            covered += 1
+    assert covered == len(results)
+    assert summarize_runs(results).number("ambiguous_identifications") > 0
 
 
 def test_at_most_q_of_any_n() -> None:

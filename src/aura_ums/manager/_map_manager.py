@@ -12,8 +12,6 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import shapely
-
 from aura_ums._validate import Choice, finite_float
 from aura_ums.errors import FileFormatError, InputError, OutsideMapError, UnknownLandmarkError
 from aura_ums.manager import _relaxed
@@ -28,7 +26,6 @@ from aura_ums.uncertainty import (
     GroundLineObservation,
     Landmark,
     Observation,
-    Pose,
     RangeBearingObservation,
     SpatialUncertaintyMap,
     TerrainStats,
@@ -37,7 +34,7 @@ from aura_ums.uncertainty import (
     grow_from_anchor,
     intersect_maps,
 )
-from aura_ums.world import RUN_TOLERANCE, Meadow, MeadowMap, grow_through
+from aura_ums.world import MeadowMap, grow_through, outer_terrain
 
 _KIND = "aura-ums/uncertainty-map-manager"
 
@@ -279,14 +276,13 @@ class UncertaintyMapManager:
     observation, using the landmark's geometry from the meadow map. Finally it grows the
     map by the remaining reports up to ``now``. Every report is grown by exactly once
     (the manager keeps the index of the last report it consumed), with
-    :func:`~aura_ums.world.grow_through`: the run is split, from the map's most probable
-    pose, where it crosses meadows, and each piece grows with its meadow's terrain.
+    :func:`~aura_ums.world.grow_through`: on the terrain of the one meadow within reach of
+    the map, or on the outer terrain of every meadow within reach (a true run may cross
+    them anywhere).
 
     A report covers the motion since the previous one; an observation between two reports
     is applied to the map grown to the earlier one, so reports should be at least as
-    frequent as camera frames (post one per frame). A run shorter than
-    :data:`~aura_ums.world.RUN_TOLERANCE` grows whole on the terrain of the meadow the
-    most probable pose is in (:func:`~aura_ums.world.split_run` cannot cut it).
+    frequent as camera frames (post one per frame).
 
     Rejections (the map is kept and the reason counted): an observation older than the
     map's time (the map was grown past it), an unknown landmark id, an observation of
@@ -656,9 +652,9 @@ class UncertaintyMapManager:
             observations); for a blackboard that is not the one this manager has been
             reading (fewer reports than consumed, or a different last consumed report); for a
             ``now`` before :attr:`map_time` (the map cannot go back in time). A
-            run that meets no meadow (it leaves the mapped free space; the meadow map knows no
-            walls) is not refused: it grows on the terrain of the meadow nearest the map's
-            most probable pose.
+            map beyond reach of every meadow (it left the mapped free space; the meadow map
+            knows no walls) is not refused: it grows on the outer terrain of every terrain of
+            the meadow map (:func:`~aura_ums.world.outer_terrain`).
 
         Examples
         --------
@@ -1137,14 +1133,6 @@ class UncertaintyMapManager:
         return result
 
     def _grow_one(self, current: SpatialUncertaintyMap, command: TurnAndRun) -> SpatialUncertaintyMap:
-        pose = current.most_probable_pose()
-        if command.run <= RUN_TOLERANCE:
-            # A run too short to cut by meadows: whole, on the start meadow's terrain.
-            meadow = self._meadow_map.meadow_at(pose.x, pose.y)
-            if meadow is not None:
-                return current.grow(
-                    command, self._table[meadow.terrain], sigmas=self._sigmas, max_vertices=self._max_vertices
-                )
         try:
             return grow_through(
                 current,
@@ -1156,14 +1144,11 @@ class UncertaintyMapManager:
             )
         except OutsideMapError:
             pass
-        # The estimate's run leaves every meadow (it grazes the edge of mapped free space,
-        # the map knows no walls): grow on the nearest meadow's terrain, not give up.
-        terrain = self._table[self._nearest_meadow(pose).terrain]
+        # No meadow within reach of the map (it left mapped free space; the map knows no
+        # walls): the robot moves on the terrain of the meadow it was last in, one of them.
+        terrains = [self._table[name] for name in sorted({m.terrain for m in self._meadow_map.meadows})]
+        terrain = outer_terrain(terrains, 1, command, self._sigmas)
         return current.grow(command, terrain, sigmas=self._sigmas, max_vertices=self._max_vertices)
-
-    def _nearest_meadow(self, pose: Pose) -> Meadow:
-        point = shapely.Point(pose.x, pose.y)
-        return min(self._meadow_map.meadows, key=lambda meadow: meadow.polygon.to_shapely().distance(point))
 
     def _reduce_instant(
         self,

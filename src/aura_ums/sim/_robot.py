@@ -25,10 +25,10 @@ class SimulatedRobot:
        ``TurnAndRun(0, piece.distance)`` is drawn with its own meadow's statistics, from
        the true pose the previous piece ended at.
 
-    This matches :func:`~aura_ums.world.commands_for`, which grows the uncertainty map
-    with one step per meadow crossed (each piece has its own losses and noise). Where the
-    robot is outside every meadow (it skittered or ran off the map), the meadow it was
-    last in counts.
+    :func:`~aura_ums.world.grow_through` bounds this for every pose of a map, wherever its
+    run crosses a boundary (:func:`~aura_ums.world.meadows_in_reach`). Where the robot is
+    outside every meadow (it skittered or ran off the map), the meadow it was last in
+    counts; a map partly outside every meadow is bounded only if that meadow is in reach.
 
     Parameters
     ----------

@@ -54,6 +54,8 @@ from aura_ums.world._navigator import (
     RunPiece,
     commands_for,
     grow_through,
+    meadows_in_reach,
+    outer_terrain,
     plan_route,
     split_run,
 )
@@ -72,6 +74,8 @@ __all__ = [
     "commands_for",
     "grow_through",
     "make_grid_world",
+    "meadows_in_reach",
+    "outer_terrain",
     "plan_route",
     "sample_world",
     "split_run",

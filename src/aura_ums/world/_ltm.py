@@ -338,6 +338,7 @@ class MeadowMap:
     _shapes: tuple[Polygon, ...]
     _tree: shapely.STRtree
     _clip: tuple[tuple[float, float, float, float, tuple[tuple[float, float, float, float], ...]], ...]
+    _halfplanes: tuple[NDArray[np.float64], ...]
     _portals: Mapping[tuple[str, str], NDArray[np.float64]]
     _adjacent: Mapping[str, tuple[str, ...]]
 
@@ -428,6 +429,7 @@ class MeadowMap:
         object.__setattr__(self, "_shapes", shapes)
         object.__setattr__(self, "_tree", tree)
         object.__setattr__(self, "_clip", tuple(_clip_edges(m.polygon.vertices) for m in meadow_tuple))
+        object.__setattr__(self, "_halfplanes", tuple(_halfplanes(m.polygon.vertices) for m in meadow_tuple))
         object.__setattr__(self, "_portals", types.MappingProxyType(portals))
         object.__setattr__(self, "_adjacent", types.MappingProxyType(adjacent))
 
@@ -681,6 +683,22 @@ expected the id of a landmark feature, got 'pole'
         return f"MeadowMap({len(self.meadows)} meadows, {len(self.landmarks)} landmarks)"
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _halfplanes(vertices: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return a convex meadow as half-planes, shape (k, 4).
+
+    Per edge: the unit outward normal ``(nx, ny)``, the offset ``c`` (inside:
+    ``nx x + ny y <= c``, metres) and the normal's angle (radians).
+    """
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    keep = lengths > 0.0
+    normals = np.column_stack((edges[keep, 1], -edges[keep, 0])) / lengths[keep, None]  # ccw: outward
+    offsets = np.einsum("ij,ij->i", normals, vertices[keep])
+    planes = np.column_stack((normals, offsets, np.arctan2(normals[:, 1], normals[:, 0])))
+    planes.setflags(write=False)
+    return planes
 
 
 def _clip_edges(

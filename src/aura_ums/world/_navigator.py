@@ -10,18 +10,20 @@ meadow's terrain statistics to the part of the run made on it.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
+from shapely.geometry.base import BaseGeometry
 
-from aura_ums._validate import finite_float, items_of, nonnegative_float, points_array, read_only
+from aura_ums._validate import SIGMAS, finite_float, items_of, nonnegative_float, points_array, read_only
 from aura_ums.errors import InputError, OutsideMapError
+from aura_ums.geometry import POSITION_TOLERANCE, outer_annular_sector
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
-from aura_ums.world._ltm import MeadowMap
+from aura_ums.world._ltm import Meadow, MeadowMap
 
 #: Stretches of a run shorter than this (m) are rounding, not a meadow crossed.
 RUN_TOLERANCE = 1e-9
@@ -390,9 +392,11 @@ def commands_for(
     The turn happens in the start meadow, so the first step carries the turn and the first
     piece; each later piece is ``TurnAndRun(0.0, piece)`` with its own meadow's terrain.
     Parts outside every meadow count on the terrain of the meadow before them (see
-    :func:`split_run`). Growing through the steps in order applies each terrain's
-    statistics to its part of the run; it is conservative compared with one step, since
-    each step bounds its own fixed (inertial) loss and noise.
+    :func:`split_run`). This is the paper's split: growing through the steps in order
+    applies each terrain's statistics to the most probable pose's part of the run. It is
+    not a bound for the other poses of a map, whose runs cross boundaries elsewhere (and
+    each step pays the fixed inertial loss again, which one true run does not):
+    :func:`grow_through` grows soundly.
 
     Parameters
     ----------
@@ -484,18 +488,25 @@ def grow_through(
     sigmas: float = 3.0,
     max_vertices: int = 64,
 ) -> SpatialUncertaintyMap:
-    """Grow a spatial uncertainty map by a command, meadow by meadow (:func:`commands_for`).
+    """Grow a spatial uncertainty map by a command through the meadows its poses may cross.
 
-    The run is split from the map's most probable pose; each piece grows as
-    :meth:`~aura_ums.uncertainty.SpatialUncertaintyMap.grow` with ``sigmas`` and
-    ``max_vertices`` (whose defaults are that method's).
+    Every pose of the map may meet other meadows than the most probable one does, so the
+    terrains are those of every meadow within reach: within the commanded run (plus the
+    skitter of the turn) of the map's polygon. With one such meadow, the map grows as
+    :meth:`~aura_ums.uncertainty.SpatialUncertaintyMap.grow` on its terrain. With several,
+    it grows once on their outer terrain (:func:`outer_terrain`), which bounds the motion
+    whatever meadows a true run crosses and wherever it crosses them: the true robot draws
+    each piece on its own meadow's terrain (:class:`~aura_ums.sim.SimulatedRobot`). The
+    paper splits the run where the most probable pose's run crosses a boundary
+    (:func:`commands_for`); that is not sound for the poses whose runs cross elsewhere.
+    ``sigmas`` and ``max_vertices`` (whose defaults are ``grow``'s) go to the growth.
 
     Raises
     ------
     UnknownTerrainError
         When a meadow's terrain is not in ``table``.
     OutsideMapError
-        When the run from the map's most probable pose meets no meadow.
+        When no meadow is within reach of the map.
 
     Examples
     --------
@@ -510,19 +521,256 @@ def grow_through(
     >>> grow_through(far, make_grid_world(1, 3), TurnAndRun(0.0, 1.0), table)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    aura_ums.errors.OutsideMapError: uncertainty_map (its most probable pose), command: expected a run ...
+    aura_ums.errors.OutsideMapError: uncertainty_map, command: expected a map within reach of a meadow, ...
     """
     if not isinstance(uncertainty_map, SpatialUncertaintyMap):
         raise InputError(
             f"uncertainty_map: expected a SpatialUncertaintyMap, got {type(uncertainty_map).__name__}"
         )
-    result = uncertainty_map
-    pose = uncertainty_map.most_probable_pose()
+    if not isinstance(meadow_map, MeadowMap):
+        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
     if not isinstance(table, TerrainTable):
         raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
     if not isinstance(command, TurnAndRun):
         raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-    pieces = _split_for("uncertainty_map (its most probable pose), command", meadow_map, pose, command)
-    for step, terrain in _steps(pieces, command, table):
-        result = result.grow(step, terrain, sigmas=sigmas, max_vertices=max_vertices)
-    return result
+    bound = SIGMAS.check(sigmas, "sigmas")
+    meadow, prefix = _first_meadow_run(meadow_map, uncertainty_map, command, table, bound)
+    if meadow is not None and prefix >= command.run:
+        # Every true run stays in the one meadow every pose stands in (most growths).
+        return uncertainty_map.grow(command, table[meadow.terrain], sigmas=bound, max_vertices=max_vertices)
+    near, covered = _reach(meadow_map, uncertainty_map, command, table, bound)
+    if not near:
+        raise OutsideMapError(
+            f"uncertainty_map, command: expected a map within reach of a meadow, got one whose polygon "
+            f"(centre {_xy(uncertainty_map.center)}) is more than the run of {command.run!r} m and its "
+            "skitter from every meadow"
+        )
+    terrains = [table[found.terrain] for found in near]
+    if not covered:
+        # A pose of the map may stand outside every meadow: the true robot then turns (and on
+        # a run that meets no meadow, runs) on the terrain of the meadow it was last in.
+        terrains += _every_terrain(meadow_map, table)
+    elif len(near) == 1:
+        return uncertainty_map.grow(command, terrains[0], sigmas=bound, max_vertices=max_vertices)
+    if meadow is None or prefix <= RUN_TOLERANCE:
+        terrain = outer_terrain(terrains, len(near), command, bound)
+        return uncertainty_map.grow(command, terrain, sigmas=bound, max_vertices=max_vertices)
+    # Every true run stays in the meadow it starts in for its first `prefix` metres: that
+    # part grows on the meadow's terrain (with the command's inertial loss), the rest on the
+    # outer terrain of every meadow in reach.
+    first = uncertainty_map.grow(
+        TurnAndRun(command.turn, prefix), table[meadow.terrain], sigmas=bound, max_vertices=max_vertices
+    )
+    rest = TurnAndRun(0.0, command.run - prefix)
+    terrain = outer_terrain(terrains, len(near), rest, bound, first=False)
+    return first.grow(rest, terrain, sigmas=bound, max_vertices=max_vertices)
+
+
+def _covers(meadow_map: MeadowMap, indices: NDArray[np.intp], hull: BaseGeometry) -> bool:
+    """Whether the meadows at ``indices`` cover ``hull`` (to the tolerance; they do not overlap)."""
+    shapes = [meadow_map._shapes[int(i)] for i in indices]
+    area = float(shapely.area(hull))
+    if area > 0.0:
+        held = float(shapely.area(shapely.intersection(shapes, hull)).sum())
+        return held >= area * (1.0 - 1e-9) - POSITION_TOLERANCE**2
+    return bool(shapely.covers(shapely.buffer(shapely.union_all(shapes), POSITION_TOLERANCE), hull))
+
+
+def _every_terrain(meadow_map: MeadowMap, table: TerrainTable) -> list[TerrainStats]:
+    return [table[name] for name in sorted({meadow.terrain for meadow in meadow_map.meadows})]
+
+
+def _meadow_holding(meadow_map: MeadowMap, x: float, y: float) -> int | None:
+    """Return the index of a meadow holding (x, y), boundary included, or None (a small map: a scan)."""
+    if len(meadow_map.meadows) > _SCAN_LIMIT:
+        meadow = meadow_map.meadow_at(x, y)
+        return None if meadow is None else meadow_map._meadow_index[meadow.id]
+    for index, (xmin, ymin, xmax, ymax, edges) in enumerate(meadow_map._clip):
+        if (
+            xmin <= x <= xmax
+            and ymin <= y <= ymax
+            and all(nx * (x - ax) + ny * (y - ay) <= 0.0 for ax, ay, nx, ny in edges)
+        ):
+            return index
+    return None
+
+
+def _first_meadow_run(
+    meadow_map: MeadowMap,
+    uncertainty_map: SpatialUncertaintyMap,
+    command: TurnAndRun,
+    table: TerrainTable,
+    sigmas: float,
+) -> tuple[Meadow | None, float]:
+    """Return the one meadow every pose of the map stands in, and how far every true run stays in it.
+
+    (None, 0) unless the polygon, widened by the turn's skitter and a tolerance, lies inside
+    one meadow. The distance is the longest ``t <= command.run`` for which the region the
+    true runs sweep in their first ``t`` metres (:func:`meadows_in_reach`) stays inside
+    it: on every edge's inner side, for every vertex of the polygon moved ``t`` metres in
+    any heading of the turned wedge.
+    """
+    vertices = uncertainty_map.polygon.vertices
+    index = _meadow_holding(meadow_map, float(vertices[0, 0]), float(vertices[0, 1]))
+    if index is None:
+        return None, 0.0
+    meadow = meadow_map.meadows[index]
+    planes = meadow_map._halfplanes[index]
+    stats = table[meadow.terrain]
+    margin = abs(command.turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd) + POSITION_TOLERANCE
+    slack = planes[:, 2] - margin - vertices @ planes[:, :2].T  # metres, (polygon vertex, edge)
+    if not np.all(slack >= 0.0):
+        return None, 0.0
+    low = max(0.0, 1.0 - stats.rotation_loss - sigmas * stats.rotation_sd)
+    high = min(1.0, 1.0 - stats.rotation_loss + sigmas * stats.rotation_sd)
+    wedge = uncertainty_map.wedge
+    start = wedge.center - wedge.cw + min(command.turn * low, command.turn * high)
+    width = wedge.cw + wedge.ccw + abs(command.turn) * (high - low)
+    # How fast a run in the heading sector [start, start + width] nears each edge, m/m: the
+    # largest cosine between a heading of it and the edge's outward normal.
+    normal = planes[:, 3]
+    if width >= 2.0 * math.pi:
+        rates = np.ones(len(planes))
+    else:
+        inside = np.mod(normal - start, 2.0 * math.pi) <= width
+        rates = np.where(inside, 1.0, np.maximum(np.cos(start - normal), np.cos(start + width - normal)))
+    nearing = rates > 0.0
+    if not np.any(nearing):
+        return meadow, command.run
+    return meadow, float(min(command.run, (slack[:, nearing] / rates[nearing]).min()))
+
+
+def meadows_in_reach(
+    meadow_map: MeadowMap,
+    uncertainty_map: SpatialUncertaintyMap,
+    command: TurnAndRun,
+    table: TerrainTable,
+    sigmas: float,
+) -> tuple[Meadow, ...]:
+    """Return the meadows a true pose of the map may stand in or run through during ``command``.
+
+    The true robot (:class:`~aura_ums.sim.SimulatedRobot`) turns in the meadow it stands in,
+    one the map's polygon meets; the turn's skitter moves it by at most ``|turn|`` times the
+    largest ``skitter + sigmas * skitter_sd`` of their terrains; then its run is cut by
+    meadows along the straight line of ``command.run`` metres from there, in its heading
+    after the turn: a heading of the map's wedge turned by the turn's bounds on those
+    terrains. Every meadow within the skitter of the region those lines sweep is in reach,
+    in map order. A map off every meadow turns on the terrain of one the run may reach in
+    any direction; with none, the result is empty.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
+    >>> from aura_ums.world import make_grid_world
+    >>> world, table = make_grid_world(1, 3), TerrainTable.default()      # 5 m cells
+    >>> start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.5, 0.1)
+    >>> [m.id for m in meadows_in_reach(world, start, TurnAndRun(0.0, 1.5), table, 3.0)]
+    ['cell_0_0']
+    >>> [m.id for m in meadows_in_reach(world, start, TurnAndRun(0.0, 2.5), table, 3.0)]
+    ['cell_0_0', 'cell_0_1']
+    >>> [m.id for m in meadows_in_reach(world, start, TurnAndRun(math.pi, 2.5), table, 3.0)]   # west: none
+    ['cell_0_0']
+    """
+    return _reach(meadow_map, uncertainty_map, command, table, sigmas)[0]
+
+
+def _reach(
+    meadow_map: MeadowMap,
+    uncertainty_map: SpatialUncertaintyMap,
+    command: TurnAndRun,
+    table: TerrainTable,
+    sigmas: float,
+) -> tuple[tuple[Meadow, ...], bool]:
+    """:func:`meadows_in_reach`, and whether the meadows cover the map's polygon.
+
+    Where they do not, a true pose may stand outside every meadow and turn on the terrain
+    of the meadow it was last in: the skitter is then the largest of every terrain's.
+    """
+    vertices = uncertainty_map.polygon.vertices
+    hull: BaseGeometry = (
+        shapely.Polygon(vertices) if len(vertices) >= 3 else shapely.MultiPoint(vertices).convex_hull
+    )
+    tree = meadow_map._tree
+    standing = np.sort(tree.query(hull, predicate="intersects"))
+    covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
+    if not len(standing):
+        # Off every meadow: the meadows the run alone may reach.
+        standing = np.sort(
+            tree.query(hull, predicate="dwithin", distance=max(command.run, POSITION_TOLERANCE))
+        )
+    if not len(standing):
+        return (), False
+    turning = [table[meadow_map.meadows[int(i)].terrain] for i in standing]
+    if not covered:
+        turning = _every_terrain(meadow_map, table)
+    skitter = abs(command.turn) * max(max(0.0, t.skitter + sigmas * t.skitter_sd) for t in turning)
+    swept = hull
+    if command.run > 0.0:
+        low = min(max(0.0, 1.0 - t.rotation_loss - sigmas * t.rotation_sd) for t in turning)
+        high = max(min(1.0, 1.0 - t.rotation_loss + sigmas * t.rotation_sd) for t in turning)
+        wedge = uncertainty_map.wedge
+        start = wedge.center - wedge.cw + min(command.turn * low, command.turn * high)
+        stop = wedge.center + wedge.ccw + max(command.turn * low, command.turn * high)
+        sector = outer_annular_sector(0.0, command.run, start, stop)
+        ends = (vertices[:, None, :] + sector[None, :, :]).reshape(-1, 2)
+        swept = shapely.MultiPoint(np.concatenate((vertices, ends))).convex_hull
+    near = tree.query(swept, predicate="dwithin", distance=max(skitter, POSITION_TOLERANCE))
+    found = sorted({int(i) for i in near} | {int(i) for i in standing})
+    return tuple(meadow_map.meadows[i] for i in found), covered
+
+
+def outer_terrain(
+    terrains: Sequence[TerrainStats], pieces: int, command: TurnAndRun, sigmas: float, *, first: bool = True
+) -> TerrainStats:
+    """Return terrain statistics whose growth by ``command`` bounds a run through any of ``terrains``.
+
+    The true run may cross the terrains' meadows in up to ``pieces`` pieces, each drawn on
+    its own terrain (with its own fixed inertial loss, as :class:`~aura_ums.sim.SimulatedRobot`
+    draws them), and the turn on any of them. At ``sigmas``, the true run of ``R = command.run``
+    metres is then at least ``R`` times the least kept fraction less ``pieces`` of the largest
+    inertial losses, and at most ``R`` times the largest kept fraction less the least inertial
+    loss (nothing less when not ``first``: the rest of a run whose start, and its loss, grew
+    already); the returned statistics have no inertial loss and a kept fraction and spread that
+    give exactly that interval. The turn's kept fraction covers every terrain's interval;
+    drift, skitter and its spread are the largest. Valid for this command and ``sigmas`` only.
+
+    Examples
+    --------
+    >>> from aura_ums.uncertainty import TerrainTable, TurnAndRun
+    >>> table = TerrainTable.default()
+    >>> outer = outer_terrain([table["concrete"], table["grass"]], 2, TurnAndRun(0.5, 2.0), 3.0)
+    >>> outer.drift == max(table["concrete"].drift, table["grass"].drift), outer.translation_inertial_loss
+    (True, 0.0)
+    >>> outer_terrain([table["concrete"]], 1, TurnAndRun(0.0, 0.0), 3.0).translation_sd   # nothing to run
+    0.0
+    """
+    run = command.run
+    kept = [1.0 - t.translation_loss for t in terrains]
+    spread = [sigmas * t.translation_sd for t in terrains]
+    losses = [t.translation_inertial_loss for t in terrains]
+    paid = min(losses) if first else 0.0
+    longest = min(run, max(0.0, run * max(k + s for k, s in zip(kept, spread, strict=True)) - paid))
+    shortest = min(
+        longest, max(0.0, run * min(k - s for k, s in zip(kept, spread, strict=True)) - pieces * max(losses))
+    )
+    if run > 0.0:
+        # Rounded outwards: the growth recomputes the ends from the middle and the spread.
+        high, low = min(1.0, longest / run * (1.0 + 1e-12)), max(0.0, shortest / run * (1.0 - 1e-12))
+    else:
+        high = low = 1.0
+    turn_high = max(min(1.0, 1.0 - t.rotation_loss + sigmas * t.rotation_sd) for t in terrains)
+    turn_low = min(max(0.0, 1.0 - t.rotation_loss - sigmas * t.rotation_sd) for t in terrains)
+    return TerrainStats(
+        rotation_loss=min(_BELOW_ONE, 1.0 - (turn_high + turn_low) / 2.0),
+        rotation_sd=(turn_high - turn_low) / (2.0 * sigmas) * (1.0 + 1e-12),
+        translation_loss=min(_BELOW_ONE, 1.0 - (high + low) / 2.0),
+        translation_inertial_loss=0.0,
+        translation_sd=(high - low) / (2.0 * sigmas),
+        drift=max(t.drift for t in terrains),
+        skitter=max(t.skitter for t in terrains),
+        skitter_sd=max(t.skitter_sd for t in terrains),
+    )
+
+
+#: The largest loss a TerrainStats takes (its range is [0, 1)): nothing kept at all.
+_BELOW_ONE = math.nextafter(1.0, 0.0)
