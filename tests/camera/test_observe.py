@@ -294,7 +294,7 @@ def test_ground_line_bound_is_sound(rng: np.random.Generator) -> None:
             offset, offset_error, angle, angle_error = bound_ground_line(
                 scene.nominal,
                 segment,
-                expected_angle=true_angle + rng.uniform(-1.2, 1.2),
+                expected_angle=true_angle + rng.uniform(-1.55, 1.55),  # within 90 degrees
                 pixel_error=scene.pixel_error,
                 bounds=scene.bounds,
             )
@@ -340,6 +340,33 @@ def test_pan_bound_adds_exactly_to_the_bearing_error() -> None:
     )
     assert angle_error == pytest.approx(0.01, rel=1e-5)
     assert offset_error < 1e-8  # a rotation about the sensor keeps the distance to the line
+
+
+def test_a_wide_ground_line_bound_keeps_the_orientation_the_hint_allows() -> None:
+    """The angle interval is nearly half a turn: parts of both orientations lie within 90
+    degrees of the hint. Orienting by the nominal chord alone took the reverse one, and the
+    bounds excluded the true angle and offset (the offset by 28 m)."""
+    camera = Camera(
+        CameraIntrinsics(300.0, 300.0, 329.215677353786, 237.6014013822726, 640, 480),
+        CameraMount(height=0.5, pan=0.2, tilt=0.1),
+    )
+    start, end = (
+        np.array([-30.376837306192826, 20.778405793617633]),
+        np.array([-37.188851285189614, -18.63728227027328]),
+    )
+    pose = Pose(0.0, 0.0, 3.061732917256518)
+    pixels = [375.84544580130824, 213.7832707631455, 405.2297086536809, 210.81186070814087]  # within 2 px
+    direction = end - start
+    true_angle = wrap_angle(math.atan2(direction[1], direction[0]) - pose.heading)
+    unit = direction / np.linalg.norm(direction)
+    true_offset = float(unit[0] * (pose.y - start[1]) - unit[1] * (pose.x - start[0]))
+    hint = true_angle - 0.334
+    offset, offset_error, angle, angle_error = bound_ground_line(
+        camera, pixels, expected_angle=hint, pixel_error=2.0
+    )
+    assert abs(wrap_angle(true_angle - angle)) <= angle_error
+    assert abs(true_offset - offset) <= offset_error
+    assert angle_error <= math.pi / 2 + 1e-5  # the hint bounds it to a half turn (and rounding)
 
 
 def test_height_bound_scales_the_ground_offset() -> None:

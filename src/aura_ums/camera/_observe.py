@@ -898,10 +898,6 @@ def bound_ground_line(
     p0 = np.column_stack([1.0 / np.tan(rays.psi0), -rays.w0 / np.sin(rays.psi0)])
     chord = p0[1] - p0[0]
     theta0 = math.atan2(float(chord[1]), float(chord[0]))
-    swap = abs(wrap_angle(theta0 + mount.pan - hint)) > math.pi / 2
-    if swap:
-        theta0 = wrap_angle(theta0 + math.pi)
-    first, second = (1, 0) if swap else (0, 1)
 
     sine = _isin(rays.psi)
     if bool(np.any(sine.lo <= 0.0)) or bool(np.any(rays.psi.hi >= math.pi)):
@@ -913,19 +909,44 @@ def bound_ground_line(
     py = -rays.w / sine
     pad = _PAD * (1.0 + np.abs(px.lo) + np.abs(px.hi) + np.abs(py.lo) + np.abs(py.hi))
     px, py = px.padded(pad), py.padded(pad)
-    ax, ay = _Interval(px.lo[:, first], px.hi[:, first]), _Interval(py.lo[:, first], py.hi[:, first])
-    bx, by = _Interval(px.lo[:, second], px.hi[:, second]), _Interval(py.lo[:, second], py.hi[:, second])
+    ax, ay = _Interval(px.lo[:, 0], px.hi[:, 0]), _Interval(py.lo[:, 0], py.hi[:, 0])
+    bx, by = _Interval(px.lo[:, 1], px.hi[:, 1]), _Interval(py.lo[:, 1], py.hi[:, 1])
     reference, low, high, full = _atan2_range(by - ay, bx - ax)
     if bool(np.any(full)):
         raise InputError(
             "segment: expected a segment long enough for its error bounds to fix the line's direction, "
             f"got ends ({uv[0, 0]}, {uv[0, 1]}) and ({uv[1, 0]}, {uv[1, 1]})"
         )
+    # The image gives the line's direction up to a half turn: from end 1 to end 2 in
+    # theta0 + [rel_lo, rel_hi], or the reverse. The landmark's (start -> end) is the one
+    # within 90 degrees of the hint, with the pan's bound (pan-free frame): keep the parts
+    # of both orientations in that window. A wide interval can have parts of both, and
+    # choosing one by the nominal chord alone lost the truth.
     shift = wrap_angle(reference - theta0)
     rel_lo, rel_hi = shift + low - _PAD, shift + high + _PAD
+    centre = hint - mount.pan
+    reach = math.pi / 2 + checked.pan + _PAD
+    middle, half = theta0 + 0.5 * (rel_lo + rel_hi), 0.5 * (rel_hi - rel_lo)
+    parts_lo, parts_hi = [], []
+    for turn in (0.0, math.pi):
+        at = centre + wrap_angle(middle + turn - centre)
+        parts_lo.append(np.maximum(at - half, centre - reach))
+        parts_hi.append(np.minimum(at + half, centre + reach))
+    lo = np.column_stack(parts_lo)  # (sub-boxes, orientation)
+    hi = np.column_stack(parts_hi)
+    kept = lo <= hi
+    if not bool(np.any(kept)):
+        raise InputError(
+            f"expected_angle: expected a direction within 90 degrees of the line's, got {hint!r} rad, "
+            f"which no direction the segment allows is"
+        )
     fractions = np.linspace(0.0, 1.0, _ANGLE_PIECES + 1)
-    edges = rel_lo[:, None] + (rel_hi - rel_lo)[:, None] * fractions[None, :]
-    pieces = _Interval(theta0 + edges[:, :-1], theta0 + edges[:, 1:])  # (sub-boxes, pieces)
+    span = np.where(kept, hi - lo, 0.0)
+    edges = lo[:, :, None] + span[:, :, None] * fractions[None, None, :]
+    pieces = _Interval(
+        edges[:, :, :-1].reshape(len(lo), -1), edges[:, :, 1:].reshape(len(lo), -1)
+    )  # (sub-boxes, pieces of both orientations)
+    valid = np.repeat(kept, _ANGLE_PIECES, axis=1)
 
     def offsets(bx_: _Interval, by_: _Interval) -> _Interval:
         # cross(p, d(theta)) = |p| sin(theta - angle(p)); linear in p: extreme at a corner
@@ -938,7 +959,7 @@ def bound_ground_line(
         return _Interval(np.minimum.reduce(lows), np.maximum.reduce(highs))
 
     both = offsets(ax, ay).intersect(offsets(bx, by))
-    feasible = both.lo <= both.hi
+    feasible = (both.lo <= both.hi) & valid
     if not bool(np.any(feasible)):  # cannot happen but for rounding beyond the padding
         raise InputError("segment: expected a consistent line, got ends that no line through both fits")
     angle_lo = float(np.min(np.where(feasible, pieces.lo, np.inf))) - checked.pan + mount.pan
