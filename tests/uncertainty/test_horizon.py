@@ -11,6 +11,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -167,6 +168,19 @@ def test_large_position_bound_takes_more_turns() -> None:
     grown = grow_from_anchor(anchor, composite, stats, 3.0, 64)
     assert position_bound > 10.0 * 2.0 * math.pi
     assert grown.contains(Pose(5.0, 0.9 * position_bound, 0.0))
+
+
+@pytest.mark.parametrize("sigmas", [0.1, 0.5, 3.0])
+def test_a_large_position_bound_at_few_sigmas_takes_more_turns_too(sigmas: float) -> None:
+    # Below one sigma the skitter's spread (position bound / turn / sigmas) outgrew its range
+    # (10 m/rad) and the growth raised on a valid call.
+    anchor = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 0.0, 0.0)
+    stats = TerrainStats(0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0)
+    composite = Composite().extended([TurnAndRun(0.0, 200.0)], stats)
+    _, position_bound = anchor_bounds(stats, composite, sigmas)
+    grown = grow_from_anchor(anchor, composite, stats, sigmas, 64)
+    assert grown.contains(Pose(200.0, 0.9 * position_bound, 0.0))
+    assert grown.contains(Pose(200.0 - 0.9 * position_bound, 0.0, 0.0))
 
 
 @settings(max_examples=40, deadline=None)

@@ -205,7 +205,8 @@ def grow_from_anchor(
     rest = math.remainder(composite.heading - direction, _TWO_PI)
     turns = 1
     spin = rest + _TWO_PI + heading_bound
-    while position_bound > _MAX_SKITTER * spin:
+    # More turns until the skitter's spread, position_bound / spin / sigmas, is within its range.
+    while position_bound > _MAX_SKITTER * min(1.0, sigmas) * spin:
         turns += 1
         spin += _TWO_PI
     if heading_bound == 0.0 and position_bound == 0.0:
