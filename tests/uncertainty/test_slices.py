@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -377,3 +378,38 @@ def test_sliced_map_repr_and_product_slices() -> None:
     assert isinstance(only.wedge, HeadingWedge)
     assert start.slice_width is None
     assert start.max_slices is None
+
+
+def test_a_distribution_over_its_cell_budget_merges_neighbours_into_an_outer_bound(
+    monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator
+) -> None:
+    """Every slice grown over a wide interval covers many cells: past the budget, neighbours merge first.
+
+    0.1 degree cells over +-1.5 rad took 23 s for one growth before; at 1 degree with a small
+    budget here, the merged map must hold every sampled true motion, and not much looser.
+    """
+    import aura_ums.uncertainty._slices as slices_module
+
+    terrain = TerrainStats(0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.0, 0.0)  # drift: +-1 rad over 10 m
+    start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, math.pi).with_slices(
+        math.radians(1.0), 360
+    )
+    command = TurnAndRun(0.0, 10.0)
+    exact = start.grow(command, terrain)
+    monkeypatch.setattr(slices_module, "CELL_ROW_BUDGET", 4_000)
+    within = slices_module._within_budget
+    pieces: list[tuple[int, int]] = []
+
+    def spy(*args: Any) -> Any:
+        found = within(*args)
+        pieces.append((len(args[1]), len(found[1])))
+        return found
+
+    monkeypatch.setattr(slices_module, "_within_budget", spy)
+    merged = start.grow(command, terrain)
+    assert any(after < before for before, after in pieces)  # the budget did bite
+    assert len(merged.slices) <= len(exact.slices)
+    # Both are outer bounds (each cell's hull is capped at 64 vertices, outwards), not nested.
+    assert merged.area <= 1.5 * exact.area
+    truths = terrain.sample_motions(start.sample_poses(4000, rng), command, rng, truncate=3.0)
+    assert np.all(merged.contains(truths[:, 0], truths[:, 1], truths[:, 2]))

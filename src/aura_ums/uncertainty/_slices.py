@@ -192,12 +192,51 @@ def distributed(
     """Put pieces (packed polygons, unwrapped heading intervals) on the grid: ``_native.distribute_slices``.
 
     Returns the slices and their summary wedge, centred on ``heading`` clamped into it.
+    Pieces that would cover more than :data:`CELL_ROW_BUDGET` cells in all (finely sliced
+    maps grown over wide heading intervals: every cell a piece covers holds its polygon
+    until the cell's hull is taken; 0.1 degree cells over +-1.5 rad took 23 s and hundreds
+    of MB for one growth) are first merged with their neighbours in heading order, hull and
+    interval (an outer bound), so that they cover about that many. Grids of 1 degree or
+    coarser never reach it (181 pieces of 181 cells each).
     """
+    points, counts, starts, stops, sources = _within_budget(
+        points, counts, starts, stops, sources, cells, max_vertices
+    )
     grid = _native.distribute_slices(
         points, counts, starts, stops, sources, cells, max_vertices, max_slices, heading
     )
     slices = SliceSet(_read_only(grid.points), grid.counts, grid.lo, grid.hi, grid.sources)
     return slices, HeadingWedge._trusted(grid.center, grid.cw, grid.ccw)
+
+
+#: Cells the pieces of one distribution may cover in all (see distributed).
+CELL_ROW_BUDGET = 131_072
+
+
+def _within_budget(
+    points: Array, counts: Counts, starts: Array, stops: Array, sources: Counts, cells: int, max_vertices: int
+) -> tuple[Array, Counts, Array, Array, Counts]:
+    """Merge neighbouring pieces (in heading order) until they cover at most the budget of cells."""
+    step = _TWO_PI / cells
+    spans = np.minimum(np.ceil(stops / step) - np.floor(starts / step), cells + 1)
+    total, budget = float(spans.sum()), CELL_ROW_BUDGET
+    if total <= budget or len(counts) < 2:
+        return points, counts, starts, stops, sources
+    size = math.ceil(total / budget)
+    order = np.argsort(starts, kind="stable")
+    offsets = np.concatenate(([0], np.cumsum(counts)))
+    groups = [order[i : i + size] for i in range(0, len(order), size)]
+    gathered = np.concatenate([points[offsets[j] : offsets[j + 1]] for group in groups for j in group])
+    sizes = [int(counts[group].sum()) for group in groups]
+    hulls = _native.merge_groups(np.ascontiguousarray(gathered), sizes, max_vertices)
+    fresh = int(sources.max()) + 1
+    return (
+        np.ascontiguousarray(np.concatenate(hulls), dtype=np.float64),
+        np.array([len(hull) for hull in hulls], dtype=np.int64),
+        np.array([float(starts[group].min()) for group in groups]),
+        np.array([float(stops[group].max()) for group in groups]),
+        np.arange(fresh, fresh + len(groups), dtype=np.int64),
+    )
 
 
 def _read_only(points: Array) -> Array:
