@@ -576,6 +576,25 @@ def _covers(meadow_map: MeadowMap, indices: NDArray[np.intp], hull: BaseGeometry
     return bool(shapely.covers(shapely.buffer(shapely.union_all(shapes), POSITION_TOLERANCE), hull))
 
 
+def _skitter(command: TurnAndRun, terrains: Sequence[TerrainStats], sigmas: float) -> float:
+    """Return how far the turn's skitter may move the robot on any of ``terrains``, metres."""
+    return abs(command.turn) * max(max(0.0, t.skitter + sigmas * t.skitter_sd) for t in terrains)
+
+
+def _turned_headings(
+    uncertainty_map: SpatialUncertaintyMap,
+    command: TurnAndRun,
+    terrains: Sequence[TerrainStats],
+    sigmas: float,
+) -> tuple[float, float]:
+    """Return the headings (start <= stop, radians) the wedge may have after the turn on ``terrains``."""
+    low = min(max(0.0, 1.0 - t.rotation_loss - sigmas * t.rotation_sd) for t in terrains)
+    high = max(min(1.0, 1.0 - t.rotation_loss + sigmas * t.rotation_sd) for t in terrains)
+    wedge = uncertainty_map.wedge
+    start = wedge.center - wedge.cw + min(command.turn * low, command.turn * high)
+    return start, start + wedge.cw + wedge.ccw + abs(command.turn) * (high - low)
+
+
 def _every_terrain(meadow_map: MeadowMap, table: TerrainTable) -> list[TerrainStats]:
     return [table[name] for name in sorted({meadow.terrain for meadow in meadow_map.meadows})]
 
@@ -616,16 +635,13 @@ def _first_meadow_run(
         return None, 0.0
     meadow = meadow_map.meadows[index]
     planes = meadow_map._halfplanes[index]
-    stats = table[meadow.terrain]
-    margin = abs(command.turn) * max(0.0, stats.skitter + sigmas * stats.skitter_sd) + POSITION_TOLERANCE
+    stats = [table[meadow.terrain]]
+    margin = _skitter(command, stats, sigmas) + POSITION_TOLERANCE
     slack = planes[:, 2] - margin - vertices @ planes[:, :2].T  # metres, (polygon vertex, edge)
     if not np.all(slack >= 0.0):
         return None, 0.0
-    low = max(0.0, 1.0 - stats.rotation_loss - sigmas * stats.rotation_sd)
-    high = min(1.0, 1.0 - stats.rotation_loss + sigmas * stats.rotation_sd)
-    wedge = uncertainty_map.wedge
-    start = wedge.center - wedge.cw + min(command.turn * low, command.turn * high)
-    width = wedge.cw + wedge.ccw + abs(command.turn) * (high - low)
+    start, stop = _turned_headings(uncertainty_map, command, stats, sigmas)
+    width = stop - start
     # How fast a run in the heading sector [start, start + width] nears each edge, m/m: the
     # largest cosine between a heading of it and the edge's outward normal.
     normal = planes[:, 3]
@@ -703,14 +719,10 @@ def _reach(
     turning = [table[meadow_map.meadows[int(i)].terrain] for i in standing]
     if not covered:
         turning = _every_terrain(meadow_map, table)
-    skitter = abs(command.turn) * max(max(0.0, t.skitter + sigmas * t.skitter_sd) for t in turning)
+    skitter = _skitter(command, turning, sigmas)
     swept = hull
     if command.run > 0.0:
-        low = min(max(0.0, 1.0 - t.rotation_loss - sigmas * t.rotation_sd) for t in turning)
-        high = max(min(1.0, 1.0 - t.rotation_loss + sigmas * t.rotation_sd) for t in turning)
-        wedge = uncertainty_map.wedge
-        start = wedge.center - wedge.cw + min(command.turn * low, command.turn * high)
-        stop = wedge.center + wedge.ccw + max(command.turn * low, command.turn * high)
+        start, stop = _turned_headings(uncertainty_map, command, turning, sigmas)
         sector = outer_annular_sector(0.0, command.run, start, stop)
         ends = (vertices[:, None, :] + sector[None, :, :]).reshape(-1, 2)
         swept = shapely.MultiPoint(np.concatenate((vertices, ends))).convex_hull
