@@ -538,7 +538,8 @@ def grow_through(
     if meadow is not None and prefix >= command.run:
         # Every true run stays in the one meadow every pose stands in (most growths).
         return uncertainty_map.grow(command, table[meadow.terrain], sigmas=bound, max_vertices=max_vertices)
-    near, covered = _reach(meadow_map, uncertainty_map, command, table, bound)
+    inside = None if meadow is None else meadow_map._meadow_index[meadow.id]
+    near, covered = _reach(meadow_map, uncertainty_map, command, table, bound, inside)
     if not near:
         raise OutsideMapError(
             f"uncertainty_map, command: expected a map within reach of a meadow, got one whose polygon "
@@ -696,19 +697,24 @@ def _reach(
     command: TurnAndRun,
     table: TerrainTable,
     sigmas: float,
+    inside: int | None = None,
 ) -> tuple[tuple[Meadow, ...], bool]:
     """:func:`meadows_in_reach`, and whether the meadows cover the map's polygon.
 
     Where they do not, a true pose may stand outside every meadow and turn on the terrain
     of the meadow it was last in: the skitter is then the largest of every terrain's.
+    ``inside``: the index of a meadow known to hold the whole polygon (no query needed).
     """
     vertices = uncertainty_map.polygon.vertices
     hull: BaseGeometry = (
         shapely.Polygon(vertices) if len(vertices) >= 3 else shapely.MultiPoint(vertices).convex_hull
     )
     tree = meadow_map._tree
-    standing = np.sort(tree.query(hull, predicate="intersects"))
-    covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
+    if inside is not None:
+        standing, covered = np.array([inside]), True
+    else:
+        standing = np.sort(tree.query(hull, predicate="intersects"))
+        covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
     if not len(standing):
         # Off every meadow: the meadows the run alone may reach.
         standing = np.sort(
