@@ -117,7 +117,7 @@ def _free_of_critical_points(hull: Array, c: Coefficients) -> NDArray[np.bool_]:
     free = np.ones(2, dtype=bool)
     for _ in range(4):
         cells = cells[_touches(cells, axes, hull_lo, hull_hi)]
-        sxx, sxy, syx, syy = _signs((cells[:, 0], cells[:, 1]), (cells[:, 2], cells[:, 3]), c)
+        sxx, sxy, syx, syy = _signs((cells[:, 0], cells[:, 1]), (cells[:, 2], cells[:, 3]), c, strict=True)
         undecided_x = (sxx == 0.0) & (sxy == 0.0)
         undecided_y = (syx == 0.0) & (syy == 0.0)
         undecided = (undecided_x & free[0]) | (undecided_y & free[1])
@@ -127,7 +127,7 @@ def _free_of_critical_points(hull: Array, c: Coefficients) -> NDArray[np.bool_]:
             break
         cells = _split(cells[undecided])
     cells = cells[_touches(cells, axes, hull_lo, hull_hi)]
-    sxx, sxy, syx, syy = _signs((cells[:, 0], cells[:, 1]), (cells[:, 2], cells[:, 3]), c)
+    sxx, sxy, syx, syy = _signs((cells[:, 0], cells[:, 1]), (cells[:, 2], cells[:, 3]), c, strict=True)
     free[0] &= not bool(np.any((sxx == 0.0) & (sxy == 0.0)))
     free[1] &= not bool(np.any((syx == 0.0) & (syy == 0.0)))
     return free
@@ -384,12 +384,30 @@ def _square(a: Interval) -> Interval:
     return low, np.maximum(lo2, hi2)
 
 
+#: Largest ratio of a derivative's coefficients to its leading one whose roots are computed.
+_ROOTS_CONDITION = 1e12
+
+
+def _horner_range(coefficients: Array, t: Interval) -> Interval:
+    """Enclose a polynomial (ascending coefficients) over intervals of t by interval Horner."""
+    value: Interval = (np.full(t[0].shape, coefficients[-1]), np.full(t[0].shape, coefficients[-1]))
+    for coefficient in coefficients[-2::-1]:
+        value = _add(_mul(value, t), (np.full(t[0].shape, coefficient), np.full(t[0].shape, coefficient)))
+    return value
+
+
 def _poly_range(coefficients: Array, t: Interval) -> Interval:
     """Exact range of a polynomial (ascending coefficients) over intervals of t."""
     derivative = np.polynomial.polynomial.polyder(coefficients)
     candidates = [t[0], t[1]]
     if len(derivative) and np.any(derivative != 0.0):
-        roots = np.polynomial.polynomial.polyroots(np.trim_zeros(derivative, "b"))
+        trimmed = np.trim_zeros(derivative, "b")
+        if np.max(np.abs(trimmed)) > _ROOTS_CONDITION * abs(trimmed[-1]):
+            # A leading coefficient this small next to the others (1e-300, say) gives roots
+            # the companion matrix cannot resolve, or overflows it: bound the polynomial by
+            # Horner's scheme in interval arithmetic instead (wider, sound).
+            return _horner_range(coefficients, t)
+        roots = np.polynomial.polynomial.polyroots(trimmed)
         # Every root's real part is a candidate: extra points inside the interval are
         # harmless, and a real root computed with a spurious imaginary part is not lost.
         for root in np.real(roots):
@@ -413,8 +431,15 @@ def _natural(x: Interval, y: Interval, c: Coefficients) -> tuple[Interval, Inter
     return xd, yd
 
 
-def _signs(x: Interval, y: Interval, c: Coefficients) -> tuple[Array, Array, Array, Array]:
-    """Signs (+1, -1, 0 unknown) of d xd/dx, d xd/dy, d yd/dx, d yd/dy over each box."""
+def _signs(
+    x: Interval, y: Interval, c: Coefficients, *, strict: bool = False
+) -> tuple[Array, Array, Array, Array]:
+    """Signs (+1, -1, 0 unknown) of d xd/dx, d xd/dy, d yd/dx, d yd/dy over each box.
+
+    Not ``strict``: +1 for >= 0 on the box (monotone: its extremes are on a side). ``strict``:
+    +1 only for > 0, as the proof of no critical point needs (a derivative that reaches 0
+    on a box's edge may vanish there together with the other one).
+    """
     k1, k2, p1, p2, k3 = c
     x2 = _square(x)
     y2 = _square(y)
@@ -427,6 +452,8 @@ def _signs(x: Interval, y: Interval, c: Coefficients) -> tuple[Array, Array, Arr
     dyy = _add(_add(radial, _mul(_scale(2.0, y2), slope)), _add(_scale(6.0 * p1, y), _scale(2.0 * p2, x)))
 
     def sign(d: Interval) -> Array:
+        if strict:
+            return np.where(d[0] > 0.0, 1.0, np.where(d[1] < 0.0, -1.0, 0.0))
         return np.where(d[0] >= 0.0, 1.0, np.where(d[1] <= 0.0, -1.0, 0.0))
 
     return sign(dxx), sign(cross), sign(cross), sign(dyy)
