@@ -9,6 +9,7 @@ meadow's terrain statistics to the part of the run made on it.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -553,17 +554,23 @@ def grow_through(
         terrains += _every_terrain(meadow_map, table)
     elif len(near) == 1:
         return uncertainty_map.grow(command, terrains[0], sigmas=bound, max_vertices=max_vertices)
+    # A straight run cuts each convex meadow once, but a run along a boundary two meadows
+    # share alternates between them (the first in map order takes the shared part): at most
+    # one piece per interval between the meadows' 2 n cut points.
+    pieces = 2 * len(near) + 1
     if meadow is None or prefix <= RUN_TOLERANCE:
-        terrain = outer_terrain(terrains, len(near), command, bound)
+        terrain = outer_terrain(terrains, pieces, command, bound)
         return uncertainty_map.grow(command, terrain, sigmas=bound, max_vertices=max_vertices)
     # Every true run stays in the meadow it starts in for its first `prefix` metres: that
-    # part grows on the meadow's terrain (with the command's inertial loss), the rest on the
-    # outer terrain of every meadow in reach.
+    # part grows on the meadow's terrain, the rest on the outer terrain of every meadow in
+    # reach, which pays the inertial losses. The first part pays none: a true run clips its
+    # piece as a whole (to no more than its length), not its first metres.
+    own = dataclasses.replace(table[meadow.terrain], translation_inertial_loss=0.0)
     first = uncertainty_map.grow(
-        TurnAndRun(command.turn, prefix), table[meadow.terrain], sigmas=bound, max_vertices=max_vertices
+        TurnAndRun(command.turn, prefix), own, sigmas=bound, max_vertices=max_vertices
     )
     rest = TurnAndRun(0.0, command.run - prefix)
-    terrain = outer_terrain(terrains, len(near), rest, bound, first=False)
+    terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
     return first.grow(rest, terrain, sigmas=bound, max_vertices=max_vertices)
 
 
@@ -716,10 +723,9 @@ def _reach(
         standing = np.sort(tree.query(hull, predicate="intersects"))
         covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
     if not len(standing):
-        # Off every meadow: the meadows the run alone may reach.
-        standing = np.sort(
-            tree.query(hull, predicate="dwithin", distance=max(command.run, POSITION_TOLERANCE))
-        )
+        # Off every meadow: the meadows the run may reach after a skitter on any terrain.
+        farthest = command.run + _skitter(command, _every_terrain(meadow_map, table), sigmas)
+        standing = np.sort(tree.query(hull, predicate="dwithin", distance=max(farthest, POSITION_TOLERANCE)))
     if not len(standing):
         return (), False
     turning = [table[meadow_map.meadows[int(i)].terrain] for i in standing]
