@@ -183,6 +183,22 @@ def test_a_large_position_bound_at_few_sigmas_takes_more_turns_too(sigmas: float
     assert grown.contains(Pose(200.0 - 0.9 * position_bound, 0.0, 0.0))
 
 
+@pytest.mark.parametrize(("runs", "sigmas"), [(1, 0.5), (2, 1.0), (10, 3.0)])
+def test_a_kilometre_scale_composite_grows_without_refusing_its_own_commands(
+    runs: int, sigmas: float
+) -> None:
+    # The growth's internal turn (a thousand turns for a 10 km bound) and run (20 km) are
+    # beyond the public TurnAndRun's ranges; it raised their range error instead of growing.
+    anchor = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 1.0, 0.5)
+    stats = TerrainStats(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    composite = Composite().extended([TurnAndRun(0.0, 10_000.0)] * runs, stats)
+    _, position_bound = anchor_bounds(stats, composite, sigmas)
+    grown = grow_from_anchor(anchor, composite, stats, sigmas, 64)
+    far = 10_000.0 * runs
+    assert grown.contains(Pose(far, 0.9 * position_bound, 0.0))
+    assert grown.contains(Pose(far - 0.9 * position_bound, 0.0, 0.0))
+
+
 @settings(max_examples=40, deadline=None)
 @given(
     stats=terrains,

@@ -198,26 +198,31 @@ def grow_from_anchor(
     heading_bound, position_bound = _anchor_bounds(terrain, composite, sigmas)
     chord = math.hypot(composite.x, composite.y)
     direction = math.atan2(composite.y, composite.x) if chord > 0.0 else 0.0
-    grown = anchor._grow_many((TurnAndRun(direction, chord),), TerrainStats.zero(), sigmas, max_vertices)
+    # Internal commands: kilometre-scale composites exceed the public TurnAndRun's ranges.
+    grown = anchor._grow_many(
+        (TurnAndRun._trusted(direction, chord),), TerrainStats.zero(), sigmas, max_vertices
+    )
     if heading_bound >= math.pi:
         # Every heading: a full turn's band, which the wedge takes as the full circle.
         heading_bound = math.pi
     rest = math.remainder(composite.heading - direction, _TWO_PI)
-    turns = 1
     spin = rest + _TWO_PI + heading_bound
-    # More turns until the skitter's spread, position_bound / spin / sigmas, is within its range.
-    while position_bound > _MAX_SKITTER * min(1.0, sigmas) * spin:
-        turns += 1
+    # More turns until the skitter's spread, position_bound / spin / sigmas, is within its
+    # range: counted, not looped (a 10 km bound takes a thousand).
+    limit = _MAX_SKITTER * min(1.0, sigmas)
+    if position_bound > limit * spin:
+        spin += _TWO_PI * math.ceil((position_bound / limit - spin) / _TWO_PI)
+    while position_bound > limit * spin:  # rounding: a turn more at most
         spin += _TWO_PI
     if heading_bound == 0.0 and position_bound == 0.0:
         if rest == 0.0:
             return grown
-        return grown._grow_many((TurnAndRun(rest, 0.0),), TerrainStats.zero(), sigmas, max_vertices)
+        return grown._grow_many((TurnAndRun._trusted(rest, 0.0),), TerrainStats.zero(), sigmas, max_vertices)
     # The actual turn is spin * clip(1 - loss + sd z, 0, 1): mean spin - heading_bound, and
     # with |z| <= sigmas every value from spin - 2 heading_bound to spin.
     band = heading_bound / spin
     spot = TerrainStats(0.0, 0.0, 0.0, 0.0, band, band / sigmas, 0.0, position_bound / spin / sigmas)
-    return grown._grow_many((TurnAndRun(spin, 0.0),), spot, sigmas, max_vertices)
+    return grown._grow_many((TurnAndRun._trusted(spin, 0.0),), spot, sigmas, max_vertices)
 
 
 def intersect_maps(
