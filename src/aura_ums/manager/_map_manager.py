@@ -1146,7 +1146,7 @@ class UncertaintyMapManager:
             pass
         # No meadow within reach of the map (it left mapped free space; the map knows no
         # walls): the robot moves on the terrain of the meadow it was last in, one of them.
-        terrains = [self._table[name] for name in sorted({m.terrain for m in self._meadow_map.meadows})]
+        terrains = [self._table[name] for name in self._meadow_map.terrains]
         terrain = outer_terrain(terrains, 1, command, self._sigmas)
         return current.grow(command, terrain, sigmas=self._sigmas, max_vertices=self._max_vertices)
 

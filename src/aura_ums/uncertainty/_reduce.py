@@ -31,6 +31,7 @@ from aura_ums.uncertainty._landmarks import (
     GroundLineLandmark,
     GroundLineObservation,
     Landmark,
+    LandmarkClass,
     Observation,
     PointLandmark,
     RangeBearingObservation,
@@ -102,22 +103,25 @@ def arc_wedge(arc: tuple[float, float], center: float) -> HeadingWedge:
 
 # --- the map-level entry point ------------------------------------------------------
 
-#: The observation types, and the landmark types each can name (LandmarkClass.observes).
-_PAIRS: dict[type, tuple[type, ...]] = {
-    BearingObservation: (VerticalLineLandmark, PointLandmark),
-    RangeBearingObservation: (PointLandmark,),
-    GroundLineObservation: (GroundLineLandmark,),
+#: The observation types, and the landmark type of each class (which classes an observation
+#: can name is LandmarkClass.observes).
+_OBSERVATIONS = (BearingObservation, RangeBearingObservation, GroundLineObservation)
+_LANDMARKS = {
+    LandmarkClass.VERTICAL_LINE: VerticalLineLandmark,
+    LandmarkClass.POINT: PointLandmark,
+    LandmarkClass.GROUND_LINE: GroundLineLandmark,
 }
 
 
 def check_pair(observation: object, landmark: object) -> None:
     """Raise :class:`InputError` unless the observation can name the landmark, by class and id."""
-    expected = _PAIRS.get(type(observation))
-    if expected is None:
-        names = ", ".join(kind.__name__ for kind in _PAIRS)
+    if type(observation) not in _OBSERVATIONS:
+        names = ", ".join(kind.__name__ for kind in _OBSERVATIONS)
         raise InputError(f"observation: expected one of {names}, got {type(observation).__name__}")
-    if not isinstance(landmark, expected):
-        names = " or ".join(kind.__name__ for kind in expected)
+    observed = cast(Observation, observation).landmark_class
+    named = isinstance(landmark, (VerticalLineLandmark, PointLandmark, GroundLineLandmark))
+    if not named or not observed.observes(cast(Landmark, landmark).landmark_class):
+        names = " or ".join(kind.__name__ for each, kind in _LANDMARKS.items() if observed.observes(each))
         raise InputError(
             f"landmark: expected a {names} for a {type(observation).__name__}, got {type(landmark).__name__}"
         )

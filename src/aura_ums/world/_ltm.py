@@ -585,6 +585,18 @@ expected the id of a landmark feature, got 'pole'
             float(boxes[:, 3].max()),
         )
 
+    @property
+    def terrains(self) -> tuple[str, ...]:
+        """The terrain names of the meadows, each once, sorted.
+
+        Examples
+        --------
+        >>> from aura_ums.world import make_grid_world
+        >>> make_grid_world(1, 5).terrains                    # five cells, four terrains
+        ('concrete', 'grass', 'gravel', 'tile')
+        """
+        return tuple(sorted({meadow.terrain for meadow in self.meadows}))
+
     # --- spatial queries -------------------------------------------------------------------
 
     def meadows_containing(self, x: float, y: float) -> tuple[Meadow, ...]:

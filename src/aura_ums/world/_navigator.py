@@ -540,19 +540,14 @@ def grow_through(
         # Every true run stays in the one meadow every pose stands in (most growths).
         return uncertainty_map.grow(command, table[meadow.terrain], sigmas=bound, max_vertices=max_vertices)
     inside = None if meadow is None else meadow_map._meadow_index[meadow.id]
-    near, covered = _reach(meadow_map, uncertainty_map, command, table, bound, inside)
+    near, terrains, covered = _reach(meadow_map, uncertainty_map, command, table, bound, inside)
     if not near:
         raise OutsideMapError(
             f"uncertainty_map, command: expected a map within reach of a meadow, got one whose polygon "
             f"(centre {_xy(uncertainty_map.center)}) is more than the run of {command.run!r} m and its "
             "skitter from every meadow"
         )
-    terrains = [table[found.terrain] for found in near]
-    if not covered:
-        # A pose of the map may stand outside every meadow: the true robot then turns (and on
-        # a run that meets no meadow, runs) on the terrain of the meadow it was last in.
-        terrains += _every_terrain(meadow_map, table)
-    elif len(near) == 1:
+    if covered and len(near) == 1:
         return uncertainty_map.grow(command, terrains[0], sigmas=bound, max_vertices=max_vertices)
     # A straight run cuts each convex meadow once, but a run along a boundary two meadows
     # share alternates between them (the first in map order takes the shared part): at most
@@ -604,7 +599,7 @@ def _turned_headings(
 
 
 def _every_terrain(meadow_map: MeadowMap, table: TerrainTable) -> list[TerrainStats]:
-    return [table[name] for name in sorted({meadow.terrain for meadow in meadow_map.meadows})]
+    return [table[name] for name in meadow_map.terrains]
 
 
 def _meadow_holding(meadow_map: MeadowMap, x: float, y: float) -> int | None:
@@ -705,11 +700,12 @@ def _reach(
     table: TerrainTable,
     sigmas: float,
     inside: int | None = None,
-) -> tuple[tuple[Meadow, ...], bool]:
-    """:func:`meadows_in_reach`, and whether the meadows cover the map's polygon.
+) -> tuple[tuple[Meadow, ...], list[TerrainStats], bool]:
+    """:func:`meadows_in_reach`, the terrains a true run may move on, and whether the meadows cover the map.
 
-    Where they do not, a true pose may stand outside every meadow and turn on the terrain
-    of the meadow it was last in: the skitter is then the largest of every terrain's.
+    Where they do not cover its polygon, a true pose may stand outside every meadow and
+    turn (and, on a run that meets no meadow, run) on the terrain of the meadow it was last
+    in: the terrains are then every terrain of the map, theirs too.
     ``inside``: the index of a meadow known to hold the whole polygon (no query needed).
     """
     vertices = uncertainty_map.polygon.vertices
@@ -722,15 +718,14 @@ def _reach(
     else:
         standing = np.sort(tree.query(hull, predicate="intersects"))
         covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
+    every = [] if covered else _every_terrain(meadow_map, table)
     if not len(standing):
         # Off every meadow: the meadows the run may reach after a skitter on any terrain.
-        farthest = command.run + _skitter(command, _every_terrain(meadow_map, table), sigmas)
+        farthest = command.run + _skitter(command, every, sigmas)
         standing = np.sort(tree.query(hull, predicate="dwithin", distance=max(farthest, POSITION_TOLERANCE)))
     if not len(standing):
-        return (), False
-    turning = [table[meadow_map.meadows[int(i)].terrain] for i in standing]
-    if not covered:
-        turning = _every_terrain(meadow_map, table)
+        return (), [], False
+    turning = [table[meadow_map.meadows[int(i)].terrain] for i in standing] if covered else every
     skitter = _skitter(command, turning, sigmas)
     swept = hull
     if command.run > 0.0:
@@ -739,8 +734,10 @@ def _reach(
         ends = (vertices[:, None, :] + sector[None, :, :]).reshape(-1, 2)
         swept = shapely.MultiPoint(np.concatenate((vertices, ends))).convex_hull
     near = tree.query(swept, predicate="dwithin", distance=max(skitter, POSITION_TOLERANCE))
-    found = sorted({int(i) for i in near} | {int(i) for i in standing})
-    return tuple(meadow_map.meadows[i] for i in found), covered
+    reached = tuple(
+        meadow_map.meadows[i] for i in sorted({int(i) for i in near} | {int(i) for i in standing})
+    )
+    return reached, [table[meadow.terrain] for meadow in reached] + every, covered
 
 
 def outer_terrain(
