@@ -217,6 +217,8 @@ def _within_budget(
     points: Array, counts: Counts, starts: Array, stops: Array, sources: Counts, cells: int, max_vertices: int
 ) -> tuple[Array, Counts, Array, Array, Counts]:
     """Merge neighbouring pieces (in heading order) until they cover at most the budget of cells."""
+    if len(counts) * (cells + 1) <= CELL_ROW_BUDGET:
+        return points, counts, starts, stops, sources  # within it whatever they cover (every growth step)
     step = _TWO_PI / cells
     spans = np.minimum(np.ceil(stops / step) - np.floor(starts / step), cells + 1)
     total, budget = float(spans.sum()), CELL_ROW_BUDGET
