@@ -495,9 +495,12 @@ def grow_through(
     terrains are those of every meadow within reach: within the commanded run (plus the
     skitter of the turn) of the map's polygon. With one such meadow, the map grows as
     :meth:`~aura_ums.uncertainty.SpatialUncertaintyMap.grow` on its terrain. With several,
-    it grows once on their outer terrain (:func:`outer_terrain`), which bounds the motion
+    it grows on their outer terrain (:func:`outer_terrain`), which bounds the motion
     whatever meadows a true run crosses and wherever it crosses them: the true robot draws
-    each piece on its own meadow's terrain (:class:`~aura_ums.sim.SimulatedRobot`). The
+    each piece on its own meadow's terrain (:class:`~aura_ums.sim.SimulatedRobot`), and
+    loses each piece's inertial loss. The first metres that every true run spends in the
+    meadow every pose stands in grow on that meadow's terrain; their growth also loses
+    whatever of the pieces' losses the rest of the run is too short to lose. The
     paper splits the run where the most probable pose's run crosses a boundary
     (:func:`commands_for`); that is not sound for the poses whose runs cross elsewhere.
     ``sigmas`` and ``max_vertices`` (whose defaults are ``grow``'s) go to the growth.
@@ -559,14 +562,52 @@ def grow_through(
     # Every true run stays in the meadow it starts in for its first `prefix` metres: that
     # part grows on the meadow's terrain, the rest on the outer terrain of every meadow in
     # reach, which pays the inertial losses. The first part pays none: a true run clips its
-    # piece as a whole (to no more than its length), not its first metres.
+    # piece as a whole (to no more than its length), not its first metres. But a rest too
+    # short to pay them all leaves the first part the remainder: a true piece cut just past
+    # `prefix` loses its whole loss there.
+    rest = TurnAndRun(0.0, command.run - prefix)
+    terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
     own = dataclasses.replace(table[meadow.terrain], translation_inertial_loss=0.0)
+    owed = (
+        pieces * max(t.translation_inertial_loss for t in terrains)
+        - rest.run * _kept_interval(terrains, bound)[0]
+    )
+    if owed > 0.0:
+        low, high = _kept_interval([own], bound)
+        own = _running(own, prefix, max(0.0, prefix * low - owed), prefix * min(1.0, high), bound)
     first = uncertainty_map.grow(
         TurnAndRun(command.turn, prefix), own, sigmas=bound, max_vertices=max_vertices
     )
-    rest = TurnAndRun(0.0, command.run - prefix)
-    terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
     return first.grow(rest, terrain, sigmas=bound, max_vertices=max_vertices)
+
+
+def _kept_interval(terrains: Sequence[TerrainStats], sigmas: float) -> tuple[float, float]:
+    """Return the least (at least 0) and largest kept fraction of a run on ``terrains`` at ``sigmas``.
+
+    The largest may pass 1: a run that keeps more than it was commanded loses its inertial
+    loss from that, before the clip to its length.
+    """
+    low = min(1.0 - t.translation_loss - sigmas * t.translation_sd for t in terrains)
+    high = max(1.0 - t.translation_loss + sigmas * t.translation_sd for t in terrains)
+    return max(0.0, low), high
+
+
+def _running(
+    terrain: TerrainStats, run: float, shortest: float, longest: float, sigmas: float
+) -> TerrainStats:
+    """Return ``terrain`` with no inertial loss, whose ``run`` metres last ``shortest`` to ``longest`` m."""
+    if run > 0.0:
+        # Rounded outwards: the growth recomputes the ends from the middle and the spread.
+        high = min(1.0, longest / run * (1.0 + 1e-12))
+        low = max(0.0, min(shortest, longest) / run * (1.0 - 1e-12))
+    else:
+        high = low = 1.0
+    return dataclasses.replace(
+        terrain,
+        translation_loss=min(_BELOW_ONE, 1.0 - (high + low) / 2.0),
+        translation_inertial_loss=0.0,
+        translation_sd=(high - low) / (2.0 * sigmas),
+    )
 
 
 def _covers(meadow_map: MeadowMap, indices: NDArray[np.intp], hull: BaseGeometry) -> bool:
@@ -766,31 +807,24 @@ def outer_terrain(
     0.0
     """
     run = command.run
-    kept = [1.0 - t.translation_loss for t in terrains]
-    spread = [sigmas * t.translation_sd for t in terrains]
+    low, high = _kept_interval(terrains, sigmas)
     losses = [t.translation_inertial_loss for t in terrains]
     paid = min(losses) if first else 0.0
-    longest = min(run, max(0.0, run * max(k + s for k, s in zip(kept, spread, strict=True)) - paid))
-    shortest = min(
-        longest, max(0.0, run * min(k - s for k, s in zip(kept, spread, strict=True)) - pieces * max(losses))
-    )
-    if run > 0.0:
-        # Rounded outwards: the growth recomputes the ends from the middle and the spread.
-        high, low = min(1.0, longest / run * (1.0 + 1e-12)), max(0.0, shortest / run * (1.0 - 1e-12))
-    else:
-        high = low = 1.0
+    longest = min(run, max(0.0, run * high - paid))
+    shortest = min(longest, max(0.0, run * low - pieces * max(losses)))
     turn_high = max(min(1.0, 1.0 - t.rotation_loss + sigmas * t.rotation_sd) for t in terrains)
     turn_low = min(max(0.0, 1.0 - t.rotation_loss - sigmas * t.rotation_sd) for t in terrains)
-    return TerrainStats(
+    turning = TerrainStats(
         rotation_loss=min(_BELOW_ONE, 1.0 - (turn_high + turn_low) / 2.0),
         rotation_sd=(turn_high - turn_low) / (2.0 * sigmas) * (1.0 + 1e-12),
-        translation_loss=min(_BELOW_ONE, 1.0 - (high + low) / 2.0),
+        translation_loss=0.0,
         translation_inertial_loss=0.0,
-        translation_sd=(high - low) / (2.0 * sigmas),
+        translation_sd=0.0,
         drift=max(t.drift for t in terrains),
         skitter=max(t.skitter for t in terrains),
         skitter_sd=max(t.skitter_sd for t in terrains),
     )
+    return _running(turning, run, shortest, longest, sigmas)
 
 
 #: The largest loss a TerrainStats takes (its range is [0, 1)): nothing kept at all.
