@@ -525,7 +525,8 @@ def test_a_rest_too_short_to_pay_the_inertial_losses_leaves_them_to_the_first_me
     truth = SimulatedRobot(world, table, pose, np.random.default_rng(0), truncate=3.0).execute(command)
     assert truth.x == pytest.approx(9.5)
     assert grown.contains(truth)
-    assert grown.polygon.vertices[:, 0].min() == pytest.approx(9.0)  # the least run: 0, not 1 m
+    # The least run: 1.05 m less the two pieces' losses (not the 1 m of the first part).
+    assert grown.polygon.vertices[:, 0].min() == pytest.approx(9.05)
 
 
 def test_small_maps_whose_runs_end_just_past_a_boundary_hold_every_true_run() -> None:
@@ -547,6 +548,27 @@ def test_small_maps_whose_runs_end_just_past_a_boundary_hold_every_true_run() ->
             outside += not grown.contains(truth)
             total += 1
     assert outside == 0, f"{outside} of {total} true poses outside"
+
+
+def test_a_run_across_boundaries_loses_one_inertial_loss_per_meadow() -> None:
+    """Crossing from A into B, a true run is two pieces: two losses, not the 2 n + 1 of a run along an edge.
+
+    From 9 m, 3 m east: 0.5 m kept of the 1 m in A, 1.5 m of the 2 m in B, so 11 m; the
+    map's least run is 3 m less two losses, to the metre. A run along the edge the two
+    meadows share (heading north on x = 10) may alternate between them: five losses.
+    """
+    table = TerrainTable({"t": TerrainStats(0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)})  # 0.5 m per piece
+    world = MeadowMap([_rect("A", 0, 0, 10, 4, "t"), _rect("B", 10, 0, 20, 4, "t")], [])
+    pose = Pose(9.0, 2.0, 0.0)
+    command = TurnAndRun(0.0, 3.0)
+    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
+    truth = SimulatedRobot(world, table, pose, np.random.default_rng(0), truncate=3.0).execute(command)
+    assert truth.x == pytest.approx(11.0)
+    assert grown.polygon.vertices[:, 0].min() == pytest.approx(11.0)
+    assert grown.contains(truth)
+    along = SpatialUncertaintyMap.from_pose(Pose(10.0, 0.5, math.pi / 2), 0.0, 0.0)
+    north = grow_through(along, world, TurnAndRun(0.0, 3.0), table)
+    assert north.polygon.vertices[:, 1].min() == pytest.approx(1.0)  # 3 m less five losses: 0.5 m
 
 
 def test_a_run_along_a_shared_boundary_may_cross_a_meadow_twice() -> None:

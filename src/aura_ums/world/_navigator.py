@@ -552,10 +552,7 @@ def grow_through(
         )
     if covered and len(near) == 1:
         return uncertainty_map.grow(command, terrains[0], sigmas=bound, max_vertices=max_vertices)
-    # A straight run cuts each convex meadow once, but a run along a boundary two meadows
-    # share alternates between them (the first in map order takes the shared part): at most
-    # one piece per interval between the meadows' 2 n cut points.
-    pieces = 2 * len(near) + 1
+    pieces = _most_pieces(meadow_map, uncertainty_map, command, near, terrains, bound)
     if meadow is None or prefix <= RUN_TOLERANCE:
         terrain = outer_terrain(terrains, pieces, command, bound)
         return uncertainty_map.grow(command, terrain, sigmas=bound, max_vertices=max_vertices)
@@ -579,6 +576,47 @@ def grow_through(
         TurnAndRun(command.turn, prefix), own, sigmas=bound, max_vertices=max_vertices
     )
     return first.grow(rest, terrain, sigmas=bound, max_vertices=max_vertices)
+
+
+def _most_pieces(
+    meadow_map: MeadowMap,
+    uncertainty_map: SpatialUncertaintyMap,
+    command: TurnAndRun,
+    near: Sequence[Meadow],
+    terrains: Sequence[TerrainStats],
+    sigmas: float,
+) -> int:
+    """Return how many pieces the meadows in reach may cut a true run into (each loses its inertial loss).
+
+    A straight run cuts each convex meadow once, and its parts outside every meadow join the
+    piece before them: one piece per meadow. But a run along a boundary two meadows share
+    alternates between them (the first in map order takes the shared part): at most one
+    piece per interval between the meadows' ``2 n`` cut points. A true run can follow an edge
+    only if a heading of the turned wedge is parallel to it and a start (a vertex of the
+    polygon, moved by the turn's skitter) can lie on its line.
+    """
+    count = len(near)
+    if command.run <= 0.0:
+        return 2 * count + 1
+    start, stop = _turned_headings(uncertainty_map, command, terrains, sigmas)
+    width = stop - start + 2.0 * _PARALLEL
+    reach = _skitter(command, terrains, sigmas) + POSITION_TOLERANCE
+    vertices = uncertainty_map.polygon.vertices
+    for meadow in near:
+        planes = meadow_map._halfplanes[meadow_map._meadow_index[meadow.id]]
+        # an edge runs along its outward normal turned by a quarter turn, either way
+        parallel = np.mod(planes[:, 3] + math.pi / 2.0 - start + _PARALLEL, math.pi) <= width
+        offsets = vertices @ planes[:, :2].T  # (vertex, edge), metres along each normal
+        on_line = (offsets.min(axis=0) - reach <= planes[:, 2]) & (
+            planes[:, 2] <= offsets.max(axis=0) + reach
+        )
+        if np.any(parallel & on_line):
+            return 2 * count + 1
+    return count
+
+
+#: Radians: headings this close to an edge's direction count as running along it.
+_PARALLEL = 1e-9
 
 
 def _kept_interval(terrains: Sequence[TerrainStats], sigmas: float) -> tuple[float, float]:
