@@ -9,7 +9,15 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from aura_ums.camera import CalibrationBounds, Camera, CameraIntrinsics, CameraMount, undistort_points
+from aura_ums.camera import (
+    CalibrationBounds,
+    Camera,
+    CameraIntrinsics,
+    CameraMount,
+    distort,
+    fold_radius,
+    undistort_points,
+)
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import Pose
 
@@ -185,3 +193,138 @@ def test_intrinsics_refuse_distortion_aura_ums_does_not_model() -> None:
         InputError, match=r"^CameraIntrinsics\.distortion\[1\]: expected a number in \[-1000, 1000\]"
     ):
         CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(0.1, 2000.0, 0.0, 0.0))  # type: ignore[arg-type]
+
+
+# --------------------------------------------------------------------------- the lens's fold
+
+#: Trial 1045 of the soundness attack on the observers (seed 1): a barrel lens that folds at a
+#: normalized radius of 1.29, 52 degrees off the optical axis.
+FOLDING = (-0.14037735976465748, -0.019756094563861994, 0.0011521003782993247, -0.002270688788373455, 0.0)
+
+
+def test_fold_radius_of_a_radial_lens_is_the_first_root_of_the_slope() -> None:
+    # r (1 + k1 r^2 + k2 r^4) has slope 1 + 3 k1 r^2 + 5 k2 r^4: a quadratic in r^2
+    assert fold_radius((-0.14, 0.0, 0.0, 0.0, 0.0)) == pytest.approx(1.0 / math.sqrt(0.42), rel=1e-11)
+    k1, k2 = FOLDING[0], FOLDING[1]
+    s = (-3.0 * k1 - math.sqrt(9.0 * k1 * k1 - 20.0 * k2)) / (10.0 * k2)
+    assert fold_radius((k1, k2, 0.0, 0.0, 0.0)) == pytest.approx(math.sqrt(s), rel=1e-11)
+    # a slope with two positive roots (1 - 0.3 s + 0.0125 s^2: s = 4 and 20): the first
+    assert fold_radius((-0.1, 0.0025, 0.0, 0.0, 0.0)) == pytest.approx(2.0, rel=1e-11)
+    # never above the fold: the radius returned is within it (rounded inwards)
+    assert fold_radius((-0.14, 0.0, 0.0, 0.0, 0.0)) <= 1.0 / math.sqrt(0.42)
+
+
+def test_tangential_terms_move_the_fold_inwards() -> None:
+    radial = fold_radius((*FOLDING[:2], 0.0, 0.0, 0.0))
+    assert 1.28 < fold_radius(FOLDING) < radial < 1.31
+
+
+@pytest.mark.parametrize(
+    "distortion",
+    [
+        (0.0, 0.0, 0.0, 0.0, 0.0),
+        (0.1, 0.01, 0.0, 0.0, 0.002),  # pincushion
+        (-0.1, 0.05, 0.0, 0.0, 0.0),  # barrel, but 1 - 0.3 s + 0.25 s^2 never vanishes
+        (0.0, 0.0, 0.0, 0.0, 1e-300),
+        None,
+    ],
+)
+def test_a_lens_that_never_folds_images_every_ray_in_front_as_before(
+    distortion: tuple[float, float, float, float, float] | None,
+) -> None:
+    assert fold_radius(distortion) == math.inf
+    lens = CameraIntrinsics(300.0, 300.0, 320.0, 240.0, 640, 480, distortion)
+    points = np.array([[x, y, 1.0] for x in (-40.0, -3.0, 0.0, 0.7, 25.0) for y in (-9.0, 0.0, 2.0)])
+    x, y = points[:, 0], points[:, 1]
+    if distortion is not None:
+        x, y = distort(x, y, distortion)  # the polynomial, however far off axis
+    pixels = Camera(lens, CameraMount(1.0)).project_camera_frame(points)
+    np.testing.assert_array_equal(pixels, np.column_stack([300.0 * x + 320.0, 300.0 * y + 240.0]))
+
+
+def test_a_tiny_leading_coefficient_does_not_hide_the_fold() -> None:
+    # The companion matrix's roots of 1 - 0.9 r^2 + 7e-150 r^6 lose the root at r = 1.054.
+    assert fold_radius((-0.3, 0.0, 0.0, 0.0, 1e-150)) == pytest.approx(1.0 / math.sqrt(0.9), rel=1e-11)
+    assert fold_radius((-0.3, 0.0, 0.0, 0.0, -5e-324)) == pytest.approx(1.0 / math.sqrt(0.9), rel=1e-11)
+    # a fold that far out is none: 1 - 7e-150 r^6 vanishes at r = 7e24, below the horizon 1e30
+    assert fold_radius((0.0, 0.0, 0.0, 0.0, -1e-150)) == pytest.approx(7.23020026e24, rel=1e-8)
+    assert fold_radius((0.0, 0.0, 0.0, 0.0, -1e-190)) == math.inf
+
+
+def test_fold_radius_takes_any_form_of_the_vector_and_refuses_bad_ones() -> None:
+    assert fold_radius([-0.14, 0.0, 0.0, 0.0]) == fold_radius((-0.14, 0.0, 0.0, 0.0, 0.0))  # type: ignore[arg-type]
+    assert fold_radius(np.array(FOLDING)) == fold_radius(FOLDING)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="distortion: expected finite numbers, got non-finite values"):
+        fold_radius((math.nan, 0.0, 0.0, 0.0, 0.0))
+    with pytest.raises(InputError, match=r"distortion: expected 4, 5, 8, 12 or 14 .*, got 3"):
+        fold_radius((0.1, 0.0, 0.0))  # type: ignore[arg-type]
+
+
+@given(
+    distortion=st.tuples(
+        st.floats(-2.0, 0.5),
+        st.floats(-1.0, 1.0),
+        st.floats(-0.05, 0.05),
+        st.floats(-0.05, 0.05),
+        st.floats(-1.0, 1.0),
+    ),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_lens_is_one_to_one_within_its_fold(
+    distortion: tuple[float, float, float, float, float], seed: int
+) -> None:
+    # Within the fold the Jacobian of the distortion is positive definite, so the map is
+    # strictly monotone on the disk: (d(a) - d(b)) . (a - b) > 0, no two rays share a pixel.
+    limit = min(fold_radius(distortion), 1e3)
+    rng = np.random.default_rng(seed)
+    radius = limit * np.sqrt(rng.uniform(0.0, 1.0, (2, 400)))
+    angle = rng.uniform(-math.pi, math.pi, (2, 400))
+    ax, ay = radius[0] * np.cos(angle[0]), radius[0] * np.sin(angle[0])
+    bx, by = radius[1] * np.cos(angle[1]), radius[1] * np.sin(angle[1])
+    (dax, day), (dbx, dby) = distort(ax, ay, distortion), distort(bx, by, distortion)
+    assert np.all((dax - dbx) * (ax - bx) + (day - dby) * (ay - by) > 0.0)
+    k1, k2, p1, p2, k3 = distortion
+    r2 = ax * ax + ay * ay
+    rho = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    slope = k1 + r2 * (2.0 * k2 + r2 * 3.0 * k3)
+    j00 = rho + 2.0 * ax * ax * slope + 2.0 * p1 * ay + 6.0 * p2 * ax
+    j11 = rho + 2.0 * ay * ay * slope + 6.0 * p1 * ay + 2.0 * p2 * ax
+    j01 = 2.0 * ax * ay * slope + 2.0 * p1 * ax + 2.0 * p2 * ay
+    assert np.all((j00 > 0.0) & (j00 * j11 - j01 * j01 > 0.0))
+
+
+def test_projection_beyond_the_fold_is_nan_like_behind_the_camera() -> None:
+    # The regression: 63 degrees off axis, beyond the fold at 52 degrees, the polynomial put a
+    # ground point at (256, 296), inside the image (undistorted it lies at (-176, 600)), over
+    # the pixels of a ray within the fold.
+    true_camera = Camera(
+        CameraIntrinsics(295.0, 300.0, 314.1104361779169, 256.3198179581066, 640, 480, FOLDING),
+        CameraMount(2.02, left=-0.2, pan=-0.5),
+    )
+    pose = Pose(0.0, 0.0, -2.9644228825344228)
+    beyond = (-2.6389038271351124, -2.0229579890451834, 0.0)
+    frame = true_camera.to_camera_frame(pose.as_array(), [beyond])[0, 0]
+    assert math.hypot(frame[0] / frame[2], frame[1] / frame[2]) > fold_radius(FOLDING)
+    polynomial = distort(np.array([frame[0] / frame[2]]), np.array([frame[1] / frame[2]]), FOLDING)
+    assert 0.0 < 295.0 * polynomial[0][0] + 314.11 < 640.0  # the pixel the polynomial gave, in the image
+    assert np.isnan(true_camera.project(pose, [beyond])).all()
+    # 17 degrees off axis, on the same line on the ground: imaged
+    within = (-10.630440158822351, 7.151084478052063, 0.0)
+    assert np.isfinite(true_camera.project(pose, [within])).all()
+    # on the fold's edge, at every angle around the axis: imaged just inside, NaN just outside
+    limit = fold_radius(FOLDING)
+    angle = np.linspace(-math.pi, math.pi, 16)
+    edge = np.column_stack([np.cos(angle), np.sin(angle), np.ones(16)])
+    inside = true_camera.project_camera_frame(edge * [limit * (1 - 1e-9), limit * (1 - 1e-9), 1.0])
+    outside = true_camera.project_camera_frame(edge * [limit * (1 + 1e-9), limit * (1 + 1e-9), 1.0])
+    assert np.isfinite(inside).all()
+    assert np.isnan(outside).all()
+
+
+def test_undistort_finds_no_ray_beyond_the_fold() -> None:
+    # The top-left corner of this image is reached by no ray within the fold; the iteration
+    # converged on the ray at r = 2.44, beyond the fold (1.29), where the lens images nothing.
+    lens = CameraIntrinsics(300.0, 300.0, 314.11, 257.62, 640, 480, FOLDING)
+    result = undistort_points(lens, [(0.0, 0.0), (391.38736871558046, 304.14233415635124)])
+    assert np.isnan(result[0]).all()
+    assert math.hypot(*result[1]) < fold_radius(FOLDING)

@@ -106,7 +106,12 @@ def extreme_poses(the_map: SpatialUncertaintyMap, per_edge: int = 4) -> Array:
 
 
 def visible_pixels(camera: Camera, poses: Array, points: Array) -> Array:
-    """Pixels (k, 2) of the points in front of the camera (z > NEAR_PLANE) from every pose."""
+    """Pixels (k, 2) of the points the camera images from every pose.
+
+    Those in front of it (z > NEAR_PLANE) and, with lens distortion, within the lens's fold
+    (``fold_radius``): the others project to NaN.
+    """
     frame = camera.to_camera_frame(poses, points)
     visible = frame[..., 2] > NEAR_PLANE
-    return np.asarray(camera.project_camera_frame(frame[visible]), dtype=np.float64)
+    pixels = np.asarray(camera.project_camera_frame(frame[visible]), dtype=np.float64)
+    return pixels[np.isfinite(pixels).all(axis=1)]

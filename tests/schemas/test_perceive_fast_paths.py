@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import shapely
 
-from aura_ums.camera import Camera, CameraIntrinsics, CameraMount, undistort_points
+from aura_ums.camera import Camera, CameraIntrinsics, CameraMount, fold_radius, undistort_points
 from aura_ums.expecter import ImageWindow
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.schemas._perceive import _project, _rotation, map_gap, may_be_within, predicted_shift
@@ -158,3 +158,25 @@ def test_float_projection_agrees_with_camera_project(camera: Camera, rng: np.ran
             continue
         assert ours == pytest.approx(reference.tolist(), rel=1e-12, abs=1e-9)
     assert behind > 0
+
+
+def test_float_projection_beyond_the_lens_fold_is_none_as_camera_project_is_nan() -> None:
+    # A barrel lens folding 57 degrees off axis (r = 1.543): the polynomial put a point 63
+    # degrees off axis on the pixels of a ray within the fold; both projections refuse it.
+    camera = Camera(
+        CameraIntrinsics(300.0, 300.0, 320.0, 240.0, 640, 480, distortion=(-0.14, 0.0, 0.0, 0.0, 0.0)),
+        CameraMount(height=1.0),
+    )
+    rotation = _rotation(camera.mount.pan, camera.mount.tilt)
+    pose = Pose(0.0, 0.0, 0.0)
+    limit = fold_radius(camera.intrinsics.distortion)
+    for angle in np.linspace(-math.pi, math.pi, 13):  # around the optical axis (robot forward)
+        for scale, imaged in ((0.999, True), (1.001, False), (1.3, False)):
+            r = scale * limit
+            point = (1.0, -r * math.cos(angle), 1.0 - r * math.sin(angle))  # 1 m ahead
+            ours = _project(camera, rotation, pose, point)
+            reference = camera.project(pose, [point])[0]
+            assert (ours is not None) is imaged
+            assert bool(np.isfinite(reference).all()) is imaged
+            if ours is not None:
+                assert ours == pytest.approx(reference.tolist(), rel=1e-12, abs=1e-9)

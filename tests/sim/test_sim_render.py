@@ -7,7 +7,7 @@ import pytest
 from matplotlib.path import Path as MplPath
 from numpy.typing import NDArray
 
-from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
+from aura_ums.camera import Camera, CameraIntrinsics, CameraMount, fold_radius
 from aura_ums.errors import InputError
 from aura_ums.perception import FastLineFinder, evaluate_vertical_line
 from aura_ums.sim import Building, GroundStripe, Pole, Scene, SyntheticCamera
@@ -233,3 +233,41 @@ def test_distorted_camera_renders() -> None:
     image = SyntheticCamera(camera, scene, np.random.default_rng(0), noise=0.0).render(Pose(0.0, 0.0, 0.0))
     ((u, v),) = camera.project(Pose(0.0, 0.0, 0.0), [(8.0, 0.0, 2.0)])
     assert image[round(v), round(u)] == 45
+
+
+#: A barrel lens on a wide image: it folds 57 degrees off axis (r = 1.543), and the image's
+#: corners lie beyond the image of the fold, where it images nothing.
+FOLDING_CAMERA = Camera(
+    CameraIntrinsics(300.0, 300.0, 319.5, 239.5, 640, 480, distortion=(-0.14, 0.0, 0.0, 0.0, 0.0)),
+    CameraMount(1.0),
+)
+
+
+def test_a_pole_beyond_the_lens_fold_is_not_drawn() -> None:
+    # 63 degrees to the left of the optical axis the polynomial put the pole at u = 49, inside
+    # the image, over the rays of 43 degrees; the camera images no ray beyond the fold.
+    pose = Pose(0.0, 0.0, 0.0)
+    pole = Pole(1.0, math.tan(math.radians(63.0)), 0.0, 2.0, 0.05, shade=20.0)
+    empty = SyntheticCamera(FOLDING_CAMERA, Scene(), np.random.default_rng(0), noise=0.0).render(pose)
+    drawn = SyntheticCamera(FOLDING_CAMERA, Scene(poles=(pole,)), np.random.default_rng(0), noise=0.0)
+    assert np.array_equal(drawn.render(pose), empty)
+    assert np.isnan(FOLDING_CAMERA.project(pose, [(pole.x, pole.y, 1.0)])).all()
+
+
+def test_a_wall_crossing_the_lens_fold_is_drawn_up_to_it() -> None:
+    # A wall 1 m to the left from 3 m ahead to 0.1 m ahead: 18 to 84 degrees off axis. Its part
+    # within the fold is drawn where it projects; nothing is drawn past the fold's image.
+    pose = Pose(0.0, 0.0, 0.0)
+    wall = Building([(0.1, 1.0), (3.0, 1.0), (3.0, 1.2), (0.1, 1.2)], 0.0, 1.5, shades=(30.0, 30.0))
+    image = SyntheticCamera(
+        FOLDING_CAMERA, Scene(buildings=(wall,)), np.random.default_rng(0), noise=0.0
+    ).render(pose)
+    for ahead in (1.0, 2.0, 2.9):  # 45, 27 and 19 degrees off axis, at the camera's height
+        ((u, v),) = FOLDING_CAMERA.project(pose, [(ahead, 1.0, 1.0)])
+        assert image[round(v), round(u)] == 30
+    limit = fold_radius(FOLDING_CAMERA.intrinsics.distortion)
+    fold_image = limit * (1.0 - 0.14 * limit**2)  # the distorted radius of the fold
+    vv, uu = np.mgrid[0:480, 0:640]
+    outside = np.hypot((uu - 319.5) / 300.0, (vv - 239.5) / 300.0) > fold_image * 1.001
+    assert not (image[outside] == 30).any()
+    assert (image[~outside] == 30).sum() > 1000

@@ -18,6 +18,7 @@ from aura_ums.camera._model import (
     CameraIntrinsics,
     CameraMount,
     distort,
+    fold_radius,
     robot_from_camera_rotation,
 )
 from aura_ums.camera._observe import (
@@ -39,6 +40,7 @@ __all__ = [
     "bound_vertical_line",
     "camera_to_toml",
     "distort",
+    "fold_radius",
     "load_calibration_bounds",
     "load_camera",
     "load_opencv_calibration",

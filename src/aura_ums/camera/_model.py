@@ -7,6 +7,7 @@ top-left pixel.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -71,6 +72,126 @@ def distort(
     xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
     yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
     return xd, yd
+
+
+#: Folds farther out than this radius are reported as none: a point in front of the near
+#: plane (z > NEAR_PLANE) that far out lies more than 1e24 m off the optical axis.
+_FOLD_HORIZON = 1e30
+#: The search for the fold stops at intervals this narrow (relative): the radius returned is
+#: at most this far inside the fold, for a simple root.
+_FOLD_RESOLUTION = 2.0**-40
+#: An interval's lower bound counts as positive above this fraction of its terms' size (rounding).
+_FOLD_ROUNDING = 1e-13
+
+
+def fold_radius(distortion: tuple[float, float, float, float, float] | None) -> float:
+    r"""Return the normalized radius within which the lens is one-to-one: the rays the camera images.
+
+    OpenCV's radial factor makes the image radius ``r (1 + k1 r^2 + k2 r^4 + k3 r^6)`` of a
+    ray at normalized radius ``r = hypot(x/z, y/z)``; past the first positive root of its
+    derivative ``1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6`` the polynomial folds back and maps
+    farther rays onto the pixels of nearer ones. A camera of this model images the rays with
+    ``r <= fold_radius`` and no others: :meth:`Camera.project_camera_frame` gives NaN beyond
+    (as behind the camera), :func:`~aura_ums.camera.undistort_points` inverts pixels only to
+    rays within, and the schemas' projections and the simulator's renderer read this radius.
+
+    Within it :func:`distort` is one-to-one. Its Jacobian is symmetric (the map is a
+    gradient); in the basis (radial, tangential) the radial terms give eigenvalues
+    ``1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6`` and ``1 + k1 r^2 + k2 r^4 + k3 r^6``, and the
+    tangential terms ``2 q x^T + 2 x q^T + 2 (q . x) I`` (``q = (p2, p1)``) add a matrix whose
+    eigenvalues are ``2 |q| r (2 cos b +- 1)``, at least ``-6 |q| r``. So the Jacobian is
+    positive definite on the disk where both
+
+    .. math:: 1 - 6 |q| r + k_1 r^2 + k_2 r^4 + k_3 r^6 > 0, \qquad
+              1 - 6 |q| r + 3 k_1 r^2 + 5 k_2 r^4 + 7 k_3 r^6 > 0,
+
+    and the radius returned is the first positive root of either (infinite when neither has
+    one). On that disk (convex) ``(d(a) - d(b)) . (a - b) > 0`` for ``a != b``: no two rays
+    share a pixel. With ``p1 = p2 = 0`` it is exactly the radial fold (the second polynomial's
+    root comes first: the first is ``1/r`` times the integral of the second); tangential
+    terms move it inwards by about ``6 |q| r`` over the slope there, a sufficient bound, not
+    the exact edge of the one-to-one region.
+
+    Parameters
+    ----------
+    distortion : tuple of 5 floats, or None
+        OpenCV's (k1, k2, p1, p2, k3) (as :attr:`CameraIntrinsics.distortion`); None for an
+        ideal pinhole.
+
+    Returns
+    -------
+    float
+        The radius (dimensionless: the tangent of the angle off the optical axis), > 0;
+        ``math.inf`` when the lens never folds.
+
+    Raises
+    ------
+    InputError
+        For coefficients :class:`CameraIntrinsics` would refuse.
+
+    Examples
+    --------
+    >>> round(fold_radius((-0.14, 0.0, 0.0, 0.0, 0.0)), 6)   # 1 - 0.42 r^2 = 0: 57 degrees off axis
+    1.543033
+    >>> fold_radius((0.1, 0.01, 0.0, 0.0, 0.0)), fold_radius(None)   # pincushion, pinhole: never folds
+    (inf, inf)
+    """
+    if distortion is None:
+        return math.inf
+    try:
+        return _fold_radius(distortion)
+    except TypeError:  # unhashable (a list, an array): the same values as a tuple
+        return _fold_radius(tuple(float_array(distortion, "distortion").reshape(-1).tolist()))
+
+
+@functools.lru_cache(maxsize=256)
+def _fold_radius(distortion: tuple[float, ...]) -> float:
+    """:func:`fold_radius` of a hashable vector, cached (every projection of a camera asks for it)."""
+    k1, k2, p1, p2, k3 = opencv_distortion(float_array(distortion, "distortion"), "distortion")
+    tangential = -6.0 * math.hypot(p1, p2)
+    return min(
+        _first_zero(((1, tangential), (2, k1), (4, k2), (6, k3))),
+        _first_zero(((1, tangential), (2, 3.0 * k1), (4, 5.0 * k2), (6, 7.0 * k3))),
+    )
+
+
+def _first_zero(terms: tuple[tuple[int, float], ...]) -> float:
+    """Return a radius ``R`` with ``1 + sum(c r^i) > 0`` proved on ``[0, R)``, just below the first zero.
+
+    ``terms`` are (power >= 1, coefficient). Intervals of r are proved positive by interval
+    arithmetic (each power is monotone for r > 0: positive terms at the interval's left end,
+    negative ones at its right end), left to right, doubling outwards; the left end of the
+    first interval that cannot be proved positive at width ``_FOLD_RESOLUTION`` is returned.
+    Unlike the companion matrix's roots, this cannot lose a root to bad scaling: it can only
+    stop early, which moves the fold inwards. ``math.inf`` when no zero lies below
+    ``_FOLD_HORIZON``.
+    """
+    live = [(power, c) for power, c in terms if c != 0.0]
+    if all(c > 0.0 for _, c in live):
+        return math.inf  # 1 plus positive terms never vanishes (no terms: the constant 1)
+    # Below this radius every term is smaller than 1 / len(live): the sum stays positive.
+    log_start = min(-(math.log(len(live)) + math.log(abs(c))) / power for power, c in live)
+    if log_start >= math.log(_FOLD_HORIZON):
+        return math.inf
+    a = math.exp(log_start)
+    while a < _FOLD_HORIZON:
+        stack = [(a, 2.0 * a)]
+        while stack:
+            lo, hi = stack.pop()
+            positive, negative = 1.0, 0.0
+            for power, c in live:
+                if c > 0.0:
+                    positive += c * lo**power
+                else:
+                    negative += c * hi**power
+            if positive + negative > _FOLD_ROUNDING * (positive - negative):
+                continue  # proved positive on [lo, hi]
+            if hi - lo <= _FOLD_RESOLUTION * lo:
+                return lo
+            middle = 0.5 * (lo + hi)
+            stack += [(middle, hi), (lo, middle)]  # the left half first
+        a *= 2.0
+    return math.inf
 
 
 #: The lengths of OpenCV's distortion vector: (k1, k2, p1, p2[, k3[, k4, k5, k6[, s1-s4[, taux, tauy]]]]).
@@ -273,7 +394,22 @@ class Camera:
         return np.asarray(robot @ self.mount.rotation(), dtype=np.float64)
 
     def project_camera_frame(self, points_camera: ArrayLike) -> Array:
-        """Project camera-frame points ``(..., 3)`` to pixels ``(..., 2)``; NaN behind the camera."""
+        """Project camera-frame points ``(..., 3)`` to pixels ``(..., 2)``; NaN where not imaged.
+
+        A point is imaged when it is in front of the camera (``z > NEAR_PLANE``) and, with
+        lens distortion, its ray lies within the lens's fold (``(x/z)^2 + (y/z)^2 <=
+        fold_radius^2``, :func:`fold_radius`): beyond it the distortion polynomial folds
+        back onto the pixels of nearer rays, which this camera does not model.
+
+        Examples
+        --------
+        >>> lens = CameraIntrinsics(300, 300, 320, 240, 640, 480, distortion=(-0.14, 0, 0, 0, 0))
+        >>> camera = Camera(lens, CameraMount(height=1.0))
+        >>> camera.project_camera_frame([(0.0, 0.0, 5.0), (0.0, 0.0, -5.0)]).tolist()   # behind: NaN
+        [[320.0, 240.0], [nan, nan]]
+        >>> camera.project_camera_frame([(1.5, 0.0, 1.0), (1.6, 0.0, 1.0)]).round(1).tolist()   # fold: 1.543
+        [[628.2, 240.0], [nan, nan]]
+        """
         pts = np.asarray(points_camera, dtype=np.float64)
         z = pts[..., 2]
         in_front = z > NEAR_PLANE
@@ -282,13 +418,19 @@ class Camera:
             y = np.where(in_front, pts[..., 1] / z, np.nan)
         k = self.intrinsics
         if k.distortion is not None:
+            limit = fold_radius(k.distortion)
+            if limit < math.inf:
+                with np.errstate(over="ignore", invalid="ignore"):
+                    beyond = x * x + y * y > limit * limit  # NaN (behind) compares False: stays NaN
+                x, y = np.where(beyond, np.nan, x), np.where(beyond, np.nan, y)
             x, y = distort(x, y, k.distortion)
         return np.asarray(np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1), dtype=np.float64)
 
     def project(self, pose: Pose | ArrayLike, points_world: ArrayLike) -> Array:
         """Project world points ``(n, 3)`` (m) seen from a robot pose to pixels ``(n, 2)``.
 
-        Points behind the camera give NaN. ``pose`` may also be an ``(m, 3)`` array of
+        Points the camera does not image give NaN: behind it, or beyond the lens's fold
+        (:meth:`project_camera_frame`). ``pose`` may also be an ``(m, 3)`` array of
         poses, giving an ``(m, n, 2)`` array.
         """
         if isinstance(pose, Pose):

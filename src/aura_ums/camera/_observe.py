@@ -39,10 +39,14 @@ Floating-point rounding is not directed; it is covered by a documented safety ma
 every error bound is multiplied by ``1 + _SAFETY_RELATIVE`` and increased by
 ``_SAFETY_ABSOLUTE`` (radians or metres), and intermediate boxes are padded by ``1e-12``.
 
-Assumptions: the distortion model is one-to-one over the image (true of any usable
-calibration; OpenCV's iterative undistortion assumes the same); the distortion
-coefficients and the mount's ``forward``/``left`` are exact; the landmark is where the
-landmark says (its own ``position_uncertainty`` is for the reduction to handle).
+The camera images only the rays within the lens's fold (:func:`~aura_ums.camera.fold_radius`),
+where the distortion is proved one-to-one: a pixel is inverted to the one ray within the fold
+that reaches it (NaN, or an error, where none does), and an enclosure is kept only when its
+box lies within the fold, so that the unique solution it proves is that ray.
+
+Assumptions: the distortion coefficients and the mount's ``forward``/``left`` are exact;
+the landmark is where the landmark says (its own ``position_uncertainty`` is for the
+reduction to handle).
 """
 
 from __future__ import annotations
@@ -56,7 +60,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, points_array
-from aura_ums.camera._model import Camera, CameraIntrinsics, distort
+from aura_ums.camera._model import Camera, CameraIntrinsics, distort, fold_radius
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
 
@@ -227,7 +231,7 @@ def _point_jacobian(x: Array, y: Array, k: Coefficients) -> tuple[Array, Array, 
 
 
 def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int) -> tuple[Array, Array]:
-    """Invert :func:`distort` point by point; NaN where it does not converge to the principal branch."""
+    """Invert :func:`distort` point by point; NaN where it finds no ray within the lens's fold."""
     k1, k2, p1, p2, k3 = k
     x, y = xd.copy(), yd.copy()
     with np.errstate(all="ignore"):
@@ -252,6 +256,8 @@ def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int
             fx, fy = distort(x, y, k)
         j00, j01, j10, j11 = _point_jacobian(x, y, k)
         good = (np.hypot(fx - xd, fy - yd) <= _UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
+        limit = fold_radius(k)
+        good &= x * x + y * y <= limit * limit  # the rays the camera images (Camera.project_camera_frame)
     return np.where(good, x, np.nan), np.where(good, y, np.nan)
 
 
@@ -260,8 +266,10 @@ def undistort_points(intrinsics: CameraIntrinsics, pixels: ArrayLike, *, iterati
 
     The iterative inverse of OpenCV's radial-tangential model, as ``cv::undistortPoints``
     (``iterations`` fixed-point steps), polished by Newton steps and checked: a pixel
-    whose residual exceeds 1e-10 (normalized units), or that lies beyond the fold of
-    the distortion polynomial, gives NaN.
+    whose residual exceeds 1e-10 (normalized units), or whose ray lies beyond the fold of
+    the distortion polynomial (:func:`~aura_ums.camera.fold_radius`, where the camera
+    images nothing), gives NaN. Within the fold the distortion is one-to-one, so a ray
+    found there is the only one the camera images at that pixel.
 
     Parameters
     ----------
@@ -283,7 +291,7 @@ def undistort_points(intrinsics: CameraIntrinsics, pixels: ArrayLike, *, iterati
     >>> undistort_points(k, [(320, 240)]).tolist()   # the principal point is its own image
     [[0.0, 0.0]]
     >>> bad = CameraIntrinsics(500, 500, 320, 240, 640, 480, distortion=(-1.0, 0.0, 0.0, 0.0, 0.0))
-    >>> undistort_points(bad, [(639, 479)]).tolist()  # beyond the fold of r(1 - r^2): no ray
+    >>> undistort_points(bad, [(639, 479)]).tolist()  # beyond the image of r(1 - r^2)'s fold: no ray
     [[nan, nan]]
     """
     if not isinstance(intrinsics, CameraIntrinsics):
@@ -328,13 +336,16 @@ def _undistort_box(xd: _Interval, yd: _Interval, k: Coefficients | None) -> tupl
         return (c0 + m00 * d0 + m01 * d1).padded(pad), (c1 + m10 * d0 + m11 * d1).padded(pad)
 
     for _ in range(_KRAWCZYK_STEPS):
-        k0, k1 = krawczyk(x0, x1)
-        inside = (k0.lo >= x0.lo) & (k0.hi <= x0.hi) & (k1.lo >= x1.lo) & (k1.hi <= x1.hi)
-        if np.all(inside):
-            break
-        # epsilon-inflation of the boxes that failed, keeping the ones that passed
-        grow0 = k0.padded(0.5 * (k0.hi - k0.lo) + pad)
-        grow1 = k1.padded(0.5 * (k1.hi - k1.lo) + pad)
+        # A box inflated past the fold may overflow (inf, then NaN): it then never passes the
+        # test below, and the loop ends in the error; numpy need not warn about it.
+        with np.errstate(over="ignore", invalid="ignore"):
+            k0, k1 = krawczyk(x0, x1)
+            inside = (k0.lo >= x0.lo) & (k0.hi <= x0.hi) & (k1.lo >= x1.lo) & (k1.hi <= x1.hi)
+            if np.all(inside):
+                break
+            # epsilon-inflation of the boxes that failed, keeping the ones that passed
+            grow0 = k0.padded(0.5 * (k0.hi - k0.lo) + pad)
+            grow1 = k1.padded(0.5 * (k1.hi - k1.lo) + pad)
         x0 = _Interval(np.where(inside, x0.lo, np.minimum(grow0.lo, mx)), np.where(inside, x0.hi, grow0.hi))
         x1 = _Interval(np.where(inside, x1.lo, np.minimum(grow1.lo, my)), np.where(inside, x1.hi, grow1.hi))
         x0 = _Interval(x0.lo, np.maximum(x0.hi, mx))
@@ -348,7 +359,18 @@ def _undistort_box(xd: _Interval, yd: _Interval, k: Coefficients | None) -> tupl
     for _ in range(2):
         x0, x1 = k0.intersect(x0), k1.intersect(x1)
         k0, k1 = krawczyk(x0, x1)
-    return k0.intersect(x0), k1.intersect(x1)
+    x0, x1 = k0.intersect(x0), k1.intersect(x1)
+    # The solution proved unique in the box is the imaged ray only if the box lies within the
+    # fold, where the distortion is one-to-one: beyond, a ray within the fold elsewhere may
+    # share the pixel.
+    limit = fold_radius(k)
+    reach = np.maximum(x0.lo * x0.lo, x0.hi * x0.hi) + np.maximum(x1.lo * x1.lo, x1.hi * x1.hi)
+    if not bool(np.all(reach <= limit * limit)):
+        raise InputError(
+            "pixel: expected error bounds small enough to bound the undistortion, "
+            "got a box that reaches the fold of the distortion model"
+        )
+    return x0, x1
 
 
 # ------------------------------------------------------------------ calibration bounds

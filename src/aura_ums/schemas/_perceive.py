@@ -31,6 +31,7 @@ from aura_ums.camera import (
     NEAR_PLANE,
     CalibrationBounds,
     Camera,
+    fold_radius,
     robot_from_camera_rotation,
     undistort_points,
 )
@@ -308,7 +309,8 @@ def predicted_shift(
     The detection's pixel is back-projected from the pose at detection time to a world
     point at the landmark's known distance (Class I and II: its horizontal range from
     the camera; Class III: the ground plane); that point is projected from ``pose``. None
-    when it is then behind the camera (the landmark has left the view).
+    when the camera does not image it from there, behind the camera or beyond the lens's
+    fold (the landmark has left the view).
     """
     k = camera.intrinsics
     if k.distortion is None:
@@ -359,7 +361,11 @@ def _rotation(pan: float, tilt: float) -> tuple[float, ...]:
 def _project(
     camera: Camera, r: tuple[float, ...], pose: Pose, point: tuple[float, float, float]
 ) -> tuple[float, float] | None:
-    """:meth:`Camera.project` of one world point (m) from one pose, on floats; None behind the camera."""
+    """:meth:`Camera.project` of one world point (m) from one pose, on floats; None where it gives NaN.
+
+    None behind the camera and beyond the lens's fold (:func:`~aura_ums.camera.fold_radius`),
+    as :meth:`Camera.project_camera_frame`.
+    """
     mount, k = camera.mount, camera.intrinsics
     c, s = math.cos(pose.heading), math.sin(pose.heading)
     dx, dy = point[0] - pose.x, point[1] - pose.y
@@ -371,9 +377,12 @@ def _project(
         return None
     x = (bx * r[0] + by * r[3] + bz * r[6]) / z
     y = (bx * r[1] + by * r[4] + bz * r[7]) / z
-    if k.distortion is not None:  # camera.distort's polynomial, on floats
-        k1, k2, p1, p2, k3 = k.distortion
+    if k.distortion is not None:  # camera.distort's polynomial, on floats, within the fold
+        limit = fold_radius(k.distortion)
         r2 = x * x + y * y
+        if not r2 <= limit * limit:
+            return None
+        k1, k2, p1, p2, k3 = k.distortion
         radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
         x, y = (
             x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),

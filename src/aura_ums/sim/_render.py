@@ -4,8 +4,10 @@ The image is drawn in painter's order on a float buffer:
 
 1. the background, computed once per camera (the camera is fixed on the robot and the
    ground is flat): sky shaded by elevation above the horizon, bare ground below it;
-2. ground patches and strips, clipped to the half-space in front of the camera, projected
-   with :meth:`~aura_ums.camera.Camera.project_camera_frame` and filled;
+2. ground patches and strips, clipped to the half-space in front of the camera (and, with
+   lens distortion, to the cone of rays within the lens's fold,
+   :func:`~aura_ums.camera.fold_radius`: the camera images no others), projected with
+   :meth:`~aura_ums.camera.Camera.project_camera_frame` and filled;
 3. the ground texture, looked up at the world point of every ground pixel (the point is
    fixed in the robot frame, so only a rotation and a translation per frame) and faded
    with distance;
@@ -24,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._validate import check_rng, integer_at_least, nonnegative_float
-from aura_ums.camera import Camera, undistort_points
+from aura_ums.camera import Camera, fold_radius, undistort_points
 from aura_ums.errors import InputError
 from aura_ums.sim._scene import Building, Pole, Scene
 from aura_ums.uncertainty import Pose
@@ -42,6 +44,9 @@ TEXTURE_HORIZON = 500.0
 
 #: Points per polygon edge when the camera has lens distortion (edges become curves).
 DISTORTION_SUBDIVISIONS = 8
+
+#: Bisections locating where a polygon's edge leaves the cone of the lens's fold (2**-50 of the edge).
+_FOLD_BISECTIONS = 50
 
 _SKY_SPAN = math.radians(30.0)
 
@@ -106,6 +111,45 @@ def _clip_near(points: Array, near: float) -> Array:
         if a_in != b_in:
             t = (near - a[2]) / (b[2] - a[2])
             out.append(a + t * (b - a))
+    return np.array(out)
+
+
+def _clip_fold(points: Array, limit: float) -> Array:
+    """Clip a planar polygon ``(n, 3)`` in front of the camera to the rays within the lens's fold.
+
+    The cone ``(x/z)^2 + (y/z)^2 <= limit^2`` (``z > 0``) is convex, so Sutherland-Hodgman
+    applies: each edge that leaves it is cut where it does, found by bisection and kept on
+    the inside by the very test :meth:`~aura_ums.camera.Camera.project_camera_frame` makes;
+    the cone's curved boundary between two cuts becomes their chord, which lies inside.
+    """
+    bound = limit * limit
+    with np.errstate(over="ignore", invalid="ignore"):
+        x, y = points[:, 0] / points[:, 2], points[:, 1] / points[:, 2]
+        inside = x * x + y * y <= bound
+    if inside.all():
+        return points
+    if not inside.any():
+        return points[:0]
+    out: list[Array] = []
+    n = len(points)
+    for i in range(n):
+        a, b = points[i], points[(i + 1) % n]
+        a_in, b_in = bool(inside[i]), bool(inside[(i + 1) % n])
+        if a_in:
+            out.append(a)
+        if a_in != b_in:
+            start, end = (a, b) if a_in else (b, a)
+            (sx, sy, sz), (dx, dy, dz) = start.tolist(), (end - start).tolist()
+            low, high = 0.0, 1.0  # start + low * (end - start) is inside, + high * (...) outside
+            for _ in range(_FOLD_BISECTIONS):
+                middle = 0.5 * (low + high)
+                z = sz + middle * dz
+                u, v = (sx + middle * dx) / z, (sy + middle * dy) / z
+                if u * u + v * v <= bound:
+                    low = middle
+                else:
+                    high = middle
+            out.append(start + low * (end - start))
     return np.array(out)
 
 
@@ -245,12 +289,21 @@ class SyntheticCamera:
 
     def _project_polygon(self, points_camera: Array) -> Array:
         clipped = _clip_near(points_camera, _CLIP_NEAR)
+        distortion = self._camera.intrinsics.distortion
+        if distortion is not None and len(clipped) >= 3:
+            limit = fold_radius(distortion)
+            if limit < math.inf:
+                clipped = _clip_fold(clipped, limit)
         if len(clipped) < 3:
             return clipped[:, :2]
-        if self._camera.intrinsics.distortion is not None:
+        if distortion is not None:
             nxt = np.roll(clipped, -1, axis=0)
             steps = np.arange(DISTORTION_SUBDIVISIONS)[None, :, None] / DISTORTION_SUBDIVISIONS
             clipped = (clipped[:, None, :] + steps * (nxt - clipped)[:, None, :]).reshape(-1, 3)
+            # A point of a chord between two cuts of the fold's cone is inside it; should rounding
+            # put one out (NaN), the polygon is drawn without that point rather than not at all.
+            pixels = self._camera.project_camera_frame(clipped)
+            return pixels[np.isfinite(pixels).all(axis=1)]
         return self._camera.project_camera_frame(clipped)
 
     def _fill_all(
