@@ -601,18 +601,15 @@ def _most_pieces(
     start, stop = _turned_headings(uncertainty_map, command, terrains, sigmas)
     width = stop - start + 2.0 * _PARALLEL
     reach = _skitter(command, terrains, sigmas) + POSITION_TOLERANCE
-    vertices = uncertainty_map.polygon.vertices
-    for meadow in near:
-        planes = meadow_map._halfplanes[meadow_map._meadow_index[meadow.id]]
-        # an edge runs along its outward normal turned by a quarter turn, either way
-        parallel = np.mod(planes[:, 3] + math.pi / 2.0 - start + _PARALLEL, math.pi) <= width
-        offsets = vertices @ planes[:, :2].T  # (vertex, edge), metres along each normal
-        on_line = (offsets.min(axis=0) - reach <= planes[:, 2]) & (
-            planes[:, 2] <= offsets.max(axis=0) + reach
-        )
-        if np.any(parallel & on_line):
-            return 2 * count + 1
-    return count
+    planes = np.concatenate([meadow_map._halfplanes[meadow_map._meadow_index[m.id]] for m in near])
+    # an edge runs along its outward normal turned by a quarter turn, either way
+    parallel = np.mod(planes[:, 3] + math.pi / 2.0 - start + _PARALLEL, math.pi) <= width
+    if not np.any(parallel):
+        return count
+    offsets = uncertainty_map.polygon.vertices @ planes[parallel, :2].T  # (vertex, edge), metres
+    offset = planes[parallel, 2]
+    on_line = (offsets.min(axis=0) - reach <= offset) & (offset <= offsets.max(axis=0) + reach)
+    return 2 * count + 1 if np.any(on_line) else count
 
 
 #: Radians: headings this close to an edge's direction count as running along it.
