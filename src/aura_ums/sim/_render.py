@@ -21,6 +21,7 @@ rows and columns of their bounding box.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -94,9 +95,14 @@ def fill_polygon(image: NDArray[np.float32], polygon: Array, value: float) -> No
     image[row0:row1, col0:col1][mask] = value
 
 
-def _clip_near(points: Array, near: float) -> Array:
-    """Clip a planar polygon ``(n, 3)`` in the camera frame to ``z >= near`` (Sutherland-Hodgman)."""
-    inside = points[:, 2] >= near
+def _clip_convex(
+    points: Array, inside: NDArray[np.bool_], cut: Callable[[Array, Array, bool], Array]
+) -> Array:
+    """Clip a planar polygon ``(n, 3)`` to a convex region (Sutherland-Hodgman).
+
+    ``inside`` marks the vertices in the region; ``cut(a, b, a_inside)`` returns the point
+    where the edge from vertex ``a`` to the next, ``b``, crosses the region's boundary.
+    """
     if inside.all():
         return points
     if not inside.any():
@@ -109,48 +115,48 @@ def _clip_near(points: Array, near: float) -> Array:
         if a_in:
             out.append(a)
         if a_in != b_in:
-            t = (near - a[2]) / (b[2] - a[2])
-            out.append(a + t * (b - a))
+            out.append(cut(a, b, a_in))
     return np.array(out)
+
+
+def _clip_near(points: Array, near: float) -> Array:
+    """Clip a planar polygon ``(n, 3)`` in the camera frame to ``z >= near``."""
+
+    def cut(a: Array, b: Array, _: bool) -> Array:
+        t = (near - a[2]) / (b[2] - a[2])
+        return np.asarray(a + t * (b - a), dtype=np.float64)
+
+    return _clip_convex(points, points[:, 2] >= near, cut)
 
 
 def _clip_fold(points: Array, limit: float) -> Array:
     """Clip a planar polygon ``(n, 3)`` in front of the camera to the rays within the lens's fold.
 
-    The cone ``(x/z)^2 + (y/z)^2 <= limit^2`` (``z > 0``) is convex, so Sutherland-Hodgman
-    applies: each edge that leaves it is cut where it does, found by bisection and kept on
-    the inside by the very test :meth:`~aura_ums.camera.Camera.project_camera_frame` makes;
-    the cone's curved boundary between two cuts becomes their chord, which lies inside.
+    The cone ``(x/z)^2 + (y/z)^2 <= limit^2`` (``z > 0``) is convex: each edge that leaves
+    it is cut where it does, found by bisection and kept on the inside by the very test
+    :meth:`~aura_ums.camera.Camera.project_camera_frame` makes; the cone's curved boundary
+    between two cuts becomes their chord, which lies inside.
     """
     bound = limit * limit
     with np.errstate(over="ignore", invalid="ignore"):
         x, y = points[:, 0] / points[:, 2], points[:, 1] / points[:, 2]
         inside = x * x + y * y <= bound
-    if inside.all():
-        return points
-    if not inside.any():
-        return points[:0]
-    out: list[Array] = []
-    n = len(points)
-    for i in range(n):
-        a, b = points[i], points[(i + 1) % n]
-        a_in, b_in = bool(inside[i]), bool(inside[(i + 1) % n])
-        if a_in:
-            out.append(a)
-        if a_in != b_in:
-            start, end = (a, b) if a_in else (b, a)
-            (sx, sy, sz), (dx, dy, dz) = start.tolist(), (end - start).tolist()
-            low, high = 0.0, 1.0  # start + low * (end - start) is inside, + high * (...) outside
-            for _ in range(_FOLD_BISECTIONS):
-                middle = 0.5 * (low + high)
-                z = sz + middle * dz
-                u, v = (sx + middle * dx) / z, (sy + middle * dy) / z
-                if u * u + v * v <= bound:
-                    low = middle
-                else:
-                    high = middle
-            out.append(start + low * (end - start))
-    return np.array(out)
+
+    def cut(a: Array, b: Array, a_inside: bool) -> Array:
+        start, end = (a, b) if a_inside else (b, a)
+        (sx, sy, sz), (dx, dy, dz) = start.tolist(), (end - start).tolist()
+        low, high = 0.0, 1.0  # start + low * (end - start) is inside, + high * (...) outside
+        for _ in range(_FOLD_BISECTIONS):
+            middle = 0.5 * (low + high)
+            z = sz + middle * dz
+            u, v = (sx + middle * dx) / z, (sy + middle * dy) / z
+            if u * u + v * v <= bound:
+                low = middle
+            else:
+                high = middle
+        return np.asarray(start + low * (end - start), dtype=np.float64)
+
+    return _clip_convex(points, inside, cut)
 
 
 class SyntheticCamera:
