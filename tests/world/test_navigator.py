@@ -509,6 +509,18 @@ def test_the_first_metres_in_the_start_meadow_pay_no_inertial_loss_of_their_own(
     assert outside == 0
 
 
+def _east_from_nine(run: float) -> tuple[MeadowMap, TerrainTable, SpatialUncertaintyMap, Pose]:
+    """Meadows A (x 0 to 10 m) and B (10 to 20 m) losing 0.5 m per piece, nothing else; a point map
+    at (9, 2) facing east, grown by ``run`` metres, and a true robot's end pose."""
+    table = TerrainTable({"t": TerrainStats(0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)})
+    world = MeadowMap([_rect("A", 0, 0, 10, 4, "t"), _rect("B", 10, 0, 20, 4, "t")], [])
+    pose = Pose(9.0, 2.0, 0.0)
+    command = TurnAndRun(0.0, run)
+    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
+    truth = SimulatedRobot(world, table, pose, np.random.default_rng(0), truncate=3.0).execute(command)
+    return world, table, grown, truth
+
+
 def test_a_rest_too_short_to_pay_the_inertial_losses_leaves_them_to_the_first_metres() -> None:
     """A true piece cut just past the first part loses its whole inertial loss there.
 
@@ -517,12 +529,7 @@ def test_a_rest_too_short_to_pay_the_inertial_losses_leaves_them_to_the_first_me
     map held only 10.0 to 10.05 m, while the robot's 1 m piece in A keeps 0.5 m and its
     0.05 m piece in B nothing: it stops at 9.5 m.
     """
-    table = TerrainTable({"t": TerrainStats(0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)})  # 0.5 m per piece
-    world = MeadowMap([_rect("A", 0, 0, 10, 4, "t"), _rect("B", 10, 0, 20, 4, "t")], [])
-    pose = Pose(9.0, 2.0, 0.0)
-    command = TurnAndRun(0.0, 1.05)
-    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
-    truth = SimulatedRobot(world, table, pose, np.random.default_rng(0), truncate=3.0).execute(command)
+    _, _, grown, truth = _east_from_nine(1.05)
     assert truth.x == pytest.approx(9.5)
     assert grown.contains(truth)
     # The least run: 1.05 m less the two pieces' losses (not the 1 m of the first part).
@@ -557,12 +564,7 @@ def test_a_run_across_boundaries_loses_one_inertial_loss_per_meadow() -> None:
     map's least run is 3 m less two losses, to the metre. A run along the edge the two
     meadows share (heading north on x = 10) may alternate between them: five losses.
     """
-    table = TerrainTable({"t": TerrainStats(0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)})  # 0.5 m per piece
-    world = MeadowMap([_rect("A", 0, 0, 10, 4, "t"), _rect("B", 10, 0, 20, 4, "t")], [])
-    pose = Pose(9.0, 2.0, 0.0)
-    command = TurnAndRun(0.0, 3.0)
-    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
-    truth = SimulatedRobot(world, table, pose, np.random.default_rng(0), truncate=3.0).execute(command)
+    world, table, grown, truth = _east_from_nine(3.0)
     assert truth.x == pytest.approx(11.0)
     assert grown.polygon.vertices[:, 0].min() == pytest.approx(11.0)
     assert grown.contains(truth)
