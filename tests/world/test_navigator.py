@@ -532,8 +532,8 @@ def test_a_rest_too_short_to_pay_the_inertial_losses_leaves_them_to_the_first_me
     _, _, grown, truth = _east_from_nine(1.05)
     assert truth.x == pytest.approx(9.5)
     assert grown.contains(truth)
-    # The least run: 1.05 m less the two pieces' losses (not the 1 m of the first part).
-    assert grown.polygon.vertices[:, 0].min() == pytest.approx(9.05)
+    # The least run: the first metre less A's own loss, the rest nothing (not the 1 m of the first part).
+    assert grown.polygon.vertices[:, 0].min() == pytest.approx(9.5)
 
 
 def test_small_maps_whose_runs_end_just_past_a_boundary_hold_every_true_run() -> None:
@@ -560,17 +560,100 @@ def test_small_maps_whose_runs_end_just_past_a_boundary_hold_every_true_run() ->
 def test_a_run_across_boundaries_loses_one_inertial_loss_per_meadow() -> None:
     """Crossing from A into B, a true run is two pieces: two losses, not the 2 n + 1 of a run along an edge.
 
-    From 9 m, 3 m east: 0.5 m kept of the 1 m in A, 1.5 m of the 2 m in B, so 11 m; the
-    map's least run is 3 m less two losses, to the metre. A run along the edge the two
-    meadows share (heading north on x = 10) may alternate between them: five losses.
+    From 9 m, 3 m east: 0.5 m kept of the 1 m in A, 1.5 m of the 2 m in B, so 11 m. The
+    map's least run is the first metre less A's loss and the other 2 m less two losses
+    (A's counted twice: the rest does not know where A's piece ends), 1.5 m, where five
+    losses would leave nothing of the rest. A run along the edge the two meadows share
+    (heading north on x = 10) may alternate between them: five losses.
     """
     world, table, grown, truth = _east_from_nine(3.0)
     assert truth.x == pytest.approx(11.0)
-    assert grown.polygon.vertices[:, 0].min() == pytest.approx(11.0)
+    assert grown.polygon.vertices[:, 0].min() == pytest.approx(10.5)
     assert grown.contains(truth)
     along = SpatialUncertaintyMap.from_pose(Pose(10.0, 0.5, math.pi / 2), 0.0, 0.0)
     north = grow_through(along, world, TurnAndRun(0.0, 3.0), table)
     assert north.polygon.vertices[:, 1].min() == pytest.approx(1.0)  # 3 m less five losses: 0.5 m
+
+
+def test_a_first_piece_that_loses_its_length_leaves_the_drift_of_the_next_meadow_all_of_the_run() -> None:
+    """The first 0.3 m are in A (no drift, 0.5 m lost per piece), the rest on ice (drift 0.3 rad/m).
+
+    The first part grew a straight 0.3 m, then the rest's arc. The robot's piece in A loses
+    all 0.3 m, so its whole arc on the ice starts 0.3 m further back: 204 of 2000 ended
+    outside, up to 0.12 m (helper-54's repro_prefix_drift.py).
+    """
+    table = TerrainTable(
+        {
+            "slab": TerrainStats(0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            "ice": TerrainStats(0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0, 0.0),
+        }
+    )
+    world = MeadowMap([_rect("A", 0, -5, 1, 5, "slab"), _rect("B", 1, -5, 10, 5, "ice")], [])
+    pose = Pose(0.7, 0.0, 0.0)
+    command = TurnAndRun(0.0, 3.0)
+    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
+    rng = np.random.default_rng(1)
+    outside = sum(
+        not grown.contains(SimulatedRobot(world, table, pose, rng, truncate=3.0).execute(command))
+        for _ in range(500)
+    )
+    assert outside == 0
+
+
+def test_a_start_within_the_tolerance_of_a_meadow_turns_on_its_terrain() -> None:
+    """5e-10 m outside A, the robot stands in A (MeadowMap.meadow_at's tolerance) and skitters on gravel.
+
+    The growth took only the meadows the map exactly meets (B), so the bog within A's skitter
+    was out of reach: 347 of 1000 runs outside, up to 0.98 m (repro_standing_tolerance.py).
+    """
+    table = TerrainTable(
+        {
+            "gravel": TerrainStats(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.0),
+            "slab": TerrainStats(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            "bog": TerrainStats(0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0),
+        }
+    )
+    world = MeadowMap(
+        [
+            _rect("A", 0, -1, 1, 1, "gravel"),
+            _rect("B", 1, -0.05, 3, 1, "slab"),
+            _rect("C", 1, -1, 3, -0.05, "bog"),
+        ],
+        [],
+    )
+    pose = Pose(1.0 + 5e-10, 0.0, -0.5)
+    command = TurnAndRun(0.5, 1.5)
+    standing = world.meadow_at(pose.x, pose.y)
+    assert standing is not None
+    assert standing.id == "A"
+    start = SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0)
+    assert [m.id for m in meadows_in_reach(world, start, command, table, 3.0)] == ["A", "B", "C"]
+    grown = grow_through(start, world, command, table)
+    rng = np.random.default_rng(3)
+    outside = sum(
+        not grown.contains(SimulatedRobot(world, table, pose, rng, truncate=3.0).execute(command))
+        for _ in range(300)
+    )
+    assert outside == 0
+
+
+def test_meadows_that_overlap_within_the_tolerance_may_cut_a_run_into_more_pieces() -> None:
+    """B, first in map order, bulges 1.5e-7 m into A (7.5e-7 m^2, accepted): a run north along it is A, B, A.
+
+    Three pieces of 1 m loss each, where the growth counted one (it took A alone): the
+    robot ran 5.25 m of 8, the map held only 7 m (repro_overlap_bulge.py).
+    """
+    bulge = 1.5e-7
+    b = Meadow("B", ConvexPolygon([(5, 0), (10, 0), (10, 10), (5, 10), (5 - bulge, 5)]), "t")
+    world = MeadowMap([b, _rect("A", 0, 0, 5, 10, "t")], [])
+    table = TerrainTable({"t": TerrainStats(0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)})
+    pose = Pose(5 - 1e-7, 1.0, math.pi / 2 + 1e-8)
+    command = TurnAndRun(0.0, 8.0)
+    assert [p.meadow_id for p in split_run(world, (pose.x, pose.y), pose.heading, 8.0)] == ["A", "B", "A"]
+    grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
+    truth = SimulatedRobot(world, table, pose, np.random.default_rng(47), truncate=3.0).execute(command)
+    assert truth.y == pytest.approx(6.25)
+    assert grown.contains(truth)
 
 
 def test_a_run_along_a_shared_boundary_may_cross_a_meadow_twice() -> None:

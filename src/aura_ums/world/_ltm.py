@@ -341,6 +341,7 @@ class MeadowMap:
     _halfplanes: tuple[NDArray[np.float64], ...]
     _portals: Mapping[tuple[str, str], NDArray[np.float64]]
     _adjacent: Mapping[str, tuple[str, ...]]
+    _overlapping: frozenset[int]
 
     def __init__(
         self,
@@ -418,7 +419,7 @@ class MeadowMap:
 
         shapes = tuple(shapely.Polygon(m.polygon.vertices) for m in meadow_tuple)
         tree = shapely.STRtree(shapes)
-        portals, adjacent = _adjacency(meadow_tuple, shapes, tree)
+        portals, adjacent, overlapping = _adjacency(meadow_tuple, shapes, tree)
 
         object.__setattr__(self, "meadows", meadow_tuple)
         object.__setattr__(self, "landmarks", landmark_tuple)
@@ -432,6 +433,7 @@ class MeadowMap:
         object.__setattr__(self, "_halfplanes", tuple(_halfplanes(m.polygon.vertices) for m in meadow_tuple))
         object.__setattr__(self, "_portals", types.MappingProxyType(portals))
         object.__setattr__(self, "_adjacent", types.MappingProxyType(adjacent))
+        object.__setattr__(self, "_overlapping", overlapping)
 
     # --- loading and saving ----------------------------------------------------------------
 
@@ -731,8 +733,13 @@ def _clip_edges(
 
 def _adjacency(
     meadows: Sequence[Meadow], shapes: Sequence[Polygon], tree: shapely.STRtree
-) -> tuple[dict[tuple[str, str], NDArray[np.float64]], dict[str, tuple[str, ...]]]:
-    """Find the portals between meadows; refuse overlapping meadows."""
+) -> tuple[dict[tuple[str, str], NDArray[np.float64]], dict[str, tuple[str, ...]], frozenset[int]]:
+    """Find the portals between meadows; refuse overlapping meadows.
+
+    Also return the indices of the meadows that overlap another within the tolerance: a
+    straight run may then leave one of them and come back (growth through meadows counts
+    its pieces accordingly).
+    """
     pairs = tree.query(list(shapes), predicate="dwithin", distance=_ADJACENCY_TOLERANCE)
     keep = pairs[0] < pairs[1]
     first, second = pairs[0][keep], pairs[1][keep]
@@ -767,7 +774,10 @@ def _adjacency(
         neighbours[a].append(int(j))
         neighbours[b].append(int(i))
     adjacent = {name: tuple(meadows[k].id for k in sorted(found)) for name, found in neighbours.items()}
-    return portals, adjacent
+    overlapping = frozenset(
+        int(k) for i, j, area in zip(first, second, overlap, strict=True) if area > 0.0 for k in (i, j)
+    )
+    return portals, adjacent, overlapping
 
 
 def _portal_segment(geometry: BaseGeometry) -> NDArray[np.float64] | None:

@@ -539,6 +539,9 @@ def grow_through(
         raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
     bound = SIGMAS.check(sigmas, "sigmas")
     meadow, prefix = _first_meadow_run(meadow_map, uncertainty_map, command, table, bound)
+    if meadow is not None and meadow_map._meadow_index[meadow.id] in meadow_map._overlapping:
+        # A meadow earlier in map order may take part of it: a run in it can leave it and come back.
+        meadow, prefix = None, 0.0
     if meadow is not None and prefix >= command.run:
         # Every true run stays in the one meadow every pose stands in (most growths).
         return uncertainty_map.grow(command, table[meadow.terrain], sigmas=bound, max_vertices=max_vertices)
@@ -558,20 +561,16 @@ def grow_through(
         return uncertainty_map.grow(command, terrain, sigmas=bound, max_vertices=max_vertices)
     # Every true run stays in the meadow it starts in for its first `prefix` metres: that
     # part grows on the meadow's terrain, the rest on the outer terrain of every meadow in
-    # reach, which pays the inertial losses. The first part pays none: a true run clips its
-    # piece as a whole (to no more than its length), not its first metres. But a rest too
-    # short to pay them all leaves the first part the remainder: a true piece cut just past
-    # `prefix` loses its whole loss there.
+    # reach, which pays the inertial losses. A true piece in that meadow is at least `prefix`
+    # long and loses its loss as a whole: the first part runs at least its least kept
+    # fraction less that loss (the robot may have lost it all before the next meadow's
+    # drift takes over), and at most its largest, as long as the rest (clipped to its length).
     rest = TurnAndRun(0.0, command.run - prefix)
     terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
-    own = dataclasses.replace(table[meadow.terrain], translation_inertial_loss=0.0)
-    owed = (
-        pieces * max(t.translation_inertial_loss for t in terrains)
-        - rest.run * _kept_interval(terrains, bound)[0]
-    )
-    if owed > 0.0:
-        low, high = _kept_interval([own], bound)
-        own = _running(own, prefix, max(0.0, prefix * low - owed), prefix * min(1.0, high), bound)
+    own = table[meadow.terrain]
+    low, high = _kept_interval([own], bound)
+    shortest = max(0.0, prefix * low - own.translation_inertial_loss)
+    own = _running(own, prefix, shortest, prefix * min(1.0, high), bound)
     first = uncertainty_map.grow(
         TurnAndRun(command.turn, prefix), own, sigmas=bound, max_vertices=max_vertices
     )
@@ -596,7 +595,7 @@ def _most_pieces(
     polygon, moved by the turn's skitter) can lie on its line.
     """
     count = len(near)
-    if command.run <= 0.0:
+    if command.run <= 0.0 or any(meadow_map._meadow_index[m.id] in meadow_map._overlapping for m in near):
         return 2 * count + 1
     start, stop = _turned_headings(uncertainty_map, command, terrains, sigmas)
     width = stop - start + 2.0 * _PARALLEL
@@ -792,7 +791,8 @@ def _reach(
     if inside is not None:
         standing, covered = np.array([inside]), True
     else:
-        standing = np.sort(tree.query(hull, predicate="intersects"))
+        # Within the tolerance, as MeadowMap.meadow_at (and so the true robot) finds them.
+        standing = np.sort(tree.query(hull, predicate="dwithin", distance=POSITION_TOLERANCE))
         covered = bool(len(standing)) and _covers(meadow_map, standing, hull)
     every = [] if covered else _every_terrain(meadow_map, table)
     if not len(standing):
