@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from aura_ums.camera import distort
+from aura_ums.camera import distort, fold_radius
 from aura_ums.expecter._distortion import distorted_range
 
 Array = NDArray[np.float64]
@@ -18,11 +18,22 @@ FOLDING: Coefficients = (2.7752199057918254, -2.5335874851127196, 0.0, 0.0, -0.4
 
 
 def sampled(points: Array, coefficients: Coefficients, rng: np.random.Generator, count: int) -> Array:
-    """Distorted (x_d, y_d) of random convex combinations of the points, and the points themselves."""
+    """Distorted (x_d, y_d) of random convex combinations of the points, and the points themselves.
+
+    Only those the camera images: within the lens's fold (beyond it, no ray reaches a pixel).
+    """
     weights = rng.dirichlet(np.full(len(points), 0.3), count)
     inside = np.vstack([points, weights @ points])
+    inside = inside[np.hypot(inside[:, 0], inside[:, 1]) <= fold_radius(coefficients)]
     x, y = distort(inside[:, 0], inside[:, 1], coefficients)
     return np.column_stack([x, y])
+
+
+def bounds(points: Array, coefficients: Coefficients, tolerance: float) -> tuple[Array, Array]:
+    """:func:`distorted_range`, for a region the camera images some of."""
+    found = distorted_range(points, coefficients, tolerance)
+    assert found is not None
+    return found
 
 
 def test_a_critical_point_on_a_cells_edge_is_not_missed(rng: np.random.Generator) -> None:
@@ -34,7 +45,7 @@ def test_a_critical_point_on_a_cells_edge_is_not_missed(rng: np.random.Generator
     attained, and the Expecter's window missed a true camera's pixel.
     """
     square = np.array([[0.65, -0.32], [1.0, -0.32], [1.0, 0.32], [0.65, 0.32]])
-    lower, upper = distorted_range(square, FOLDING, 1e-5)
+    lower, upper = bounds(square, FOLDING, 1e-5)
     values = sampled(square, FOLDING, rng, 200_000)
     assert values[:, 0].max() > 1.3  # the peak is inside
     assert np.all(values >= lower - 1e-12)
@@ -56,8 +67,33 @@ def test_every_distorted_point_of_a_region_lies_within_the_range(
 ) -> None:
     (cx, cy), (hx, hy) = centre, half
     box = np.array([[cx - hx, cy - hy], [cx + hx, cy - hy], [cx + hx, cy + hy], [cx - hx, cy + hy]])
-    lower, upper = distorted_range(box, k, 1e-6)
+    found = distorted_range(box, k, 1e-6)
+    if found is None:  # every point beyond the fold: none imaged
+        assert not len(sampled(box, k, np.random.default_rng(seed), 4000))
+        return
+    lower, upper = found
     values = sampled(box, k, np.random.default_rng(seed), 4000)
     slack = 1e-9 * (1.0 + np.abs(values))
     assert np.all(values >= lower - slack)
     assert np.all(values <= upper + slack)
+
+
+def test_the_range_is_taken_over_the_rays_within_the_fold(rng: np.random.Generator) -> None:
+    """Beyond the fold (r = 0.818 here) the polynomial falls back: those pixels are no ray's.
+
+    A region from r = 0.5 to 1.6 reaches x_d = -1.2 beyond the fold, where no ray is imaged;
+    within it x_d stays above 0.5. The bounds hold every imaged point and leave the rest out.
+    A region wholly beyond the fold is not imaged at all.
+    """
+    region = np.array([[0.5, -0.1], [1.6, -0.1], [1.6, 0.1], [0.5, 0.1]])
+    x, _ = distort(region[:, 0], region[:, 1], FOLDING)
+    assert x.min() < -1.0  # the corners beyond the fold
+    lower, upper = bounds(region, FOLDING, 1e-6)
+    values = sampled(region, FOLDING, rng, 100_000)
+    assert np.all(values >= lower - 1e-12)
+    assert np.all(values <= upper + 1e-12)
+    assert lower[0] > 0.4  # not the fold-back's -1.2
+    beyond = np.array([[1.0, -0.1], [1.6, -0.1], [1.6, 0.1], [1.0, 0.1]])
+    assert distorted_range(beyond, FOLDING, 1e-6) is None
+    assert distorted_range(np.array([[0.9, 0.0], [1.2, 0.0]]), FOLDING, 1e-6) is None  # a segment
+    assert distorted_range(np.array([[0.5, 0.0], [1.2, 0.0]]), FOLDING, 1e-6) is not None

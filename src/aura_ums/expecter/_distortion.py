@@ -1,5 +1,9 @@
 """Rigorous bounds of OpenCV's lens distortion over a convex region of normalized coordinates.
 
+The camera images only the rays within its lens's fold (:func:`~aura_ums.camera.fold_radius`),
+so the region is first cut to an outer polygon of that disk: the window need not hold the
+pixels the polynomial would give beyond it, which no ray reaches.
+
 The distortion map (k1, k2, p1, p2, k3) is a polynomial in (x, y). Its range over a
 convex polygon ``C`` is bounded by branch and bound on axis-aligned cells:
 
@@ -28,8 +32,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums.camera import distort
-from aura_ums.geometry import convex_hull, polygon_area, simplify_outer
+from aura_ums.camera import distort, fold_radius
+from aura_ums.geometry import clip_halfplane, convex_hull, polygon_area, simplify_outer
 
 Array = NDArray[np.float64]
 Interval = tuple[Array, Array]
@@ -42,6 +46,15 @@ _MAX_CELLS = 2048
 _HULL_VERTICES = 10
 #: ...when that polygon's area is at most this fraction larger than the hull's.
 _HULL_GROWTH = 0.05
+#: Sides of the polygon around the fold's disk that cuts the region (their distance from the
+#: centre is the fold radius, rounded outwards): at most 0.5% wider than the disk.
+_FOLD_SIDES = 32
+_FOLD_NORMALS = np.array(
+    [
+        (math.cos(2.0 * math.pi * i / _FOLD_SIDES), math.sin(2.0 * math.pi * i / _FOLD_SIDES))
+        for i in range(_FOLD_SIDES)
+    ]
+)
 #: Rounding slack, relative to the sum of the absolute values of the terms: 20 operations
 #: at 2**-53 each, for our evaluation and the camera's, with a safety factor of ten.
 _ROUNDING = 5e-14
@@ -55,8 +68,13 @@ _BERNSTEIN = np.array(
 )
 
 
-def distorted_range(points: Array, coefficients: Coefficients, tolerance: float) -> tuple[Array, Array]:
-    """Bound the distortion of the convex hull of ``points`` (normalized coordinates).
+def distorted_range(
+    points: Array, coefficients: Coefficients, tolerance: float
+) -> tuple[Array, Array] | None:
+    """Bound the distortion of the imaged part of the convex hull of ``points`` (normalized coordinates).
+
+    The imaged part is the hull within the lens's fold (:func:`~aura_ums.camera.fold_radius`),
+    taken as the hull cut by a polygon around the fold's disk: None when nothing of it is.
 
     When interval arithmetic proves that a coordinate of the distortion has no critical
     point in the hull (the usual case), its extremes lie on the hull's boundary and are
@@ -74,11 +92,14 @@ def distorted_range(points: Array, coefficients: Coefficients, tolerance: float)
 
     Returns
     -------
-    lower, upper : ndarray, shape (2,)
-        Bounds of (x_d, y_d) over the hull; may be infinite, never NaN.
+    lower, upper : ndarray, shape (2,), or None
+        Bounds of (x_d, y_d) over the imaged part of the hull; may be infinite, never NaN.
+        None when the whole hull lies beyond the fold.
     """
     with np.errstate(all="ignore"):
-        hull = _hull(points)
+        hull = _within_fold(_hull(points), fold_radius(coefficients))
+        if not len(hull):
+            return None
         lower, upper = _boundary_range(hull, coefficients, tolerance)
         free = _free_of_critical_points(hull, coefficients)
         if not np.all(free):
@@ -86,6 +107,25 @@ def distorted_range(points: Array, coefficients: Coefficients, tolerance: float)
             lower = np.where(free, lower, box_lower)
             upper = np.where(free, upper, box_upper)
         return lower, upper
+
+
+def _within_fold(hull: Array, limit: float) -> Array:
+    """Return the convex polygon ``hull`` cut to a polygon around the disk of radius ``limit``.
+
+    Sound: the polygon holds the disk. A hull of fewer than 3 vertices (a point, a segment)
+    is kept whole unless it lies beyond, where the camera images none of it.
+    """
+    if not math.isfinite(limit):
+        return hull
+    offset = limit * (1.0 + 1e-12)
+    reach = hull @ _FOLD_NORMALS.T  # (vertex, side)
+    if len(hull) < 3:
+        return hull[:0] if np.any(reach.min(axis=0) > offset) else hull
+    for side in np.flatnonzero(reach.max(axis=0) > offset):
+        hull = clip_halfplane(hull, _FOLD_NORMALS[side], offset)
+        if not len(hull):
+            break
+    return hull
 
 
 def _hull(points: Array) -> Array:

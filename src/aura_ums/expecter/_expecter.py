@@ -265,7 +265,10 @@ def _bounds(expecter: Expecter, map: SpatialUncertaintyMap, landmark: Landmark) 
         lower, upper = np.array([found.x_min, found.y_min]), np.array([found.x_max, found.y_max])
     else:
         tolerance = _DISTORTION_TOLERANCE_PIXELS / max(k.fx, k.fy)
-        lower, upper = distorted_range(found.points, k.distortion, tolerance)
+        imaged = distorted_range(found.points, k.distortion, tolerance)
+        if imaged is None:  # every ray beyond the lens's fold: not in view
+            return None
+        lower, upper = imaged
     # Zero bounds leave focal x + centre as it is, bit for bit (x - 0.0 is x).
     within = _EXACT if bounds is None else bounds
     with np.errstate(over="ignore", invalid="ignore"):
