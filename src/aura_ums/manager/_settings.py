@@ -629,7 +629,7 @@ class MapProfile(Choice):
       bearings only. It shrinks only where more than ``relaxed_q`` sightings of the window
       agree: with few sightings a frame and much growth between frames it keeps the truth
       but grows until the manager is lost (the simulator's four-terrain scenario, a frame
-      every 2 m: 54-55 of 60 runs lost, against 28-29 with ``PRODUCT`` and 15-18 with
+      every 2 m: 53-55 of 60 runs lost, against 27-30 with ``PRODUCT`` and 14-18 with
       ``SLICED``).
 
     Examples
