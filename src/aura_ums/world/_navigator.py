@@ -564,7 +564,7 @@ def grow_through(
     # reach, which pays the inertial losses. A true piece in that meadow is at least `prefix`
     # long and loses its loss as a whole: the first part runs at least its least kept
     # fraction less that loss (the robot may have lost it all before the next meadow's
-    # drift takes over), and at most its largest, as long as the rest (clipped to its length).
+    # drift takes over), and at most its largest kept fraction, no more than its length.
     rest = TurnAndRun(0.0, command.run - prefix)
     terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
     own = table[meadow.terrain]
