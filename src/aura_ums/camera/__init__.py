@@ -20,6 +20,7 @@ from aura_ums.camera._model import (
     distort,
     fold_radius,
     robot_from_camera_rotation,
+    within_fold,
 )
 from aura_ums.camera._observe import (
     CalibrationBounds,
@@ -46,4 +47,5 @@ __all__ = [
     "load_opencv_calibration",
     "robot_from_camera_rotation",
     "undistort_points",
+    "within_fold",
 ]

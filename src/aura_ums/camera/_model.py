@@ -144,6 +144,27 @@ def fold_radius(distortion: tuple[float, float, float, float, float] | None) -> 
         return _fold_radius(tuple(float_array(distortion, "distortion").reshape(-1).tolist()))
 
 
+def within_fold(
+    x: ArrayLike, y: ArrayLike, distortion: tuple[float, float, float, float, float] | None
+) -> NDArray[np.bool_]:
+    """Tell which normalized rays ``(x/z, y/z)`` the camera images: those within :func:`fold_radius`.
+
+    The one test of what a distorted camera sees (:meth:`Camera.project_camera_frame`, the
+    pixel observers, the simulator's renderer). NaN coordinates are not imaged.
+
+    Examples
+    --------
+    >>> within_fold([0.0, 1.5, 1.6, np.nan], [0.0, 0.0, 0.0, 0.0], (-0.14, 0.0, 0.0, 0.0, 0.0)).tolist()
+    [True, True, False, False]
+    >>> within_fold([1e200], [0.0], None).tolist()   # a pinhole images every ray in front of it
+    [True]
+    """
+    limit = fold_radius(distortion)
+    xs, ys = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.asarray(xs * xs + ys * ys <= limit * limit)
+
+
 @functools.lru_cache(maxsize=256)
 def _fold_radius(distortion: tuple[float, ...]) -> float:
     """:func:`fold_radius` of a hashable vector, cached (every projection of a camera asks for it)."""
@@ -418,11 +439,8 @@ class Camera:
             y = np.where(in_front, pts[..., 1] / z, np.nan)
         k = self.intrinsics
         if k.distortion is not None:
-            limit = fold_radius(k.distortion)
-            if limit < math.inf:
-                with np.errstate(over="ignore", invalid="ignore"):
-                    beyond = x * x + y * y > limit * limit  # NaN (behind) compares False: stays NaN
-                x, y = np.where(beyond, np.nan, x), np.where(beyond, np.nan, y)
+            imaged = within_fold(x, y, k.distortion)  # behind the camera: NaN, not imaged
+            x, y = np.where(imaged, x, np.nan), np.where(imaged, y, np.nan)
             x, y = distort(x, y, k.distortion)
         return np.asarray(np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1), dtype=np.float64)
 

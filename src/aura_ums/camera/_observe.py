@@ -60,7 +60,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, points_array
-from aura_ums.camera._model import Camera, CameraIntrinsics, distort, fold_radius
+from aura_ums.camera._model import Camera, CameraIntrinsics, distort, fold_radius, within_fold
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
 
@@ -256,8 +256,7 @@ def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int
             fx, fy = distort(x, y, k)
         j00, j01, j10, j11 = _point_jacobian(x, y, k)
         good = (np.hypot(fx - xd, fy - yd) <= _UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
-        limit = fold_radius(k)
-        good &= x * x + y * y <= limit * limit  # the rays the camera images (Camera.project_camera_frame)
+        good &= within_fold(x, y, k)  # the rays the camera images (Camera.project_camera_frame)
     return np.where(good, x, np.nan), np.where(good, y, np.nan)
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._validate import check_rng, integer_at_least, nonnegative_float
-from aura_ums.camera import Camera, fold_radius, undistort_points
+from aura_ums.camera import Camera, fold_radius, undistort_points, within_fold
 from aura_ums.errors import InputError
 from aura_ums.sim._scene import Building, Pole, Scene
 from aura_ums.uncertainty import Pose
@@ -129,28 +129,24 @@ def _clip_near(points: Array, near: float) -> Array:
     return _clip_convex(points, points[:, 2] >= near, cut)
 
 
-def _clip_fold(points: Array, limit: float) -> Array:
+def _clip_fold(points: Array, distortion: tuple[float, float, float, float, float]) -> Array:
     """Clip a planar polygon ``(n, 3)`` in front of the camera to the rays within the lens's fold.
 
-    The cone ``(x/z)^2 + (y/z)^2 <= limit^2`` (``z > 0``) is convex: each edge that leaves
-    it is cut where it does, found by bisection and kept on the inside by the very test
-    :meth:`~aura_ums.camera.Camera.project_camera_frame` makes; the cone's curved boundary
-    between two cuts becomes their chord, which lies inside.
+    The cone of rays :func:`~aura_ums.camera.within_fold` accepts (``z > 0``) is convex: each
+    edge that leaves it is cut where it does, found by bisection and kept on the inside by
+    that very test; the cone's curved boundary between two cuts becomes their chord, which
+    lies inside.
     """
-    bound = limit * limit
-    with np.errstate(over="ignore", invalid="ignore"):
-        x, y = points[:, 0] / points[:, 2], points[:, 1] / points[:, 2]
-        inside = x * x + y * y <= bound
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        inside = within_fold(points[:, 0] / points[:, 2], points[:, 1] / points[:, 2], distortion)
 
     def cut(a: Array, b: Array, a_inside: bool) -> Array:
         start, end = (a, b) if a_inside else (b, a)
-        (sx, sy, sz), (dx, dy, dz) = start.tolist(), (end - start).tolist()
         low, high = 0.0, 1.0  # start + low * (end - start) is inside, + high * (...) outside
         for _ in range(_FOLD_BISECTIONS):
             middle = 0.5 * (low + high)
-            z = sz + middle * dz
-            u, v = (sx + middle * dx) / z, (sy + middle * dy) / z
-            if u * u + v * v <= bound:
+            x, y, z = start + middle * (end - start)
+            if within_fold(x / z, y / z, distortion):
                 low = middle
             else:
                 high = middle
@@ -296,10 +292,8 @@ class SyntheticCamera:
     def _project_polygon(self, points_camera: Array) -> Array:
         clipped = _clip_near(points_camera, _CLIP_NEAR)
         distortion = self._camera.intrinsics.distortion
-        if distortion is not None and len(clipped) >= 3:
-            limit = fold_radius(distortion)
-            if limit < math.inf:
-                clipped = _clip_fold(clipped, limit)
+        if distortion is not None and len(clipped) >= 3 and fold_radius(distortion) < math.inf:
+            clipped = _clip_fold(clipped, distortion)
         if len(clipped) < 3:
             return clipped[:, :2]
         if distortion is not None:
