@@ -575,6 +575,22 @@ def test_a_run_across_boundaries_loses_one_inertial_loss_per_meadow() -> None:
     assert north.polygon.vertices[:, 1].min() == pytest.approx(1.0)  # 3 m less five losses: 0.5 m
 
 
+def _runs_outside(
+    grown: SpatialUncertaintyMap,
+    world: MeadowMap,
+    table: TerrainTable,
+    pose: Pose,
+    command: TurnAndRun,
+    rng: np.random.Generator,
+    runs: int,
+) -> int:
+    """How many of ``runs`` true robots from ``pose`` (at 3 sigmas) end outside ``grown``."""
+    return sum(
+        not grown.contains(SimulatedRobot(world, table, pose, rng, truncate=3.0).execute(command))
+        for _ in range(runs)
+    )
+
+
 def test_a_first_piece_that_loses_its_length_leaves_the_drift_of_the_next_meadow_all_of_the_run() -> None:
     """The first 0.3 m are in A (no drift, 0.5 m lost per piece), the rest on ice (drift 0.3 rad/m).
 
@@ -592,12 +608,7 @@ def test_a_first_piece_that_loses_its_length_leaves_the_drift_of_the_next_meadow
     pose = Pose(0.7, 0.0, 0.0)
     command = TurnAndRun(0.0, 3.0)
     grown = grow_through(SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0), world, command, table)
-    rng = np.random.default_rng(1)
-    outside = sum(
-        not grown.contains(SimulatedRobot(world, table, pose, rng, truncate=3.0).execute(command))
-        for _ in range(500)
-    )
-    assert outside == 0
+    assert _runs_outside(grown, world, table, pose, command, np.random.default_rng(1), 500) == 0
 
 
 def test_a_start_within_the_tolerance_of_a_meadow_turns_on_its_terrain() -> None:
@@ -629,12 +640,7 @@ def test_a_start_within_the_tolerance_of_a_meadow_turns_on_its_terrain() -> None
     start = SpatialUncertaintyMap.from_pose(pose, 0.0, 0.0)
     assert [m.id for m in meadows_in_reach(world, start, command, table, 3.0)] == ["A", "B", "C"]
     grown = grow_through(start, world, command, table)
-    rng = np.random.default_rng(3)
-    outside = sum(
-        not grown.contains(SimulatedRobot(world, table, pose, rng, truncate=3.0).execute(command))
-        for _ in range(300)
-    )
-    assert outside == 0
+    assert _runs_outside(grown, world, table, pose, command, np.random.default_rng(3), 300) == 0
 
 
 def test_meadows_that_overlap_within_the_tolerance_may_cut_a_run_into_more_pieces() -> None:
