@@ -142,14 +142,16 @@ def _child(folder: str, terrain: str, sensors: str, out: str) -> None:
 def _older_inputs(folder: Path, sensors: Path) -> Path:
     """Make the log and sensors file readable by a tree older than the sensor offset and the noise table.
 
-    The log's ``[sensor] forward`` and ``left`` are 0.0 (the default those trees assumed) and
-    a replay does not read the sensors file's ``[noise]`` (compare does): both are dropped.
+    The log's ``[sensor] forward`` and ``left`` are 0.0 (the default those trees assumed), a
+    replay does not read the sensors file's ``[noise]`` (compare does), and its ``growth = "move"``
+    names the growth those trees had: all three are dropped.
     """
     meta = folder / "meta.toml"
     kept = [line for line in meta.read_text().splitlines() if line not in ("forward = 0.0", "left = 0.0")]
     meta.write_text("\n".join(kept) + "\n")
     older = sensors.with_name("older.sensors.toml")
-    older.write_text(re.sub(r"\n\[noise\]\n(?:[^\[\n].*\n?|\n)*", "\n", sensors.read_text()))
+    text = re.sub(r"\n\[noise\]\n(?:[^\[\n].*\n?|\n)*", "\n", sensors.read_text())
+    older.write_text(text.replace('\ngrowth = "move"\n', "\n"))
     return older
 
 
