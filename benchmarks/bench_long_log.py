@@ -15,12 +15,33 @@ tree that refuses a log (more rows than it reads) is reported as failed.
     .venv/bin/python benchmarks/bench_long_log.py
     .venv/bin/python benchmarks/bench_long_log.py --rows 1000000 --frame-every 10 --src /tmp/old/src
 
-Measured on the 2-core development machine, 29 November 2026 about 09:39 UTC, shared
-(load average 0.57 to 0.84): this tree and 2ee5097 (the tree before that day's savings in
-reading, judging and posting; ``git archive`` of it with this tree's compiled kernel, built
-from the same C), one replay of each in turn, three of each, the medians. "load" is ``open_log``
-(one pass over ``groundtruth.csv``; the other files are parsed as the replay reads them,
-so their parsing is in the total):
+Against f47bbb6, the tree issue 19 was filed against (``git archive`` of it, its compiled
+kernel built from its own C sources; ``--src``), on the 2-core development machine, quiet
+(load average below 0.2, nothing else running), 29 November 2026 about 19:15 UTC: one
+replay of each in turn, three of each, the medians; at a frame every row, one of each
+(f47bbb6's with a helper's load of about 1.3 beside it). "load" is ``open_log`` (one pass
+over ``groundtruth.csv``; the other files are parsed as the replay reads them, so their
+parsing is in the total):
+
+===============================  ========  =====================  ======================  =====
+10^6 rows                        steps     this tree: load,       f47bbb6: load,          gain
+                                           update, total s; peak  update, total s; peak
+===============================  ========  =====================  ======================  =====
+a frame every 100 rows           9,335     0.10, 0.43, 0.86; 86   5.56, 0.44, 6.94; 746   8.1x
+a frame every 10 rows            93,359    0.11, 3.02, 5.24; 91   6.64, 3.73, 19.52; 785  3.7x
+a frame every row                932,437   0.11, 31.4, 52.1; 231  14.2, 50.5, 174.8; 2757 3.4x
+===============================  ========  =====================  ======================  =====
+
+At the command line (``aura-ums replay LOG --terrain T --metrics-json M --steps-csv S``,
+bytecode compiled, the same quiet machine), a frame every 100 rows: 1.16 and 1.22 s and
+101 MB against f47bbb6's 7.62 and 7.90 s and 780 MB, 6.5x; the interpreter, numpy, typer
+and the library's imports take about 0.2 s of each (``aura-ums --version``: 0.20 s).
+
+An earlier series against 2ee5097, the tree before that day's savings in reading, judging
+and posting, measured on the same machine on 29 November about 09:39 UTC, shared
+(load average 0.57 to 0.84): this tree and 2ee5097 (``git archive`` of it with this tree's
+compiled kernel, built from the same C), one replay of each in turn, three of each, the
+medians:
 
 ===============================  ========  =====================  =====================  =====
 10^6 rows                        steps     this tree: load,       2ee5097: load,         gain
@@ -33,9 +54,8 @@ a frame every 10 rows            93,359    0.19, 4.11, 7.38; 89   0.20, 4.14, 7.
 How to read it:
 
 - Times move by up to 2x with the machine's load (another process's, on these 2 cores):
-  compare trees only within one series. Against f47bbb6, the tree issue 19 was filed
-  against (7.61, 0.62, 9.66 s; 746 MB at a frame every 100 rows), the earlier series in
-  this file's history measured 7.5x and 3.7x.
+  compare trees only within one series. Under a load of about 1, earlier series in this
+  file's history measured 7.5x, 3.7x and 3.2x against f47bbb6.
 - The gain depends on the log's shape. These savings are in reading the log (the ground
   truth's and odometry's blocks, the observations' text), cutting the odometry into
   reports, judging the truth and posting; the manager's update is as it was, so the more
@@ -43,17 +63,19 @@ How to read it:
 - The peak no longer holds the log. What still grows with the log (about 17 MB per 10^6
   rows) is the replay's record, the trace (84 bytes a step), and the allocator's heap
   around it.
-- At a frame every 10 rows the update is about 44 us a step, most of it Python around the
-  compiled kernels (about 11 us of it, by the earlier series). At a frame every 100 rows
-  the update (0.57 s), opening the log (0.19 s) and reading the odometry (about 0.12 s)
-  already pass the 0.97 s that tenfold against f47bbb6 would allow: issue 19's tenfold
-  gain needs the per-step update compiled, not more small savings.
-- A frame every row (10^6 rows, 932,437 steps; ``--rows 1000000 --frame-every 1``), one
-  run of each on 29 November about 11:12 UTC, load about 1: this tree 0.43, 45.0, 78.0 s
-  and 232 MB; f47bbb6 19.3, 70.7, 248 s and 2,799 MB: 3.2x. Here every step costs: 84 us
-  a step in all, 48 of them the manager's update and 36 the rest of the replay (posting,
-  judging, the trace and the CSV). Tenfold at this shape would need 27 us a step in all,
-  so not only the update but the replay's whole step loop compiled.
+- At a frame every 10 rows the update is about 32 us a step, most of it Python around the
+  compiled kernels. At a frame every 100 rows the compiled growth alone (about 8 commands
+  a step, twice: the working map and the envelope; 1.5 us a command) takes 0.22 s of the
+  0.86: with the update (0.43 s), opening the log (0.10 s) and reading the odometry, it
+  leaves no room under the 0.69 s that tenfold against f47bbb6 would allow. Growing a
+  step's commands in one Minkowski sum (its sectors summed, then one vertex cap) would be
+  cheaper, but on MRCLAM it gave larger maps, not smaller (median Class I area 17.70 m^2
+  against 17.42 on Dataset 6 robot 2): one cap from many vertices cuts more than a cap
+  per command.
+- At a frame every row every step costs: 56 us a step in all, 34 of them the manager's
+  update and 22 the rest of the replay (posting, judging, the trace and the CSV). Tenfold
+  at this shape would need 19 us a step in all, so not only the update but the replay's
+  whole step loop compiled.
 
 Earlier series (27 and 28 November, before the compiled CSV reader and the per-step
 trimming) are in the repository's history of this file.
