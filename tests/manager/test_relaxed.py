@@ -5,10 +5,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import pytest
 
+from aura_ums import MapProfile
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import ConvexPolygon
@@ -19,13 +22,16 @@ from aura_ums.manager import (
     PositionReport,
     RejectReason,
     UncertaintyMapManager,
+    _relaxed,
 )
 from aura_ums.manager._relaxed import Branch, RelaxedState
 from aura_ums.manager._relaxed import grow as relaxed_grow
 from aura_ums.uncertainty import (
     BearingObservation,
     Observation,
+    PointLandmark,
     Pose,
+    RangeBearingObservation,
     SpatialUncertaintyMap,
     TerrainTable,
     TurnAndRun,
@@ -359,10 +365,180 @@ def test_growth_ends_what_branches_carry_and_keeps_their_choices() -> None:
         (Branch(frozenset(), start), Branch(frozenset({4}), start, frozenset({6, 7}))), (), frozenset(), 8
     )
 
-    grown = relaxed_grow(state, lambda m: m.grow(TurnAndRun(0.0, 1.0), FLOOR["floor"]))
+    grown = relaxed_grow(state, lambda m: m.grow(TurnAndRun(0.0, 1.0), FLOOR["floor"]), 64)
 
     assert [(b.excluded, b.carried) for b in grown.branches] == [
         (frozenset(), frozenset()),
         (frozenset({4}), frozenset()),
     ]
     assert all(b.map.area > start.area for b in grown.branches)
+
+
+def test_growth_merges_branches_left_with_the_same_choices_and_keeps_both_maps() -> None:
+    # Two hypotheses that chose the same sighting and differ only in what they carry: once
+    # growth ends what they carry they are one, and either may hold the truth.
+    east = SpatialUncertaintyMap.from_pose(Pose(10.0, 1.0, 0.0), 0.1, 0.02)
+    west = SpatialUncertaintyMap.from_pose(Pose(6.0, 1.0, 0.0), 0.1, 0.02)
+    state = RelaxedState(
+        (
+            Branch(frozenset(), east),
+            Branch(frozenset({4}), east, frozenset({6})),
+            Branch(frozenset({4}), west, frozenset({5, 6})),
+        ),
+        (),
+        frozenset(),
+        8,
+    )
+
+    grown = relaxed_grow(state, lambda m: m.grow(TurnAndRun(0.0, 1.0), FLOOR["floor"]), 64)
+
+    assert [(b.excluded, b.carried) for b in grown.branches] == [
+        (frozenset(), frozenset()),
+        (frozenset({4}), frozenset()),
+    ]
+    merged = grown.branches[1].map
+    for start in (east, west):
+        alone = start.grow(TurnAndRun(0.0, 1.0), FLOOR["floor"])
+        assert all(merged.contains(Pose(x, y, 0.0)) for x, y in alone.polygon.vertices.tolist())
+
+
+TWO_POINTS = (PointLandmark("A", 58.0, 20.0, 1.0), PointLandmark("B", 20.0, 30.0, 1.0))
+TWO_POINT_WORLD = MeadowMap(
+    [Meadow("floor", ConvexPolygon([(0, 0), (60, 0), (60, 40), (0, 40)]), "floor", ("A", "B"))],
+    [LandmarkRecord(lm, PerceptualStrategy.LINE_FINDER, {}, 80.0, 0.5) for lm in TWO_POINTS],
+)
+
+
+def _wrong_choice_then_growth(seed: int, *, save_after: bool) -> tuple[Pose, ManagerStep | None, str]:
+    """Sightings s0..s7 of two point landmarks, A far east and B north; s1 (B) and s6 (A) are wrong.
+
+    Every 5 consecutive hold wrong sightings of at most one landmark (q = 1, N = 5). After
+    the instant of s5 and s6 (no growth before it), two branches exclude s5 and differ only
+    in what they carry; one of them, which carries s6, holds the truth. Returns the truth,
+    the last step (None with ``save_after``: the state after one more growth instead) and
+    the manager's JSON.
+    """
+    a, b = TWO_POINTS
+    rng = np.random.default_rng(seed)
+    truth = Pose(20.0, 20.0, 0.0)
+    settings = ManagerSettings.from_dict(
+        {"relaxed_q": 1, "relaxed_window": 5}, base=MapProfile.RELAXED.settings()
+    )
+    manager = UncertaintyMapManager(
+        SpatialUncertaintyMap.from_pose(truth, 3.0, 0.3), TWO_POINT_WORLD, FLOOR, settings
+    )
+    board = Blackboard()
+
+    def seen(landmark: PointLandmark, pose: Pose) -> float:
+        return math.atan2(landmark.y - pose.y, landmark.x - pose.x) - pose.heading
+
+    def move(now: float) -> None:
+        nonlocal truth
+        truth = FLOOR["floor"].sample_motion(truth, TurnAndRun(0.0, 0.3), rng, truncate=3.0)
+        board.post_report(PositionReport(now, TurnAndRun(0.0, 0.3)))
+
+    def good(landmark: PointLandmark, now: float, fraction: float) -> None:
+        board.identified.post(
+            BearingObservation(landmark.id, now, seen(landmark, truth) + fraction * ERROR, ERROR)
+        )
+
+    move(1.0)
+    good(a, 1.0, 0.8)
+    elsewhere = Pose(truth.x, truth.y - 2.5, truth.heading)  # B seen from 2.5 m south: consistent, wrong
+    reach = math.hypot(b.x - elsewhere.x, b.y - elsewhere.y)
+    board.identified.post(
+        RangeBearingObservation("B", 1.0, seen(b, elsewhere), ERROR, reach - 0.2, reach + 0.2)
+    )
+    manager.update(board, now=1.0)
+    move(2.0)
+    good(a, 2.0, -0.8)
+    good(a, 2.0, 0.6)
+    manager.update(board, now=2.0)
+    move(3.0)
+    good(a, 3.0, -0.7)
+    manager.update(board, now=3.0)
+    good(a, 3.5, 0.75)
+    board.identified.post(BearingObservation("A", 3.5, seen(a, truth) + 0.15, ERROR))  # wrong
+    manager.update(board, now=3.5)
+    if save_after:
+        move(3.8)
+        manager.update(board, now=3.8)
+        return truth, None, manager.to_json()
+    move(4.0)
+    good(b, 4.0, 0.5)
+    return truth, manager.update(board, now=4.0), manager.to_json()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_branches_that_differ_only_in_what_they_carry_both_survive_growth(seed: int) -> None:
+    truth, step, _ = _wrong_choice_then_growth(seed, save_after=False)
+
+    assert step is not None
+    assert not step.relocalized
+    assert step.map.contains(truth)
+
+
+def test_a_state_saved_after_such_branches_grew_reads_back() -> None:
+    _, _, text = _wrong_choice_then_growth(0, save_after=True)
+
+    branches = json.loads(text)["relaxed"]["branches"]
+    keys = [(tuple(b["excluded"]), tuple(b.get("carried", []))) for b in branches]
+    assert len(set(keys)) == len(keys)
+    restored = UncertaintyMapManager.from_json(text, TWO_POINT_WORLD, FLOOR)
+    assert restored.to_json() == text
+
+
+@dataclasses.dataclass(frozen=True)
+class _Respecting:
+    """An abstract map: the sightings whose bounds it respects (it holds the truth iff none is wrong)."""
+
+    serials: frozenset[int]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Named:
+    landmark_id: str
+
+
+def _respected_by_both(maps: list[_Respecting], max_vertices: int = 0) -> _Respecting:
+    del max_vertices
+    return _Respecting(frozenset.intersection(*(m.serials for m in maps)))
+
+
+@pytest.mark.parametrize(("q", "window"), [(1, 2), (1, 5), (2, 5), (3, 4)])
+def test_some_branch_respects_only_correct_sightings_under_any_admissible_pattern(
+    q: int, window: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The bookkeeping alone, with maps reduced to the sightings they respect: merges, growth
+    # (which ends what branches carry) and sightings that leave the window, in random order.
+    # Whenever the wrong sightings among any N consecutive name at most q landmarks, some
+    # branch must respect no wrong one.
+    monkeypatch.setattr(_relaxed, "union_of_maps", _respected_by_both)
+    rng = np.random.default_rng(q * 100 + window)
+    for _ in range(150):
+        state = RelaxedState.start(_Respecting(frozenset()))  # type: ignore[arg-type]
+        history: list[tuple[str, bool]] = []
+        wrong: set[int] = set()
+        for _step in range(40):
+            instant: list[tuple[str, bool]] = []
+            for _ in range(int(rng.integers(1, 4))):
+                landmark = "ABCD"[int(rng.integers(4))]
+                before = history[max(0, len(history) - window + 1) :]  # the N - 1 before it
+                named = {name for name, bad in before if bad} | {landmark}
+                instant.append((landmark, bool(rng.random() < 0.6 and len(named) <= q)))
+                history.append(instant[-1])
+            for start in range(0, len(instant), window):
+                chunk = instant[start : start + window]
+                sightings: list[Any] = [_Named(name) for name, _ in chunk]
+                state, serials = _relaxed.admit(state, sightings, window, 0)
+                wrong |= {serial for serial, (_, bad) in zip(serials, chunk, strict=True) if bad}
+
+                def reduce(m: Any, keep: Sequence[int], serials: tuple[int, ...] = serials) -> Any:
+                    return _Respecting(m.serials | {serials[index] for index in keep})
+
+                relaxed = _relaxed.relax(state, serials, q, reduce)
+                assert relaxed is not None
+                state = relaxed
+            if rng.random() < 0.4:
+                state = _relaxed.grow(state, lambda m: m, 0)
+            assert any(not (branch.map.serials & wrong) for branch in state.branches)  # type: ignore[attr-defined]

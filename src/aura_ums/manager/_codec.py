@@ -327,7 +327,11 @@ def decode_relaxed(reader: Reader, value: object, where: str, q: int, window: in
         if both := sorted(carried & excluded):
             reader.fail(f"{place}.carried", f"expected no serial of excluded, got {both}")
         if any((branch.excluded, branch.carried) == (excluded, carried) for branch in branches):
-            reader.fail(f"{place}.excluded", f"expected a set no other branch has, got {sorted(excluded)}")
+            reader.fail(
+                f"{place}.excluded",
+                f"expected excluded and carried sets no other branch has, got excluded {sorted(excluded)} "
+                f"and carried {sorted(carried)} twice",
+            )
         branches.append(Branch(excluded, reader.uncertainty_map(entry["map"], f"{place}.map"), carried))
     if not branches:
         reader.fail(f"{where}.branches", "expected at least one branch, got none")

@@ -797,7 +797,9 @@ class UncertaintyMapManager:
         """Grow every branch by ``reports[start:stop]``; return them and the last report's time."""
         if start == stop:
             return state, map_time
-        state = _relaxed.grow(state, lambda m: self._grow(m, reports, start, stop, map_time)[0])
+        state = _relaxed.grow(
+            state, lambda m: self._grow(m, reports, start, stop, map_time)[0], self._max_vertices
+        )
         return state, reports[stop - 1].time
 
     def _relax_instant(

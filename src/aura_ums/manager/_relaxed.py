@@ -17,16 +17,18 @@ but those (and, after merges, an outer bound of that).
 - When a sighting leaves the window, each branch forgets it (its choices and carried
   sightings without it); branches left with the same sets merge (an outer bound: hull of
   polygons, union of headings).
-- Growth applies to every branch and ends what each carries (see :func:`grow`); the
-  reported map is the outer bound of all branches.
+- Growth applies to every branch and ends what each carries (see :func:`grow`); branches
+  then left with the same choices merge, as on a departure. The reported map is the outer
+  bound of all branches.
 
 Guarantee: the truth stays inside whenever the wrong sightings among any ``N`` consecutive
 ones name at most ``q`` landmarks; in particular whenever at most ``q`` of any ``N``
 consecutive sightings are wrong (and the growth and the correct sightings' bounds hold).
 Invariant, by induction over sightings: some branch holds the truth whose choices are
 sightings of the window of distinct landmarks, each with a wrong sighting of its landmark
-in its instant. Growth keeps it; a departing sighting only
-merges it (an outer bound) into a branch with the same property; a correct arrival reduces
+in its instant. Growth keeps it, or merges it (an outer bound) with the branches left with
+its choices; a departing sighting only merges it into a branch with the same property (a
+merge never drops a map: two branches with the same sets are one hypothesis); a correct arrival reduces
 it soundly or is carried (ignoring a sighting only loosens); a wrong arrival of a landmark
 it chose in the window is carried; a wrong arrival of another landmark finds it with fewer
 than ``q`` choices (they and the arrival are wrong sightings of distinct landmarks in ``N``
@@ -39,7 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from aura_ums.uncertainty import Observation, SpatialUncertaintyMap, union_of_maps
@@ -108,18 +110,25 @@ def _sorted(branches: Sequence[Branch]) -> tuple[Branch, ...]:
 
 
 def grow(
-    state: RelaxedState, grow_map: Callable[[SpatialUncertaintyMap], SpatialUncertaintyMap]
+    state: RelaxedState,
+    grow_map: Callable[[SpatialUncertaintyMap], SpatialUncertaintyMap],
+    max_vertices: int,
 ) -> RelaxedState:
     """Return the state with every branch's map grown by ``grow_map``; the branches carry nothing after.
 
     Dropping what a branch carries is what keeps the branch count within the sum of
-    ``C(N, k)``: after merges, branches with the same choices could otherwise differ only in
-    what they carry, and none would ever merge. It is sound: a carried sighting was never
-    applied to the branch's map, so forgetting it only spares the merge its leaving would
-    have made (the map stays an outer bound of what it claims).
+    ``C(N, k)``: branches with the same choices could otherwise differ only in what they
+    carry, and none would ever merge. Those left with the same choices merge here (the
+    outer bound of their grown maps, the first in order's centre kept): each may be the
+    one that holds the truth. It is sound: a carried sighting was never applied to the
+    branch's map, so forgetting it only spares the merge its leaving would have made (the
+    map stays an outer bound of what it claims).
     """
+    grown = [((branch.excluded, frozenset[int]()), grow_map(branch.map)) for branch in state.branches]
+    joined = _joined(grown, max_vertices)
+    # In order still: the branches' choices are as they were, and only equal ones merged.
     return dataclasses.replace(
-        state, branches=tuple(Branch(branch.excluded, grow_map(branch.map)) for branch in state.branches)
+        state, branches=tuple(Branch(excluded, found) for (excluded, _), found in joined.items())
     )
 
 
@@ -149,17 +158,34 @@ def admit(
 
 def _merged(branches: Sequence[Branch], leaving: int, max_vertices: int) -> list[Branch]:
     """Forget ``leaving`` in every branch; merge the branches then left with the same sets."""
-    by_set: dict[tuple[frozenset[int], frozenset[int]], SpatialUncertaintyMap] = {
-        (branch.excluded, branch.carried): branch.map for branch in branches if leaving not in branch.ignored
-    }
-    for branch in branches:
-        if leaving in branch.ignored:
-            target = (branch.excluded - {leaving}, branch.carried - {leaving})
-            there = by_set.get(target)
-            by_set[target] = (
-                branch.map if there is None else union_of_maps([there, branch.map], max_vertices=max_vertices)
-            )
-    return [Branch(excluded, found, carried) for (excluded, carried), found in by_set.items()]
+    # The branches that ignore it last: each joins the one already left with its sets.
+    keyed = [
+        ((branch.excluded - {leaving}, branch.carried - {leaving}), branch.map)
+        for branch in sorted(branches, key=lambda branch: leaving in branch.ignored)
+    ]
+    return [
+        Branch(excluded, found, carried)
+        for (excluded, carried), found in _joined(keyed, max_vertices).items()
+    ]
+
+
+_Key = tuple[frozenset[int], frozenset[int]]
+
+
+def _joined(
+    keyed: Iterable[tuple[_Key, SpatialUncertaintyMap]], max_vertices: int
+) -> dict[_Key, SpatialUncertaintyMap]:
+    """Return one map per key (its choices and carried sightings), in the order keys first come.
+
+    Maps of one key join in their outer bound, pairwise in order: two branches with the
+    same sets are one hypothesis, and either may hold the truth (one must not replace the
+    other).
+    """
+    by_set: dict[_Key, SpatialUncertaintyMap] = {}
+    for key, found in keyed:
+        there = by_set.get(key)
+        by_set[key] = found if there is None else union_of_maps([there, found], max_vertices=max_vertices)
+    return by_set
 
 
 def relax(state: RelaxedState, serials: Sequence[int], q: int, reduce: Reducer) -> RelaxedState | None:
