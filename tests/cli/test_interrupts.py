@@ -245,3 +245,21 @@ def test_a_request_to_stop_is_met_as_a_ctrl_c_with_its_own_exit_code(
     assert "Traceback" not in stderr
     assert f"error: terminated ({stop}): nothing was written" in stderr
     assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("stop", ["SIGTERM", "SIGHUP"])
+def test_a_request_to_stop_while_the_arguments_are_read_keeps_its_exit_code(stop: str) -> None:
+    # Typer turns any KeyboardInterrupt it meets while it reads the arguments (a Terminated
+    # included) into a Ctrl-C's status: a SIGTERM there exited 130, "interrupted".
+    script = (
+        "import os, signal, sys, time\nimport typer.core\n"
+        "def parse_args(self, ctx, args):\n"
+        f"    os.kill(os.getpid(), signal.{stop})\n    time.sleep(5)\n"
+        "typer.core.TyperCommand.parse_args = parse_args\n"
+        "sys.argv = ['aura-ums', 'replay', 'log', '--terrain', 't.toml']\n"
+        "from aura_ums.cli import main\nmain()\n"
+    )
+    command = [sys.executable, "-c", script]
+    done = subprocess.run(command, capture_output=True, text=True, check=False, timeout=60)
+    assert done.returncode == 128 + getattr(signal, stop), done.stderr
+    assert done.stderr == f"error: terminated ({stop}): nothing was written\n"

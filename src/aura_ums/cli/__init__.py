@@ -8,7 +8,7 @@ the command line itself are still loading.
 from __future__ import annotations
 
 from aura_ums import TYPE_CHECKING
-from aura_ums.cli._interrupt import INTERRUPTED, TERMINATION_SIGNALS, exit_code, say_interrupted
+from aura_ums.cli._interrupt import INTERRUPTED, TERMINATION_SIGNALS, exit_code, received, say_interrupted
 
 if TYPE_CHECKING:
     from types import FrameType
@@ -47,6 +47,12 @@ def main() -> None:
         say_interrupted(stop)
         raise SystemExit(code) from None
     except SystemExit as exc:
+        request = received() if exc.code == INTERRUPTED else None
+        if request is not None:  # typer's answer to a SIGTERM or SIGHUP while it reads the arguments
+            code = exit_code(request)
+            _finish_on_interrupt(code)
+            say_interrupted(request)
+            raise SystemExit(code) from None
         _finish_on_interrupt(_status(exc.code))
         if exc.code == INTERRUPTED:  # typer's own answer to a Ctrl-C while it reads the arguments
             say_interrupted()

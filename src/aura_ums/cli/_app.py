@@ -52,7 +52,7 @@ from aura_ums.cli._interop import (
     rosbag_command,
     write_simulation_mcap_option,
 )
-from aura_ums.cli._interrupt import TERMINATION_SIGNALS, Terminated
+from aura_ums.cli._interrupt import TERMINATION_SIGNALS, Terminated, received
 from aura_ums.cli._logs import import_app
 from aura_ums.cli._outputs import (
     CWD_GONE,
@@ -376,7 +376,9 @@ def _stop_as_on_ctrl_c() -> None:
     import signal
 
     def stop(signum: int, frame: object) -> None:
-        raise Terminated(signum, signal.Signals(signum).name)
+        request = Terminated(signum, signal.Signals(signum).name)
+        received(request)
+        raise request
 
     stop.stops_the_command = True  # type: ignore[attr-defined]  # told apart at the end (cli.main)
     for name in TERMINATION_SIGNALS:

@@ -32,6 +32,21 @@ class Terminated(KeyboardInterrupt):
         self.name = name
 
 
+#: The last request to stop the handler raised (see :func:`received`).
+_received: list[Terminated | None] = [None]
+
+
+def received(stop: Terminated | None = None) -> Terminated | None:
+    """Record ``stop`` (the handler raises it), or return the last one recorded.
+
+    Typer turns any KeyboardInterrupt it meets while it reads the arguments into the exit
+    status of a Ctrl-C, 130; a SIGTERM there must still end the command with 143.
+    """
+    if stop is not None:
+        _received[0] = stop
+    return _received[0]
+
+
 def exit_code(stop: KeyboardInterrupt) -> int:
     """Return the exit code a Ctrl-C or a :class:`Terminated` ends the command with."""
     return 128 + stop.signum if isinstance(stop, Terminated) else INTERRUPTED
