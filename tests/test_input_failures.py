@@ -459,6 +459,29 @@ def test_scenario_clutter_lines_1e6_is_refused_with_the_estimate(tmp_path: Path)
 
 
 @pytest.mark.parametrize(
+    ("old", "new", "named"),
+    [
+        # A frame's million clutter lines (190 s) made even the route's 3 frames too long; the
+        # refusal named frame_rate, which no value could have fixed.
+        ("clutter_lines = 5", "clutter_lines = 1000000", r"\[render\] clutter_lines"),
+        # 1e-300 m/s made 4.6e18 frames; the refusal named frame_rate alone.
+        ("speed = 2.0", "speed = 1e-300", r"frame_rate and speed \(the frame spacing\)"),
+    ],
+)
+def test_a_run_too_long_names_what_makes_it_so(tmp_path: Path, old: str, new: str, named: str) -> None:
+    for name in ("four_terrains.geojson", "paper_camera.toml"):
+        shutil.copy(REPOSITORY / "scenarios" / name, tmp_path / name)
+    text = (REPOSITORY / "scenarios" / "four_terrains.toml").read_text()
+    assert old in text
+    (tmp_path / "four_terrains.toml").write_text(text.replace(old, new))
+    with pytest.raises(
+        FileFormatError,
+        match=r"four_terrains\.toml: " + named + r": expected at most 600 s and 4 GB a run, got ",
+    ):
+        Scenario.from_toml(tmp_path / "four_terrains.toml")
+
+
+@pytest.mark.parametrize(
     ("parameters", "message"),
     [
         ({"bogus": 1}, r"pole_a\.parameters: expected names among orientation, .*, got 'bogus'"),

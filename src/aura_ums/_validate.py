@@ -233,6 +233,13 @@ ANGLE = Range(-1e3, 1e3, "rad")
 #: bearing closer; 1e-300 rad passed and bounded the map to nothing) to absurd magnitudes
 #: (from pi on it says nothing, but a widened envelope may pass it).
 ANGLE_ERROR = Range(1e-6, 1e3, "rad")
+#: How near, metres, a find-landmark schema wakes (a landmark farther than 10 km is not seen).
+ACTIVATION_RANGE = Range(0.0, 1e4, "m", low_open=True)
+#: Most consecutive frames a discovery may need to be confirmed: 1,000 s of frames at 10 Hz.
+MAX_CONFIRM_FRAMES = 10_000
+#: An extent of a heading wedge as saved, radians: from 2 pi on it is the full circle (the
+#: library saves that as pi and pi), so anything far beyond is not a wedge it wrote.
+WEDGE_EXTENT = Range(0.0, 1e3, "rad")
 #: A time stamp, seconds (Unix times run to 1e10 s in the year 2286).
 TIME = Range(-1e10, 1e10, "s")
 #: Forward velocity of a ground robot, m/s (100 m/s is 360 km/h).

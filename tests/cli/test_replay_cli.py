@@ -567,6 +567,7 @@ def test_an_empty_log_argument_is_named(argv: list[str], name: str) -> None:
 _NAMED = "OUT_DIR: expected a path ending in the new log folder's name, got"
 _TOPICS = ["--odom", "/odom", "--observations", "/obs"]
 _EMPTY = "got an empty path ''"
+_TERRAIN = "--terrain: expected a terrain table TOML file, got"
 
 
 @pytest.mark.parametrize(
@@ -581,15 +582,21 @@ _EMPTY = "got an empty path ''"
         (["replay", "log", "--terrain", "t.toml", "--plot", ""], f"--plot: expected a folder, {_EMPTY}"),
         (["figures", "--out", ""], "--out: expected a folder, got an empty path ''"),
         (["demo", "--out", ""], "--out: expected a folder, got an empty path ''"),
+        (["replay", "log", "--terrain", ""], f"--terrain: expected a terrain table TOML file, {_EMPTY}"),
+        (["replay", "log", "--terrain", "."], f"{_TERRAIN} '.', which names a folder"),
+        (["compare", "log", "--terrain", "/"], f"{_TERRAIN} '/', which names a folder"),
+        (["replay", "log", "--terrain", "cal/"], f"{_TERRAIN} 'cal/', which names a folder"),
     ],
     ids=["import-dataset", "import-out-empty", "import-out-dot", "import-out-dotdot", "rosbag-bag",
-         "rosbag-out-dot", "replay-plot", "figures-out", "demo-out"],
+         "rosbag-out-dot", "replay-plot", "figures-out", "demo-out", "replay-terrain-empty",
+         "replay-terrain-dot", "compare-terrain-root", "replay-terrain-folder"],
 )  # fmt: skip
 def test_an_empty_or_nameless_path_is_refused_naming_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, argv: list[str], message: str
 ) -> None:
     # '' was the current folder: `--plot ''` wrote its figure there, and `import ... .` in an
-    # empty folder raised ValueError from pathlib (no name to put the scratch folder beside).
+    # empty folder raised ValueError from pathlib (no name to put the scratch folder beside),
+    # as did `--terrain .` (no name to put its sensors file's beside).
     monkeypatch.chdir(tmp_path)
     result = runner.invoke(app, argv)
     assert result.exit_code == 2

@@ -221,8 +221,8 @@ def test_a_nullable_setting_takes_none_as_its_message_says(flag: str) -> None:
 @pytest.mark.parametrize(
     ("given", "message"),
     [
-        (["--area-limit", "abc"], "--area-limit: expected a positive number or none, got 'abc'"),
-        (["--area-limit", "1_0"], "--area-limit: expected a positive number or none, got '1_0'"),
+        (["--area-limit", "abc"], "--area-limit: expected a number in (0, 4e+12] or none, got 'abc'"),
+        (["--area-limit", "1_0"], "--area-limit: expected a number in (0, 4e+12] or none, got '1_0'"),
         (
             ["--envelope-max-vertices", "1.5"],
             "--envelope-max-vertices: expected an integer >= 3 or none, got '1.5'",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -104,3 +105,22 @@ def test_a_state_before_any_frame_and_bad_states() -> None:
         )
     with pytest.raises(FileFormatError, match="expected a key 'log', got none"):
         ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 2}')
+
+
+def test_a_refused_state_says_what_does_not_fit() -> None:
+    # It said which log the state was from and how far, but not what did not fit (a state
+    # claiming 10^12 position reports named the same log twice and nothing else).
+    log = synthetic_log(np.random.default_rng(12), duration=10.0)
+    state = replay_log(log, TABLE, until=5.0, save_state=True).state
+    assert state is not None
+    other = synthetic_log(np.random.default_rng(13), duration=10.0)
+    with pytest.raises(
+        InputError, match=r"with a digest of other observations than those of the log's first \d+ frames$"
+    ):
+        replay_log(other, TABLE, resume=state)
+    with pytest.raises(
+        InputError, match=r"with reports_posted 1000000000000, more than the log's \d+ position reports$"
+    ):
+        replay_log(log, TABLE, resume=dataclasses.replace(state, reports_posted=10**12))
+    with pytest.raises(InputError, match=r"with another log's name, 'elsewhere'$"):
+        replay_log(log, TABLE, resume=dataclasses.replace(state, log_name="elsewhere"))

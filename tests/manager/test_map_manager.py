@@ -633,7 +633,12 @@ def edited(path: str, value: object) -> str:
             r"map\.vertices: .*expected a convex counter-clockwise polygon",
         ),
         (edited("map/center", [40.0, 0.0]), r"map\.center: center: expected a point inside the polygon"),
-        (edited("map/wedge/cw", -0.1), r"map\.wedge: HeadingWedge\.cw: expected a non-negative number"),
+        (edited("map/wedge/cw", -0.1), r"map\.wedge\.cw: expected a number in \[0, 1000\] rad, got -0\.1"),
+        (
+            edited("map/wedge/ccw", 1e300),
+            r"map\.wedge\.ccw: expected a number in \[0, 1000\] rad, got 1e\+300",
+        ),
+        (edited("settings/area_limit", 1e300), r"settings\.area_limit: expected a number in \(0, 4e\+12\]"),
         (edited("map/wedge/center", 4.0), r"map\.wedge\.center: expected a heading in \(-pi, pi\], got 4\.0"),
         (edited("map/wedge/spin", 0.0), r"map\.wedge: expected only the keys"),
         (edited("version", True), r"version: expected 1, got true"),  # JSON true == 1 in Python
@@ -650,7 +655,7 @@ def edited(path: str, value: object) -> str:
         (edited("settings/missed_limit", 0), r"settings\.missed_limit: expected an integer >= 1, got 0"),
         (
             edited("settings/area_limit", "big"),
-            r"settings\.area_limit: expected a positive number or none, got 'big'",
+            r"settings\.area_limit: expected a number in \(0, 4e\+12\] or none, got 'big'",
         ),
         (edited("settings/sigma", 3.0), r"settings\.sigma: expected a field of ManagerSettings \(sigmas, "),
         (

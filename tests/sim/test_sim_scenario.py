@@ -245,6 +245,13 @@ MALFORMED = [
         r"\[route\] waypoints\[0\]",
         r"expected \[x, y\]",
     ),
+    (  # within the coordinates' range, but a leg longer than any run: named, not TurnAndRun.run
+        "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
+        "waypoints = [[1000000.0, 0.0]]",
+        r"\[route\] waypoints\[0\]",
+        r"expected a point at most 10000 m from the previous one \(a leg's run\), "
+        r"got \(1000000\.0, 0\.0\)",
+    ),
     (
         "commands = [{ turn_deg = 0.0, run = 5.0 }, { turn_deg = 10.0, run = 1.0 }]",
         "waypoints = [[0.0, 0.0]]",
@@ -257,7 +264,12 @@ MALFORMED = [
         r"\[route\] goal",
         "expected a goal reachable",
     ),
-    ("area_limit = 20.0", "area_limit = 0", r"\[manager\] area_limit", "positive number or none, got 0"),
+    (
+        "area_limit = 20.0",
+        "area_limit = 0",
+        r"\[manager\] area_limit",
+        "number in \\(0, 4e\\+12\\] or none, got 0",
+    ),
     ("missed_limit = 2", "missed_limit = 1.5", r"\[manager\] missed_limit", "integer >= 1, got 1.5"),
     ("missed_limit = 2", "sigma = 2", r"\[manager\] sigma", "unknown key 'sigma'"),
     # the key the file sets is named, not the default it conflicts with

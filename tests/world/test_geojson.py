@@ -398,7 +398,7 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "zero activation range",
         feature(2, activation_range=0),
         "features[2] (id 'pole') properties.activation_range",
-        "expected a positive number, got 0.0",
+        "expected a number in (0, 10000] m, got 0.0",
     ),
     (
         "threshold as a string",
@@ -440,7 +440,19 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "confirm frames zero",
         feature(3, confirm_frames=0),
         "features[3] (id 'corner') properties.confirm_frames",
-        "expected an integer >= 1, got 0",
+        "expected an integer in [1, 10000], got 0",
+    ),
+    (
+        "confirm frames a billion",
+        feature(3, confirm_frames=10**9),
+        "features[3] (id 'corner') properties.confirm_frames",
+        "expected an integer in [1, 10000], got 1000000000",
+    ),
+    (
+        "activation range 1e300",
+        feature(2, activation_range=1e300),
+        "features[2] (id 'pole') properties.activation_range",
+        "expected a number in (0, 10000] m, got 1e+300",
     ),
     (
         "symbol not a string",

@@ -95,6 +95,22 @@ def folder_argument(name: str, what: str = "a log folder") -> Callable[[str], Pa
     return parse
 
 
+def input_file(name: str, what: str) -> Callable[[str], Path]:
+    """Return the parser of an input file's path that refuses one naming no file (exit 2, naming it).
+
+    ``''``, ``.``, ``/`` and a path ending in a separator name a folder, not a file: a file
+    read beside it (a terrain table's sensors file) would have no name to take its own from.
+    """
+
+    def parse(text: str) -> Path:
+        path = folder_argument(name, what)(text)
+        if not path.name or path.name == ".." or text.endswith(("/", os.sep)):
+            raise fail(f"{name}: expected {what}, got {text!r}, which names a folder")
+        return path
+
+    return parse
+
+
 def output_file(flag: str, example: str, help: str) -> Any:
     """Return the ``typer.Option`` of an output file: refuses an empty path or a folder's (exit 2).
 

@@ -34,6 +34,7 @@ from aura_ums.cli._common import (
     err_console,
     fail,
     folder_argument,
+    input_file,
     manager_options,
     output_file,
     progress_bar,
@@ -97,7 +98,13 @@ class Reverse(enum.StrEnum):
 
 _Classes = Annotated[Classes, typer.Option("--classes", help="I: bearings only; II: range and bearing.")]
 _Terrain = Annotated[
-    Path, typer.Option("--terrain", readable=False, help="Terrain table TOML holding the log's terrain.")
+    Path,
+    typer.Option(
+        "--terrain",
+        parser=input_file("--terrain", "a terrain table TOML file"),
+        metavar="<path>",
+        help="Terrain table TOML holding the log's terrain.",
+    ),
 ]
 _Sensors = Annotated[
     Path | None,

@@ -324,8 +324,17 @@ def sensors_path(terrain: str | Path) -> Path:
     --------
     >>> sensors_path("runs/calib/terrain.toml").as_posix()
     'runs/calib/terrain.sensors.toml'
+    >>> sensors_path("runs/..")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: terrain: expected a terrain table file's path, got 'runs/..', ...
     """
-    return as_path(terrain, "terrain").with_suffix(".sensors.toml")
+    path = as_path(terrain, "terrain")
+    if not path.name or path.name == "..":
+        raise InputError(
+            f"terrain: expected a terrain table file's path, got {str(terrain)!r}, which names a folder"
+        )
+    return path.with_suffix(".sensors.toml")
 
 
 def _read_sensors(path: str | Path) -> tuple[Fields, dict[str, object]]:

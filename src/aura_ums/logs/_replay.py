@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from aura_ums._files import as_path, atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
-from aura_ums._validate import finite_float, nonnegative_float, positive_float
+from aura_ums._validate import ACTIVATION_RANGE, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, edge_distances, polygon_area, wedges_contain
@@ -702,7 +702,10 @@ def _meadow_map(
             landmark = PointLandmark(
                 lm.id, lm.x, lm.y, (bottom + top) / 2.0, lm.symbol, lm.position_uncertainty
             )
-        records.append(LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, 1.0e6, 0.0))
+        # Every landmark always awake: a log's sightings come from its own sensor, not from schemas.
+        records.append(
+            LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, ACTIVATION_RANGE.high, 0.0)
+        )
     arena = ConvexPolygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
     meadow = Meadow("arena", arena, meta.terrain, tuple(lm.id for lm in landmarks))
     return MeadowMap([meadow], records)
@@ -1700,24 +1703,24 @@ def _resumed_at(
     reports: int,
 ) -> tuple[int, int]:
     """Return the frame and report indices to resume at; a state from another log is refused."""
-    fits = (
-        state.log_name == log.meta.name
-        and state.frames_done <= frame_times.size
-        and state.log_digest == _digest(frames, frame_times[: state.frames_done])
-        and state.reports_posted <= reports
-        and (
-            math.isnan(state.last_time)
-            if state.frames_done == 0
-            else float(frame_times[state.frames_done - 1]) == state.last_time
-        )
+    done = state.frames_done
+    if state.log_name != log.meta.name:
+        why = f"another log's name, {state.log_name!r}"
+    elif done > frame_times.size:
+        why = f"{done} frames done, more than the log has"
+    elif state.log_digest != _digest(frames, frame_times[:done]):
+        why = f"a digest of other observations than those of the log's first {done} frames"
+    elif state.reports_posted > reports:
+        why = f"reports_posted {state.reports_posted}, more than the log's {reports} position reports"
+    elif not (math.isnan(state.last_time) if done == 0 else float(frame_times[done - 1]) == state.last_time):
+        where = "no frame done" if done == 0 else f"its frame {done} at {float(frame_times[done - 1])!r} s"
+        why = f"a last frame at {state.last_time!r} s, where the log has {where}"
+    else:
+        return done, state.reports_posted
+    raise InputError(
+        f"resume: expected a state saved from a replay of log {log.meta.name!r} ({frame_times.size} frames, "
+        f"{reports} position reports), got one after {done} frames at {state.last_time!r} s with {why}"
     )
-    if not fits:
-        raise InputError(
-            f"resume: expected a state saved from a replay of log {log.meta.name!r} "
-            f"({frame_times.size} frames), got one of log {state.log_name!r} after "
-            f"{state.frames_done} frames at {state.last_time!r} s"
-        )
-    return state.frames_done, state.reports_posted
 
 
 def with_motion(log: LogT, motion: MotionCalibration | None) -> LogT:

@@ -18,6 +18,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from aura_ums._files import Fields, describe, parse_json
+from aura_ums._validate import WEDGE_EXTENT
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
 from aura_ums.manager._relaxed import Branch, RelaxedState, Sighting
@@ -100,6 +101,13 @@ class Reader:
         """Return ``value`` as a finite float (a JSON number, not a boolean)."""
         return self.fields.number(value, where)
 
+    def extent(self, value: object, where: str) -> float:
+        """Return ``value`` as a wedge's extent, radians, in :data:`~aura_ums._validate.WEDGE_EXTENT`."""
+        found = self.number(value, where)
+        if not WEDGE_EXTENT.contains(found):
+            self.fail(where, f"expected {WEDGE_EXTENT.text()}, got {found!r}")
+        return found
+
     def optional_number(self, value: object, where: str) -> float | None:
         """Return ``value`` as a finite float, or None for JSON ``null``."""
         return None if value is None else self.number(value, where)
@@ -177,12 +185,10 @@ class Reader:
         heading = self.number(wedge_data["center"], f"{where}.wedge.center")
         if not -math.pi < heading <= math.pi:
             self.fail(f"{where}.wedge.center", f"expected a heading in (-pi, pi], got {heading!r}")
+        cw = self.extent(wedge_data["cw"], f"{where}.wedge.cw")
+        ccw = self.extent(wedge_data["ccw"], f"{where}.wedge.ccw")
         try:
-            wedge = HeadingWedge._restored(
-                heading,
-                self.number(wedge_data["cw"], f"{where}.wedge.cw"),
-                self.number(wedge_data["ccw"], f"{where}.wedge.ccw"),
-            )
+            wedge = HeadingWedge._restored(heading, cw, ccw)
         except InputError as exc:
             self.fail(f"{where}.wedge", str(exc))
         if "slices" in data:

@@ -230,6 +230,8 @@ relocalize_after (2), got 1
             float,
             low=0.0,
             low_open=True,
+            # The square of every coordinate a map may hold (COORDINATE, +-1e6 m): no map is larger.
+            high=4e12,
             nullable=True,
         ),
     )

@@ -551,22 +551,26 @@ class Scenario:
             f"{memory / 1e9:.3g} GB a run"
         )
         limits = f"at most {MAX_RUN_SECONDS:g} s and {MAX_RUN_BYTES / 1e9:g} GB a run"
-        # Name the input that makes the run too big: the one whose cost dominates.
-        frames = self.frame_count()
-        per_frame = seconds / frames
+        # Name the input that makes the run too big: a frame's costliest part when a few
+        # frames of it would already be too many, else the number of frames.
+        per_frame = seconds / self.frame_count()
+        parts = {
+            "Scenario.camera": _SECONDS_PER_FRAME + float(k.width) * float(k.height) * _SECONDS_PER_PIXEL,
+            "Scenario.render.clutter": float(self.render.clutter) * _SECONDS_PER_STRIP,
+            "Scenario.render.clutter_lines": float(self.render.clutter_lines) * _SECONDS_PER_LINE,
+        }
+        costliest = max(parts, key=lambda part: parts[part])
         if memory > MAX_RUN_BYTES:
             clutter = self.render.clutter * _BYTES_PER_STRIP > memory / 2
             name = "Scenario.render.clutter" if clutter else "Scenario.camera"
+        elif parts[costliest] * _FEW_FRAMES > MAX_RUN_SECONDS:
+            name = costliest
         elif self.frame_spacing is not None and per_frame * (len(self.commands) + 1) <= MAX_RUN_SECONDS:
             name = "Scenario.frame_spacing"
-        elif self.frame_spacing is None and per_frame * _FEW_FRAMES <= MAX_RUN_SECONDS < seconds:
+        elif self.frame_spacing is None:
             name = "Scenario.commands"  # a frame after each command: too many commands
-        elif frames * self.render.clutter * _SECONDS_PER_STRIP > seconds / 2:
-            name = "Scenario.render.clutter"
-        elif frames * self.render.clutter_lines * _SECONDS_PER_LINE > seconds / 2:
-            name = "Scenario.render.clutter_lines"
         else:
-            name = "Scenario.camera"
+            name = costliest
         raise InputError(f"{name}: expected {limits}, got {work}")
 
     def check_runs(self, runs: object) -> int:
@@ -672,7 +676,11 @@ class Scenario:
             where = {
                 "Scenario.render.clutter": "[render] clutter",
                 "Scenario.render.clutter_lines": "[render] clutter_lines",
-                "Scenario.frame_spacing": "frame_spacing" if "frame_spacing" in document else "frame_rate",
+                "Scenario.frame_spacing": (
+                    "frame_spacing"
+                    if "frame_spacing" in document
+                    else "frame_rate and speed (the frame spacing)"
+                ),
                 "Scenario.commands": "[route]",
             }.get(field_name, field_name.removeprefix("Scenario."))
             raise reader.fail(where, message) from None
@@ -920,6 +928,12 @@ def _commands_through(
         if run == 0.0:
             raise reader.fail(
                 f"{where}[{index}]", f"expected a point away from the previous one, got ({px}, {py})"
+            )
+        if not LENGTH.contains(run):
+            raise reader.fail(
+                f"{where}[{index}]",
+                f"expected a point at most {LENGTH.high:g} m from the previous one (a leg's run), "
+                f"got ({px}, {py}), {run:.6g} m away",
             )
         direction = math.atan2(dy, dx)
         commands.append(TurnAndRun(wrap_angle(direction - heading), run))

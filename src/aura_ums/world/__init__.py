@@ -31,8 +31,8 @@ positions, start and end (Class III), with properties:
   (default 0);
 - ``strategy``: ``"line_finder"``, ``"interest_operator"`` or ``"region_segmenter"``;
   ``parameters``: object of numbers for the strategy (default ``{}``);
-- ``activation_range`` (m, > 0), ``recognition_threshold`` (>= 0), ``confirm_frames``
-  (integer >= 1, default 3).
+- ``activation_range`` (m, in (0, 10000]), ``recognition_threshold`` (>= 0),
+  ``confirm_frames`` (integer in [1, 10000], default 3).
 
 Properties whose value is ``null`` count as absent (GIS tools write them); any other
 property is refused, so that typing mistakes are caught. Ids are unique across all

@@ -16,7 +16,7 @@ from typing import NoReturn
 import numpy as np
 
 from aura_ums._files import Fields, describe, load_json, regular_file, write_text_atomic
-from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, POSITION_UNCERTAINTY, Range
+from aura_ums._validate import ANGLE, COORDINATE, HEIGHT, MAX_CONFIRM_FRAMES, POSITION_UNCERTAINTY, Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import (
@@ -282,8 +282,11 @@ class _Reader:
             for key, value in parameters.items()
         }
         frames = props.get("confirm_frames", 3)
-        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 1:
-            self.fail(f"{where} properties.confirm_frames", f"expected an integer >= 1, got {_kind(frames)}")
+        if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_CONFIRM_FRAMES:
+            self.fail(
+                f"{where} properties.confirm_frames",
+                f"expected an integer in [1, {MAX_CONFIRM_FRAMES}], got {_kind(frames)}",
+            )
         activation = required_number("activation_range")
         threshold = required_number("recognition_threshold")
         try:

@@ -19,7 +19,15 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import Choice, finite_float, items_of, points_array, read_only
+from aura_ums._validate import (
+    ACTIVATION_RANGE,
+    MAX_CONFIRM_FRAMES,
+    Choice,
+    finite_float,
+    items_of,
+    points_array,
+    read_only,
+)
 from aura_ums.errors import InputError, UnknownLandmarkError, UnknownTerrainError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon
 from aura_ums.uncertainty import (
@@ -106,14 +114,14 @@ class LandmarkRecord:
         radians, ``tolerance``: radians, ``min_length``: pixels). Names are non-empty
         strings, values finite numbers. Stored as a read-only mapping.
     activation_range : float
-        Metres, > 0: the find-landmark schema wakes from hibernation when the robot may be
+        Metres, in (0, 10,000]: the find-landmark schema wakes from hibernation when the robot may be
         within this distance of the landmark.
     recognition_threshold : float
         Evaluation value (>= 0, on the scale of the strategy's evaluation function) that
         an image structure must reach to count as the landmark: for lines, length (px) times
         contrast (gray levels per px); for corners, the Moravec response.
     confirm_frames : int
-        Number of consecutive frames (>= 1) that must confirm a discovery.
+        Number of consecutive frames (1 to 10,000) that must confirm a discovery.
 
     Raises
     ------
@@ -131,7 +139,7 @@ class LandmarkRecord:
     >>> LandmarkRecord(pole, PerceptualStrategy.LINE_FINDER, {}, 0.0, 0.6)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: lamppost_107.activation_range: expected a positive number, got 0.0
+    aura_ums.errors.InputError: lamppost_107.activation_range: expected a number in (0, 10000] m, got 0.0
     """
 
     landmark: Landmark
@@ -159,10 +167,11 @@ class LandmarkRecord:
             _identifier(key, f"{name}.parameters key")
             checked[key] = finite_float(value, f"{name}.parameters.{key}")
         object.__setattr__(self, "parameters", types.MappingProxyType(checked))
-        activation = finite_float(self.activation_range, f"{name}.activation_range")
-        if activation <= 0.0:
-            raise InputError(f"{name}.activation_range: expected a positive number, got {activation!r}")
-        object.__setattr__(self, "activation_range", activation)
+        object.__setattr__(
+            self,
+            "activation_range",
+            ACTIVATION_RANGE.check(self.activation_range, f"{name}.activation_range"),
+        )
         threshold = finite_float(self.recognition_threshold, f"{name}.recognition_threshold")
         if threshold < 0.0:
             raise InputError(
@@ -170,8 +179,14 @@ class LandmarkRecord:
             )
         object.__setattr__(self, "recognition_threshold", threshold)
         frames = self.confirm_frames
-        if isinstance(frames, bool) or not isinstance(frames, (int, np.integer)) or frames < 1:
-            raise InputError(f"{name}.confirm_frames: expected an integer >= 1, got {frames!r}")
+        if (
+            isinstance(frames, bool)
+            or not isinstance(frames, (int, np.integer))
+            or not 1 <= frames <= MAX_CONFIRM_FRAMES
+        ):
+            raise InputError(
+                f"{name}.confirm_frames: expected an integer in [1, {MAX_CONFIRM_FRAMES}], got {frames!r}"
+            )
         object.__setattr__(self, "confirm_frames", int(frames))
 
     @property
