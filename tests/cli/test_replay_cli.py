@@ -541,6 +541,21 @@ def test_a_bad_max_truth_gap_is_named_as_the_option(command: str, log_folder: Pa
     )
 
 
+def test_calibrate_names_the_log_folder_without_ground_truth(log_folder: Path, tmp_path: Path) -> None:
+    # It said "calibrating from their contents: logs: expected logs with ground truth, got
+    # 'synthetic' without": the library's argument and the log's name, not the folder.
+    bare = tmp_path / "bare"
+    shutil.copytree(log_folder, bare)
+    (bare / "groundtruth.csv").unlink()
+    result = runner.invoke(app, ["calibrate", str(log_folder), str(bare), "--out", str(tmp_path / "t.toml")])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        "error: LOG_DIRS: expected log folders with ground truth (the calibration fits the motion and "
+        f"sensor bounds against it), got {bare} without a groundtruth.csv\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bare"]
+
+
 def test_calibrate_refuses_an_empty_out_path(log_folder: Path) -> None:
     result = runner.invoke(app, ["calibrate", str(log_folder), "--out", ""])
     assert result.exit_code == 2

@@ -350,6 +350,12 @@ def calibrate(
     except AuraUmsError as exc:
         raise fail(campaign_failure(exc)) from None
     logs = list(loaded.values)
+    for folder, log in zip(log_dirs, logs, strict=True):
+        if log.groundtruth is None:
+            raise fail(
+                f"LOG_DIRS: expected log folders with ground truth (the calibration fits the motion and "
+                f"sensor bounds against it), got {folder} without a groundtruth.csv"
+            )
     try:
         if horizons:
             calibration = calibrate_logs(
