@@ -62,6 +62,18 @@ def test_compiled_hull_sorts_any_order_as_the_reference(seed: int, order: str) -
     assert ours.tobytes() == reference.tobytes()
 
 
+@built
+@pytest.mark.parametrize(("radius", "count"), [(1e-11, 150), (3e-12, 100)])
+def test_compiled_hull_of_a_speck_is_the_references_segment(radius: float, count: int) -> None:
+    # Every corner straight to within rounding: both kept nothing before (an empty hull).
+    turn = np.linspace(0.0, 2.0 * np.pi, count, endpoint=False)
+    speck = np.column_stack([16.0 + radius * np.cos(turn), 1.5 + radius * np.sin(turn)])
+    (ours,) = merge_groups_compiled(speck, [count], count)
+    (reference,) = merge_groups_reference(speck, [count], count)
+    assert len(ours) == 2
+    assert ours.tobytes() == reference.tobytes()
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 8, 64]))
 def test_each_merge_holds_its_group_within_the_cap(seed: int, cap: int) -> None:
     from aura_ums import _native

@@ -139,6 +139,19 @@ def test_hull_of_collinear_points_is_a_segment() -> None:
     assert convex_hull(many).shape == (2, 2)  # Qhull fails on these; the exact chain does not
 
 
+@pytest.mark.parametrize(("radius", "count"), [(1e-10, 432), (1e-11, 150), (3e-12, 100)])
+def test_hull_of_a_speck_far_from_the_origin_keeps_its_extent(radius: float, count: int) -> None:
+    # A joint reduction's 432 sector results 2.7e-9 m across at (16, 1.5): every corner of
+    # their hull was straight to within rounding, all went, and the hull was empty (an
+    # IndexError from the manager's update, building a map on it).
+    turn = np.linspace(0.0, 2.0 * np.pi, count, endpoint=False)
+    speck = np.column_stack([16.0 + radius * np.cos(turn), 1.5 + radius * np.sin(turn)])
+    hull = convex_hull(speck)
+    assert len(hull) == 2
+    assert np.hypot(*(hull[1] - hull[0])) == pytest.approx(2.0 * radius, rel=1e-3)
+    assert ConvexPolygon(speck).vertices.shape == (2, 2)
+
+
 # --- containment --------------------------------------------------------------------------
 
 

@@ -558,6 +558,23 @@ int remove_collinear(Poly *p, Work *w) {
         count += straight[i];
     }
     if (count == 0) return 0;
+    if (n - count < 2) {
+        /* Every corner straight to within rounding (a polygon of the noise's size): the
+           segment from the first vertex to the farthest from it (the first such), not nothing. */
+        Py_ssize_t far = 0;
+        double farthest = -1.0;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            double d = hypot(v[2 * i] - v[0], v[2 * i + 1] - v[1]);
+            if (d > farthest) {
+                farthest = d;
+                far = i;
+            }
+        }
+        v[2] = v[2 * far];
+        v[3] = v[2 * far + 1];
+        p->n = 2;
+        return 0;
+    }
     m = 0;
     for (Py_ssize_t i = 0; i < n; i++) {
         if (straight[i]) continue;

@@ -141,6 +141,10 @@ def remove_collinear(vertices: Array) -> Array:
     >>> far = np.array([[2e4, 0.0], [2e4 + 1.0, 0.0], [2e4 + 2.0, 1.0], [2e4 + 2.0, 1.0 + 4e-12], [2e4, 1.0]])
     >>> remove_collinear(far).tolist()   # the two corners 4e-12 m apart are one
     [[20000.0, 0.0], [20001.0, 0.0], [20002.0, 1.000000000004], [20000.0, 1.0]]
+    >>> turn = np.linspace(0.0, 2.0 * np.pi, 432, endpoint=False)
+    >>> speck = np.column_stack([16.0 + 1e-10 * np.cos(turn), 1.5 + 1e-10 * np.sin(turn)])
+    >>> len(remove_collinear(speck))     # every corner straight within rounding: a segment, not nothing
+    2
     """
     n = len(vertices)
     if n < 2:
@@ -167,7 +171,14 @@ def remove_collinear(vertices: Array) -> Array:
         np.einsum("ij,ij->i", preceding, following) > 0
     )
     if np.any(straight):
-        vertices = vertices[~straight]
+        kept = vertices[~straight]
+        if len(kept) < 2:
+            # Every corner is straight to within rounding: a polygon of the noise's size (a
+            # tiny round cluster far from the origin). Its extent stays, as the segment from
+            # the first vertex to the farthest from it, not as nothing.
+            far = int(np.argmax(np.hypot(vertices[:, 0] - vertices[0, 0], vertices[:, 1] - vertices[0, 1])))
+            return vertices[[0, far]]
+        vertices = kept
     return vertices
 
 
