@@ -213,6 +213,27 @@ def test_twins_that_do_not_pair_are_refused_and_nothing_changes() -> None:
     assert manager.update(board, now=1.0, envelope=seen).outcomes[0].accepted
 
 
+def test_a_re_seed_uses_no_sighting_taken_before_the_motion_the_envelope_has_grown_since() -> None:
+    # One update: a metre, the sightings (the pole wrong: re-localization), then half a metre
+    # more. The re-seed reduced the envelope map, grown to the end, by the sightings taken
+    # half a metre back: it put the robot where it was, and the truth ended outside.
+    manager = UncertaintyMapManager(START, WORLD, FLOOR)
+    board = Blackboard()
+    seen_at = Pose(3.0, 0.0, 0.0)
+    board.post_report(PositionReport(1.0, STRIDE))
+    for observation in sightings(seen_at, 1.0):
+        if isinstance(observation, BearingObservation):
+            observation = dataclasses.replace(observation, bearing=observation.bearing + 2.0)
+        board.identified.post(observation)
+    board.post_report(PositionReport(2.0, TurnAndRun(0.0, 0.5)))
+    step = manager.update(board, now=2.0)
+    assert step.relocalized
+    assert step.envelope_map is not None
+    truth = Pose(3.5, 0.0, 0.0)
+    assert step.envelope_map.contains(truth)
+    assert step.map.contains(truth)
+
+
 def test_relocalize_after_counts_inconsistencies_in_a_window() -> None:
     settings = ManagerSettings(relocalize_after=2, relocalize_window=6)
     manager = UncertaintyMapManager(START, WORLD, FLOOR, settings)

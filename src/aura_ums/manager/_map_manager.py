@@ -308,8 +308,9 @@ class UncertaintyMapManager:
     being larger. When ``relocalize_after`` of the last ``relocalize_window`` observations
     that reached a reduction were inconsistent with the working map, it is presumed
     wrong (the paper's "a landmark shown to be incorrect", seen from the other side) and
-    re-localized: re-seeded from the envelope map, reduced by the update's observations
-    under their typical bounds. The same code runs in simulation, in replay and live.
+    re-localized: re-seeded from the envelope map, reduced by the update's consistent
+    observations taken at its time, under their typical bounds. The same code runs in
+    simulation, in replay and live.
 
     Wrong landmarks (with :attr:`ManagerSettings.relaxed_q` ``= q > 0``): a misidentified
     landmark can be consistent with both maps and still wrong; a gate cannot see it. The
@@ -716,7 +717,14 @@ class UncertaintyMapManager:
                 # Not the observations the map found inconsistent: one is as likely a misread
                 # (a gross outlier) as the map wrong, and one that is consistent with the wider
                 # envelope map would cut the re-seeded map to its own region.
-                agreeing = [o.observation for o in outcomes if o.reason is None or not o.reason.inconsistent]
+                # Nor those taken before the motion the envelope map has grown since (a stale
+                # one included): they tell where the robot was, not where it is.
+                agreeing = [
+                    o.observation
+                    for o in outcomes
+                    if (o.reason is None or not o.reason.inconsistent)
+                    and (wide_time is None or o.observation.time >= wide_time)
+                ]
                 self._reseed_from(wide, agreeing)
                 self._relocalizations += 1
                 recent.clear()
