@@ -229,6 +229,10 @@ def test_a_nullable_setting_takes_none_as_its_message_says(flag: str) -> None:
         ),
         (["--slice-width", "1e-6"], "--slice-width: expected at least 0.00174533 rad (0.1 degree, 3600"),
         (["--sigmas", "1e300"], "--sigmas: expected a number in [0.1, 100], got 1e+300"),
+        # typer's own conversion: a boxed "Invalid value for '--sigmas': Input should be a valid
+        # number", without the value
+        (["--sigmas", "abc"], "--sigmas: expected a number in [0.1, 100], got 'abc'"),
+        (["--max-vertices", "1.5"], "--max-vertices: expected an integer >= 3, got '1.5'"),
         (
             ["--relaxed-q", "3", "--relaxed-window", "100"],
             "--relaxed-q: expected at most 2000 branches of the relaxed intersection",

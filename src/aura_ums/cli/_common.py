@@ -383,7 +383,7 @@ def _parameters(field: dataclasses.Field[Any], default_from: str) -> list[inspec
         flag,
         help=help_text,
         show_default=default,
-        parser=_setting_option(flag, info) if angle or info.nullable else None,
+        parser=_setting_option(flag, info),
         metavar="<angle>" if angle else None,
     )
     parameters = [
@@ -405,10 +405,11 @@ _NONE_TYPED: Any = object()
 
 
 def _setting_option(flag: str, info: SettingInfo) -> Callable[[str], object]:
-    """Return the parser of an angle option or a nullable setting's option.
+    """Return the parser of a setting's option: a refusal names the option and the text given.
 
     An angle is radians, or degrees with a suffix (``2deg``, ``2°``); a nullable setting
-    also takes ``none``, as its help says.
+    also takes ``none``, as its help says. (Typer's own conversion said "Input should be a
+    valid number" in a boxed usage block, without the value.)
     """
     angle = info.unit == "rad"
     also = " (radians, or degrees as 2deg)" if angle else ""
