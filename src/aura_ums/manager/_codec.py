@@ -101,13 +101,6 @@ class Reader:
         """Return ``value`` as a finite float (a JSON number, not a boolean)."""
         return self.fields.number(value, where)
 
-    def extent(self, value: object, where: str) -> float:
-        """Return ``value`` as a wedge's extent, radians, in :data:`~aura_ums._validate.WEDGE_EXTENT`."""
-        found = self.number(value, where)
-        if not WEDGE_EXTENT.contains(found):
-            self.fail(where, f"expected {WEDGE_EXTENT.text()}, got {found!r}")
-        return found
-
     def optional_number(self, value: object, where: str) -> float | None:
         """Return ``value`` as a finite float, or None for JSON ``null``."""
         return None if value is None else self.number(value, where)
@@ -185,8 +178,8 @@ class Reader:
         heading = self.number(wedge_data["center"], f"{where}.wedge.center")
         if not -math.pi < heading <= math.pi:
             self.fail(f"{where}.wedge.center", f"expected a heading in (-pi, pi], got {heading!r}")
-        cw = self.extent(wedge_data["cw"], f"{where}.wedge.cw")
-        ccw = self.extent(wedge_data["ccw"], f"{where}.wedge.ccw")
+        cw = self.fields.ranged(wedge_data["cw"], f"{where}.wedge.cw", WEDGE_EXTENT)
+        ccw = self.fields.ranged(wedge_data["ccw"], f"{where}.wedge.ccw", WEDGE_EXTENT)
         try:
             wedge = HeadingWedge._restored(heading, cw, ccw)
         except InputError as exc:
