@@ -37,7 +37,9 @@ def test_demo_writes_the_report(tmp_path: Path) -> None:
 def test_unknown_option_is_a_usage_error() -> None:
     result = runner.invoke(app, ["figures", "--colour", "red"])
     assert result.exit_code == 2
-    assert "No such option" in result.output
+    # typer's boxed "No such option", worded as every other refusal
+    assert result.stderr.startswith("error: --colour: expected an option of aura-ums figures (see --help")
+    assert result.stderr.endswith("got --colour\n")
 
 
 @pytest.mark.parametrize(
@@ -60,3 +62,23 @@ def test_bad_numbers_are_refused_before_any_work(arguments: list[str], message: 
     assert "Traceback" not in result.output
     assert result.stderr == f"error: {message}\n"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["simulate", "s.toml", "--runs", "1.5"], "--runs: expected an integer, got '1.5'"),
+        (["simulate", "s.toml", "--runs=x"], "--runs: expected an integer, got 'x'"),
+        (["import", "mrclam", "d", "o", "--robot", "abc"], "--robot: expected an integer, got 'abc'"),
+        (
+            ["import", "rosbag", "b", "o", "--odom", "/o", "--observations", "/x"],
+            "--landmarks: expected a value (the option is required), got none",
+        ),
+    ],
+)
+def test_typers_own_refusals_name_the_option_and_what_was_typed(argv: list[str], message: str) -> None:
+    # They came boxed under a usage line: "Invalid value for '--runs': Input should be a valid
+    # integer", without the value.
+    result = runner.invoke(app, argv)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {message}\n"

@@ -153,7 +153,7 @@ def test_the_landmark_classes_are_a_choice(command: str, log_folder: Path, tmp_p
     terrain.write_text("")
     result = runner.invoke(app, [command, str(log_folder), "--terrain", str(terrain), "--classes", "III"])
     assert result.exit_code == 2
-    assert "'III' is not one of 'I', 'II'" in result.output
+    assert result.stderr == "error: --classes: expected one of I, II, got 'III'\n"
 
 
 VIRTUAL_CAMERA = Path(__file__).resolve().parents[2] / "examples" / "virtual_camera_60deg.toml"

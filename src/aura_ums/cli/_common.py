@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.console import Console
 from rich.markup import escape
+from typer._click.exceptions import MissingParameter, NoSuchOption, UsageError
 from typer.core import TyperCommand, TyperGroup
 
 from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
@@ -487,7 +488,10 @@ def _plain_text(text: str | None) -> str | None:
 
 
 class PlainCommand(TyperCommand):
-    """A typer command whose help shows flags and bracketed text as written (see :func:`_plain_help`)."""
+    """A typer command whose help shows flags and bracketed text as written (see :func:`_plain_help`).
+
+    Its arguments' refusals read as every other error does (see :func:`_usage_error`).
+    """
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -495,6 +499,47 @@ class PlainCommand(TyperCommand):
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _plain_help(super().get_params(ctx))
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        given = list(args)
+        try:
+            return super().parse_args(ctx, args)
+        except UsageError as exc:
+            message = None if ctx.resilient_parsing else _usage_error(exc, given, ctx.command_path)
+            if message is None:
+                raise
+            raise fail(message) from None
+
+
+def _usage_error(exc: UsageError, given: Sequence[str], command: str) -> str | None:
+    """Word typer's refusal of an argument as ``OPTION: expected ..., got ...``; None to leave it.
+
+    Typer's own words come in a boxed usage block, and its conversions do not echo the
+    value ("Input should be a valid integer"): the option and what was typed are named here.
+    """
+    if isinstance(exc, NoSuchOption):
+        hint = f"; did you mean {', '.join(exc.possibilities)}?" if exc.possibilities else ""
+        return f"{exc.option_name}: expected an option of {command} (see --help{hint}), got {exc.option_name}"
+    flags = [
+        flag for flag in getattr(getattr(exc, "param", None), "opts", None) or [] if flag.startswith("-")
+    ]
+    if not flags:
+        return None
+    if isinstance(exc, MissingParameter):
+        return f"{flags[0]}: expected a value (the option is required), got none"
+    typed = None
+    for index, text in enumerate(given):
+        flag, equals, value = text.partition("=")
+        if flag in flags:
+            typed = value if equals else given[index + 1] if index + 1 < len(given) else None
+    reason = exc.message.removeprefix("Value error, ")
+    expected = {"valid integer": "an integer", "valid number": "a number"}
+    what = next((words for key, words in expected.items() if key in reason), None)
+    if what is None and " is not one of " in reason:
+        what = "one of " + reason.split(" is not one of ", 1)[1].rstrip(".").replace("'", "")
+    if what is None or typed is None:
+        return f"{flags[0]}: {reason}"
+    return f"{flags[0]}: expected {what}, got {typed!r}"
 
 
 class PlainGroup(TyperGroup):
