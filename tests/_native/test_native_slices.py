@@ -74,6 +74,16 @@ def test_compiled_hull_of_a_speck_is_the_references_segment(radius: float, count
     assert ours.tobytes() == reference.tobytes()
 
 
+@built
+def test_compiled_hull_keeps_a_corner_between_two_straight_ones_as_the_reference() -> None:
+    from tests.geometry.test_polygon import _SLIVER
+
+    (ours,) = merge_groups_compiled(_SLIVER, [len(_SLIVER)], len(_SLIVER))
+    (reference,) = merge_groups_reference(_SLIVER, [len(_SLIVER)], len(_SLIVER))
+    assert len(ours) == 4
+    assert ours.tobytes() == reference.tobytes()
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 8, 64]))
 def test_each_merge_holds_its_group_within_the_cap(seed: int, cap: int) -> None:
     from aura_ums import _native

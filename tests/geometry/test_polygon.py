@@ -152,6 +152,30 @@ def test_hull_of_a_speck_far_from_the_origin_keeps_its_extent(radius: float, cou
     assert ConvexPolygon(speck).vertices.shape == (2, 2)
 
 
+# The slice vertices of a sliced map whose summary polygon left the truth 1.26e-6 m outside:
+# two near-duplicate pairs (a picometre apart) on a thin sliver's ends, each corner straight
+# between its own neighbours; removed at once, they cut off a real 1.9-micrometre bump.
+_SLIVER = np.array(
+    [
+        [-1.348961310048351, 1.981656260958965],
+        [-1.3489595212881924, 1.981654461482052],
+        [-1.0231352548689467, 2.0212234963151907],
+        [-1.0231352548650159, 2.021223496315668],
+        [-1.023135254867362, 2.0212234963153834],
+        [-1.042989624013734, 2.018814341404329],
+        [-1.0429896240154017, 2.0188143414041266],
+        [-1.331340663694983, 1.9837961628668288],
+    ]
+)
+
+
+def test_hull_keeps_a_corner_between_two_straight_ones() -> None:
+    hull = convex_hull(_SLIVER)
+    outline = shapely.Polygon(hull)
+    assert max(outline.distance(shapely.Point(*p)) for p in _SLIVER) < 1e-12
+    assert np.array_equal(ConvexPolygon.from_points(_SLIVER).vertices, hull)
+
+
 # --- containment --------------------------------------------------------------------------
 
 

@@ -537,52 +537,61 @@ int remove_collinear(Poly *p, Work *w) {
         n = m;
         p->n = n;
     }
-    if (n < 3) return 0;
-    if (!measured) { /* the kept vertices' own magnitude, as the reference takes it */
-        magnitude = 0.0;
-        for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
-    }
     char *straight = scratch(&w->flags, n, 1);
     if (!straight) return -1;
-    Py_ssize_t count = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
-        double fx = v[2 * next] - v[2 * i], fy = v[2 * next + 1] - v[2 * i + 1];
-        double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
-        double length = measured ? lengths[i] : hypot(fx, fy);
-        double preceding_length = measured ? lengths[prev] : hypot(px, py);
-        double turn = px * fy - py * fx;
-        double noise =
-            COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length);
-        straight[i] = fabs(turn) <= noise && px * fx + py * fy > 0.0;
-        count += straight[i];
-    }
-    if (count == 0) return 0;
-    if (n - count < 2) {
-        /* Every corner straight to within rounding (a polygon of the noise's size): the
-           segment from the first vertex to the farthest from it (the first such), not nothing. */
-        Py_ssize_t far = 0;
-        double farthest = -1.0;
-        for (Py_ssize_t i = 0; i < n; i++) {
-            double d = hypot(v[2 * i] - v[0], v[2 * i + 1] - v[1]);
-            if (d > farthest) {
-                farthest = d;
-                far = i;
-            }
+    /* See the reference: a straight vertex goes only if the one before it stays, pass after
+       pass while one waited for its neighbour. */
+    while (n >= 3) {
+        if (!measured) { /* the kept vertices' own magnitude, as the reference takes it */
+            magnitude = 0.0;
+            for (Py_ssize_t i = 0; i < 2 * n; i++) magnitude = greater(magnitude, fabs(v[i]));
         }
-        v[2] = v[2 * far];
-        v[3] = v[2 * far + 1];
-        p->n = 2;
-        return 0;
+        Py_ssize_t count = 0;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            Py_ssize_t prev = i > 0 ? i - 1 : n - 1, next = i + 1 < n ? i + 1 : 0;
+            double fx = v[2 * next] - v[2 * i], fy = v[2 * next + 1] - v[2 * i + 1];
+            double px = v[2 * i] - v[2 * prev], py = v[2 * i + 1] - v[2 * prev + 1];
+            double length = measured ? lengths[i] : hypot(fx, fy);
+            double preceding_length = measured ? lengths[prev] : hypot(px, py);
+            double turn = px * fy - py * fx;
+            double noise =
+                COLLINEAR_EPS * length * preceding_length + 1e-15 * magnitude * (length + preceding_length);
+            straight[i] = fabs(turn) <= noise && px * fx + py * fy > 0.0;
+            count += straight[i];
+        }
+        if (count == 0) return 0;
+        if (count == n) {
+            /* Every corner straight to within rounding (a polygon of the noise's size): the
+               segment from the first vertex to the farthest from it (the first such), not nothing. */
+            Py_ssize_t far = 0;
+            double farthest = -1.0;
+            for (Py_ssize_t i = 0; i < n; i++) {
+                double d = hypot(v[2 * i] - v[0], v[2 * i + 1] - v[1]);
+                if (d > farthest) {
+                    farthest = d;
+                    far = i;
+                }
+            }
+            v[2] = v[2 * far];
+            v[3] = v[2 * far + 1];
+            p->n = 2;
+            return 0;
+        }
+        int waited = 0;
+        Py_ssize_t m = 0;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            int goes = straight[i] && !straight[i > 0 ? i - 1 : n - 1];
+            waited |= straight[i] && !goes;
+            if (goes) continue;
+            v[2 * m] = v[2 * i];
+            v[2 * m + 1] = v[2 * i + 1];
+            m++;
+        }
+        n = m;
+        p->n = n;
+        if (!waited) return 0;
+        measured = 0;
     }
-    m = 0;
-    for (Py_ssize_t i = 0; i < n; i++) {
-        if (straight[i]) continue;
-        v[2 * m] = v[2 * i];
-        v[2 * m + 1] = v[2 * i + 1];
-        m++;
-    }
-    p->n = m;
     return 0;
 }
 
