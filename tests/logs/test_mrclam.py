@@ -197,6 +197,15 @@ def test_robot1_values_match_the_files(robot1: RobotLog) -> None:
     assert all(a.time <= b.time for a, b in zip(robot1.observations, robot1.observations[1:], strict=False))
 
 
+def test_measurements_out_of_time_order_are_sorted_and_said(tmp_path: Path) -> None:
+    # Sorted in silence before: the log's source did not say its file was out of order.
+    shuffled = HEADER + "11.0 \t 81 \t 4.0 \t -0.1\n10.0 \t 63 \t 2.0 \t 0.5\n20.0 \t 63 \t 2.5 \t 0.2\n"
+    log = read_mrclam(tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{"Robot1_Measurement.dat": shuffled}), 1)
+    assert [o.time for o in log.observations] == [10.0, 11.0, 20.0]
+    assert "sorted Robot1_Measurement.dat by time (1 row earlier than the one above)" in log.meta.source
+    assert "sorted" not in read_mrclam(tiny_dataset(tmp_path / "in_order"), 1).meta.source
+
+
 @needs_mrclam6
 def test_robot2_drops_its_repeated_odometry_time() -> None:
     log = read_mrclam(MRCLAM6, 2)

@@ -291,6 +291,12 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     truth_rows, truth_repeats = truth_file.increasing()
 
     notes = [f"dropped {robots} robot and {unknown} unknown-barcode measurements"]
+    earlier = int(np.count_nonzero(np.diff(measurements.data[:, 0]) < 0.0)) if len(measurements.data) else 0
+    if earlier:
+        # Sorted by time above: said, so that a reader of the log knows its file was not in order.
+        notes.append(
+            f"sorted {prefix}Measurement.dat by time ({_plural(earlier, 'row')} earlier than the one above)"
+        )
     if not len(measurements.data):
         # As an observations.csv with its header alone: a log without observations is one
         # to replay on odometry alone, so it is kept, but said (a truncated download?).
