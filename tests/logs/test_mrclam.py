@@ -197,6 +197,14 @@ def test_robot1_values_match_the_files(robot1: RobotLog) -> None:
     assert all(a.time <= b.time for a, b in zip(robot1.observations, robot1.observations[1:], strict=False))
 
 
+def test_a_subject_with_two_barcodes_is_refused(tmp_path: Path) -> None:
+    # Accepted before: measurements of either barcode became that landmark.
+    barcodes = TINY["Barcodes.dat"] + "  6 \t 99\n"
+    folder = tiny_dataset(tmp_path / "MRCLAM_Dataset9", **{"Barcodes.dat": barcodes})
+    with pytest.raises(FileFormatError, match=r"Barcodes\.dat:9: expected each subject once, got 6 again"):
+        read_mrclam(folder, 1)
+
+
 def test_measurements_out_of_time_order_are_sorted_and_said(tmp_path: Path) -> None:
     # Sorted in silence before: the log's source did not say its file was out of order.
     shuffled = HEADER + "11.0 \t 81 \t 4.0 \t -0.1\n10.0 \t 63 \t 2.0 \t 0.5\n20.0 \t 63 \t 2.5 \t 0.2\n"

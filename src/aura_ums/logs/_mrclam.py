@@ -241,6 +241,7 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     # in silence: the import would succeed with no observation or the wrong landmark.
     barcodes.need_rows()
     barcodes.once(1, "barcode")
+    barcodes.once(0, "subject")  # two barcodes of one subject: a typing slip, or two landmarks made one
     subject_of = {int(barcode): int(subject) for subject, barcode in barcodes.data}
     landmark_file = _DatFile(folder / "Landmark_Groundtruth.dat", ("subject", "x", "y", "x_sd", "y_sd"))
     landmark_file.need_rows()
