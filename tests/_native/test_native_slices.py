@@ -84,6 +84,25 @@ def test_compiled_hull_keeps_a_corner_between_two_straight_ones_as_the_reference
     assert ours.tobytes() == reference.tobytes()
 
 
+@built
+@given(st.integers(0, 2**32 - 1))
+def test_compiled_hull_drops_runs_of_straight_vertices_as_the_reference(seed: int) -> None:
+    # Runs of near-straight vertices of every length on a polygon's edges: the reference's
+    # every-other-one passes and the kernel's must keep the very same vertices.
+    rng = np.random.default_rng(seed)
+    corners = random_polygon(rng)
+    pieces = []
+    for k in range(len(corners)):
+        a, b = corners[k], corners[(k + 1) % len(corners)]
+        t = np.sort(rng.uniform(0.0, 1.0, int(rng.integers(0, 12))))
+        pieces += [a[None, :], a + t[:, None] * (b - a)]
+    points = np.ascontiguousarray(np.concatenate(pieces))
+    cap = max(len(points), 3)
+    (ours,) = merge_groups_compiled(points, [len(points)], cap)
+    (reference,) = merge_groups_reference(points, [len(points)], cap)
+    assert ours.tobytes() == reference.tobytes()
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 8, 64]))
 def test_each_merge_holds_its_group_within_the_cap(seed: int, cap: int) -> None:
     from aura_ums import _native

@@ -23,7 +23,7 @@ from aura_ums.geometry import (
     regular_polygon,
     simplify_outer,
 )
-from aura_ums.geometry._convex import convexity_defect
+from aura_ums.geometry._convex import convexity_defect, remove_collinear
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
 
 SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
@@ -167,6 +167,14 @@ _SLIVER = np.array(
         [-1.331340663694983, 1.9837961628668288],
     ]
 )
+
+
+def test_a_long_run_of_straight_vertices_goes_in_few_passes() -> None:
+    # One straight vertex of a run a pass took a pass per vertex: a saved map of a million
+    # vertices on a line did not load in a minute. Every other one a pass: a few passes.
+    edge = np.column_stack([np.linspace(0.0, 1.0, 200_001), np.zeros(200_001)])
+    triangle = remove_collinear(np.vstack([edge, [[0.5, 1.0]]]))
+    assert triangle.tolist() == [[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]
 
 
 def test_hull_keeps_a_corner_between_two_straight_ones() -> None:

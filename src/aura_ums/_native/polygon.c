@@ -577,12 +577,21 @@ int remove_collinear(Poly *p, Work *w) {
             p->n = 2;
             return 0;
         }
-        int waited = 0;
+        /* In a run of straight vertices every other one goes, from the run's first: counted
+           from a vertex that is not straight (there is one), the run halves each pass. */
+        Py_ssize_t first = 0;
+        while (straight[first]) first++;
+        int waited = 0, went = 0;
+        for (Py_ssize_t k = 1; k <= n; k++) {
+            Py_ssize_t i = first + k < n ? first + k : first + k - n;
+            int goes = straight[i] && !went;
+            waited |= straight[i] && !goes;
+            went = goes;
+            straight[i] = (char)(goes ? 2 : straight[i]); /* 2: goes this pass */
+        }
         Py_ssize_t m = 0;
         for (Py_ssize_t i = 0; i < n; i++) {
-            int goes = straight[i] && !straight[i > 0 ? i - 1 : n - 1];
-            waited |= straight[i] && !goes;
-            if (goes) continue;
+            if (straight[i] == 2) continue;
             v[2 * m] = v[2 * i];
             v[2 * m + 1] = v[2 * i + 1];
             m++;
