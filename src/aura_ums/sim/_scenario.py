@@ -530,15 +530,18 @@ class Scenario:
         """
         k = self.camera.intrinsics
         pixels = float(k.width) * float(k.height)
-        frames = float(self.frame_count())
-        seconds = frames * (
-            _SECONDS_PER_FRAME
-            + pixels * _SECONDS_PER_PIXEL
-            + float(self.render.clutter) * _SECONDS_PER_STRIP
-            + float(self.render.clutter_lines) * _SECONDS_PER_LINE
-        )
+        seconds = float(self.frame_count()) * sum(self._frame_seconds().values())
         memory = pixels * _BYTES_PER_PIXEL + float(self.render.clutter) * _BYTES_PER_STRIP
         return seconds, memory
+
+    def _frame_seconds(self) -> dict[str, float]:
+        """Return a frame's estimated seconds by the field that sets each part (see :meth:`estimate`)."""
+        k = self.camera.intrinsics
+        return {
+            "Scenario.camera": _SECONDS_PER_FRAME + float(k.width) * float(k.height) * _SECONDS_PER_PIXEL,
+            "Scenario.render.clutter": float(self.render.clutter) * _SECONDS_PER_STRIP,
+            "Scenario.render.clutter_lines": float(self.render.clutter_lines) * _SECONDS_PER_LINE,
+        }
 
     def _refuse_too_much_work(self) -> None:
         seconds, memory = self.estimate()
@@ -554,11 +557,7 @@ class Scenario:
         # Name the input that makes the run too big: a frame's costliest part when a few
         # frames of it would already be too many, else the number of frames.
         per_frame = seconds / self.frame_count()
-        parts = {
-            "Scenario.camera": _SECONDS_PER_FRAME + float(k.width) * float(k.height) * _SECONDS_PER_PIXEL,
-            "Scenario.render.clutter": float(self.render.clutter) * _SECONDS_PER_STRIP,
-            "Scenario.render.clutter_lines": float(self.render.clutter_lines) * _SECONDS_PER_LINE,
-        }
+        parts = self._frame_seconds()
         costliest = max(parts, key=lambda part: parts[part])
         if memory > MAX_RUN_BYTES:
             clutter = self.render.clutter * _BYTES_PER_STRIP > memory / 2
