@@ -137,6 +137,30 @@ def test_a_full_disk_leaves_no_csv_no_scratch_and_no_folder_made_for_it(
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_ctrl_c_while_the_csv_is_opened_leaves_no_scratch(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A SIGHUP sent the moment the scratch CSV appeared (tests/cli/test_interrupts.py) once
+    # left it behind: a stop raised inside the CSV's __enter__ skipped its __exit__.
+    opened = Path.open
+
+    def stop_once_made(path: Path, mode: str = "r", *args: object, **kwargs: object) -> object:
+        stream = opened(path, mode, *args, **kwargs)  # type: ignore[call-overload]
+        if "steps.csv" in path.name and "x" in mode:
+            stream.close()
+            raise KeyboardInterrupt
+        return stream
+
+    monkeypatch.setattr(Path, "open", stop_once_made)
+    log = synthetic_log(np.random.default_rng(3), duration=10.0)
+    with pytest.raises(KeyboardInterrupt, match=r"^$") as stopped:
+        replay_log(log, FLOOR, OPTIONS, steps_csv=tmp_path / "new" / "steps.csv")
+    # While the interrupt is still held (the command line says what was written, then exits
+    # without waiting for the collector), not only once its frames are collected.
+    assert stopped.value.__traceback__ is not None
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_batched_truth_check_judges_a_sliced_map_by_its_slices() -> None:
     from aura_ums.logs._replay import _contains
     from aura_ums.uncertainty import Pose, SpatialUncertaintyMap

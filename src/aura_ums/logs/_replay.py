@@ -1660,10 +1660,14 @@ class _StepsCsv:
                 # "x": a fresh file that honours the umask (tempfile.mkstemp's 0600 would stay).
                 self.stream = self._held.enter_context(scratch.open("x", encoding="utf-8", newline=""))
                 self.stream.write(STEPS_CSV_HEADER + "\n")
-            except OSError as exc:
+            except BaseException as exc:
+                # A with statement whose __enter__ raises never calls __exit__: the scratch file
+                # made so far goes here (a Ctrl-C or SIGTERM too, not when it is collected).
                 with contextlib.suppress(OSError):
                     self._held.__exit__(type(exc), exc, exc.__traceback__)
-                raise FileFormatError.unwritable(str(self.target), exc) from None
+                if isinstance(exc, OSError):
+                    raise FileFormatError.unwritable(str(self.target), exc) from None
+                raise
         return self
 
     def write(self, trace: ReplayTrace) -> None:
