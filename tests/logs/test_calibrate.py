@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from pathlib import Path
 
@@ -12,17 +13,22 @@ import pytest
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.logs import (
     Calibration,
+    GroundTruth,
+    LogMeta,
+    MotionCalibration,
+    Odometry,
     RobotLog,
     SensorBounds,
     calibrate_logs,
     fitted_for_anchor,
+    horizon_checks,
     load_noise,
     load_sensors,
     observation_errors,
     synthetic_log,
 )
-from aura_ums.uncertainty import TerrainTable
-from tests.logs.log_helpers import MRCLAM6, steady_arc_log
+from aura_ums.uncertainty import Pose, TerrainTable
+from tests.logs.log_helpers import LOSSLESS, MRCLAM6, steady_arc_log
 
 MRCLAM = MRCLAM6
 
@@ -305,3 +311,41 @@ def test_mrclam_anchor_bound_holds_at_every_horizon_and_grows_sublinearly(
     for horizon in (10.0, 30.0):
         assert anchored[horizon].heading_bound < 0.5 * per_move[horizon].heading_bound
         assert anchored[horizon].position_bound < 0.6 * per_move[horizon].position_bound
+
+
+def _shuttle_log(*, v: float = 0.3, omega: float = 0.1, leg: float = 4.0, duration: float = 40.0) -> RobotLog:
+    """A robot running ``leg`` s forward, then as long backing up, turning steadily; exact odometry, truth."""
+    rate, truth_rate = 50.0, 20.0
+    time = np.arange(0.0, duration + 1e-9, 1.0 / rate)
+    speed = np.where(np.floor(time / leg) % 2 == 0, v, -v)
+    truth_time = np.arange(0.0, duration + 1e-9, 1.0 / truth_rate)
+    x, y, heading, at = [0.0], [0.0], [0.0], 0.0
+    # Closed form within each leg (constant speed and turn rate), leg by leg.
+    for when in truth_time[1:]:
+        signed = v if math.floor(at / leg) % 2 == 0 else -v
+        h0, h1 = heading[-1], heading[-1] + omega * (when - at)
+        x.append(x[-1] + signed / omega * (math.sin(h1) - math.sin(h0)))
+        y.append(y[-1] - signed / omega * (math.cos(h1) - math.cos(h0)))
+        heading.append(h1)
+        at = when
+    meta = LogMeta("shuttle", terrain="lossless", start=Pose(0.0, 0.0, 0.0))
+    return RobotLog(
+        meta,
+        (),
+        (),
+        odometry=Odometry(time, speed, np.full(len(time), omega)),
+        groundtruth=GroundTruth(truth_time, np.array(x), np.array(y), np.array(heading)),
+    )
+
+
+@pytest.mark.parametrize("move", [0.5, 0.3])
+def test_the_bound_check_grows_a_move_backing_up_as_a_flipped_replay_does(move: float) -> None:
+    # Backing up was grown as a forward run, so the check judged every window that backs up
+    # against a truth on the far side of its start: containment 0.35 at 30 s on a real log
+    # whose replay (--reverse flip) kept the truth. Legs of 4 s: with 0.3 s moves, some
+    # moves both run and back up.
+    log = _shuttle_log()
+    assert bool((log.odometry is not None) and (log.odometry.v < 0).any())
+    checks = horizon_checks([log], LOSSLESS, MotionCalibration(), horizons=(1.0, 2.0, 10.0), move=move)
+    assert [c.windows > 0 for c in checks] == [True, True, True]
+    assert [c.containment for c in checks] == [1.0, 1.0, 1.0]

@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeVar
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -513,19 +513,34 @@ _MOVING = 0.02
 _BANDS = np.linspace(0.0, 0.95, 96)
 
 
-def _cumulative_motion(log: RobotLog) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+class _Cumulative(NamedTuple):
+    """A log's recorded motion summed from its start, before delay and scales (zero-order hold)."""
+
+    time: NDArray[np.float64]
+    #: Metres run either way (forward and backing up alike).
+    run: NDArray[np.float64]
+    turn: NDArray[np.float64]
+    #: Metres of ``run`` backing up (negative ``v``): 0 for commands, which never back up.
+    back: NDArray[np.float64]
+    #: Whether the motion from each row on backs up.
+    backing: NDArray[np.bool_]
+
+
+def _cumulative_motion(log: RobotLog) -> _Cumulative:
     """Return the times and cumulative recorded run and turn, before delay and scales (zero-order hold)."""
     if log.odometry is not None:
         time = log.odometry.time
         dt = np.diff(time)
-        run = np.concatenate(([0.0], np.cumsum(np.abs(log.odometry.v[:-1]) * dt)))
+        v = log.odometry.v
+        run = np.concatenate(([0.0], np.cumsum(np.abs(v[:-1]) * dt)))
         turn = np.concatenate(([0.0], np.cumsum(log.odometry.omega[:-1] * dt)))
-        return time, run, turn
+        back = np.concatenate(([0.0], np.cumsum(np.maximum(-v[:-1], 0.0) * dt)))
+        return _Cumulative(time, run, turn, back, v < 0.0)
     assert log.commands is not None
     time = np.array([r.time for r in log.commands], dtype=np.float64)
     run = np.cumsum([r.command.run for r in log.commands], dtype=np.float64)
     turn = np.cumsum([r.command.turn for r in log.commands], dtype=np.float64)
-    return time, run, turn
+    return _Cumulative(time, run, turn, np.zeros(len(time)), np.zeros(len(time), dtype=np.bool_))
 
 
 @dataclass(frozen=True, slots=True)
@@ -535,7 +550,8 @@ class _Moves:
     ``run``/``turn`` are recorded (before scales), ``path``/``heading`` the true chord
     length and heading change; ``pose`` the true pose at each move's start and at the
     last one's end, ``(n + 1, 3)``; ``valid`` marks moves whose both ends lie in the
-    ground truth (not in a gap).
+    ground truth (not in a gap). ``back`` is the part of ``run`` backing up, and
+    ``backing_first`` whether a move starts backing up.
     """
 
     run: NDArray[np.float64]
@@ -544,6 +560,8 @@ class _Moves:
     heading: NDArray[np.float64]
     pose: NDArray[np.float64]
     valid: NDArray[np.bool_]
+    back: NDArray[np.float64]
+    backing_first: NDArray[np.bool_]
 
 
 #: Longest horizon of :func:`calibrate_logs`, s: no map goes a day without a correction.
@@ -585,7 +603,7 @@ def _record_spans(log: RobotLog) -> str:
 def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
     truth = log.groundtruth
     assert truth is not None
-    time, run, turn = _cumulative_motion(log)
+    time, run, turn, back, backing = _cumulative_motion(log)
     first = max(float(time[0]) + delay, float(truth.time[0]))
     last = min(float(time[-1]) + delay, float(truth.time[-1]))
     count = math.floor((last - first) / move) if last > first else 0
@@ -594,6 +612,8 @@ def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
     cum_turn = np.interp(edges, time + delay, turn)
     pose = truth.at(edges)
     known = ~np.isnan(pose[:, 0])
+    # The row whose motion holds at each move's start (the last row at or before it).
+    holding = np.clip(np.searchsorted(time + delay, edges[:-1], side="right") - 1, 0, len(time) - 1)
     return _Moves(
         np.diff(cum_run),
         np.diff(cum_turn),
@@ -601,6 +621,8 @@ def _moves(log: RobotLog, delay: float, move: float) -> _Moves:
         np.angle(np.exp(1j * np.diff(pose[:, 2]))),
         pose,
         known[:-1] & known[1:],
+        np.diff(np.interp(edges, time + delay, back)),
+        backing[holding],
     )
 
 
@@ -952,14 +974,11 @@ def horizon_checks(
     longest = max(lengths, default=0)
     for log in logs:
         m = _moves(log, motion.delay_s, step)
-        # Half the turn before the run and half after: a move turns while it runs, and its
-        # chord points along the middle heading, not the last one.
         commands = [
-            (
-                TurnAndRun(turn * motion.turn_scale / 2.0, run * motion.run_scale),
-                TurnAndRun(turn * motion.turn_scale / 2.0, 0.0),
+            _move_commands(turn, run, back, backing_first, motion)
+            for turn, run, back, backing_first in zip(
+                m.turn.tolist(), m.run.tolist(), m.back.tolist(), m.backing_first.tolist(), strict=True
             )
-            for turn, run in zip(m.turn.tolist(), m.run.tolist(), strict=True)
         ]
         for first in range(0, len(commands), every):
             x, y, heading = m.pose[first]
@@ -998,6 +1017,34 @@ def horizon_checks(
             )
         )
     return tuple(checks)
+
+
+def _move_commands(
+    turn: float, run: float, back: float, backing_first: bool, motion: MotionCalibration
+) -> tuple[TurnAndRun, ...]:
+    """Return the commands one move grows by in :func:`horizon_checks`, as a replay grows it.
+
+    Half the turn before the run and half after: a move turns while it runs, and its chord
+    points along the middle heading, not the last one. A move backing up is grown as
+    ``replay --reverse flip`` grows it (``ReverseMotion.FLIP``): turn round, run, turn back.
+    A move that both runs and backs up is the two in the order they began (the turn shared
+    in proportion to their lengths); grown forward, a move backing up was judged against
+    a truth on the far side of its start.
+    """
+    half = turn * motion.turn_scale / 2.0
+    if not back > 0.0 or not run > 0.0:
+        return (TurnAndRun(half, run * motion.run_scale), TurnAndRun(half, 0.0))
+    ahead = max(run - back, 0.0)
+    pieces = [(ahead, False), (back, True)]
+    if backing_first:
+        pieces.reverse()
+    commands: list[TurnAndRun] = []
+    for length, backing in pieces:
+        if length > 0.0:
+            share = half * length / run
+            flip = math.pi if backing else 0.0
+            commands += [TurnAndRun(share + flip, length * motion.run_scale), TurnAndRun(share - flip, 0.0)]
+    return tuple(commands)
 
 
 def _judge(
