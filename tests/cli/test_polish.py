@@ -507,3 +507,30 @@ def test_the_camera_files_calibration_bounds_widen_the_windows(
         invoke(*sample_replay, "--until", "10", "--camera", camera, "--metrics-json", metrics)
         widths.append(json.loads(metrics.read_text())["median_window_width_frac"])
     assert widths[1] > widths[0]
+
+
+def test_a_resume_with_other_inputs_is_refused_naming_the_option(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    # --sigmas was refused, but --classes and --terrain were taken: a mix of two replays.
+    folder, terrain = walk
+    state = tmp_path / "half.json"
+    invoke(
+        "replay", folder, "--terrain", terrain, "--classes", "II", "--until", 20, "--save-state", state, "-q"
+    )
+    grass = tmp_path / "grass.toml"
+    grass.write_text(TerrainTable({"floor": TerrainTable.default()["grass"]}).to_toml())
+    cases = [
+        (
+            ("--terrain", terrain, "--classes", "I"),
+            "--classes: expected landmark_class 'II', as the state in ",
+        ),
+        (("--terrain", grass, "--classes", "II"), "--terrain: expected the terrain table the state in "),
+    ]
+    for options, said in cases:
+        result = runner.invoke(app, [str(a) for a in ("replay", folder, *options, "--resume", state, "-q")])
+        assert result.exit_code == 2, result.output
+        assert said in result.stderr
+        assert f"{state} (--resume)" in result.stderr
+        assert "Traceback" not in result.output
+    invoke("replay", folder, "--terrain", terrain, "--classes", "II", "--resume", state, "-q")

@@ -10,9 +10,17 @@ import numpy as np
 import pytest
 
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs import ReplayOptions, ReplayState, compare_on_log, replay_log, synthetic_log
+from aura_ums.logs import (
+    ReplayOptions,
+    ReplayState,
+    ReverseMotion,
+    SensorBounds,
+    compare_on_log,
+    replay_log,
+    synthetic_log,
+)
 from aura_ums.manager import ManagerSettings
-from aura_ums.uncertainty import TerrainTable
+from aura_ums.uncertainty import LandmarkClass, TerrainTable
 
 TABLE = TerrainTable({"floor": TerrainTable.default()["tile"]})
 
@@ -124,3 +132,51 @@ def test_a_refused_state_says_what_does_not_fit() -> None:
         replay_log(log, TABLE, resume=dataclasses.replace(state, reports_posted=10**12))
     with pytest.raises(InputError, match=r"with another log's name, 'elsewhere'$"):
         replay_log(log, TABLE, resume=dataclasses.replace(state, log_name="elsewhere"))
+
+
+def test_a_state_resumes_only_with_the_inputs_it_was_saved_with() -> None:
+    # The manager's JSON holds its settings, not what the replay feeds it: a state saved
+    # with points resumed with bearings only (or other bounds, another terrain table) ran
+    # on silently as a mix of two replays.
+    log = synthetic_log(np.random.default_rng(14), duration=10.0)
+    points = ReplayOptions(landmark_class=LandmarkClass.POINT)
+    state = replay_log(log, TABLE, points, until=5.0, save_state=True).state
+    assert state is not None
+    assert ReplayState.from_json(state.to_json()).inputs == state.inputs
+    lines = ReplayOptions(landmark_class=LandmarkClass.VERTICAL_LINE)
+    with pytest.raises(
+        InputError, match=r"^resume: expected landmark_class 'II', as the state was saved with, got 'I'$"
+    ):
+        replay_log(log, TABLE, lines, resume=state)
+    flip = dataclasses.replace(points, reverse=ReverseMotion.FLIP)
+    with pytest.raises(
+        InputError, match=r"^resume: expected reverse 'error', as the state was saved with, got 'flip'$"
+    ):
+        replay_log(log, TABLE, flip, resume=state)
+    wider = dataclasses.replace(points, working=SensorBounds(0.2, 0.3))
+    with pytest.raises(
+        InputError, match=r"^resume: expected the sensor bounds the state was saved with \(SHA-256 "
+    ):
+        replay_log(log, TABLE, wider, resume=state)
+    grass = TerrainTable({"floor": TerrainTable.default()["grass"]})
+    with pytest.raises(InputError, match=r"^resume: expected the terrain table the state was saved with"):
+        replay_log(log, grass, points, resume=state)
+    whole = replay_log(log, TABLE, points)
+    rest = replay_log(log, TABLE, points, resume=state)
+    assert rest.steps[-1].map.polygon.vertices.tobytes() == whole.steps[-1].map.polygon.vertices.tobytes()
+
+
+def test_a_version_2_state_still_resumes_with_nothing_to_check() -> None:
+    log = synthetic_log(np.random.default_rng(15), duration=10.0)
+    state = replay_log(log, TABLE, until=5.0, save_state=True).state
+    assert state is not None
+    body = json.loads(state.to_json())
+    del body["inputs"]
+    body["version"] = 2
+    older = ReplayState.from_json(json.dumps(body))
+    assert dict(older.inputs) == {}
+    lines = ReplayOptions(landmark_class=LandmarkClass.POINT)
+    assert replay_log(log, TABLE, lines, resume=older).steps  # not recorded: not checked
+    body["inputs"] = {}
+    with pytest.raises(FileFormatError, match=r"expected only the keys \[.*'blackboard'\], got 'inputs'"):
+        ReplayState.from_json(json.dumps(body))

@@ -236,6 +236,23 @@ def _setting_text(value: object) -> str:
     return "none" if value is None else f"{value:g}" if isinstance(value, float) else str(value).lower()
 
 
+#: The replay's inputs a resumed state recorded (``ReplayState.inputs``) and the options that give them.
+_RESUMED_INPUTS = {
+    "landmark_class": "--classes",
+    "reverse": "--reverse",
+    "sensor bounds": "--sensors",
+    "terrain table": "--terrain",
+}
+
+
+def _resumed_input(message: str) -> str:
+    """Return the input a library refusal to resume names (``resume: expected [the] NAME ...``), else ''."""
+    for name in _RESUMED_INPUTS:
+        if message.startswith((f"resume: expected {name} ", f"resume: expected the {name} ")):
+            return name
+    return ""
+
+
 def _options(
     classes: Classes, sensors: Path | None, settings: ManagerSettings, reverse: Reverse = Reverse.ERROR
 ) -> ReplayOptions:
@@ -500,9 +517,9 @@ def replay(
     With --camera, also the image windows of each real observation (ours, an EKF's
     3-sigma box, the disk model) and how often the observation fell inside.
 
-    With --resume the replay continues where a --save-state left it (its settings are the
-    saved ones: an option asking for another value is refused) and reports the frames
-    after it; it ends with exactly the map of a replay run in one go. With --live, the
+    With --resume the replay continues where a --save-state left it (its settings, landmark
+    class, sensors and terrain are the saved ones: an option asking for others is refused)
+    and reports the frames after it; it ends with exactly the map of a replay run in one go. With --live, the
     replay is streamed to Foxglove as it computes (with --camera, its windows too, on a
     blank image: logs carry no images).
 
@@ -639,7 +656,13 @@ def replay(
                 raise fail(f"--mcap: expected a replay of at least one frame to export, got none{early}")
     except AuraUmsError as exc:
         message = str(exc)
-        if resume is not None and message.startswith("resume: "):
+        option = _RESUMED_INPUTS.get(_resumed_input(message)) if resume is not None else None
+        if option is not None:
+            # The library names the input; the user gave it with an option.
+            state = f"the state in {resume} (--resume)"
+            said = message.removeprefix("resume: ").replace("the state", state, 1)
+            message = f"{option}: {said}"
+        elif resume is not None and message.startswith("resume: "):
             # the library names its argument; the user gave a file
             message = f"{resume}: --{message}"
         elif resume is not None and message.startswith(_STATE_PARTS):

@@ -972,6 +972,7 @@ def replay_log(
     manager = UncertaintyMapManager(initial, source.meadow_map, table, opts.settings)
     board = Blackboard()
     if resume is not None:
+        _same_inputs(resume, opts, table)
         manager = UncertaintyMapManager.from_json(
             resume.manager_json, source.meadow_map, table, source="resume"
         )
@@ -1095,6 +1096,7 @@ def replay_log(
             _digest(source.frames, frame_times[:last]),
             manager.to_json(),
             board.to_json(),
+            types.MappingProxyType(_inputs(opts, table)),
         )
     return ReplayResult(
         log,
@@ -1688,6 +1690,42 @@ class _StepsCsv:
             if error is None:
                 raise FileFormatError.unwritable(str(self.target), exc) from None
             # Otherwise the error already on its way (maybe this same one, from a write) says more.
+
+
+#: The inputs of :func:`_inputs` recorded as a SHA-256 of their text, not as it is.
+DIGESTED_INPUTS = ("sensor bounds", "terrain table")
+
+
+def _inputs(opts: ReplayOptions, table: TerrainTable) -> dict[str, str]:
+    """Return what a replay runs with besides its manager's settings, as text (``ReplayState.inputs``).
+
+    The manager's JSON holds its settings and maps, not what the replay feeds it: a state
+    resumed with another landmark class or other sensor bounds ran on, silently, as a mix
+    of two replays (helper-63).
+    """
+    sensors = repr((opts.working, opts.envelope, opts.motion)).encode("utf-8")
+    return {
+        "landmark_class": opts.landmark_class.value,
+        "reverse": opts.reverse.value,
+        "max_interval": repr(opts.max_interval),
+        "arena_margin": repr(opts.arena_margin),
+        DIGESTED_INPUTS[0]: hashlib.sha256(sensors).hexdigest(),
+        DIGESTED_INPUTS[1]: hashlib.sha256(table.to_toml().encode("utf-8")).hexdigest(),
+    }
+
+
+def _same_inputs(state: ReplayState, opts: ReplayOptions, table: TerrainTable) -> None:
+    """Refuse to resume ``state`` with other inputs than it was saved with (those it recorded)."""
+    for name, given in _inputs(opts, table).items():
+        saved = state.inputs.get(name)
+        if saved is None or saved == given:
+            continue
+        if name in DIGESTED_INPUTS:
+            raise InputError(
+                f"resume: expected the {name} the state was saved with (SHA-256 {saved[:12]}...), "
+                f"got others ({given[:12]}...)"
+            )
+        raise InputError(f"resume: expected {name} {saved!r}, as the state was saved with, got {given!r}")
 
 
 def _digest(frames: Mapping[float, list[LogObservation]], times: np.ndarray) -> str:

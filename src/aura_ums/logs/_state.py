@@ -11,8 +11,10 @@ from __future__ import annotations
 import json
 import math
 import os
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from aura_ums._files import Fields, parse_json, read_text, write_text_atomic
@@ -22,8 +24,10 @@ from aura_ums.errors import InputError
 STATE_FORMAT = "aura_ums.ReplayState"
 #: Its version; bumped when the layout or the meaning of a field changes (2: a piece of
 #: odometry that turns while it runs is two position reports, so ``reports_posted`` counts
-#: them both).
-STATE_VERSION = 2
+#: them both; 3: ``inputs``, what else the replay ran with). Version 2 still reads, with no
+#: inputs to check.
+STATE_VERSION = 3
+_READ_VERSIONS = (2, 3)
 _KEYS = (
     "format",
     "version",
@@ -34,6 +38,7 @@ _KEYS = (
     "log_digest",
     "manager",
     "blackboard",
+    "inputs",
 )
 
 
@@ -58,6 +63,10 @@ class ReplayState:
         :meth:`UncertaintyMapManager.to_json` after that frame.
     blackboard_json : str
         :meth:`Blackboard.to_json` after that frame.
+    inputs : mapping of str to str
+        What else the replay ran with, that its manager's JSON does not hold (the landmark
+        class, the sensor bounds, the terrain table...), each as text: a resumed replay
+        must run with the same (empty: not recorded, a version 2 file).
 
     Examples
     --------
@@ -75,7 +84,7 @@ class ReplayState:
     >>> ReplayState.from_json('{"format": "aura_ums.ReplayState", "version": 9}')
     Traceback (most recent call last):
     ...
-    aura_ums.errors.FileFormatError: <replay state JSON>: version: expected 2, got 9
+    aura_ums.errors.FileFormatError: <replay state JSON>: version: expected 3, got 9
     """
 
     log_name: str
@@ -85,6 +94,7 @@ class ReplayState:
     log_digest: str
     manager_json: str
     blackboard_json: str
+    inputs: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
 
     def to_json(self) -> str:
         """Return the state as strict JSON text (no NaN: a missing time is ``null``)."""
@@ -98,6 +108,7 @@ class ReplayState:
             "log_digest": self.log_digest,
             "manager": json.loads(self.manager_json),
             "blackboard": json.loads(self.blackboard_json),
+            "inputs": dict(self.inputs),
         }
         return json.dumps(body, indent=1, allow_nan=False) + "\n"
 
@@ -119,14 +130,20 @@ class ReplayState:
         top: dict[str, Any] = fields.table(parse_json(text, source), "")
         if top.get("format") != STATE_FORMAT:
             fields.fail("format", f"expected {STATE_FORMAT!r}, got {fields.describe(top.get('format'))}")
-        if top.get("version") != STATE_VERSION:
-            fields.fail("version", f"expected {STATE_VERSION}, got {fields.describe(top.get('version'))}")
+        version = top.get("version")
+        if version not in _READ_VERSIONS or isinstance(version, bool):
+            fields.fail("version", f"expected {STATE_VERSION}, got {fields.describe(version)}")
+        keys = _KEYS if version == STATE_VERSION else _KEYS[:-1]
         for key in top:
-            if key not in _KEYS:
-                fields.fail("", f"expected only the keys {list(_KEYS)}, got {fields.describe(key)}")
-        for key in _KEYS:
+            if key not in keys:
+                fields.fail("", f"expected only the keys {list(keys)}, got {fields.describe(key)}")
+        for key in keys:
             if key not in top:
                 fields.fail("", f"expected a key {key!r}, got none")
+        inputs = {
+            name: fields.string(value, f"inputs.{name}")
+            for name, value in fields.table(top.get("inputs", {}), "inputs").items()
+        }
         last = top["last_time"]
         return cls(
             fields.string(top["log"], "log"),
@@ -136,4 +153,5 @@ class ReplayState:
             fields.string(top["log_digest"], "log_digest"),
             json.dumps(fields.table(top["manager"], "manager")),
             json.dumps(fields.table(top["blackboard"], "blackboard")),
+            MappingProxyType(dict(inputs)),
         )
