@@ -250,6 +250,14 @@ _TABLE: tuple[MetricKey, ...] = (
     ),
     _key("relocalizations", "count", _K.COUNT, (REPLAY,), "Times the envelope re-seeded the working map."),
     _key(
+        "observations_before_start",
+        "count",
+        _K.COUNT,
+        (REPLAY,),
+        "Observations at or before the replay's start (the later of the first motion and the first "
+        "ground truth, or meta.toml's start): not replayed.",
+    ),
+    _key(
         "slice_width_rad",
         "rad",
         _K.NUMBER,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import math
 import tracemalloc
@@ -19,8 +20,10 @@ from aura_ums.logs import (
     ReplayResult,
     ReplayTrace,
     RobotLog,
+    open_log,
     replay_log,
     synthetic_log,
+    write_log,
 )
 from aura_ums.uncertainty import LandmarkClass, TerrainTable, TurnAndRun
 from tests.logs.log_helpers import long_odometry_log
@@ -252,3 +255,21 @@ def test_the_batched_truth_check_takes_a_repeated_vertex_as_no_edge() -> None:
     for maps in ([repeated] * 3, [repeated, segment, repeated]):
         vertices = [m.polygon.vertices for m in maps]
         assert _contains(maps, poses, rings=_Rings(vertices)).tolist() == _contains(maps, poses).tolist()
+
+
+def test_observations_at_or_before_the_start_are_counted_not_lost_silently(tmp_path: Path) -> None:
+    # Dropped without a word: 806 of 807 accepted, none rejected, none excluded (helper-63).
+    log = synthetic_log(np.random.default_rng(3), duration=10.0)
+    first = log.observations[0]
+    early = [dataclasses.replace(first, time=when) for when in (-2.0, -1.0, 0.0)]
+    log = dataclasses.replace(log, observations=(*early, *log.observations))
+    whole = replay_log(log, FLOOR, OPTIONS, keep_maps=False)
+    streamed = replay_log(open_log(write_log(log, tmp_path / "log")), FLOOR, OPTIONS, keep_maps=False)
+    assert whole.start_time == 0.0
+    assert whole.early_observations == streamed.early_observations == 3
+    assert whole.metrics()["observations_before_start"] == 3
+    plain = replay_log(
+        synthetic_log(np.random.default_rng(3), duration=10.0), FLOOR, OPTIONS, keep_maps=False
+    )
+    assert plain.early_observations == 0
+    assert whole.trace.area_m2.tobytes() == plain.trace.area_m2.tobytes()

@@ -677,6 +677,7 @@ def replay(
     if windows is not None and camera is not None:
         _warn_unseen(windows, camera)
     _warn_unscored(log, log_dir, metrics)
+    _warn_early(result.early_observations, result.start_time, log_dir)
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if json_target is not None:
@@ -721,6 +722,16 @@ def _warn_unscored(log: RobotLog | LogStream, log_dir: Path, metrics: Metrics) -
             f"{log_dir}: expected some frames between ground-truth rows at most --max-truth-gap "
             f"{gap:g} s apart, got none of the {frames} frames: the containment is n/a; if the ground "
             "truth is recorded more sparsely, pass a larger --max-truth-gap"
+        )
+
+
+def _warn_early(early: int, start: float, log_dir: Path) -> None:
+    """Say so when observations came at or before the replay's start: no frame replays them."""
+    if early:
+        warn(
+            f"{log_dir}: {early} observation{'s' if early != 1 else ''} at or before the replay's start "
+            f"({start!r} s: the first motion, or the first ground truth when later) not replayed "
+            "(observations_before_start)"
         )
 
 

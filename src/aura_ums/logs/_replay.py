@@ -395,6 +395,9 @@ class ReplayResult:
         The replay's start, s: the motion's first time, or the ground truth's first row
         when that is later (NaN when not known). A replay whose frames all come before it
         has no step.
+    early_observations : int
+        Observations at or before :attr:`start_time`, which no frame replays (of a log
+        opened block by block: those read).
 
     Examples
     --------
@@ -467,6 +470,7 @@ class ReplayResult:
 
     state: ReplayState | None = None
     start_time: float = math.nan
+    early_observations: int = 0
 
     def require_steps(self, until: float | None = None) -> None:
         """Refuse a replay that made no step: its figures would all be undefined.
@@ -563,6 +567,7 @@ class ReplayResult:
                 "inconsistent_observations": self.inconsistent_observations,
                 "rejected_by_reason": {reason.value: count for reason, count in self.rejected_counts.items()},
                 "relocalizations": self.relocalizations,
+                "observations_before_start": self.early_observations,
                 "slice_width_rad": self.options.settings.slice_width,
                 "relaxed_q": self.options.settings.relaxed_q,
                 "relaxed_window": self.options.settings.relaxed_window,
@@ -1107,6 +1112,7 @@ def replay_log(
         tuple(maps) if keep_maps else None,
         state,
         source.start_time,
+        source.early[0],
     )
 
 
@@ -1215,6 +1221,8 @@ class _Source:
     first: int = 0  # frames done before (a resumed replay)
     frames: Mapping[float, list[LogObservation]] | None = None
     frame_times: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
+    # Observations at or before the start, which no frame replays (a stream counts them as read).
+    early: list[int] = field(default_factory=lambda: [0])
 
     def finish(self) -> None:
         self.reports.finish()
@@ -1273,6 +1281,7 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
         first,
         frames,
         frame_times,
+        [sum(row.time <= start_time for row in log.observations)],
     )
 
 
@@ -1312,22 +1321,30 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
         whole = RobotLog(meta, stream.landmarks, (), commands=stream.commands)
         reports = _WholeReports(*whole.position_report_arrays(start=start_time), 0)
 
+    early = [0]
     return _Source(
         start_time,
         start_pose,
         meadow_map,
-        _stream_chunks(stream, start_time, stop, keep_rows),
+        _stream_chunks(stream, start_time, stop, keep_rows, early),
         reports,
         _truth_at(truth),
         0,
+        early=early,
     )
 
 
-def _stream_chunks(stream: LogStream, start: float, stop: float, keep_rows: bool) -> Iterator[_FrameChunk]:
-    """Yield the frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time."""
+def _stream_chunks(
+    stream: LogStream, start: float, stop: float, keep_rows: bool, early: list[int]
+) -> Iterator[_FrameChunk]:
+    """Yield the frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time.
+
+    ``early[0]`` counts the observations read at or before ``start``.
+    """
     pending: list[_Row] = []
     lines: list[int] = []
     for times, ids, bearing, measured, bearing_error, range_error, line in stream.observation_blocks():
+        early[0] += int(np.count_nonzero(times <= start))
         beyond = bool(times.size) and float(times[-1]) > stop
         wanted = (times > start) & (times <= stop)
         if not np.all(wanted):
