@@ -216,8 +216,8 @@ _TABLE: tuple[MetricKey, ...] = (
         "m",
         _K.NUMBER,
         (COMPARE_ROW,),
-        "Root mean square distance from the region's centre (ours) or the mean (a filter) to the "
-        "true position; null: no ground truth.",
+        "Root mean square distance from the map's centre, its most probable position (ours; not the "
+        "polygon's centroid), or the mean (a filter) to the true position; null: no ground truth.",
     ),
     _key(
         "landmark_detection_rate",

@@ -49,8 +49,9 @@ class MethodSummary:
         Median width of the heading region (our wedge; the filters' confidence
         intervals), radians.
     position_rmse_m : float
-        Root mean square distance from the region's centre (our map) or the mean (the
-        filters) to the true position, metres.
+        Root mean square distance from our map's centre (its most probable position, kept
+        inside the polygon; not the polygon's centroid) or the mean (the filters) to the true
+        position, metres.
     median_update_us : float
         Median microseconds per step (growth or prediction since the previous step, and
         the step's observations).
