@@ -192,6 +192,13 @@ def test_csv_header_rows_and_line_numbers() -> None:
     assert len(table) == 2
 
 
+def test_a_quoted_cell_may_follow_spaces_after_the_comma() -> None:
+    # "Spaces around cells are ignored" did not hold for a quoted cell: `, "sign, red"` was
+    # read as two cells, `"sign` and `red"`, and the row refused as one cell too many.
+    table = parse_csv('id, symbol\n pole ,  "sign, red"\n', "l.csv", columns=("id", "symbol"))
+    assert table.rows == (("pole", "sign, red"),)
+
+
 def test_csv_with_an_excel_bom_reads_like_without(tmp_path: Path) -> None:
     plain = write(tmp_path / "plain.csv", b"time,v,omega\n0,1,2\n")
     excel = write(tmp_path / "excel.csv", BOM + b"time,v,omega\r\n0,1,2\r\n")

@@ -556,7 +556,8 @@ def parse_csv(
     wanted = ", ".join(required or columns)
     if not lines:
         raise FileFormatError(source, "", f"expected a header row naming the columns {wanted}, got none")
-    reader = csv.reader(lines, strict=True)
+    # A space before a quote would make the quote part of the cell: `a, "b, c"` is two cells.
+    reader = csv.reader(lines, strict=True, skipinitialspace=True)
     try:
         parsed = list(reader)
     except csv.Error as exc:
