@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import shutil
 from pathlib import Path
@@ -177,6 +178,31 @@ def test_relative_geojson_map_and_terrain_files(folder: Path) -> None:
     scenario = Scenario.from_toml(folder / "m.toml")
     assert scenario.terrain["grass"].drift == 0.01
     assert len(scenario.meadow_map.meadows) == 4
+
+
+def test_without_a_terrain_the_scenario_takes_the_table_its_map_names(folder: Path) -> None:
+    # The built-in table was taken instead, and the map then refused for a terrain it lacks.
+    document = json.loads((SCENARIOS / "four_terrains.geojson").read_text(encoding="utf-8"))
+    for feature in document["features"]:
+        if feature["properties"].get("terrain") == "grass":
+            feature["properties"]["terrain"] = "asphalt"
+    document["terrain_table"] = "own.toml"
+    (folder / "own_map.geojson").write_text(json.dumps(document), encoding="utf-8")
+    (folder / "own.toml").write_text(terrain_table_toml(("tile", "concrete", "asphalt", "gravel"), 0.02))
+    text = GOOD.replace('map = "sample:paper_sidewalk"', 'map = "own_map.geojson"').replace(
+        "x = 0.0\n", "x = 1.0\n"
+    )
+    (folder / "m.toml").write_text(text)
+    scenario = Scenario.from_toml(folder / "m.toml")
+    assert scenario.terrain["asphalt"].drift == 0.02
+    assert "grass" not in scenario.terrain
+    # A map that names no table of its own: the built-in one, which must hold its terrains.
+    del document["terrain_table"]
+    (folder / "own_map.geojson").write_text(json.dumps(document), encoding="utf-8")
+    with pytest.raises(
+        FileFormatError, match=r"m\.toml: terrain: expected a table with the terrain 'asphalt'"
+    ):
+        Scenario.from_toml(folder / "m.toml")
 
 
 MALFORMED = [

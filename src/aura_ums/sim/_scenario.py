@@ -6,7 +6,8 @@ says ``_deg``, radians otherwise; every other unit SI)::
     name = "paper_sidewalk"             # optional, default: the file's stem
     description = "..."                 # optional
     map = "sample:paper_sidewalk"       # a GeoJSON meadow map, or sample:<name>
-    terrain = "default"                 # a terrain table TOML file, or "default"
+    terrain = "default"                 # optional: a terrain table TOML file, or "default" (the
+                                        # built-in); default: the table the map names, else built-in
     camera = "paper_camera.toml"        # a camera TOML file (aura_ums.camera.load_camera)
     landmarks = ["lamppost_107"]        # optional: ids the robot uses (default: all)
     confirm_frames = 1                  # optional: consecutive frames that confirm a discovery,
@@ -634,8 +635,15 @@ class Scenario:
         description = document.get("description", "")
         if not isinstance(description, str):
             raise reader.fail("description", f"expected a string, got {describe(description)}")
-        terrain = _load_terrain(document, reader, base)
-        meadow_map = _with_confirm_frames(_load_map(document, reader, base, terrain), document, reader)
+        given = _load_terrain(document, reader, base)
+        meadow_map = _with_confirm_frames(_load_map(document, reader, base, given), document, reader)
+        # Without a terrain of its own, the scenario takes the table its map names, else the built-in one.
+        terrain = given
+        if terrain is None:
+            terrain = (
+                meadow_map.terrain_table if meadow_map.terrain_table is not None else TerrainTable.default()
+            )
+            _check_terrains(meadow_map, terrain, reader)
         if "camera" not in document:
             raise reader.fail("camera", "expected the path of a camera TOML file, got none")
         camera_path = reader.path(document["camera"], "camera", base)
@@ -805,8 +813,11 @@ class Scenario:
 # ------------------------------------------------------------------------------ parts
 
 
-def _load_terrain(document: Mapping[str, object], reader: _Reader, base: Path) -> TerrainTable:
-    value = document.get("terrain", "default")
+def _load_terrain(document: Mapping[str, object], reader: _Reader, base: Path) -> TerrainTable | None:
+    """Return the scenario's terrain table; None when it names none (the map's table, else the built-in)."""
+    if "terrain" not in document:
+        return None
+    value = document["terrain"]
     if value == "default":
         return TerrainTable.default()
     path = reader.path(value, "terrain", base)
@@ -816,8 +827,19 @@ def _load_terrain(document: Mapping[str, object], reader: _Reader, base: Path) -
         raise reader.fail("terrain", f"expected a terrain table file that loads, got: {exc}") from None
 
 
+def _check_terrains(meadow_map: MeadowMap, terrain: TerrainTable, reader: _Reader) -> None:
+    """Refuse a table without the terrain of a meadow, naming both (the scenario's ``terrain``)."""
+    for meadow in meadow_map.meadows:
+        if meadow.terrain not in terrain:
+            raise reader.fail(
+                "terrain",
+                f"expected a table with the terrain {meadow.terrain!r} of meadow {meadow.id!r}, "
+                f"got terrains {', '.join(sorted(terrain))}",
+            )
+
+
 def _load_map(
-    document: Mapping[str, object], reader: _Reader, base: Path, terrain: TerrainTable
+    document: Mapping[str, object], reader: _Reader, base: Path, terrain: TerrainTable | None
 ) -> MeadowMap:
     if "map" not in document:
         raise reader.fail("map", "expected a GeoJSON meadow map path or sample:<name>, got none")
@@ -827,13 +849,8 @@ def _load_map(
             meadow_map = sample_world(value[len(_SAMPLE_PREFIX) :])
         except InputError as exc:
             raise reader.fail("map", str(exc).split(": ", 1)[-1]) from None
-        for meadow in meadow_map.meadows:
-            if meadow.terrain not in terrain:
-                raise reader.fail(
-                    "terrain",
-                    f"expected a table with the terrain {meadow.terrain!r} of meadow {meadow.id!r}, "
-                    f"got terrains {', '.join(sorted(terrain))}",
-                )
+        if terrain is not None:
+            _check_terrains(meadow_map, terrain, reader)
         return meadow_map
     path = reader.path(value, "map", base)
     try:
