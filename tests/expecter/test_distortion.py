@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from aura_ums.camera import distort, fold_radius
+from aura_ums.camera import Camera, CameraIntrinsics, CameraMount, distort, fold_radius
+from aura_ums.expecter import Expecter
 from aura_ums.expecter._distortion import distorted_range
+from aura_ums.geometry import ConvexPolygon, HeadingWedge
+from aura_ums.uncertainty import PointLandmark, SpatialUncertaintyMap
 
 Array = NDArray[np.float64]
 Coefficients = tuple[float, float, float, float, float]
@@ -97,3 +102,38 @@ def test_the_range_is_taken_over_the_rays_within_the_fold(rng: np.random.Generat
     assert distorted_range(beyond, FOLDING, 1e-6) is None
     assert distorted_range(np.array([[0.9, 0.0], [1.2, 0.0]]), FOLDING, 1e-6) is None  # a segment
     assert distorted_range(np.array([[0.5, 0.0], [1.2, 0.0]]), FOLDING, 1e-6) is not None
+
+
+def test_a_long_lens_window_holds_a_landmark_partly_behind_the_camera() -> None:
+    # helper-62: with the wedge turning the landmark behind the camera, the normalized points
+    # hold cut-plane crossings some 1e12 across, and the hull's merge of nearly straight
+    # vertices (relative to that extent) dropped the extreme ones: the window missed true
+    # projections by up to 56 px (fx 50000), 22 px (fx 20000) and 0.1 px (fx 1000).
+    def largest_miss(fx: float, distance: float, radius: float, rise: float) -> float:
+        lens = CameraIntrinsics(fx, fx, 320.0, 240.0, 640, 480, distortion=(-0.05, 0.0, 0.0, 0.0, 0.0))
+        camera = Camera(lens, CameraMount(height=1.0))
+        the_map = SpatialUncertaintyMap(ConvexPolygon([(0.0, 0.0)]), (0.0, 0.0), HeadingWedge(0.0, 0.0, 1.7))
+        landmark = PointLandmark("corner", distance, 0.0, 1.0 + distance * rise, position_uncertainty=radius)
+        window = Expecter(camera).bounds(the_map, landmark)
+        headings = np.linspace(0.0, 1.7, 341)
+        around = np.linspace(-math.pi, math.pi, 96, endpoint=False)
+        points = np.column_stack(
+            [distance + radius * np.cos(around), radius * np.sin(around), np.full(len(around), landmark.z)]
+        )
+        poses = np.column_stack([np.zeros(len(headings)), np.zeros(len(headings)), headings])
+        pixels = camera.project(poses, points).reshape(-1, 2)
+        pixels = pixels[np.isfinite(pixels).all(axis=1)]
+        assert len(pixels)
+        return float(
+            max(
+                window.u_min - pixels[:, 0].min(),
+                pixels[:, 0].max() - window.u_max,
+                window.v_min - pixels[:, 1].min(),
+                pixels[:, 1].max() - window.v_max,
+                0.0,
+            )
+        )
+
+    assert largest_miss(50000.0, 1000.0, 5.0, 0.002) <= 1e-6
+    assert largest_miss(20000.0, 1000.0, 5.0, 0.01) <= 1e-6
+    assert largest_miss(1000.0, 1000.0, 0.5, 0.01) <= 1e-6

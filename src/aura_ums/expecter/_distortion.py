@@ -136,7 +136,10 @@ def _hull(points: Array) -> Array:
     extensions meet far away, and the bounds over such a polygon were up to 4 times wider
     than the distortion's reach.
     """
-    hull = convex_hull(points)
+    # Every vertex the chain keeps: the points may span 1e12 (cut-plane crossings of a landmark
+    # partly behind the camera), and merging vertices straight to within that extent's
+    # rounding dropped extreme ones, which the windows then missed by up to 56 px (helper-62).
+    hull = convex_hull(points, straight=True)
     if len(hull) > _HULL_VERTICES:
         fewer = simplify_outer(hull, _HULL_VERTICES)
         if polygon_area(fewer) <= (1.0 + _HULL_GROWTH) * polygon_area(hull):
