@@ -115,6 +115,7 @@ def test_a_long_lens_window_holds_a_landmark_partly_behind_the_camera() -> None:
         the_map = SpatialUncertaintyMap(ConvexPolygon([(0.0, 0.0)]), (0.0, 0.0), HeadingWedge(0.0, 0.0, 1.7))
         landmark = PointLandmark("corner", distance, 0.0, 1.0 + distance * rise, position_uncertainty=radius)
         window = Expecter(camera).bounds(the_map, landmark)
+        assert window is not None
         headings = np.linspace(0.0, 1.7, 341)
         around = np.linspace(-math.pi, math.pi, 96, endpoint=False)
         points = np.column_stack(
