@@ -199,20 +199,24 @@ def test_the_console_script_loads_nothing_heavy_before_its_ctrl_c_handler() -> N
 # command's own exit status, not death by the signal (which a caller reads as a crash).
 _INTERRUPTED_AFTER_THE_COMMAND = {
     "shutting down": (
-        "try:\n    main()\nfinally:\n    os.kill(os.getpid(), signal.SIGINT)\n    time.sleep(5)\n"
+        "try:\n    main()\nfinally:\n    os.kill(os.getpid(), signal.STOP)\n    time.sleep(5)\n"
     ),
     "tearing down": (
-        "class Late:\n    def __del__(self):\n        os.kill(os.getpid(), signal.SIGINT)\n"
+        "class Late:\n    def __del__(self):\n        os.kill(os.getpid(), signal.STOP)\n"
         "late = Late()\nmain()\n"
     ),
 }
 
 
+# A SIGTERM in the teardown ended the process by the signal (helper-64): Python had put its
+# default action back, as it does for every signal it handles, and only SIGINT was ignored.
+@pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM", "SIGHUP"])
 @pytest.mark.parametrize("moment", sorted(_INTERRUPTED_AFTER_THE_COMMAND))
-def test_a_ctrl_c_after_the_command_keeps_its_exit_status(moment: str) -> None:
+def test_a_ctrl_c_after_the_command_keeps_its_exit_status(moment: str, stop: str) -> None:
     script = (
         "import os, signal, sys, time\nsys.argv = ['aura-ums', '--version']\n"
-        "from aura_ums.cli import main\n" + _INTERRUPTED_AFTER_THE_COMMAND[moment]
+        "from aura_ums.cli import main\n"
+        + _INTERRUPTED_AFTER_THE_COMMAND[moment].replace("signal.STOP", f"signal.{stop}")
     )
     command = [sys.executable, "-c", script]
     done = subprocess.run(command, capture_output=True, text=True, check=False, timeout=60)

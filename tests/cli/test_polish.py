@@ -534,3 +534,16 @@ def test_a_resume_with_other_inputs_is_refused_naming_the_option(
         assert f"{state} (--resume)" in result.stderr
         assert "Traceback" not in result.output
     invoke("replay", folder, "--terrain", terrain, "--classes", "II", "--resume", state, "-q")
+
+
+def test_a_state_is_not_saved_from_a_replay_growing_from_anchors(
+    walk: tuple[Path, Path], tmp_path: Path
+) -> None:
+    # Its anchors are not in the state: resumed, the maps differed by up to 29% in area.
+    folder, terrain = walk
+    state = tmp_path / "s.json"
+    args = ["replay", str(folder), "--terrain", str(terrain), "--anchor-growth", "--until", "20"]
+    result = runner.invoke(app, [*args, "--save-state", str(state), "-q"])
+    assert result.exit_code == 2, result.output
+    assert "--save-state: expected a replay without --anchor-growth" in result.stderr
+    assert not state.exists()

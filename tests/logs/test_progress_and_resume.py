@@ -180,3 +180,32 @@ def test_a_version_2_state_still_resumes_with_nothing_to_check() -> None:
     body["inputs"] = {}
     with pytest.raises(FileFormatError, match=r"expected only the keys \[.*'blackboard'\], got 'inputs'"):
         ReplayState.from_json(json.dumps(body))
+
+
+def test_a_resumed_replay_counts_rejections_and_relocalizations_of_its_own_frames() -> None:
+    # The manager's counters run from the log's first frame: a resumed replay reported them
+    # whole beside figures of its own frames (3 relocalizations where its steps had none).
+    log = synthetic_log(np.random.default_rng(16), duration=40.0, bearing_noise=0.05)
+    log = dataclasses.replace(log, meta=dataclasses.replace(log.meta, bearing_error=0.01))  # understated
+    whole = replay_log(log, TABLE)
+    first = replay_log(log, TABLE, until=20.0, save_state=True)
+    assert first.state is not None
+    rest = replay_log(log, TABLE, resume=first.state)
+    assert first.inconsistent_observations > 0
+    assert first.relocalizations > 0
+    for part in (first, rest):
+        assert part.inconsistent_observations == int(part.trace.rejected.sum())
+        assert part.relocalizations == int(part.trace.relocalized.sum())
+    assert first.inconsistent_observations + rest.inconsistent_observations == whole.inconsistent_observations
+    assert first.relocalizations + rest.relocalizations == whole.relocalizations
+    for reason, count in whole.rejected_counts.items():
+        assert first.rejected_counts.get(reason, 0) + rest.rejected_counts.get(reason, 0) == count
+
+
+def test_a_replay_growing_from_anchors_saves_no_state() -> None:
+    log = synthetic_log(np.random.default_rng(17), duration=10.0)
+    anchored = ReplayOptions(settings=ManagerSettings(anchor_growth=True))
+    with pytest.raises(
+        InputError, match=r"^save_state: expected a replay without anchor_growth \(a saved state"
+    ):
+        replay_log(log, TABLE, anchored, until=5.0, save_state=True)

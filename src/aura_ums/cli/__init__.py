@@ -91,14 +91,17 @@ def _finish_on_interrupt(status: int) -> None:
 
     with contextlib.suppress(ValueError):  # not the main thread: an embedding caller's signals
         signal.signal(signal.SIGINT, finish)
+        # Python puts back the default action of every signal it handles after the exit
+        # functions, before it tears the modules down, unless it is ignored: a Ctrl-C or a
+        # SIGTERM in that last stretch would end the process by the signal (helper-64: a
+        # SIGTERM 50 ms after calibrate's last line, 8 of 8 times). By then nothing is left
+        # that a request to stop could stop.
+        atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
         for name in TERMINATION_SIGNALS:  # a request to stop, now: the same
             number = getattr(signal, name, None)
             if number is not None and getattr(signal.getsignal(number), "stops_the_command", False):
                 signal.signal(number, finish)
-        # Python puts back the default action of SIGINT after the exit functions, before it
-        # tears the modules down, unless it is ignored: a Ctrl-C in that last stretch would
-        # end the process by the signal. By then nothing is left that a Ctrl-C could stop.
-        atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
+                atexit.register(signal.signal, number, signal.SIG_IGN)
 
 
 def __getattr__(name: str) -> Any:

@@ -602,6 +602,18 @@ def replay(
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
         table = _terrain_table(terrain, log.meta.terrain, log_dir)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
+        if save_state is not None and options.settings.anchor_growth:
+            raise fail(
+                "--save-state: expected a replay without --anchor-growth (a saved state does not hold "
+                "the anchors, so a resumed replay would not end with the map of an uninterrupted one), "
+                "got both"
+            )
+        if resume is not None and camera is not None:
+            warn(
+                "--camera with --resume: the EKF's 3-sigma boxes start again at the resumed frame "
+                "(a saved state holds our map, not the EKF), so their window figures differ from an "
+                "uninterrupted replay's; ours and the disk model's do not"
+            )
         saved = None if resume is None else ReplayState.load(resume)
         if saved is not None:
             kept = UncertaintyMapManager.saved_settings(saved.manager_json, source=f"{resume}: manager")

@@ -953,6 +953,14 @@ def replay_log(
             f"until: expected a time at or after the resumed state's last frame "
             f"({resume.last_time!r} s), got {stop!r}"
         )
+    if save_state and opts.settings.anchor_growth:
+        # The manager's JSON holds its maps, not the anchors they grow from: resumed, the maps
+        # grew from the saved one alone and differed by up to 29% in area (helper-64).
+        raise InputError(
+            "save_state: expected a replay without anchor_growth (a saved state does not hold the "
+            "anchors, so a resumed replay would not end with the map of an uninterrupted one), got "
+            "anchor_growth True"
+        )
     if isinstance(log, LogStream) and (resume is not None or save_state):
         raise InputError(
             "log: expected a RobotLog (load_log) to resume or save a replay's state "
@@ -985,6 +993,11 @@ def replay_log(
         # The saved settings run the rest: the envelope's observations pair with them, and
         # the result reports them (an uninterrupted replay had them from its first frame).
         opts = dataclasses.replace(opts, settings=manager.settings)
+    # The manager's counters run from the log's first frame; a resumed replay reports its own
+    # frames (its trace's), so the counts it restored are taken off (helper-64: 3 relocalizations
+    # reported where its own steps had none).
+    rejected_before = dict(manager.rejected_counts)
+    relocalized_before = manager.relocalizations
     robust = opts.settings.robust
     envelope_bounds = (
         opts.envelope if opts.envelope is not None else working_bounds.widened(opts.settings.envelope_factor)
@@ -1107,8 +1120,13 @@ def replay_log(
         log,
         opts,
         result_trace,
-        types.MappingProxyType(dict(manager.rejected_counts)),
-        manager.relocalizations,
+        types.MappingProxyType(
+            {
+                reason: count - rejected_before.get(reason, 0)
+                for reason, count in manager.rejected_counts.items()
+            }
+        ),
+        manager.relocalizations - relocalized_before,
         tuple(maps) if keep_maps else None,
         state,
         source.start_time,
