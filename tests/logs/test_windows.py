@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from aura_ums.camera import CalibrationBounds, load_camera
+from aura_ums.camera import CalibrationBounds, Camera, CameraMount, load_camera
 from aura_ums.errors import InputError
 from aura_ums.logs import (
     Calibration,
@@ -313,6 +313,21 @@ def test_a_landmark_behind_the_camera_has_no_window_and_is_not_judged() -> None:
     assert metrics["window_truth_containment"] is None  # the log has no ground truth
     line = next(line for line in report.to_csv().splitlines() if line.split(",")[1] == "behind")
     assert line.split(",")[4:13] == ["", "", "", "", "", "", "0", "", ""]
+
+
+def test_a_pole_wholly_above_a_tilted_cameras_rows_is_not_judged(clean_log: RobotLog) -> None:
+    # Its column is in the image, so it was judged in view, and the Expecter's rightful lack
+    # of a window counted a miss: window_containment 0.097 at a tilt of 0.5 rad down, every
+    # miss a pole imaged nowhere (helper-62). Level, the same log is judged in full.
+    options = ReplayOptions(landmark_class=LandmarkClass.VERTICAL_LINE)
+    tilted = Camera(CAMERA.intrinsics, CameraMount(0.3, tilt=0.5))
+    _, report = replay_windows(clean_log, FLOOR, tilted, options)
+    ours = [row for row in report.rows if row.method == "aura-ums"]
+    assert ours
+    assert all(row.inside for row in ours if row.in_view)
+    assert report.metrics()["window_containment"] in (None, 1.0)
+    _, level = replay_windows(clean_log, FLOOR, CAMERA, options)
+    assert level.metrics()["window_containment"] == 1.0
 
 
 def test_a_landmark_inside_the_polygon_may_be_anywhere_in_the_image() -> None:
