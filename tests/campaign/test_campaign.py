@@ -93,6 +93,30 @@ def test_run_seeds_are_the_generators_simulate_always_spawned() -> None:
         assert np.array_equal(old, new)
 
 
+def test_run_seeds_are_bounded_by_a_monte_carlo_s_runs() -> None:
+    assert len(run_seeds(0, Scenario.max_runs)) == Scenario.max_runs
+    for runs in (Scenario.max_runs + 1, 10**12, 2**63):
+        message = r"runs: expected an integer in \[0, 100000\], got \d+ \(about .* GB of seeds\)"
+        with pytest.raises(InputError, match=message):
+            run_seeds(0, runs)
+
+
+@pytest.mark.parametrize(
+    ("task", "items", "message"),
+    [
+        (None, [1, 2], "task: expected a callable, task.item. -> value, got NoneType"),
+        (abs, None, "items: expected a sequence of items, one a run, got NoneType"),
+        (abs, 1, "items: expected a sequence of items, one a run, got int"),
+        (abs, "12", "items: expected a sequence of items, one a run, got str"),
+    ],
+)
+def test_run_campaign_refuses_what_is_no_task_or_no_items(task: Any, items: Any, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        run_campaign(task, items)
+    with pytest.raises(InputError, match=r"progress: expected a callable, progress\(done, total\), or None"):
+        run_campaign(abs, [1], progress=1)  # type: ignore[arg-type]
+
+
 def test_a_run_called_twice_with_one_seed_draws_the_same(scenario: Scenario) -> None:
     # run_scenario spawns from its generator's seed sequence, which counts its children.
     (seed,) = run_seeds(3, 1)

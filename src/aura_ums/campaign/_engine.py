@@ -29,6 +29,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
+from aura_ums._validate import items_of
 from aura_ums.campaign._settings import CampaignSettings
 from aura_ums.errors import AuraUmsError, InputError, MissingDependencyError, RunLostError
 
@@ -115,7 +116,8 @@ def run_campaign(
     MissingDependencyError
         For a Dask campaign without the ``aura-ums[dask]`` extra.
     InputError
-        When the scheduler cannot be reached or has no worker.
+        For a task or progress that is not callable, items that are not a sequence (a string
+        neither), or when the scheduler cannot be reached or has no worker.
     RunLostError
         When a run was lost more often than ``settings.retries`` allows.
     Exception
@@ -127,9 +129,17 @@ def run_campaign(
     (2, 3, 5)
     >>> run_campaign(abs, []).values
     ()
+    >>> run_campaign(abs, None)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: items: expected a sequence of items, one a run, got NoneType
     """
+    if not callable(task):
+        raise InputError(f"task: expected a callable, task(item) -> value, got {type(task).__name__}")
+    work = list(items_of(items, "items", "a sequence of items, one a run"))
+    if progress is not None and not callable(progress):
+        raise InputError(f"progress: expected a callable, progress(done, total), or None, got {progress!r}")
     chosen = settings_or_serial(settings)
-    work = list(items)
     if not chosen.distributed:
         values = []
         for item in work:

@@ -58,6 +58,7 @@ import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -462,6 +463,8 @@ class Scenario:
     source: str = ""
     inject_wrong_rate: float = 0.0
     files: tuple[tuple[str, Path], ...] = ()
+    #: Most Monte Carlo runs of one call (:meth:`check_runs`; :func:`aura_ums.campaign.run_seeds` too).
+    max_runs: ClassVar[int] = MAX_RUNS
 
     def __post_init__(self) -> None:
         for name, kind in (
