@@ -185,6 +185,17 @@ def test_render_consistency_rule(paper: Scenario) -> None:
         run_scenario(thick, np.random.default_rng(0))
 
 
+def test_the_summary_and_the_render_check_refuse_what_is_not_theirs(paper: Scenario) -> None:
+    with pytest.raises(InputError, match="results: expected a sequence of RunResult, got NoneType"):
+        summarize_runs(None)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"results\[0\]: expected a RunResult, got int"):
+        summarize_runs([1])  # type: ignore[list-item]
+    with pytest.raises(InputError, match="scenario: expected a Scenario, got NoneType"):
+        check_render_consistency(None)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="world: expected a MeadowMap or None, got str"):
+        check_render_consistency(paper, "paper_sidewalk")  # type: ignore[arg-type]
+
+
 def test_bad_arguments(paper: Scenario) -> None:
     with pytest.raises(InputError, match=r"stop_after: expected an integer >= 1"):
         run_scenario(paper, np.random.default_rng(0), stop_after=0)

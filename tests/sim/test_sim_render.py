@@ -213,8 +213,12 @@ def test_fill_polygon_matches_matplotlib_contains_points(convex: bool) -> None:
 
 
 def test_bad_arguments_are_refused() -> None:
-    with pytest.raises(InputError, match=r"noise: expected a non-negative number, got -1\.0"):
-        SyntheticCamera(PAPER_CAMERA, Scene(), np.random.default_rng(0), noise=-1.0)
+    for noise in (-1.0, 256.0, 1e300):
+        with pytest.raises(InputError, match=r"noise: expected a number in \[0, 255\] gray levels, got "):
+            SyntheticCamera(PAPER_CAMERA, Scene(), np.random.default_rng(0), noise=noise)
+    many = r"clutter_lines: expected at most 1,000,000 lines \(.*: 190 s a frame\), got 1000000000000"
+    with pytest.raises(InputError, match=many):
+        SyntheticCamera(PAPER_CAMERA, Scene(), np.random.default_rng(0), clutter_lines=10**12)
     with pytest.raises(InputError, match="clutter_lines: expected an integer >= 0"):
         SyntheticCamera(PAPER_CAMERA, Scene(), np.random.default_rng(0), clutter_lines=-2)
     with pytest.raises(InputError, match="scene: expected a Scene"):

@@ -72,6 +72,38 @@ def test_clutter_is_deterministic_per_seed_and_inside_the_bounds() -> None:
         (lambda: Scene(texture=np.zeros((6, 6), np.float32)), "side is a power of two"),
         (lambda: ground_texture(np.random.default_rng(0), size=100), "size: expected a power of two >= 4"),
         (
+            lambda: ground_texture(np.random.default_rng(0), size=2**63),
+            r"size: expected at most 4096 cells \(a 4096-cell tile takes about 5 s and 0.5 GB",
+        ),
+        (
+            lambda: ground_texture(np.random.default_rng(0), size=64, smoothing=1e6),
+            r"smoothing: expected a number in \[0, 100\] px, got 1000000.0",
+        ),
+        (
+            lambda: ground_texture(np.random.default_rng(0), size=64, smoothing=-1.0),
+            r"smoothing: expected a number in \[0, 100\] px, got -1.0",
+        ),
+        (
+            lambda: Building(np.array([(0, 0), (1, 0), (1, 1), (0, 1)]) * 1e300, 0.0, 5.0),
+            r"Building.footprint: expected coordinates a number in \[-1e\+06, 1e\+06\] m, got \[1e\+300, 0",
+        ),
+        (
+            lambda: random_clutter(None, 5, np.random.default_rng(0)),  # type: ignore[arg-type]
+            r"bounds: expected \(x_min, y_min, x_max, y_max\) in metres, got NoneType",
+        ),
+        (
+            lambda: random_clutter((0.0, 0.0), 5, np.random.default_rng(0)),  # type: ignore[arg-type]
+            r"bounds: expected \(x_min, y_min, x_max, y_max\) in metres, got \(0.0, 0.0\)",
+        ),
+        (
+            lambda: random_clutter((0.0, 0.0, 1e300, 1.0), 5, np.random.default_rng(0)),
+            r"bounds: expected a number in \[-1e\+06, 1e\+06\] m, got 1e\+300",
+        ),
+        (
+            lambda: random_clutter((0.0, 0.0, 10.0, 10.0), 10**12, np.random.default_rng(0)),
+            r"count: expected at most 10,000,000 strips \(about 400 bytes each: 4 GB\), got 1000000000000",
+        ),
+        (
             lambda: Building.from_corner(0.0, 0.0, 3.0, width=0.0, depth=1.0),
             "width: expected a positive number",
         ),

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import Choice, check_rng
+from aura_ums._validate import Choice, check_rng, sequence_of
 from aura_ums.errors import InputError
 from aura_ums.expecter import ImageWindow
 from aura_ums.geometry import wrap_angle
@@ -357,6 +357,10 @@ def check_render_consistency(scenario: Scenario, world: MeadowMap | None = None)
     aura_ums.errors.InputError: scenarios/paper_sidewalk.toml: [render] pole_radius: telephone_pole_12: \
 expected position_uncertainty >= the rendered pole radius 0.5 m, got 0.15
     """
+    if not isinstance(scenario, Scenario):
+        raise InputError(f"scenario: expected a Scenario, got {type(scenario).__name__}")
+    if world is not None and not isinstance(world, MeadowMap):
+        raise InputError(f"world: expected a MeadowMap or None, got {type(world).__name__}")
     drawn = scenario.meadow_map if world is None else world
     corners = [r.landmark for r in drawn.landmarks if isinstance(r.landmark, PointLandmark)]
     radius, half = scenario.render.pole_radius, scenario.render.stripe_width / 2.0
@@ -758,6 +762,7 @@ def summarize_runs(results: list[RunResult] | tuple[RunResult, ...]) -> Metrics:
     >>> metrics["frames"], metrics["containment_rate"]
     (8, 1.0)
     """
+    results = sequence_of(results, RunResult, "results")
     records = [r for result in results for r in result.records]
     if not records:
         raise InputError("results: expected at least one run with frames, got none")

@@ -26,7 +26,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import check_rng, integer_at_least, nonnegative_float
+from aura_ums._validate import Range, check_rng, integer_at_least
 from aura_ums.camera import Camera, fold_radius, undistort_points, within_fold
 from aura_ums.errors import InputError
 from aura_ums.sim._scene import Building, Pole, Scene
@@ -155,6 +155,12 @@ def _clip_fold(points: Array, distortion: tuple[float, float, float, float, floa
     return _clip_convex(points, inside, cut)
 
 
+#: Standard deviation of the sensor noise, gray levels: beyond 255 every pixel is black or white.
+NOISE = Range(0.0, 255.0, "gray levels")
+#: Clutter lines drawn over each frame (about 190 us each: 1,000,000 are minutes a frame).
+CLUTTER_LINES = Range(0, 1_000_000, "lines")
+
+
 class SyntheticCamera:
     """Render grayscale images of a :class:`Scene` as a :class:`~aura_ums.camera.Camera` sees it.
 
@@ -168,11 +174,11 @@ class SyntheticCamera:
         Source of the sensor noise and the clutter lines, drawn anew for every frame: a
         seed fixes the sequence of images.
     noise : float
-        Standard deviation of the additive Gaussian sensor noise, gray levels, >= 0
+        Standard deviation of the additive Gaussian sensor noise, gray levels, in [0, 255]
         (drawn through a table of 65536 quantiles, so within +-4.1 sigma).
     clutter_lines : int
         Random short line segments (5 to 40 pixels, random gray) drawn over every frame,
-        >= 0: image clutter that the perception must ignore.
+        in [0, 1000000]: image clutter that the perception must ignore.
 
     Examples
     --------
@@ -219,8 +225,13 @@ class SyntheticCamera:
         if not isinstance(scene, Scene):
             raise InputError(f"scene: expected a Scene, got {type(scene).__name__}")
         check_rng(rng)
-        self._noise = nonnegative_float(noise, "noise")
+        self._noise = NOISE.check(noise, "noise")
         self._clutter = integer_at_least(clutter_lines, "clutter_lines", 0)
+        if self._clutter > CLUTTER_LINES.high:
+            raise InputError(
+                f"clutter_lines: expected at most {CLUTTER_LINES.high:,.0f} lines (each drawn in every "
+                f"frame, about 190 us: 190 s a frame), got {clutter_lines!r}"
+            )
         self._camera = camera
         self._scene = scene
         self._rng = rng

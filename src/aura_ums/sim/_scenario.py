@@ -81,9 +81,9 @@ from aura_ums.expecter import Expecter
 from aura_ums.geometry import wrap_angle
 from aura_ums.manager import ManagerSettings, MapProfile, SettingInfo
 from aura_ums.schemas import FindLandmarkSchema
-from aura_ums.sim._render import SyntheticCamera
+from aura_ums.sim._render import CLUTTER_LINES, NOISE, SyntheticCamera
 from aura_ums.sim._robot import SimulatedRobot
-from aura_ums.sim._scene import Scene
+from aura_ums.sim._scene import CLUTTER, Scene
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
 from aura_ums.world import LandmarkRecord, MeadowMap, plan_route, sample_world
 
@@ -137,9 +137,9 @@ KEY_RANGES: dict[str, Range] = {
     "frame_spacing": Range(0.0, LENGTH.high, "m", low_open=True),
     "frame_rate": Range(0.0, 1000.0, "1/s", low_open=True),
     "speed": Range(0.0, 100.0, "m/s", low_open=True),
-    "noise": Range(0.0, 255.0, "gray levels"),
-    "clutter": Range(0, 10_000_000, "strips"),
-    "clutter_lines": Range(0, 1_000_000, "lines"),
+    "noise": NOISE,
+    "clutter": CLUTTER,
+    "clutter_lines": CLUTTER_LINES,
     "pole_radius": Range(0.0, 100.0, "m", low_open=True),
     "stripe_width": Range(0.0, 100.0, "m", low_open=True),
     "building_width": Range(0.0, 1000.0, "m", low_open=True),

@@ -23,6 +23,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import (
+    BLUR,
+    COORDINATE,
+    Range,
     check_rng,
     finite_float,
     integer_at_least,
@@ -31,6 +34,7 @@ from aura_ums._validate import (
     points_array,
     positive_float,
     read_only,
+    world_points,
 )
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import GroundLineLandmark, PointLandmark, VerticalLineLandmark
@@ -47,6 +51,13 @@ _TERRAIN_SHADES: Mapping[str, float] = MappingProxyType(
 #: A Class I landmark closer than this (m, horizontally) to a Class II one is the vertical
 #: corner edge of that point's building, not a pole of its own.
 CORNER_MATCH_DISTANCE = 0.05
+
+#: Most random strips of clutter (:func:`random_clutter`, a scenario's ``clutter``): a strip
+#: takes about 400 bytes in the scene (the camera's too), so 4 GB, a run's memory limit.
+CLUTTER = Range(0, 10_000_000, "strips")
+#: Longest side of a ground texture tile, cells: 4096 took 4.6 s (19 s at a smoothing of 100
+#: cells) and about 0.5 GB while it is made (float64 noise, its smoothed copy, the float32 tile).
+MAX_TEXTURE_SIZE = 4096
 
 
 def _shade(value: object, name: str) -> float:
@@ -157,7 +168,7 @@ class Building:
         object.__setattr__(self, "z_top", z_top)
         object.__setattr__(self, "shades", shades)
         object.__setattr__(self, "id", id)
-        points = points_array(footprint, "Building.footprint", min_rows=3)
+        points = world_points(footprint, "Building.footprint", min_rows=3)
         points = _counter_clockwise(points.copy())
         edges = np.roll(points, -1, axis=0) - points
         cross = edges[:, 0] * np.roll(edges[:, 1], -1) - edges[:, 1] * np.roll(edges[:, 0], -1)
@@ -302,21 +313,33 @@ def ground_texture(
     """Return a periodic random texture tile, zero mean and unit standard deviation.
 
     White noise smoothed by a Gaussian of ``smoothing`` cells (wrapping around), so that
-    the tile repeats without seams. ``size`` is a power of two.
+    the tile repeats without seams. ``size`` is a power of two, at most 4096; ``smoothing``
+    is in [0, 100] cells (an image blur's range: beyond, the tile is one grey).
 
     Examples
     --------
     >>> tile = ground_texture(np.random.default_rng(0), size=64)
     >>> tile.shape, round(float(tile.std()), 3), tile.flags.writeable
     ((64, 64), 1.0, False)
+    >>> ground_texture(np.random.default_rng(0), size=64, smoothing=1e6)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: smoothing: expected a number in [0, 100] px, got 1000000.0
     """
     from scipy import ndimage  # deferred: scipy takes ~0.5 s to import
 
     if isinstance(size, bool) or not isinstance(size, int) or size < 4 or size & (size - 1):
         raise InputError(f"size: expected a power of two >= 4, got {size!r}")
+    if size > MAX_TEXTURE_SIZE:
+        raise InputError(
+            f"size: expected at most {MAX_TEXTURE_SIZE} cells (a {MAX_TEXTURE_SIZE}-cell tile takes about "
+            f"5 s and 0.5 GB; the time and memory grow with the square), got {size!r}"
+        )
+    # A Gaussian of sigma s cells costs 8 s + 1 products a cell: 1e6 cells hung.
+    sigma = BLUR.check(smoothing, "smoothing")
     check_rng(rng)
     noise = rng.standard_normal((size, size))
-    smooth = ndimage.gaussian_filter(noise, nonnegative_float(smoothing, "smoothing"), mode="wrap")
+    smooth = ndimage.gaussian_filter(noise, sigma, mode="wrap")
     smooth = (smooth - smooth.mean()) / max(float(smooth.std()), 1e-12)
     tile: NDArray[np.float32] = smooth.astype(np.float32)
     tile.setflags(write=False)
@@ -349,7 +372,15 @@ def random_clutter(
     """
     check_rng(rng)
     integer_at_least(count, "count", 0)
-    x0, y0, x1, y1 = (finite_float(v, "bounds") for v in bounds)
+    if count > CLUTTER.high:
+        raise InputError(
+            f"count: expected at most {CLUTTER.high:,.0f} strips (about 400 bytes each: 4 GB), "
+            f"got {count!r} (about {count * 400 / 1e9:.3g} GB)"
+        )
+    corners = items_of(bounds, "bounds", "(x_min, y_min, x_max, y_max) in metres")
+    if len(corners) != 4:
+        raise InputError(f"bounds: expected (x_min, y_min, x_max, y_max) in metres, got {bounds!r}")
+    x0, y0, x1, y1 = (COORDINATE.check(v, "bounds") for v in corners)
     centre = np.column_stack([rng.uniform(x0, x1, count), rng.uniform(y0, y1, count)])
     angle = rng.uniform(-math.pi, math.pi, count)
     half = 0.5 * rng.uniform(length[0], length[1], count)
