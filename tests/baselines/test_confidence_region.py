@@ -113,6 +113,43 @@ def test_ellipse_polygon_circumscribes_the_ellipse() -> None:
     assert 1.0 < polygon.area / ellipse_area < 1.0 + 2.5e-3
 
 
+def test_ellipse_polygon_of_a_rank_one_covariance_at_the_rounding_edge() -> None:
+    # cxy**2 a rounding above cxx * cyy (a covariance computed as an outer product): taken.
+    cxx, cyy = 0.1, 0.3
+    cxy = math.sqrt(cxx * cyy) * (1.0 + 1e-12)
+    assert ellipse_polygon((0.0, 0.0), (cxx, cxy, cyy), 9.0, sides=8).shape == (8, 2)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        (((0.0, 0.0), (1.0, 0.0, 1.0), 3.0, 0), r"sides: expected an integer in \[3, 1000000\] \(16 bytes"),
+        (((0.0, 0.0), (1.0, 0.0, 1.0), 3.0, 1.5), r"sides: expected an integer in \[3, 1000000\].*got 1.5"),
+        (((0.0, 0.0), (1.0, 0.0, 1.0), 3.0, True), r"sides: expected an integer in \[3, 1000000\].*got True"),
+        (((0.0, 0.0), (1.0, 0.0, 1.0), 3.0, 10**12), r"sides: .*: 16 MB\), got 1000000000000"),
+        (((math.nan, 0.0), (1.0, 0.0, 1.0), 3.0), r"center\[0\]: expected a finite number, got nan"),
+        (((0.0, 2e6), (1.0, 0.0, 1.0), 3.0), r"center\[1\]: expected a number in \[-1e\+06, 1e\+06\] m"),
+        ((None, (1.0, 0.0, 1.0), 3.0), r"center: expected \(x, y\) in metres, got NoneType"),
+        (((0.0,), (1.0, 0.0, 1.0), 3.0), r"center: expected \(x, y\) in metres, got \(0.0,\)"),
+        (((0.0, 0.0), (math.nan, 0.0, 1.0), 3.0), r"covariance\[0\]: expected a finite number, got nan"),
+        (((0.0, 0.0), (1.0, 0.0), 3.0), r"covariance: expected \(cxx, cxy, cyy\) in m\^2, got \(1.0, 0.0\)"),
+        (((0.0, 0.0), (-1.0, 0.0, 1.0), 3.0), r"covariance\[0\]: expected a number in \[0, 1e\+12\] m\^2"),
+        (((0.0, 0.0), (1.0, 0.0, 1e300), 3.0), r"covariance\[2\]: expected a number in \[0, 1e\+12\] m\^2"),
+        (((0.0, 0.0), (1.0, 5.0, 1.0), 3.0), r"covariance: expected a positive semi-definite \(cxx, cxy"),
+        (((0.0, 0.0), (1.0, 0.0, 1.0), -1.0), r"scale: expected a number in \(0, 10000\], got -1.0"),
+        (((0.0, 0.0), (1.0, 0.0, 1.0), 1e300), r"scale: expected a number in \(0, 10000\], got 1e\+300"),
+    ],
+)
+def test_ellipse_polygon_refuses_what_is_no_ellipse(arguments: tuple[object, ...], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        ellipse_polygon(*arguments)  # type: ignore[arg-type]
+
+
+def test_chi2_quantile_takes_one_or_two_degrees_of_freedom() -> None:
+    with pytest.raises(InputError, match="dof: expected 1 or 2, got True"):
+        chi2_quantile(0.99, True)
+
+
 def _ekf_with_covariance(correlated: bool) -> ExtendedKalmanFilter:
     ekf = ExtendedKalmanFilter(
         Pose(1.0, -2.0, 3.0), position_sd=0.3, heading_sd=0.05, bearing_sd=0.01, range_sd=0.1

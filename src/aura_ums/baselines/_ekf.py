@@ -44,7 +44,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, positive_float
+from aura_ums._validate import ANGLE_ERROR, LENGTH, START_RADIUS, Range, finite_float, positive_float
 from aura_ums.baselines._moments import check_motion, motion_moments
 from aura_ums.baselines._region import ConfidenceRegion, check_probability, chi2_quantile, gaussian_region
 from aura_ums.errors import InputError
@@ -57,6 +57,32 @@ _ZERO3 = (0.0, 0.0, 0.0)
 
 #: Landmarks closer than this (m) to the predicted sensor position give no usable direction.
 _MIN_LANDMARK_DISTANCE = 1e-9
+
+# The ranges of the filters' standard deviations (the EKF's and the particle filter's): 1e300
+# overflowed their squares, and the particles of a 1e300 m cloud left the coordinate range.
+#: Initial standard deviation of x and y, metres: a start's uncertainty (10 km).
+POSITION_SD = START_RADIUS
+#: Initial standard deviation of the heading, radians: an angle's error, or none.
+HEADING_SD = Range(0.0, ANGLE_ERROR.high, "rad")
+#: Bearing measurement standard deviation, radians: as a sensor calibration's ``bearing_sd``.
+BEARING_SD = ANGLE_ERROR
+#: Range measurement standard deviation, metres: from a micrometre (no sensor measures closer;
+#: the square of a smaller one underflows) to a length a sensor measures.
+RANGE_SD = Range(1e-6, LENGTH.high, "m")
+#: Extra range standard deviation per metre of range: as a sensor calibration's
+#: ``range_sd_fraction``, or none.
+RANGE_SD_FRACTION = Range(0.0, 10.0)
+
+
+def measurement_variances(
+    bearing_sd: object, range_sd: object, range_sd_fraction: object
+) -> tuple[float, float, float]:
+    """Return the variances of a bearing and a range, and the squared fraction, checked in their ranges."""
+    return (
+        BEARING_SD.check(bearing_sd, "bearing_sd") ** 2,
+        RANGE_SD.check(range_sd, "range_sd") ** 2,
+        RANGE_SD_FRACTION.check(range_sd_fraction, "range_sd_fraction") ** 2,
+    )
 
 
 def _wrap(angle: float) -> float:
@@ -114,15 +140,15 @@ class ExtendedKalmanFilter:
     initial : Pose
         Initial mean pose.
     position_sd : float
-        Initial standard deviation of x and of y, metres, >= 0 (uncorrelated).
+        Initial standard deviation of x and of y, metres, in [0, 10000] (uncorrelated).
     heading_sd : float
-        Initial standard deviation of the heading, radians, >= 0.
+        Initial standard deviation of the heading, radians, in [0, 1000].
     bearing_sd : float
-        Bearing measurement standard deviation, radians, > 0.
+        Bearing measurement standard deviation, radians, in [1e-6, 1000].
     range_sd : float
-        Range measurement standard deviation, metres, > 0.
+        Range measurement standard deviation, metres, in [1e-6, 10000].
     range_sd_fraction : float
-        Extra range standard deviation per metre of range, >= 0 (added in quadrature).
+        Extra range standard deviation per metre of range, in [0, 10] (added in quadrature).
     gate_probability : float or None
         Reject an update whose squared Mahalanobis innovation exceeds the chi-square
         quantile of this probability (1 or 2 degrees of freedom); None accepts all.
@@ -133,9 +159,8 @@ class ExtendedKalmanFilter:
     Raises
     ------
     InputError
-        For a non-Pose initial state, negative or non-finite standard deviations, a
-        non-positive ``bearing_sd``, ``range_sd`` or ``process_noise_scale``, or a gate
-        probability outside (0, 1).
+        For a non-Pose initial state, standard deviations outside their ranges above, a
+        non-positive ``process_noise_scale``, or a gate probability outside (0, 1).
 
     Examples
     --------
@@ -156,7 +181,7 @@ class ExtendedKalmanFilter:
     >>> ExtendedKalmanFilter(Pose(0, 0, 0), position_sd=0.1, heading_sd=0.01, bearing_sd=0.0, range_sd=0.2)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: bearing_sd: expected a positive number, got 0.0
+    aura_ums.errors.InputError: bearing_sd: expected a number in [1e-06, 1000] rad, got 0.0
     """
 
     __slots__ = (
@@ -187,11 +212,11 @@ class ExtendedKalmanFilter:
     ) -> None:
         if not isinstance(initial, Pose):
             raise InputError(f"initial: expected a Pose, got {type(initial).__name__}")
-        position_var = nonnegative_float(position_sd, "position_sd") ** 2
-        heading_var = nonnegative_float(heading_sd, "heading_sd") ** 2
-        self._bearing_var = positive_float(bearing_sd, "bearing_sd") ** 2
-        self._range_var = positive_float(range_sd, "range_sd") ** 2
-        self._range_fraction_sq = nonnegative_float(range_sd_fraction, "range_sd_fraction") ** 2
+        position_var = POSITION_SD.check(position_sd, "position_sd") ** 2
+        heading_var = HEADING_SD.check(heading_sd, "heading_sd") ** 2
+        self._bearing_var, self._range_var, self._range_fraction_sq = measurement_variances(
+            bearing_sd, range_sd, range_sd_fraction
+        )
         self._bearing_gate = _gate_threshold(gate_probability, 1)
         self._range_bearing_gate = _gate_threshold(gate_probability, 2)
         self._scale = positive_float(process_noise_scale, "process_noise_scale")

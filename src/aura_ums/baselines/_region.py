@@ -18,14 +18,15 @@ probability. The joint probability of the product region is then
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from statistics import NormalDist
-from typing import overload
+from typing import cast, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, float_array
+from aura_ums._validate import COORDINATE, Range, finite_float, float_array, items_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, HeadingWedge, wrap_angle
 
@@ -33,6 +34,12 @@ Array = NDArray[np.float64]
 
 #: Vertices of the outer polygon that stands for a Gaussian confidence ellipse.
 _ELLIPSE_SIDES = 64
+#: Most vertices :func:`ellipse_polygon` makes: 16 bytes each, 16 MB (64 stand for an ellipse).
+MAX_ELLIPSE_SIDES = 1_000_000
+#: A variance of a position, m^2: up to the square of the coordinate range (1e300 overflowed).
+_VARIANCE = Range(0.0, COORDINATE.high**2, "m^2")
+#: A squared Mahalanobis radius (a chi-square quantile: 73.7 at p = 1 - 1e-16), up to 100 sigmas.
+_SCALE = Range(0.0, 1e4, "", low_open=True)
 
 _TWO_PI = 2.0 * math.pi
 
@@ -86,14 +93,14 @@ def chi2_quantile(probability: float, dof: int) -> float:
     ...
     aura_ums.errors.InputError: probability: expected a finite number, got nan
     """
+    if isinstance(dof, bool) or dof not in (1, 2):
+        raise InputError(f"dof: expected 1 or 2, got {dof!r}")
     probability = finite_float(probability, "probability")
     if not 0.0 < probability < 1.0:
         raise InputError(f"probability: expected a number in (0, 1), got {probability!r}")
     if dof == 1:
         return _STANDARD_NORMAL.inv_cdf(0.5 + 0.5 * probability) ** 2
-    if dof == 2:
-        return -2.0 * math.log1p(-probability)
-    raise InputError(f"dof: expected 1 or 2, got {dof!r}")
+    return -2.0 * math.log1p(-probability)
 
 
 def normal_halfwidth(probability: float) -> float:
@@ -122,13 +129,14 @@ def ellipse_polygon(
     Parameters
     ----------
     center : tuple of float
-        Centre (x, y), metres.
+        Centre (x, y), metres, each in [-1e6, 1e6].
     covariance : tuple of float
-        ``(cxx, cxy, cyy)``, m^2, positive semi-definite.
+        ``(cxx, cxy, cyy)``, m^2, positive semi-definite (``cxy**2 <= cxx * cyy``), the
+        variances at most 1e12.
     scale : float
-        Squared Mahalanobis radius, > 0 (a chi-square quantile).
+        Squared Mahalanobis radius, in (0, 1e4] (a chi-square quantile).
     sides : int
-        Number of vertices, >= 3.
+        Number of vertices, in [3, 1000000].
 
     Returns
     -------
@@ -142,7 +150,54 @@ def ellipse_polygon(
     [2.8284, 1.4142]
     >>> float(np.abs(ellipse_polygon((1.0, 2.0), (0.0, 0.0, 0.0), 9.0, sides=4) - [1, 2]).max())
     0.0
+    >>> ellipse_polygon((0.0, 0.0), (1.0, 5.0, 1.0), 9.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: covariance: expected a positive semi-definite (cxx, cxy, cyy), \
+cxy**2 <= cxx * cyy, got (1.0, 5.0, 1.0)
     """
+    x, y = _pair(center, "center", "(x, y) in metres")
+    cxx, cxy, cyy = _covariance(covariance)
+    scale = _SCALE.check(scale, "scale")
+    count: object = sides
+    whole = isinstance(count, (int, np.integer)) and not isinstance(count, bool)
+    if not whole or not 3 <= cast(int, count) <= MAX_ELLIPSE_SIDES:
+        raise InputError(
+            f"sides: expected an integer in [3, {MAX_ELLIPSE_SIDES}] (16 bytes a vertex: 16 MB), "
+            f"got {sides!r}"
+        )
+    return _ellipse_polygon((x, y), (cxx, cxy, cyy), scale, int(sides))
+
+
+def _pair(value: object, name: str, what: str) -> tuple[float, float]:
+    """Return ``value`` as two coordinates in the coordinate range, or raise naming ``name``."""
+    items: tuple[object, ...] = items_of(cast("Iterable[object]", value), name, what)
+    if len(items) != 2:
+        raise InputError(f"{name}: expected {what}, got {value!r}")
+    return (COORDINATE.check(items[0], f"{name}[0]"), COORDINATE.check(items[1], f"{name}[1]"))
+
+
+def _covariance(value: object) -> tuple[float, float, float]:
+    """Return ``(cxx, cxy, cyy)`` checked: variances in range, positive semi-definite (to rounding)."""
+    what = "(cxx, cxy, cyy) in m^2"
+    items: tuple[object, ...] = items_of(cast("Iterable[object]", value), "covariance", what)
+    if len(items) != 3:
+        raise InputError(f"covariance: expected {what}, got {value!r}")
+    cxx = _VARIANCE.check(items[0], "covariance[0]")
+    cxy = finite_float(items[1], "covariance[1]")
+    cyy = _VARIANCE.check(items[2], "covariance[2]")
+    if cxy * cxy > cxx * cyy * (1.0 + 1e-9):
+        raise InputError(
+            f"covariance: expected a positive semi-definite (cxx, cxy, cyy), cxy**2 <= cxx * cyy, "
+            f"got {(cxx, cxy, cyy)!r}"
+        )
+    return (cxx, cxy, cyy)
+
+
+def _ellipse_polygon(
+    center: tuple[float, float], covariance: tuple[float, float, float], scale: float, sides: int
+) -> Array:
+    """:func:`ellipse_polygon` on checked numbers."""
     cxx, cxy, cyy = covariance
     half_trace = 0.5 * (cxx + cyy)
     spread = math.hypot(0.5 * (cxx - cyy), cxy)
@@ -475,7 +530,7 @@ def gaussian_region(
     """:meth:`ConfidenceRegion.gaussian` on checked numbers: mean (m, m, rad) and covariance entries."""
     p = check_probability(probability)
     q = marginal_probability(p)
-    vertices = ellipse_polygon((x, y), (xx, xy, yy), chi2_quantile(q, 2), _ELLIPSE_SIDES)
+    vertices = _ellipse_polygon((x, y), (xx, xy, yy), chi2_quantile(q, 2), _ELLIPSE_SIDES)
     try:
         polygon = ConvexPolygon(vertices)
     except InputError:  # a (nearly) singular ellipse: its hull is a segment or a point
