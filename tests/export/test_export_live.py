@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 import socket
 import sys
 import threading
@@ -309,8 +310,13 @@ def test_bad_options_are_refused(log: Any) -> None:
         LiveOptions(rate=-1.0)
     with pytest.raises(InputError, match=r"rate: expected a finite number >= 0"):
         LiveOptions(rate=float("nan"))
-    with pytest.raises(InputError, match=r"host: expected an address such as 127\.0\.0\.1, got ''"):
-        LiveOptions(host="")
+    for host in ("", "/tmp", "a b", "http://localhost", "localhost:8765", "-x", "[::1]"):
+        with pytest.raises(
+            InputError, match=rf"host: expected an address such as 127\.0\.0\.1 .*, got '{re.escape(host)}'"
+        ):
+            LiveOptions(host=host)
+    for host in ("0.0.0.0", "::1", "localhost", "robot-7.lab.example.org"):
+        assert LiveOptions(host=host).host == host
     with pytest.raises(InputError, match=r"port: expected an integer from 0 to 65535, got True"):
         LiveOptions(port=True)
     with pytest.raises(InputError, match=r"options: expected LiveOptions or None, got dict"):

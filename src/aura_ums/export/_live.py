@@ -14,7 +14,9 @@ needs none.
 
 from __future__ import annotations
 
+import ipaddress
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from types import TracebackType
@@ -38,6 +40,20 @@ if TYPE_CHECKING:
 
 #: Where the live server listens by default: this machine only.
 DEFAULT_HOST = "127.0.0.1"
+#: A host name: dot-separated labels of letters, digits and inner hyphens (RFC 1123), 253 at most.
+_LABEL = r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,61}[A-Za-z0-9])?"
+_HOST_NAME = re.compile(rf"(?=.{{1,253}}\.?$){_LABEL}(?:\.{_LABEL})*\.?")
+
+
+def _is_host(text: str) -> bool:
+    """Whether ``text`` is an IPv4 or IPv6 address or a host name (not a path, a URL or a port)."""
+    try:
+        ipaddress.ip_address(text)
+    except ValueError:
+        return _HOST_NAME.fullmatch(text) is not None
+    return True
+
+
 #: Foxglove's default port for a WebSocket connection.
 DEFAULT_PORT = 8765
 #: Nanoseconds on the live time line between one simulation run's last frame and the next run's first.
@@ -74,8 +90,11 @@ class LiveOptions:
     rate: float = 1.0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.host, str) or not self.host.strip() or any(c.isspace() for c in self.host):
-            raise InputError(f"host: expected an address such as 127.0.0.1, got {self.host!r}")
+        if not isinstance(self.host, str) or not _is_host(self.host):
+            raise InputError(
+                f"host: expected an address such as 127.0.0.1 (or a host name such as localhost), "
+                f"got {self.host!r}"
+            )
         if isinstance(self.port, bool) or not isinstance(self.port, int) or not 0 <= self.port <= 65535:
             raise InputError(f"port: expected an integer from 0 to 65535, got {self.port!r}")
         rate = self.rate
