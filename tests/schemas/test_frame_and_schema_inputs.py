@@ -56,6 +56,12 @@ def test_frame_validates_its_inputs() -> None:
         Frame(0.0, np.array([["a"]]), SNAPSHOT)
     with pytest.raises(InputError, match=r"non-empty array.*shape \(0, 4\)"):
         Frame(0.0, np.zeros((0, 4)), SNAPSHOT)
+    nan = np.zeros((4, 5))
+    nan[2, 3] = math.nan
+    with pytest.raises(InputError, match=r"image: expected finite gray levels, got nan at pixel \(u=3, v=2"):
+        Frame(0.0, nan, SNAPSHOT)
+    with pytest.raises(InputError, match=r"image: expected finite gray levels, got inf at pixel \(u=0, v=0"):
+        Frame(0.0, np.full((2, 2), np.inf, dtype=np.float32), SNAPSHOT)
     with pytest.raises(InputError, match="map: expected a SpatialUncertaintyMap, got Pose"):
         Frame(0.0, np.zeros((4, 4)), Pose(0, 0, 0))  # type: ignore[arg-type]
     with pytest.raises(InputError, match="focus: expected a SpatialUncertaintyMap or None, got Pose"):

@@ -136,6 +136,8 @@ def test_manager_rejects_bad_input(rng: np.random.Generator) -> None:
     assert len(manager) == 1  # nothing of a refused call is instantiated
     with pytest.raises(InputError, match="expected an iterable of FindLandmarkSchema, got one"):
         SchemaManager(schema)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="schemas: expected an iterable of FindLandmarkSchema, got dict"):
+        SchemaManager({})
     with pytest.raises(InputError, match="buffer: expected an IdentifiedLandmarkBuffer or None, got list"):
         SchemaManager([], buffer=[])  # type: ignore[arg-type]
     with pytest.raises(InputError, match="frame: expected a Frame, got ndarray"):

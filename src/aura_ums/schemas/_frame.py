@@ -49,8 +49,8 @@ class Frame:
     Raises
     ------
     InputError
-        For a non-finite time, an image that is not a 2-D array of numbers, or a map of
-        the wrong type.
+        For a non-finite time, an image that is not a 2-D array of numbers (finite ones,
+        for floats), or a map of the wrong type.
 
     Examples
     --------
@@ -95,6 +95,12 @@ class Frame:
             raise InputError(
                 f"image: expected a non-empty array of integers or floats, got dtype {array.dtype} "
                 f"and shape {array.shape}"
+            )
+        if array.dtype.kind == "f" and not np.isfinite(array).all():
+            bad = np.argwhere(~np.isfinite(array))[0]
+            raise InputError(
+                f"image: expected finite gray levels, got {array[bad[0], bad[1]]} at pixel "
+                f"(u={int(bad[1])}, v={int(bad[0])})"
             )
         if array.flags.writeable:
             array = array.copy()

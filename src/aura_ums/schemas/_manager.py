@@ -220,10 +220,10 @@ class SchemaManager:
             For a schema of the wrong type, or for a landmark that already has one (the
             others of the call are then not instantiated either).
         """
-        if isinstance(schemas, FindLandmarkSchema):
-            raise InputError(
-                "schemas: expected an iterable of FindLandmarkSchema, got one FindLandmarkSchema"
-            )
+        if isinstance(schemas, (FindLandmarkSchema, Mapping)):
+            one = isinstance(schemas, FindLandmarkSchema)
+            kind = "one FindLandmarkSchema" if one else type(schemas).__name__
+            raise InputError(f"schemas: expected an iterable of FindLandmarkSchema, got {kind}")
         new = list(items_of(schemas, "schemas", "an iterable of FindLandmarkSchema"))
         seen = set(self._status)
         for position, schema in enumerate(new):
