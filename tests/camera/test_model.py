@@ -16,7 +16,9 @@ from aura_ums.camera import (
     CameraMount,
     distort,
     fold_radius,
+    robot_from_camera_rotation,
     undistort_points,
+    within_fold,
 )
 from aura_ums.errors import InputError
 from aura_ums.uncertainty import Pose
@@ -328,3 +330,97 @@ def test_undistort_finds_no_ray_beyond_the_fold() -> None:
     result = undistort_points(lens, [(0.0, 0.0), (391.38736871558046, 304.14233415635124)])
     assert np.isnan(result[0]).all()
     assert math.hypot(*result[1]) < fold_radius(FOLDING)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (
+            lambda: camera().project_camera_frame([[1.0, 2.0]]),
+            r"^points_camera: expected shape \(\.\.\., 3\), got \(1, 2\)$",
+        ),
+        (
+            lambda: camera().project_camera_frame([]),
+            r"^points_camera: expected shape \(\.\.\., 3\), got \(0,\)$",
+        ),
+        (
+            lambda: camera().project_camera_frame(1.0),
+            r"^points_camera: expected shape \(\.\.\., 3\), got \(\)$",
+        ),
+        (lambda: camera().project_camera_frame(None), "^points_camera: expected numbers, got None$"),  # type: ignore[arg-type]
+        (
+            lambda: camera().project_camera_frame([[math.nan, 0.0, 5.0]]),
+            "^points_camera: expected finite numbers, got non-finite values$",
+        ),
+        (
+            lambda: camera().project_camera_frame([[1e300, 0.0, 5.0]]),
+            r"^points_camera: expected coordinates a number in \[-1e\+07, 1e\+07\] m, got 1e\+300$",
+        ),
+        (
+            lambda: camera().to_camera_frame([1.0, 2.0], [[10.0, 0.0, 1.0]]),
+            r"^poses: expected x, y and heading of shape \(3,\) or \(m, 3\), got \(2,\)$",
+        ),
+        (
+            lambda: camera().to_camera_frame(np.zeros((2, 2, 3)), [[10.0, 0.0, 1.0]]),
+            r"^poses: expected x, y and heading of shape \(3,\) or \(m, 3\), got \(2, 2, 3\)$",
+        ),
+        (lambda: robot_from_camera_rotation(None, 0.0), "^pan: expected a finite number, got None$"),  # type: ignore[arg-type]
+        (lambda: robot_from_camera_rotation(math.nan, 0.0), "^pan: expected a finite number, got nan$"),
+        (lambda: robot_from_camera_rotation(0.0, math.inf), "^tilt: expected a finite number, got inf$"),
+        (
+            lambda: robot_from_camera_rotation(0.0, 1e4),
+            r"^tilt: expected a number in \[-1000, 1000\] rad, got 10000\.0$",
+        ),
+        (
+            lambda: distort(np.array([0.1]), np.array([0.1]), None),  # type: ignore[arg-type]
+            r"^coefficients: expected 4, 5, 8, 12 or 14 distortion coefficients, got None$",
+        ),
+        (
+            lambda: distort([0.1], [0.1], (0.1, 0.0, 0.0)),  # type: ignore[arg-type]
+            r"^coefficients: expected 4, 5, 8, 12 or 14 distortion coefficients, got 3$",
+        ),
+        (
+            lambda: distort([0.1], [0.1], (0.1, 1e4, 0.0, 0.0, 0.0)),
+            r"^coefficients\[1\]: expected a number in \[-1000, 1000\], got 10000\.0$",
+        ),
+        (lambda: distort(None, [0.1], (0.1, 0.0, 0.0, 0.0, 0.0)), "^x: expected numbers, got None$"),  # type: ignore[arg-type]
+        (
+            lambda: distort([0.1], [math.nan], (0.1, 0.0, 0.0, 0.0, 0.0)),
+            "^y: expected finite numbers, got non-finite values$",
+        ),
+        (
+            lambda: distort([1e300], [0.1], (0.1, 0.0, 0.0, 0.0, 0.0)),
+            r"^x: expected coordinates a number in \[-1e\+30, 1e\+30\], got 1e\+300$",
+        ),
+        (
+            lambda: distort([0.1, 0.2], [0.1], (0.1, 0.0, 0.0, 0.0, 0.0)),
+            r"^y: expected the shape of x \(2,\), got \(1,\)$",
+        ),
+        (lambda: within_fold(None, [0.1], None), "^x: expected numbers, got None$"),  # type: ignore[arg-type]
+        (lambda: within_fold([0.1], ["a"], None), r"^y: expected numbers, got \['a'\]$"),
+        (lambda: within_fold([0.1], [0.1, 0.2], None), r"^y: expected the shape of x \(1,\), got \(2,\)$"),
+    ],
+)
+def test_projection_helpers_refuse_bad_input(call: object, match: str) -> None:
+    assert callable(call)
+    with pytest.raises(InputError, match=match):
+        call()
+
+
+def test_checked_helpers_give_the_results_of_before() -> None:
+    x, y = np.array([0.0, 0.5, -0.3]), np.array([0.0, 0.1, 0.2])
+    xd, yd = distort(list(x), list(y), (-0.1, 0.01, 0.001, -0.002, 0.003))
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (-0.1 + r2 * (0.01 + r2 * 0.003))
+    assert xd.tolist() == (x * radial + 2.0 * 0.001 * x * y + -0.002 * (r2 + 2.0 * x * x)).tolist()
+    assert yd.tolist() == (y * radial + 0.001 * (r2 + 2.0 * y * y) + 2.0 * -0.002 * x * y).tolist()
+    assert within_fold([0.0, np.nan], [0.0, 0.0], (-0.14, 0.0, 0.0, 0.0, 0.0)).tolist() == [True, False]
+    lens = Camera(INTRINSICS, CameraMount(1.0, pan=0.2, tilt=0.1))
+    poses, points = (
+        np.array([[1.0, 2.0, 0.3], [0.0, 0.0, -0.2]]),
+        np.array([[10.0, 3.0, 0.5], [8.0, -1.0, 0.0]]),
+    )
+    assert (
+        lens.project(poses, points).tolist()
+        == lens.project_camera_frame(lens.to_camera_frame(poses, points)).tolist()
+    )

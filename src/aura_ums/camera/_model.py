@@ -21,6 +21,7 @@ from aura_ums._validate import (
     IMAGE_SIDE,
     PIXEL,
     SENSOR_OFFSET,
+    Range,
     finite_float,
     float_array,
 )
@@ -43,7 +44,16 @@ def robot_from_camera_rotation(pan: float, tilt: float) -> Array:
     --------
     >>> robot_from_camera_rotation(0.0, 0.0)[:, 2].tolist()   # optical axis: robot forward
     [1.0, 0.0, 0.0]
+    >>> robot_from_camera_rotation(float("nan"), 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: pan: expected a finite number, got nan
     """
+    return _robot_from_camera_rotation(ANGLE.check(pan, "pan"), ANGLE.check(tilt, "tilt"))
+
+
+def _robot_from_camera_rotation(pan: float, tilt: float) -> Array:
+    """:func:`robot_from_camera_rotation` of checked angles (:meth:`CameraMount.rotation`, per projection)."""
     ct, st = math.cos(tilt), math.sin(tilt)
     cp, sp = math.cos(pan), math.sin(pan)
     right = np.array([0.0, -1.0, 0.0])
@@ -53,10 +63,41 @@ def robot_from_camera_rotation(pan: float, tilt: float) -> Array:
     return np.asarray(pan_rotation @ np.column_stack([right, down, forward]), dtype=np.float64)
 
 
+#: Largest normalized coordinate (x/z or y/z, the tangent of the angle off the optical axis)
+#: :func:`distort` takes: no fold lies farther out (``_FOLD_HORIZON``), and up to it the
+#: polynomial stays far from overflow (about 1e213 with every coefficient at 1000).
+NORMALIZED = Range(-1e30, 1e30)
+#: Largest camera-frame coordinate :meth:`Camera.project_camera_frame` takes, metres: five
+#: times the diagonal of the world's square (:data:`~aura_ums._validate.COORDINATE`); 1e300
+#: overflowed the pixels.
+CAMERA_COORDINATE = Range(-1e7, 1e7, "m")
+
+
+def real_array(value: object, name: str) -> Array:
+    """Return ``value`` as a float array (NaN allowed), refusing what is not numbers (None, strings)."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as exc:  # ragged sequences
+        raise InputError(f"{name}: expected numbers, got {value!r}") from exc
+    if array.dtype.kind not in "iuf":
+        raise InputError(f"{name}: expected numbers, got {value!r}")
+    return np.asarray(array, dtype=np.float64)
+
+
+def _coefficients(value: object, name: str) -> tuple[float, float, float, float, float]:
+    """Return distortion coefficients as (k1, k2, p1, p2, k3), checked as :class:`CameraIntrinsics` does."""
+    if value is None or isinstance(value, (str, bytes)):
+        raise InputError(f"{name}: expected 4, 5, 8, 12 or 14 distortion coefficients, got {value!r}")
+    return opencv_distortion(float_array(real_array(value, name), name), name)
+
+
 def distort(
-    x: Array, y: Array, coefficients: tuple[float, float, float, float, float]
+    x: ArrayLike, y: ArrayLike, coefficients: tuple[float, float, float, float, float]
 ) -> tuple[Array, Array]:
     """Apply OpenCV's radial-tangential distortion (k1, k2, p1, p2, k3) to normalized coordinates.
+
+    ``x`` and ``y`` (the same shape) are finite, each in [-1e30, 1e30] (no lens folds
+    farther out); ``coefficients`` are checked as :attr:`CameraIntrinsics.distortion` is.
 
     Examples
     --------
@@ -65,7 +106,32 @@ def distort(
     [[0.0, 0.4875], [0.0, 0.0]]
     >>> [v.tolist() for v in distort(x, y, (0.0, 0.0, 0.0, 0.0, 0.0))]    # all zero: unchanged
     [[0.0, 0.5], [0.0, 0.0]]
+    >>> distort(x, y, None)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: coefficients: expected 4, 5, 8, 12 or 14 distortion coefficients, got None
     """
+    k = _coefficients(coefficients, "coefficients")
+    xs, ys = _normalized(x, "x"), _normalized(y, "y")
+    if xs.shape != ys.shape:
+        raise InputError(f"y: expected the shape of x {xs.shape}, got {ys.shape}")
+    return _distort(xs, ys, k)
+
+
+def _normalized(value: object, name: str) -> Array:
+    """Return finite normalized coordinates in :data:`NORMALIZED`, or raise naming ``name``."""
+    array = float_array(real_array(value, name), name)
+    if np.any(np.abs(array) > NORMALIZED.high):
+        raise InputError(
+            f"{name}: expected coordinates {NORMALIZED.text()}, got {float(np.max(np.abs(array)))!r}"
+        )
+    return array
+
+
+def _distort(
+    x: Array, y: Array, coefficients: tuple[float, float, float, float, float]
+) -> tuple[Array, Array]:
+    """:func:`distort` of trusted arrays and coefficients (the projections, per frame)."""
     k1, k2, p1, p2, k3 = coefficients
     r2 = x * x + y * y
     radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
@@ -158,9 +224,20 @@ def within_fold(
     [True, True, False, False]
     >>> within_fold([1e200], [0.0], None).tolist()   # a pinhole images every ray in front of it
     [True]
+    >>> within_fold(None, [0.1], None)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: x: expected numbers, got None
     """
     limit = fold_radius(distortion)
-    xs, ys = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    xs, ys = real_array(x, "x"), real_array(y, "y")
+    if xs.shape != ys.shape:
+        raise InputError(f"y: expected the shape of x {xs.shape}, got {ys.shape}")
+    return _within_fold(xs, ys, limit)
+
+
+def _within_fold(xs: Array, ys: Array, limit: float) -> NDArray[np.bool_]:
+    """:func:`within_fold` of float arrays of one shape and a :func:`fold_radius` (per projection)."""
     with np.errstate(over="ignore", invalid="ignore"):
         return np.asarray(xs * xs + ys * ys <= limit * limit)
 
@@ -362,7 +439,7 @@ class CameraMount:
 
     def rotation(self) -> Array:
         """Rotation from camera to robot axes (columns: camera x, y, z in the robot frame)."""
-        return robot_from_camera_rotation(self.pan, self.tilt)
+        return _robot_from_camera_rotation(self.pan, self.tilt)
 
 
 @dataclass(frozen=True, slots=True)
@@ -400,7 +477,13 @@ class Camera:
         ndarray, shape (m, n, 3)
             Camera-frame coordinates (x right, y down, z forward), metres.
         """
-        state = float_array(poses, "poses").reshape(-1, 3)
+        state = float_array(poses, "poses")
+        if state.shape[-1:] != (3,) or state.ndim > 2:
+            raise InputError(f"poses: expected x, y and heading of shape (3,) or (m, 3), got {state.shape}")
+        return self._to_camera_frame(state.reshape(-1, 3), points_world)
+
+    def _to_camera_frame(self, state: Array, points_world: ArrayLike) -> Array:
+        """:meth:`to_camera_frame` of checked poses ``(m, 3)``; checks the points."""
         points = float_array(points_world, "points_world")
         if points.ndim != 2 or points.shape[1] != 3:
             raise InputError(f"points_world: expected shape (n, 3), got {points.shape}")
@@ -430,8 +513,23 @@ class Camera:
         [[320.0, 240.0], [nan, nan]]
         >>> camera.project_camera_frame([(1.5, 0.0, 1.0), (1.6, 0.0, 1.0)]).round(1).tolist()   # fold: 1.543
         [[628.2, 240.0], [nan, nan]]
+        >>> camera.project_camera_frame([(1.0, 2.0)])
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: points_camera: expected shape (..., 3), got (1, 2)
         """
-        pts = np.asarray(points_camera, dtype=np.float64)
+        pts = float_array(real_array(points_camera, "points_camera"), "points_camera")
+        if pts.ndim == 0 or pts.shape[-1] != 3:
+            raise InputError(f"points_camera: expected shape (..., 3), got {pts.shape}")
+        if np.any(np.abs(pts) > CAMERA_COORDINATE.high):
+            raise InputError(
+                f"points_camera: expected coordinates {CAMERA_COORDINATE.text()}, "
+                f"got {float(np.max(np.abs(pts)))!r}"
+            )
+        return self._project_camera_frame(pts)
+
+    def _project_camera_frame(self, pts: Array) -> Array:
+        """:meth:`project_camera_frame` of a trusted float array ``(..., 3)`` (:meth:`project`, per frame)."""
         z = pts[..., 2]
         in_front = z > NEAR_PLANE
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -439,9 +537,9 @@ class Camera:
             y = np.where(in_front, pts[..., 1] / z, np.nan)
         k = self.intrinsics
         if k.distortion is not None:
-            imaged = within_fold(x, y, k.distortion)  # behind the camera: NaN, not imaged
+            imaged = _within_fold(x, y, fold_radius(k.distortion))  # behind the camera: NaN, not imaged
             x, y = np.where(imaged, x, np.nan), np.where(imaged, y, np.nan)
-            x, y = distort(x, y, k.distortion)
+            x, y = _distort(x, y, k.distortion)
         return np.asarray(np.stack([k.fx * x + k.cx, k.fy * y + k.cy], axis=-1), dtype=np.float64)
 
     def project(self, pose: Pose | ArrayLike, points_world: ArrayLike) -> Array:
@@ -452,12 +550,12 @@ class Camera:
         poses, giving an ``(m, n, 2)`` array.
         """
         if isinstance(pose, Pose):
-            pixels = self.project_camera_frame(self.to_camera_frame(pose.as_array(), points_world))
+            pixels = self._project_camera_frame(self._to_camera_frame(pose.as_array()[None, :], points_world))
             return np.asarray(pixels[0], dtype=np.float64)
         state = float_array(pose, "pose")
         if state.shape[-1:] != (3,) or state.ndim > 2:
             raise InputError(
                 f"pose: expected a Pose, or x, y and heading of shape (3,) or (m, 3), got {state.shape}"
             )
-        pixels = self.project_camera_frame(self.to_camera_frame(state, points_world))
+        pixels = self._project_camera_frame(self._to_camera_frame(state.reshape(-1, 3), points_world))
         return np.asarray(pixels[0] if state.ndim == 1 else pixels, dtype=np.float64)

@@ -60,7 +60,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float, points_array
-from aura_ums.camera._model import Camera, CameraIntrinsics, distort, fold_radius, within_fold
+from aura_ums.camera._model import Camera, CameraIntrinsics, _distort, _within_fold, fold_radius
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
 
@@ -245,7 +245,7 @@ def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int
             x, y = x_next, y_next
             if not step > 1e-3 * _UNDISTORT_TOLERANCE:  # converged (or NaN: left to the check below)
                 break
-        fx, fy = distort(x, y, k)
+        fx, fy = _distort(x, y, k)
         for _ in range(_NEWTON_STEPS):  # polish: Newton converges quadratically near the solution
             ex, ey = fx - xd, fy - yd
             if not np.any(np.hypot(ex, ey) > 1e-3 * _UNDISTORT_TOLERANCE):
@@ -253,10 +253,10 @@ def _undistort_normalized(xd: Array, yd: Array, k: Coefficients, iterations: int
             j00, j01, j10, j11 = _point_jacobian(x, y, k)
             det = j00 * j11 - j01 * j10
             x, y = x - (j11 * ex - j01 * ey) / det, y - (j00 * ey - j10 * ex) / det
-            fx, fy = distort(x, y, k)
+            fx, fy = _distort(x, y, k)
         j00, j01, j10, j11 = _point_jacobian(x, y, k)
         good = (np.hypot(fx - xd, fy - yd) <= _UNDISTORT_TOLERANCE) & (j00 * j11 - j01 * j10 > 0.0)
-        good &= within_fold(x, y, k)  # the rays the camera images (Camera.project_camera_frame)
+        good &= _within_fold(x, y, fold_radius(k))  # the rays the camera images (Camera.project_camera_frame)
     return np.where(good, x, np.nan), np.where(good, y, np.nan)
 
 
@@ -316,7 +316,7 @@ def _undistort_box(xd: _Interval, yd: _Interval, k: Coefficients | None) -> tupl
     j00, j01, j10, j11 = _point_jacobian(mx, my, k)
     det = j00 * j11 - j01 * j10
     y00, y01, y10, y11 = j11 / det, -j01 / det, -j10 / det, j00 / det
-    dmx, dmy = distort(mx, my, k)
+    dmx, dmy = _distort(mx, my, k)
     rx = _Interval(dmx - xd.hi, dmx - xd.lo)
     ry = _Interval(dmy - yd.hi, dmy - yd.lo)
     c0 = mx - (rx * y00 + ry * y01)
