@@ -495,7 +495,7 @@ GOOD_SEGMENT = (100.0, 400.0, 200.0, 300.0)
         (
             lambda: bound_vertical_line(FLAT, GOOD_PIXEL, pixel_error=-1.0),
             InputError,
-            "pixel_error: expected a non-negative number",
+            r"pixel_error: expected a number in \[0, 100000\] px",
         ),
         (
             lambda: bound_vertical_line(WRONG_CAMERA, GOOD_PIXEL),
@@ -577,6 +577,33 @@ GOOD_SEGMENT = (100.0, 400.0, 200.0, 300.0)
             ),
             InputError,
             "bounds.height: expected the camera height 1.0 .* to stay above the ground",
+        ),
+        (lambda: bound_point(FLAT, GOOD_PIXEL, None), InputError, "^z: expected a finite number, got None$"),  # type: ignore[arg-type]
+        (
+            lambda: bound_point(FLAT, GOOD_PIXEL, "1.0"),  # type: ignore[arg-type]
+            InputError,
+            "^z: expected a finite number, got '1.0'$",
+        ),
+        (lambda: bound_point(FLAT, GOOD_PIXEL, True), InputError, "^z: expected a finite number, got True$"),
+        (
+            lambda: bound_point(FLAT, GOOD_PIXEL, 1e5),
+            InputError,
+            r"^z: expected a number in \[-10000, 10000\] m, got 100000\.0$",
+        ),
+        (
+            lambda: bound_ground_line(FLAT, GOOD_SEGMENT, expected_angle=0.0, pixel_error=1e300),
+            InputError,
+            r"^pixel_error: expected a number in \[0, 100000\] px, got 1e\+300$",
+        ),
+        (
+            lambda: bound_point(FLAT, GOOD_PIXEL, 0.0, pixel_error=-1.0),
+            InputError,
+            r"^pixel_error: expected a number in \[0, 100000\] px, got -1\.0$",
+        ),
+        (
+            lambda: bound_vertical_line(FLAT, GOOD_PIXEL, pixel_error=math.inf),
+            InputError,
+            "^pixel_error: expected a finite number, got inf$",
         ),
     ],
 )

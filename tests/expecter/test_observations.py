@@ -136,6 +136,16 @@ SEGMENT = (100.0, 400.0, 200.0, 300.0)
             lambda: observe_ground_line(CAMERA, EDGE, (1.0, 2.0, 3.0), expected_angle=0.0, time=0.0),
             r"segment: expected \(u1, v1, u2, v2\)",
         ),
+        (
+            lambda: observe_ground_line(
+                CAMERA, EDGE, SEGMENT, expected_angle=0.0, time=0.0, pixel_error=1e300
+            ),
+            r"^pixel_error: expected a number in \[0, 100000\] px, got 1e\+300$",
+        ),
+        (
+            lambda: observe_point(CAMERA, CORNER, PIXEL, time=0.0, pixel_error=1e6),
+            r"^pixel_error: expected a number in \[0, 100000\] px, got 1000000\.0$",
+        ),
     ],
 )
 def test_bad_input_is_refused_naming_the_argument(call: object, match: str) -> None:

@@ -59,13 +59,17 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float, points_array
+from aura_ums._validate import HEIGHT, PIXEL, Range, finite_float, nonnegative_float, points_array
 from aura_ums.camera._model import Camera, CameraIntrinsics, _distort, _within_fold, fold_radius
 from aura_ums.errors import InputError
 from aura_ums.geometry import wrap_angle
 
 Array = NDArray[np.float64]
 Coefficients = tuple[float, float, float, float, float]
+
+#: A bound on a pixel's error, pixels: up to the span of any pixel coordinate (:data:`PIXEL`):
+#: beyond it a bound says nothing of the pixel, and 1e300 px overflowed the bounds.
+PIXEL_ERROR = Range(0.0, PIXEL.high, "px")
 
 #: Every error bound is multiplied by ``1 + _SAFETY_RELATIVE`` ...
 _SAFETY_RELATIVE = 1e-6
@@ -682,7 +686,7 @@ def bound_vertical_line(
     pixel : array_like, shape (2,)
         (u, v) of any point of the line's image, inside the image.
     pixel_error : float
-        Bound on the pixel's error in u and in v, pixels, >= 0.
+        Bound on the pixel's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
 
@@ -712,7 +716,7 @@ def bound_vertical_line(
 ([-0.5, 639.5] x [-0.5, 479.5]), got (640.0, 100.0)
     """
     camera, checked = _check_camera(camera, bounds)
-    error = nonnegative_float(pixel_error, "pixel_error")
+    error = PIXEL_ERROR.check(pixel_error, "pixel_error")
     u, v = _one_pixel(camera, pixel)
     return _pixel_bearing(camera, checked, _pixel_ray(camera, checked, u, v, error))
 
@@ -746,9 +750,9 @@ def bound_point(
     pixel : array_like, shape (2,)
         (u, v) of the point's image, inside the image.
     z : float
-        Height of the point above the ground, metres.
+        Height of the point above the ground, metres, in [-1e4, 1e4].
     pixel_error : float
-        Bound on the pixel's error in u and in v, pixels, >= 0.
+        Bound on the pixel's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
     max_range : float, optional
@@ -781,12 +785,13 @@ def bound_point(
 height 0.0 m (camera at 1.0 m), got (320.0, 100.0) whose ray never meets that plane
     """
     camera, checked = _check_camera(camera, bounds)
-    error = nonnegative_float(pixel_error, "pixel_error")
+    error = PIXEL_ERROR.check(pixel_error, "pixel_error")
     cap = math.inf
     if max_range is not None:
         cap = finite_float(max_range, "max_range")
         if cap <= 0.0:
             raise InputError(f"max_range: expected a positive number, got {cap}")
+    z = HEIGHT.check(z, "z")
     u, v = _one_pixel(camera, pixel)
     height = camera.mount.height
     drop_lo, drop_hi = (height - z) - checked.height, (height - z) + checked.height
@@ -859,7 +864,7 @@ def bound_ground_line(
     expected_angle : float
         Roughly expected direction of the line relative to the heading, radians.
     pixel_error : float
-        Bound on each end's error in u and in v, pixels, >= 0.
+        Bound on each end's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
 
@@ -892,7 +897,7 @@ def bound_ground_line(
     aura_ums.errors.InputError: segment: expected both ends below the horizon, got end 1 at (0.0, 0.0)
     """
     camera, checked = _check_camera(camera, bounds)
-    error = nonnegative_float(pixel_error, "pixel_error")
+    error = PIXEL_ERROR.check(pixel_error, "pixel_error")
     hint = finite_float(expected_angle, "expected_angle")
     try:
         flat = np.asarray(segment, dtype=np.float64)

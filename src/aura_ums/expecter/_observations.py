@@ -56,7 +56,7 @@ def observe_vertical_line(
     time : float
         Time of the image, seconds.
     pixel_error : float
-        Bound on the pixel's error in u and in v, pixels, >= 0.
+        Bound on the pixel's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
 
@@ -122,7 +122,7 @@ def observe_point(
     time : float
         Time of the image, seconds.
     pixel_error : float
-        Bound on the pixel's error in u and in v, pixels, >= 0.
+        Bound on the pixel's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
     max_range : float, optional
@@ -199,7 +199,7 @@ def observe_ground_line(
     time : float
         Time of the image, seconds.
     pixel_error : float
-        Bound on each end's error in u and in v, pixels, >= 0.
+        Bound on each end's error in u and in v, pixels, in [0, 1e5].
     bounds : CalibrationBounds, optional
         Bounds on the calibration; None for an exact calibration.
 
