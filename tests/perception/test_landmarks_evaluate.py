@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import matplotlib.image
 import numpy as np
@@ -22,7 +23,9 @@ from aura_ums.perception import (
     evaluate_vertical_line,
     line_intersections,
     read_gray_image,
+    sample_points,
     segment_recall_precision,
+    strongest_within,
 )
 
 
@@ -142,6 +145,61 @@ def test_read_gray_image_png_and_jpeg(tmp_path: Path) -> None:
     jpeg = tmp_path / "a.jpg"
     matplotlib.image.imsave(jpeg, rgb)  # JPEG through Pillow
     assert read_gray_image(jpeg).shape == (8, 10)
+
+
+LINES = LineSegments([[0.0, 0.0, 10.0, 0.0], [0.0, 0.0, 0.0, 10.0]], [10.0, 10.0])
+SEGMENTS = np.array([[0.0, 0.0, 10.0, 0.0], [0.0, 0.0, 0.0, 10.0]])
+NONE: Any = None
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (
+            lambda: line_intersections(LINES, radius=NONE, min_angle=0.5),
+            "^radius: expected a finite number, got None$",
+        ),
+        (
+            lambda: line_intersections(LINES, radius=math.nan, min_angle=0.5),
+            "^radius: expected a finite number, got nan$",
+        ),
+        (
+            lambda: line_intersections(LINES, radius=4.0, min_angle=[1.0, 2.0]),  # type: ignore[arg-type]
+            r"^min_angle: expected a finite number, got \[1\.0, 2\.0\]$",
+        ),
+        (
+            lambda: line_intersections(NONE, radius=4.0, min_angle=0.5),
+            "^lines: expected LineSegments, got NoneType$",
+        ),
+        (lambda: strongest_within(NONE, 0.0, 0.1), "^lines: expected LineSegments, got NoneType$"),
+        (lambda: strongest_within(LINES, 0.0, math.nan), "^tolerance: expected a finite number, got nan$"),
+        (lambda: strongest_within(LINES, "abc", 0.1), "^orientation: expected a finite number, got 'abc'$"),  # type: ignore[arg-type]
+        (lambda: sample_points(SEGMENTS, 0.0), "^step: expected a positive number, got 0.0$"),
+        (lambda: sample_points(SEGMENTS, math.nan), "^step: expected a finite number, got nan$"),
+        (lambda: sample_points([1.0, 2.0]), r"^segments: expected shape \(n, 4\), got \(2,\)$"),
+        (
+            lambda: sample_points(SEGMENTS, 1e-300),
+            r"^step: expected a step that makes at most 10000000 sample points \(about 0\.48 GB\), "
+            r"got 1e-300, which makes 2e\+301 \(about 9\.6e\+293 GB\)$",
+        ),
+        (
+            lambda: segment_recall_precision(SEGMENTS, SEGMENTS, step=1e-7),
+            "^step: expected a step that makes at most 10000000 sample points",
+        ),
+    ],
+)
+def test_segment_tools_refuse_bad_input(call: object, match: str) -> None:
+    assert callable(call)
+    with pytest.raises(InputError, match=match):
+        call()
+
+
+def test_segment_tools_give_what_they_gave() -> None:
+    points, owner = sample_points([[0, 0, 1, 1]])
+    assert points.tolist() == [[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]]
+    assert owner.tolist() == [0, 0, 0]
+    assert strongest_within(LINES, math.pi / 2, 0.1).segment == (0.0, 0.0, 0.0, 10.0)
+    assert line_intersections(LINES, radius=1.0, min_angle=0.5).tolist() == [[0.0, 0.0]]
 
 
 def test_read_gray_image_errors(tmp_path: Path) -> None:

@@ -23,11 +23,16 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import nonnegative_float
+from aura_ums._validate import nonnegative_float, positive_float
 from aura_ums.errors import InputError
-from aura_ums.perception._segments import _orientation, orientation_difference
+from aura_ums.perception._segments import _orientation, _orientation_difference
 
 _CHUNK = 2048
+#: Most sample points one call of :func:`sample_points` makes (all segments together): each
+#: takes about 48 bytes while it is built, so 0.48 GB; a step of 1e-300 px asked for far more.
+MAX_SAMPLE_POINTS = 10_000_000
+#: Bytes per sample point while :func:`sample_points` builds them (coordinates, owner, parameter).
+_SAMPLE_BYTES = 48
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,19 +93,39 @@ def _segments(value: ArrayLike, name: str) -> NDArray[np.float64]:
     return array
 
 
-def sample_points(
-    segments: NDArray[np.float64], step: float = 1.0
-) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+def sample_points(segments: ArrayLike, step: float = 1.0) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Points every ``step`` pixels along each segment, endpoints included, and their segment index.
+
+    ``segments`` is a finite ``(n, 4)`` array (``x1, y1, x2, y2``, pixels); ``step`` > 0
+    pixels. At most :data:`MAX_SAMPLE_POINTS` points are made.
 
     Examples
     --------
     >>> points, owner = sample_points(np.array([[0.0, 0.0, 2.0, 0.0]]))
     >>> points.tolist(), owner.tolist()
     ([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], [0, 0, 0])
+    >>> sample_points([[0.0, 0.0, 2.0, 0.0]], 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: step: expected a positive number, got 0.0
     """
+    return _sample_points(_segments(segments, "segments"), positive_float(step, "step"))
+
+
+def _sample_points(
+    segments: NDArray[np.float64], step: float
+) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """:func:`sample_points` of checked segments and step; refuses more than :data:`MAX_SAMPLE_POINTS`."""
     d = segments[:, 2:] - segments[:, :2]
-    counts = np.maximum(np.ceil(np.hypot(d[:, 0], d[:, 1]) / step - 1e-9).astype(np.intp), 1) + 1
+    steps = np.ceil(np.hypot(d[:, 0], d[:, 1]) / step - 1e-9)
+    total = float(np.sum(np.maximum(steps, 1.0) + 1.0))
+    if total > MAX_SAMPLE_POINTS:
+        raise InputError(
+            f"step: expected a step that makes at most {MAX_SAMPLE_POINTS} sample points "
+            f"(about {MAX_SAMPLE_POINTS * _SAMPLE_BYTES / 1e9:.2g} GB), got {step!r}, which makes "
+            f"{total:.3g} (about {total * _SAMPLE_BYTES / 1e9:.3g} GB)"
+        )
+    counts = np.maximum(steps.astype(np.intp), 1) + 1
     owner = np.repeat(np.arange(segments.shape[0]), counts)
     first = np.cumsum(counts) - counts
     t = (np.arange(owner.size) - first[owner]) / (counts[owner] - 1)
@@ -131,7 +156,8 @@ def _matched(
         ey = rel_y - t * d[None, :, 1]
         close = ex * ex + ey * ey <= distance * distance
         close &= (
-            orientation_difference(point_angle[lo : lo + _CHUNK, None], seg_angle[None, :]) <= angle_tolerance
+            _orientation_difference(point_angle[lo : lo + _CHUNK, None], seg_angle[None, :])
+            <= angle_tolerance
         )
         found += int(close.any(axis=1).sum())
     return found
@@ -187,8 +213,8 @@ def segment_recall_precision(
     step = nonnegative_float(step, "step")
     if step == 0.0:
         raise InputError(f"step: expected a positive number, got {step!r}")
-    truth_points, truth_owner = sample_points(truth, step)
-    found_points, found_owner = sample_points(found, step)
+    truth_points, truth_owner = _sample_points(truth, step)
+    found_points, found_owner = _sample_points(found, step)
     recalled = _matched(truth_points, _orientation(truth)[truth_owner], found, distance, angle_tolerance)
     precise = _matched(found_points, _orientation(found)[found_owner], against, distance, angle_tolerance)
     return RecallPrecision(recalled, int(truth_points.shape[0]), precise, int(found_points.shape[0]))

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from aura_ums._validate import finite_float, nonnegative_float
 from aura_ums.errors import InputError
-from aura_ums.perception._segments import LineSegments, orientation_difference
+from aura_ums.perception._segments import LineSegments, _orientation_difference
 
 #: At most this many of the strongest lines are intersected pairwise by :func:`evaluate_corner`.
 MAX_CORNER_LINES = 64
@@ -149,14 +149,14 @@ def evaluate_vertical_line(
     _check_lines(lines)
     target = finite_float(orientation, "orientation")
     limit = nonnegative_float(tolerance, "tolerance")
-    return strongest_within(lines, target, limit)
+    return _strongest_within(lines, target, limit)
 
 
 def strongest_within(lines: LineSegments, orientation: float, tolerance: float) -> LineEvidence:
-    """Return the strongest line within ``tolerance`` of ``orientation``, arguments unchecked.
+    """Return the strongest line within ``tolerance`` of ``orientation``.
 
-    :func:`evaluate_vertical_line` once its arguments are checked, for callers that
-    checked them already (a schema evaluates every frame with the same ones).
+    :func:`evaluate_vertical_line` with positional arguments and no defaults (a schema
+    evaluates every frame with the same ones); the checks of its arguments are cheap.
 
     Parameters
     ----------
@@ -179,8 +179,20 @@ def strongest_within(lines: LineSegments, orientation: float, tolerance: float) 
     50.5
     >>> strongest_within(lines, 0.7, 0.1).segment is None   # no line that direction
     True
+    >>> strongest_within(None, 0.7, 0.1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: lines: expected LineSegments, got NoneType
     """
-    return _best_line(lines, orientation_difference(lines.orientation, orientation) <= tolerance)
+    _check_lines(lines)
+    target = finite_float(orientation, "orientation")
+    limit = nonnegative_float(tolerance, "tolerance")
+    return _strongest_within(lines, target, limit)
+
+
+def _strongest_within(lines: LineSegments, orientation: float, tolerance: float) -> LineEvidence:
+    """:func:`strongest_within` of checked arguments."""
+    return _best_line(lines, _orientation_difference(lines.orientation, orientation) <= tolerance)
 
 
 def evaluate_path_edge(
@@ -221,7 +233,7 @@ def evaluate_path_edge(
     target = finite_float(orientation, "orientation")
     limit = nonnegative_float(tolerance, "tolerance")
     shortest = nonnegative_float(min_length, "min_length")
-    keep = (orientation_difference(lines.orientation, target) <= limit) & (lines.length >= shortest)
+    keep = (_orientation_difference(lines.orientation, target) <= limit) & (lines.length >= shortest)
     return _best_line(lines, keep)
 
 
@@ -236,8 +248,19 @@ def line_intersections(lines: LineSegments, *, radius: float, min_angle: float) 
     >>> lines = LineSegments([[10, 10, 10, 40], [11, 10, 40, 10], [60, 0, 60, 5]], [1.0, 1.0, 1.0])
     >>> line_intersections(lines, radius=2.0, min_angle=0.5)
     array([[10., 10.]])
+    >>> line_intersections(lines, radius=None, min_angle=0.5)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: radius: expected a finite number, got None
     """
     _check_lines(lines)
+    return _line_intersections(
+        lines, nonnegative_float(radius, "radius"), nonnegative_float(min_angle, "min_angle")
+    )
+
+
+def _line_intersections(lines: LineSegments, radius: float, min_angle: float) -> NDArray[np.float64]:
+    """:func:`line_intersections` of checked arguments."""
     order = np.argsort(-lines.strength, kind="stable")[:MAX_CORNER_LINES]
     seg = lines.segments[order]
     n = seg.shape[0]
@@ -245,7 +268,7 @@ def line_intersections(lines: LineSegments, *, radius: float, min_angle: float) 
         return np.zeros((0, 2))
     i, j = np.triu_indices(n, k=1)
     angles = lines.orientation[order]
-    pairs = orientation_difference(angles[i], angles[j]) >= min_angle
+    pairs = _orientation_difference(angles[i], angles[j]) >= min_angle
     i, j = i[pairs], j[pairs]
     p, r = seg[i, :2], seg[i, 2:] - seg[i, :2]
     q, s = seg[j, :2], seg[j, 2:] - seg[j, :2]
@@ -322,7 +345,7 @@ def evaluate_corner(
     order = np.argsort(-array[:, 2], kind="stable")
     array = array[order]
     if lines is not None:
-        crossings = line_intersections(lines, radius=radius, min_angle=angle)
+        crossings = _line_intersections(lines, radius, angle)
         if crossings.shape[0]:
             gap = np.hypot(
                 array[:, None, 0] - crossings[None, :, 0], array[:, None, 1] - crossings[None, :, 1]

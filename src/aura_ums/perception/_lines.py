@@ -39,7 +39,7 @@ from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import int_at_least, prepare
 from aura_ums.perception._opencv import import_cv2
-from aura_ums.perception._segments import LineSegments, orientation_difference
+from aura_ums.perception._segments import LineSegments, _orientation_difference
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 
@@ -212,7 +212,7 @@ class FastLineFinder:
         if self.orientation is not None:
             # The orientations LineSegments gives these segments, compared as it compares them.
             keep &= (
-                orientation_difference(np.mod(np.arctan2(dv, du), math.pi), self.orientation)
+                _orientation_difference(np.mod(np.arctan2(dv, du), math.pi), self.orientation)
                 <= self.tolerance
             )
         kept = np.flatnonzero(keep)

@@ -13,7 +13,7 @@ from aura_ums._validate import finite_float, nonnegative_float
 from aura_ums.errors import MissingDependencyError
 from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import prepare
-from aura_ums.perception._segments import LineSegments, orientation_difference
+from aura_ums.perception._segments import LineSegments, _orientation_difference
 
 
 def import_cv2(what: str) -> ModuleType:
@@ -128,5 +128,5 @@ class OpenCvLineFinder:
         lines = LineSegments(segments + offset, contrast)
         keep = (lines.length >= self.min_length) & (lines.contrast >= self.min_contrast)
         if self.orientation is not None:
-            keep &= orientation_difference(lines.orientation, self.orientation) <= self.tolerance
+            keep &= _orientation_difference(lines.orientation, self.orientation) <= self.tolerance
         return lines.select(keep)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import float_array
+from aura_ums._validate import ANGLE, float_array, nonnegative_float
 from aura_ums.errors import InputError
 from aura_ums.geometry import angle_difference
 
@@ -71,7 +71,39 @@ def orientation_difference(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     [0.1, 0.0416]
     >>> float(orientation_difference(0.0, np.pi))   # the same line, either way round
     0.0
+    >>> orientation_difference(None, [0.1])
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: a: expected orientations (numbers), got None
     """
+    first, second = _orientations(a, "a"), _orientations(b, "b")
+    try:
+        np.broadcast_shapes(first.shape, second.shape)
+    except ValueError as exc:
+        raise InputError(
+            f"b: expected a shape that broadcasts against a's {first.shape}, got {second.shape}"
+        ) from exc
+    return _orientation_difference(first, second)
+
+
+def _orientations(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    """Return orientations as a float array, each finite and in :data:`~aura_ums._validate.ANGLE`."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as exc:  # ragged sequences
+        raise InputError(f"{name}: expected orientations (numbers), got {value!r}") from exc
+    if array.dtype.kind not in "iuf":
+        raise InputError(f"{name}: expected orientations (numbers), got {value!r}")
+    array = float_array(array, name)
+    if np.any(np.abs(array) > ANGLE.high):
+        raise InputError(
+            f"{name}: expected orientations {ANGLE.text()}, got {float(np.max(np.abs(array)))!r}"
+        )
+    return array
+
+
+def _orientation_difference(a: NDArray[np.float64], b: NDArray[np.float64] | float) -> NDArray[np.float64]:
+    """:func:`orientation_difference` of trusted float orientations (detectors and evaluations, per frame)."""
     turn = np.abs(angle_difference(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)))
     return np.asarray(np.minimum(turn, math.pi - turn), dtype=np.float64)
 
@@ -111,9 +143,16 @@ class LineSegments:
     def __init__(self, segments: ArrayLike, contrast: ArrayLike) -> None:
         try:
             array = np.array(segments, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InputError(
+                f"LineSegments.segments: expected an (n, 4) array of numbers, got {segments!r}"
+            ) from exc
+        try:
             values = np.array(contrast, dtype=np.float64)
         except (TypeError, ValueError) as exc:
-            raise InputError(f"LineSegments: expected numeric arrays, got {segments!r}") from exc
+            raise InputError(
+                f"LineSegments.contrast: expected an (n,) array of numbers, got {contrast!r}"
+            ) from exc
         if array.size == 0:
             array = array.reshape(0, 4)
         if array.ndim != 2 or array.shape[1] != 4:
@@ -168,10 +207,62 @@ class LineSegments:
         return np.asarray(self.length * self.contrast, dtype=np.float64)
 
     def select(self, keep: ArrayLike) -> LineSegments:
-        """Return the segments picked by a boolean mask or an index array."""
-        index = np.asarray(keep)
+        """Return the segments picked by a boolean mask ``(n,)`` or a 1-D array of indices in ``[-n, n)``.
+
+        Examples
+        --------
+        >>> lines = LineSegments([[0, 0, 10, 0], [0, 0, 0, 10]], [1.0, 2.0])
+        >>> lines.select([True, False]).contrast.tolist(), lines.select([1]).contrast.tolist()
+        ([1.0], [2.0])
+        >>> len(lines.select([]))
+        0
+        >>> lines.select([0, 5])
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: keep: expected indices in [-2, 2), got 5
+        """
+        index = self._index(keep)
         return LineSegments(self.segments[index], self.contrast[index])
 
+    def _index(self, keep: ArrayLike) -> NDArray[np.bool_] | NDArray[np.intp]:
+        """Check ``keep`` (a mask or indices) against the ``n`` segments, as :meth:`select` takes it."""
+        n = len(self)
+        try:
+            index = np.asarray(keep)
+        except (TypeError, ValueError) as exc:  # ragged sequences
+            raise InputError(f"keep: expected a boolean mask or integer indices, got {keep!r}") from exc
+        if index.size == 0 and index.ndim == 1:
+            return np.zeros(0, dtype=np.intp)  # [] picks nothing (numpy reads it as float indices)
+        if index.ndim != 1 or index.dtype.kind not in "biu":
+            raise InputError(
+                f"keep: expected a 1-D boolean mask or integer indices, "
+                f"got {index.dtype} of shape {index.shape}"
+            )
+        if index.dtype.kind == "b":
+            if index.shape != (n,):
+                raise InputError(f"keep: expected a boolean mask of shape ({n},), got shape {index.shape}")
+            return index
+        outside = (index < -n) | (index >= n)
+        if np.any(outside):
+            raise InputError(f"keep: expected indices in [{-n}, {n}), got {int(index[np.argmax(outside)])}")
+        return np.asarray(index, dtype=np.intp)
+
     def within(self, orientation: float, tolerance: float) -> LineSegments:
-        """Return the segments within ``tolerance`` of direction ``orientation`` (radians, mod pi)."""
-        return self.select(orientation_difference(self.orientation, orientation) <= tolerance)
+        """Return the segments within ``tolerance`` of direction ``orientation`` (radians, mod pi).
+
+        ``orientation`` is finite, in [-1000, 1000] radians; ``tolerance`` finite and >= 0.
+
+        Examples
+        --------
+        >>> lines = LineSegments([[0, 0, 10, 0], [0, 0, 0, 10]], [1.0, 2.0])
+        >>> lines.within(np.pi / 2, 0.1).segments.tolist()
+        [[0.0, 0.0, 0.0, 10.0]]
+        >>> lines.within(0.0, float("nan"))
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: tolerance: expected a finite number, got nan
+        """
+        target = ANGLE.check(orientation, "orientation")
+        limit = nonnegative_float(tolerance, "tolerance")
+        keep = _orientation_difference(self.orientation, target) <= limit
+        return LineSegments(self.segments[keep], self.contrast[keep])
