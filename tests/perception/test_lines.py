@@ -205,8 +205,13 @@ def test_nan_pixel_is_an_input_error_naming_the_pixel() -> None:
         ({"tolerance": -0.1}, "tolerance: expected a non-negative number"),
         ({"min_length": "long"}, "min_length: expected a finite number"),
         ({"min_gradient": 0.0}, "min_gradient: expected a positive number"),
-        ({"buckets": 3}, "buckets: expected an integer >= 4"),
-        ({"buckets": 8.0}, "buckets: expected an integer >= 4"),
+        ({"buckets": 3}, r"^buckets: expected an integer in \[4, 360\], got 3$"),
+        ({"buckets": 8.0}, r"^buckets: expected an integer in \[4, 360\], got 8\.0$"),
+        (
+            {"buckets": 10**6},
+            r"^buckets: expected an integer in \[4, 360\], got 1000000 \(about 1e\+03 GB of bucket masks per "
+            r"megapixel, and as many labellings\)$",
+        ),
         ({"overlap": 1}, "overlap: expected a bool"),
         ({"backend": "numpy"}, "backend: expected a LineBackend"),
     ],

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -135,6 +137,28 @@ def test_otsu_separates_two_populations() -> None:
 def test_region_bad_parameters(kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(InputError, match=message):
         RegionSegmenter(**kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("bins", "message"),
+    [
+        (0, r"^bins: expected an integer in \[2, 1000000\], got 0$"),
+        (1, r"^bins: expected an integer in \[2, 1000000\], got 1$"),
+        (1.5, r"^bins: expected an integer in \[2, 1000000\], got 1\.5$"),
+        ("3", r"^bins: expected an integer in \[2, 1000000\], got '3'$"),
+        (True, r"^bins: expected an integer in \[2, 1000000\], got True$"),
+        (
+            10**12,
+            r"^bins: expected an integer in \[2, 1000000\], got 1000000000000 "
+            r"\(about 4\.8e\+04 GB of histogram\)$",
+        ),
+    ],
+)
+def test_otsu_bad_bins(bins: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        otsu_threshold(np.zeros((4, 4)), bins)  # type: ignore[arg-type]
+    two: Any = np.int64(2)  # numpy integers are integers
+    assert otsu_threshold([[10, 10, 200, 200]], two) == otsu_threshold([[10, 10, 200, 200]], 2)
 
 
 def test_region_bad_image() -> None:

@@ -37,11 +37,17 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import BLUR, Choice, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import InputError
 from aura_ums.geometry import ImageWindow
-from aura_ums.perception._image import int_at_least, prepare
+from aura_ums.perception._image import prepare
 from aura_ums.perception._opencv import import_cv2
 from aura_ums.perception._segments import LineSegments, _orientation_difference
 
 _EIGHT = np.ones((3, 3), dtype=bool)
+#: Most gradient-direction buckets of :class:`FastLineFinder`: one-degree buckets, narrower
+#: than a gradient's direction is known; each bucket holds a mask of the window and is
+#: labelled on its own (10**6 buckets exhausted the memory).
+MAX_BUCKETS = 360
+#: Bytes of one bucket's mask per megapixel of window.
+_MASK_BYTES_PER_MEGAPIXEL = 1_000_000
 
 
 class LineBackend(Choice):
@@ -101,7 +107,7 @@ class FastLineFinder:
     min_contrast : float
         Lowest mean gradient magnitude of a kept line's region, gray levels per pixel.
     buckets : int
-        Number of gradient-direction buckets over the full circle (>= 4); the bucket
+        Number of gradient-direction buckets over the full circle, in [4, 360]; the bucket
         width is ``2 pi / buckets`` (45 degrees for 8).
     overlap : bool
         Untuned only: also build the partition offset by half a bucket, so that lines whose
@@ -150,7 +156,22 @@ class FastLineFinder:
         object.__setattr__(self, "min_length", nonnegative_float(self.min_length, "min_length"))
         object.__setattr__(self, "min_gradient", positive_float(self.min_gradient, "min_gradient"))
         object.__setattr__(self, "min_contrast", nonnegative_float(self.min_contrast, "min_contrast"))
-        object.__setattr__(self, "buckets", int_at_least(self.buckets, "buckets", 4))
+        buckets = self.buckets
+        if (
+            isinstance(buckets, bool)
+            or not isinstance(buckets, (int, np.integer))
+            or not 4 <= buckets <= MAX_BUCKETS
+        ):
+            estimate = (
+                f" (about {int(buckets) * _MASK_BYTES_PER_MEGAPIXEL / 1e9:.3g} GB of bucket masks per "
+                "megapixel, and as many labellings)"
+                if isinstance(buckets, (int, np.integer))
+                and not isinstance(buckets, bool)
+                and buckets > MAX_BUCKETS
+                else ""
+            )
+            raise InputError(f"buckets: expected an integer in [4, {MAX_BUCKETS}], got {buckets!r}{estimate}")
+        object.__setattr__(self, "buckets", int(buckets))
         if not isinstance(self.overlap, bool):
             raise InputError(f"overlap: expected a bool, got {self.overlap!r}")
         object.__setattr__(self, "smoothing", BLUR.check(self.smoothing, "smoothing"))

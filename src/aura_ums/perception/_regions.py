@@ -13,15 +13,19 @@ from aura_ums.geometry import ImageWindow
 from aura_ums.perception._image import as_image, int_at_least, prepare
 
 _EIGHT = np.ones((3, 3), dtype=bool)
+#: Most histogram bins of :func:`otsu_threshold`: about 48 bytes each for the histogram and
+#: its sums, so 48 MB (a gray level of a 16-bit image has 65,536; 10**12 asked for 7 TiB).
+MAX_OTSU_BINS = 1_000_000
+_BIN_BYTES = 48
 
 
 def otsu_threshold(image: ArrayLike, bins: int = 256) -> float:
     """Return Otsu's threshold of an image's gray levels: it maximizes the between-class variance.
 
-    Pixels ``> threshold`` form the bright class. The histogram has ``bins`` bins over the
-    image's range; when several thresholds separate the classes equally well (an empty
-    stretch of histogram) the middle one is taken. A flat image gives its one gray level
-    (every pixel is then dark).
+    Pixels ``> threshold`` form the bright class. The histogram has ``bins`` bins (an
+    integer in [2, 1000000]) over the image's range; when several thresholds separate the
+    classes equally well (an empty stretch of histogram) the middle one is taken. A flat
+    image gives its one gray level (every pixel is then dark).
 
     Examples
     --------
@@ -29,7 +33,18 @@ def otsu_threshold(image: ArrayLike, bins: int = 256) -> float:
     105.0
     >>> otsu_threshold(np.full((3, 3), 5.0))
     5.0
+    >>> otsu_threshold([[10, 10, 200, 200]], bins=1)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: bins: expected an integer in [2, 1000000], got 1
     """
+    if isinstance(bins, bool) or not isinstance(bins, (int, np.integer)) or not 2 <= bins <= MAX_OTSU_BINS:
+        estimate = (
+            f" (about {int(bins) * _BIN_BYTES / 1e9:.3g} GB of histogram)"
+            if isinstance(bins, (int, np.integer)) and not isinstance(bins, bool) and bins > MAX_OTSU_BINS
+            else ""
+        )
+        raise InputError(f"bins: expected an integer in [2, {MAX_OTSU_BINS}], got {bins!r}{estimate}")
     pixels = np.asarray(prepare(as_image(image), None, context=0).pixels, dtype=np.float64)
     if pixels.size == 0:
         raise InputError("image: expected at least one pixel, got an empty image")
