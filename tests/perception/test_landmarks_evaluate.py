@@ -186,6 +186,7 @@ NONE: Any = None
             lambda: segment_recall_precision(SEGMENTS, SEGMENTS, step=1e-7),
             "^step: expected a step that makes at most 10000000 sample points",
         ),
+        (lambda: read_gray_image(NONE), "^path: expected a str or PathLike, got NoneType$"),
     ],
 )
 def test_segment_tools_refuse_bad_input(call: object, match: str) -> None:

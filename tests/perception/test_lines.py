@@ -182,11 +182,33 @@ def test_noisy_edge_is_still_found() -> None:
         (np.zeros((10, 10), dtype=bool), "expected integers or floats .*got dtype bool"),
         (np.zeros((10, 10), dtype=complex), "got dtype complex128"),
         ([["a", "b"], ["c", "d"]], "got dtype <U1"),
+        (
+            np.full((10, 10), 1e300),
+            r"^image: expected gray levels a number in \[-1e\+12, 1e\+12\], "
+            r"got 1e\+300 at pixel \(u=0, v=0\)$",
+        ),
+        (
+            np.full((10, 10), -(2**62), dtype=np.int64),
+            r"^image: expected gray levels a number in \[-1e\+12, 1e\+12\], "
+            r"got -4611686018427387904 at pixel",
+        ),
     ],
 )
 def test_bad_images_are_input_errors(image: object, message: str) -> None:
     with pytest.raises(InputError, match=message):
         FastLineFinder().find(image)  # type: ignore[arg-type]
+
+
+def test_gray_levels_up_to_the_range_are_taken_without_overflow() -> None:
+    image = step_edge().astype(np.float64) * (1e12 / 255.0)
+    assert FastLineFinder(VERTICAL).find(image).shape[0] >= 1
+    assert FastLineFinder(smoothing=2.0).find(-image).shape[0] >= 1
+    wide = np.full((10, 10), 2**40, dtype=np.int64)  # 64-bit integers are checked, not refused as a type
+    with pytest.raises(
+        InputError, match=r"^image: expected gray levels .*, got 1099511627776 at pixel \(u=0, v=0\)$"
+    ):
+        FastLineFinder().find(wide)
+    assert FastLineFinder().find(wide // 2**20).shape == (0, 4)
 
 
 def test_nan_pixel_is_an_input_error_naming_the_pixel() -> None:

@@ -161,6 +161,18 @@ def test_otsu_bad_bins(bins: object, message: str) -> None:
     assert otsu_threshold([[10, 10, 200, 200]], two) == otsu_threshold([[10, 10, 200, 200]], 2)
 
 
+@pytest.mark.parametrize(
+    "call", [otsu_threshold, MoravecOperator().find, MoravecOperator().response, RegionSegmenter().find]
+)
+def test_gray_levels_beyond_the_range_are_refused(call: object) -> None:
+    assert callable(call)
+    with pytest.raises(
+        InputError, match=r"^image: expected gray levels a number in \[-1e\+12, 1e\+12\], got -1e\+300"
+    ):
+        call(np.full((8, 8), -1e300))
+    call(np.full((8, 8), -1e12))  # the range's end: no overflow (warnings are errors)
+
+
 def test_region_bad_image() -> None:
     with pytest.raises(InputError, match="got dtype bool"):
         RegionSegmenter().find(np.zeros((4, 4), dtype=bool))

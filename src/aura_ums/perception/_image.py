@@ -1,7 +1,8 @@
 """Where images enter perception: validation, windows to pixel ranges, and reading files.
 
 An image is a 2-D grayscale array ``(h, w)`` of integers or floats (gray levels; the
-default thresholds of the detectors assume the 0-255 range of 8-bit images). Pixel
+default thresholds of the detectors assume the 0-255 range of 8-bit images), each in
+:data:`GRAY_LEVEL` (+-1e12: 8- to 32-bit images and floats of any usual scale). Pixel
 ``(u, v)`` = ``(column, row)``, with ``(0, 0)`` at the centre of the top-left pixel
 (DESIGN §1); pixel ``(u, v)`` covers ``[u - 0.5, u + 0.5] x [v - 0.5, v + 0.5]``.
 """
@@ -17,8 +18,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from aura_ums._validate import Range
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import ImageWindow
+
+#: A gray level the detectors take: every integer of 8- to 32-bit images, and floats of any
+#: usual scale. The detectors work in float32 (largest 3.4e38): their gradients and squared
+#: magnitudes stay far from overflow within it, where 1e300 overflowed the cast itself.
+GRAY_LEVEL = Range(-1e12, 1e12)
 
 #: ITU-R BT.601 luma weights (red, green, blue), as OpenCV's ``COLOR_RGB2GRAY`` uses.
 _LUMA = np.array([0.299, 0.587, 0.114])
@@ -118,14 +125,33 @@ def prepare(image: ArrayLike, window: ImageWindow | None, *, context: int) -> Cr
     c0, r0 = max(col_lo - context, 0), max(row_lo - context, 0)
     c1, r1 = min(col_hi + context, width), min(row_hi + context, height)
     region = array[r0:r1, c0:c1]
-    if region.dtype.kind == "f" and not np.isfinite(region).all():
-        bad = np.argwhere(~np.isfinite(region))[0]
+    # min and max are NaN when a pixel is: one test for NaN, infinity and range (per window).
+    if (
+        region.size
+        and _may_exceed(region.dtype)
+        and not (GRAY_LEVEL.low <= region.min() and region.max() <= GRAY_LEVEL.high)
+    ):
+        if region.dtype.kind == "f" and not np.isfinite(region).all():
+            bad = np.argwhere(~np.isfinite(region))[0]
+            raise InputError(
+                f"image: expected finite gray levels, got {region[bad[0], bad[1]]} at pixel "
+                f"(u={int(bad[1]) + c0}, v={int(bad[0]) + r0})"
+            )
+        bad = np.argwhere(np.abs(region.astype(np.float64)) > GRAY_LEVEL.high)[0]
         raise InputError(
-            f"image: expected finite gray levels, got {region[bad[0], bad[1]]} at pixel "
+            f"image: expected gray levels {GRAY_LEVEL.text()}, got {region[bad[0], bad[1]]} at pixel "
             f"(u={int(bad[1]) + c0}, v={int(bad[0]) + r0})"
         )
     pixels = np.asarray(region, dtype=np.float32)
     return Crop(pixels, c0, r0, col_lo - c0, row_lo - r0, col_hi - c0, row_hi - r0)
+
+
+def _may_exceed(dtype: np.dtype[Any]) -> bool:
+    """Whether values of ``dtype`` may lie outside :data:`GRAY_LEVEL` (floats, 64-bit integers)."""
+    if dtype.kind == "f":
+        return True
+    info = np.iinfo(dtype)
+    return bool(info.min < GRAY_LEVEL.low or info.max > GRAY_LEVEL.high)
 
 
 def read_gray_image(path: str | PathLike[str]) -> NDArray[np.uint8]:
@@ -146,6 +172,8 @@ def read_gray_image(path: str | PathLike[str]) -> NDArray[np.uint8]:
 
     Raises
     ------
+    InputError
+        When ``path`` is not a str or PathLike.
     FileFormatError
         When the file is missing or is not a readable image.
 
@@ -165,6 +193,8 @@ def read_gray_image(path: str | PathLike[str]) -> NDArray[np.uint8]:
     ...
     aura_ums.errors.FileFormatError: ...missing.png: expected a readable image file, got [Errno 2] No such ...
     """
+    if not isinstance(path, (str, PathLike)):
+        raise InputError(f"path: expected a str or PathLike, got {type(path).__name__}")
     import matplotlib.image  # deferred: only loaders need it
 
     try:
