@@ -91,14 +91,38 @@ def test_bad_baseline_input_is_refused() -> None:
     expecter = Expecter(CAMERAS["plain"])
     landmark = PointLandmark("corner", 10.0, 0.0, 2.0)
     good = np.eye(3) * 0.01
-    with pytest.raises(InputError, match="sigmas: expected a positive finite number"):
+    with pytest.raises(InputError, match=r"^sigmas: expected a number in \(0, 100\], got 0\.0$"):
         gaussian_window(expecter, (0.0, 0.0, 0.0), good, landmark, sigmas=0.0)
-    with pytest.raises(InputError, match="sigmas: expected a positive finite number"):
+    with pytest.raises(InputError, match=r"^sigmas: expected a number in \(0, 100\], got -3\.0$"):
         gaussian_window(expecter, (0.0, 0.0, 0.0), good, landmark, sigmas=-3.0)
-    with pytest.raises(InputError, match="sigmas: expected a positive finite number"):
+    with pytest.raises(InputError, match=r"^sigmas: expected a finite number, got inf$"):
         gaussian_box_map((0.0, 0.0, 0.0), good, sigmas=math.inf)
-    with pytest.raises(InputError, match="sigmas: expected a positive finite number"):
+    with pytest.raises(InputError, match=r"^sigmas: expected a finite number, got '3'$"):
         gaussian_box_map((0.0, 0.0, 0.0), good, sigmas="3")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"^sigmas: expected a number in \(0, 100\], got 1e\+300$"):
+        gaussian_box_map(Pose(0.5, 0.5, 0.0), np.diag([0.01, 0.01, 0.001]), 1e300)
+    with pytest.raises(InputError, match=r"^sigmas: expected a number in \(0, 100\], got 1e\+300$"):
+        gaussian_window(expecter, (0.0, 0.0, 0.0), good, landmark, sigmas=1e300)
+    with pytest.raises(
+        InputError,
+        match=r"^covariance: expected a 3-sigma box within the world's coordinates a number in "
+        r"\[-1e\+06, 1e\+06\] m, got half-widths \(3e\+100, 3e\+100\) m around \(0\.5, 0\.5\)$",
+    ):
+        gaussian_box_map(Pose(0.5, 0.5, 0.0), np.diag([1e200, 1e200, 0.001]))
+    with pytest.raises(
+        InputError,
+        match=r"^mean_pose: expected x and y each a number in \[-1e\+06, 1e\+06\] m, "
+        r"got \(10000000\.0, 0\.0\)$",
+    ):
+        gaussian_box_map((1e7, 0.0, 0.0), good)
+    assert gaussian_box_map((0.0, 0.0, 0.0), good, sigmas=100).area == pytest.approx(400.0 * 0.01 * 100.0)
+    scenario = figure4_scenario()
+    with pytest.raises(InputError, match=r"^clip: expected a bool, got 'no'$"):
+        disk_model_window(expecter, scenario.map, landmark, clip="no")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"^clip: expected a bool, got array\(\[ True, False\]\)$"):
+        disk_model_window(expecter, scenario.map, landmark, clip=np.array([True, False]))  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"^clip: expected a bool, got 1$"):
+        gaussian_window(expecter, (0.0, 0.0, 0.0), good, landmark, clip=1)  # type: ignore[arg-type]
     bad = good.copy()
     bad[1, 1] = math.nan
     with pytest.raises(InputError, match="covariance: expected finite numbers"):

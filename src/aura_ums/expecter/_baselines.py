@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import COORDINATE, Range, finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter._expecter import Expecter
 from aura_ums.expecter._window import margin_pixels
@@ -22,6 +22,9 @@ from aura_ums.world import PerceptualStrategy
 
 #: Sides of the outer polygon that stands for the disk model's circle.
 _DISK_SIDES = 64
+#: Half-width of a Gaussian box in standard deviations: up to 100 (Chebyshev leaves at most
+#: 1e-4 of any belief outside); 1e300 passed and failed later, naming the box's corners.
+BOX_SIGMAS = Range(0.0, 100.0, "", low_open=True)
 
 
 def disk_model_map(map: SpatialUncertaintyMap, *, sides: int = _DISK_SIDES) -> SpatialUncertaintyMap:
@@ -75,7 +78,7 @@ def disk_model_window(
         As in :meth:`Expecter.window`.
     clip : bool
         Clip to the image (as :meth:`Expecter.window`); False returns the guaranteed
-        window grown by the margin, for comparing areas beyond the image.
+        window grown by the margin, for comparing areas beyond the image. A bool.
 
     Returns
     -------
@@ -97,8 +100,13 @@ def disk_model_window(
     >>> disk = disk_model_window(e, m, side, margin=0.0, clip=False)
     >>> polygon.area < disk.area
     True
+    >>> disk_model_window(e, m, side, clip="no")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: clip: expected a bool, got 'no'
     """
     _check_expecter(expecter)
+    _check_clip(clip)
     return _window(expecter, disk_model_map(map), landmark, margin, clip)
 
 
@@ -119,13 +127,14 @@ def gaussian_box_map(
         Covariance of (x, y, heading): finite, symmetric, non-negative diagonal (m^2,
         m^2, rad^2; cross terms in m^2 and m rad).
     sigmas : float
-        Half-width of the box in standard deviations, > 0.
+        Half-width of the box in standard deviations, in (0, 100].
 
     Raises
     ------
     InputError
         On a non-finite or ill-shaped mean or covariance, a negative variance, an
-        asymmetric covariance, or a non-positive ``sigmas``.
+        asymmetric covariance, ``sigmas`` outside (0, 100], or a box that reaches beyond
+        the world's coordinates (+-1e6 m).
 
     Examples
     --------
@@ -137,13 +146,16 @@ def gaussian_box_map(
     """
     mean = _mean_pose(mean_pose)
     cov = _covariance(covariance)
-    if isinstance(sigmas, bool) or not isinstance(sigmas, (int, float, np.integer, np.floating)):
-        raise InputError(f"sigmas: expected a positive finite number, got {sigmas!r}")
-    s = float(sigmas)
-    if not (math.isfinite(s) and s > 0.0):
-        raise InputError(f"sigmas: expected a positive finite number, got {s!r}")
+    s = BOX_SIGMAS.check(sigmas, "sigmas")
     half = s * np.sqrt(np.diag(cov))
     x, y, heading = mean
+    if not (COORDINATE.contains(x) and COORDINATE.contains(y)):
+        raise InputError(f"mean_pose: expected x and y each {COORDINATE.text()}, got ({x}, {y})")
+    if max(abs(x), abs(y)) + max(half[0], half[1]) > COORDINATE.high:
+        raise InputError(
+            f"covariance: expected a {s:g}-sigma box within the world's coordinates {COORDINATE.text()}, "
+            f"got half-widths ({half[0]:.3g}, {half[1]:.3g}) m around ({x}, {y})"
+        )
     corners = [
         (x - half[0], y - half[1]),
         (x + half[0], y - half[1]),
@@ -184,11 +196,11 @@ def gaussian_window(
     landmark : VerticalLineLandmark, PointLandmark or GroundLineLandmark
         The expected landmark.
     sigmas : float
-        Half-width of the box in standard deviations, > 0.
+        Half-width of the box in standard deviations, in (0, 100].
     margin : float or PerceptualStrategy
         As in :meth:`Expecter.window`.
     clip : bool
-        Clip to the image; False keeps the whole window, for comparing areas.
+        Clip to the image; False keeps the whole window, for comparing areas. A bool.
 
     Returns
     -------
@@ -211,9 +223,10 @@ def gaussian_window(
     >>> gaussian_window(e, (0, 0, 0), np.eye(3), corner, sigmas=0.0)
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: sigmas: expected a positive finite number, got 0.0
+    aura_ums.errors.InputError: sigmas: expected a number in (0, 100], got 0.0
     """
     _check_expecter(expecter)
+    _check_clip(clip)
     return _window(expecter, gaussian_box_map(mean_pose, covariance, sigmas), landmark, margin, clip)
 
 
@@ -234,6 +247,11 @@ def _window(
 def _check_expecter(expecter: object) -> None:
     if not isinstance(expecter, Expecter):
         raise InputError(f"expecter: expected an Expecter, got {type(expecter).__name__}")
+
+
+def _check_clip(clip: object) -> None:
+    if not isinstance(clip, bool):  # truth-tested: 'no' clipped, an array raised numpy's error
+        raise InputError(f"clip: expected a bool, got {clip!r}")
 
 
 def _check_map(map: object) -> None:
