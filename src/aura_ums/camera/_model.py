@@ -505,6 +505,9 @@ class Camera:
         fold_radius^2``, :func:`fold_radius`): beyond it the distortion polynomial folds
         back onto the pixels of nearer rays, which this camera does not model.
 
+        ``points_camera`` are finite metres, each coordinate within 1e7 m
+        (:data:`CAMERA_COORDINATE`).
+
         Examples
         --------
         >>> lens = CameraIntrinsics(300, 300, 320, 240, 640, 480, distortion=(-0.14, 0, 0, 0, 0))
