@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import enum
 import math
+import numbers
 import sys
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import NoReturn, TypeVar, cast
+from typing import Any, NoReturn, TypeVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -66,6 +67,28 @@ def integer_at_least(value: object, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
     return value
+
+
+def bounded_count(value: object, name: str, minimum: int, maximum: int, cost: str) -> int:
+    """Return a count, an integer (numpy's too; not a bool or float) in [minimum, maximum], or raise.
+
+    ``maximum`` comes from a time or memory estimate, which ``cost`` states for the message
+    (what the largest count is and costs): 10**12 sides asked for terabytes.
+
+    Examples
+    --------
+    >>> bounded_count(16, "sides", 3, 1000, "sides (16 kB of vertices)")
+    16
+    >>> bounded_count(10**6, "sides", 3, 1000, "sides (16 kB of vertices)")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: sides: expected at most 1,000 sides (16 kB of vertices), got 1000000
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    if value > maximum:
+        raise InputError(f"{name}: expected at most {maximum:,} {cost}, got {value!r}")
+    return int(value)
 
 
 def _refuse_choice(kind: type[enum.Enum], value: object) -> NoReturn:
@@ -275,12 +298,46 @@ PIXEL = Range(-1e5, 1e5, "px")
 BLUR = Range(0.0, 100.0, "px")
 
 
+#: What an array of a dtype kind that is no number holds, for messages.
+_NOT_NUMBERS = {"b": "booleans", "c": "complex numbers", "U": "strings", "S": "bytes", "O": "objects"}
+
+
+def _numbers(
+    make: Callable[[object], NDArray[Any]], value: object, name: str, expected: str
+) -> NDArray[np.float64]:
+    """Return ``make(value)`` (``np.array``, a copy, or ``np.asarray``) as floats: integers or floats only.
+
+    ``np.array(value, dtype=np.float64)`` parsed numeric strings ("1.0") and bools, and dropped
+    complex numbers' imaginary parts with a ComplexWarning. Objects (a list holding a Fraction, an
+    int beyond int64, a None) are taken when each is a real number that is not a bool.
+    """
+    try:
+        array = make(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected {expected}, got {value!r}") from exc
+    kind = array.dtype.kind
+    if kind not in "iuf" and not (kind == "O" and all(_real(item) for item in array.flat)):
+        what = _NOT_NUMBERS.get(kind, f"dtype {array.dtype}")
+        raise InputError(f"{name}: expected {expected}, got {what} ({_short(value)})")
+    try:
+        return array.astype(np.float64, copy=False)
+    except (TypeError, ValueError, OverflowError) as exc:  # an object no float holds
+        raise InputError(f"{name}: expected {expected}, got {_short(value)}") from exc
+
+
+def _real(item: object) -> bool:
+    return isinstance(item, numbers.Real) and not isinstance(item, (bool, np.bool_))
+
+
+def _short(value: object) -> str:
+    """``repr(value)``, cut to 80 characters: a refused array may be large."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:
     """Return ``value`` as a finite ``(n, 2)`` float array, or raise naming ``name``."""
-    try:
-        array = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: expected an (n, 2) array of numbers, got {value!r}") from exc
+    array = _numbers(np.array, value, name, "an (n, 2) array of numbers")
     if array.size == 0:
         array = array.reshape(0, 2)
     if array.ndim == 1 and array.shape == (2,):
@@ -312,10 +369,7 @@ def world_points(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[n
 
 def float_array(value: ArrayLike, name: str) -> NDArray[np.float64]:
     """Return ``value`` as a finite float array of any shape, or raise naming ``name``."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: expected numbers, got {value!r}") from exc
+    array = _numbers(np.asarray, value, name, "numbers")
     if not np.all(np.isfinite(array)):
         raise InputError(f"{name}: expected finite numbers, got non-finite values")
     return array
