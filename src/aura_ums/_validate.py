@@ -335,6 +335,24 @@ def _short(value: object) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def number_array(value: ArrayLike, name: str, expected: str = "numbers") -> NDArray[np.float64]:
+    """Return ``value`` as a float array of any shape, NaN and inf kept, or raise naming ``name``.
+
+    Numbers only (integers and floats, not strings, bools or complex), for arrays whose
+    non-finite values mean something (pixels of points behind a camera are NaN).
+
+    Examples
+    --------
+    >>> number_array([1, float("nan")], "pixels").tolist()
+    [1.0, nan]
+    >>> number_array([True, False], "pixels")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: pixels: expected numbers, got booleans ([True, False])
+    """
+    return _numbers(np.asarray, value, name, expected)
+
+
 def points_array(value: ArrayLike, name: str, *, min_rows: int = 0) -> NDArray[np.float64]:
     """Return ``value`` as a finite ``(n, 2)`` float array, or raise naming ``name``."""
     array = _numbers(np.array, value, name, "an (n, 2) array of numbers")

@@ -63,3 +63,39 @@ def test_keeps_the_shape_of_its_input() -> None:
 def test_refuses_what_is_not_points(pixels: object, message: str) -> None:
     with pytest.raises(InputError, match=message):
         ImageWindow(0.0, 0.0, 1.0, 1.0).meets_pixel_of(pixels)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("pixels", "message"),
+    [
+        ([[True, False]], r"pixels: expected an \(n, 2\) array of numbers, got booleans"),
+        ([["1", "2"]], r"pixels: expected an \(n, 2\) array of numbers, got strings"),
+        (np.array([[1 + 0j, 2]]), r"pixels: expected an \(n, 2\) array of numbers, got complex numbers"),
+        (5.0, r"pixels: expected shape \(\.\.\., 2\), got \(\)"),
+        ([[1.0, 2.0, 3.0]], r"pixels: expected shape \(\.\.\., 2\), got \(1, 3\)"),
+    ],
+)
+def test_pixel_tests_refuse_what_is_no_pixel(pixels: object, message: str) -> None:
+    window = ImageWindow(0.0, 0.0, 10.0, 10.0)
+    with pytest.raises(InputError, match=message):
+        window.contains(pixels)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=message):
+        window.meets_pixel_of(pixels)  # type: ignore[arg-type]
+
+
+def test_pixel_tests_keep_nan_and_integer_pixels() -> None:
+    window = ImageWindow(0.0, 0.0, 10.0, 10.0)
+    pixels = [[5, 5], [math.nan, 5.0], [math.inf, 5.0]]
+    assert window.contains(pixels).tolist() == [True, False, False]  # type: ignore[arg-type]
+    assert window.meets_pixel_of(pixels).tolist() == [True, False, False]  # type: ignore[arg-type]
+
+
+def test_expanded_refuses_a_margin_beyond_any_image() -> None:
+    window = ImageWindow(0.0, 0.0, 10.0, 10.0)
+    assert window.expanded(20_000).u_min == -20_000.0
+    with pytest.raises(
+        InputError, match=r"margin: expected at most 20000 pixels \(an image's longest side\), got 1e\+300"
+    ):
+        window.expanded(1e300)
+    with pytest.raises(InputError, match=r"margin: expected a finite number, got nan"):
+        window.expanded(math.nan)

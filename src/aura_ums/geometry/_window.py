@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import finite_float, nonnegative_float
+from aura_ums._validate import IMAGE_SIDE, finite_float, nonnegative_float, number_array
 from aura_ums.errors import InputError
 
 #: Stand-in (pixels) for a window side that is unbounded: the largest finite float.
@@ -143,8 +143,16 @@ class ImageWindow:
         return np.asarray(meets, dtype=np.bool_)
 
     def expanded(self, margin: float) -> ImageWindow:
-        """Return the window grown by ``margin`` pixels (>= 0) on every side."""
+        """Return the window grown by ``margin`` pixels on every side, at most an image's longest side.
+
+        A margin beyond 20,000 px (:data:`~aura_ums._validate.IMAGE_SIDE`) reaches past any
+        image: 1e300 made a window of area inf.
+        """
         m = nonnegative_float(margin, "margin")
+        if m > IMAGE_SIDE.high:
+            raise InputError(
+                f"margin: expected at most {IMAGE_SIDE.high:g} pixels (an image's longest side), got {m!r}"
+            )
         return ImageWindow(
             _saturate(self.u_min - m),
             _saturate(self.v_min - m),
@@ -169,11 +177,8 @@ class ImageWindow:
 
 
 def _pixel_points(pixels: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return the u and v of points ``(..., 2)``, pixels, checked for shape."""
-    try:
-        points = np.asarray(pixels, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"pixels: expected an (n, 2) array of numbers, got {pixels!r}") from exc
+    """Return the u and v of points ``(..., 2)``, pixels, checked for numbers (NaN kept) and shape."""
+    points = number_array(pixels, "pixels", "an (n, 2) array of numbers")
     if points.ndim == 0 or points.shape[-1] != 2:
         raise InputError(f"pixels: expected shape (..., 2), got {points.shape}")
     return points[..., 0], points[..., 1]
