@@ -186,3 +186,49 @@ def test_one_heading_as_a_float_answers_as_an_array(
     base = {"lo": wedge.center - wedge.cw, "hi": wedge.center + wedge.ccw, "center": wedge.center}[where]
     heading = base + nudge
     assert wedge.contains(heading) == bool(np.asarray(wedge.contains(np.array([heading])))[0])
+
+
+@pytest.mark.parametrize(
+    ("angle", "message"),
+    [
+        (None, r"angle: expected a finite number, got None"),
+        ("1.0", r"angle: expected a finite number, got '1\.0'"),
+        (math.nan, r"angle: expected a finite number, got nan"),
+        (True, r"angle: expected a finite number, got True"),
+        (np.array([1.0, 2.0]), r"angle: expected a finite number, got array"),
+    ],
+)
+def test_rotated_names_a_bad_angle(angle: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        HeadingWedge(0.0, 0.1, 0.1).rotated(angle)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("cw", "ccw", "message"),
+    [
+        (None, 0.1, r"cw: expected a finite number, got None"),
+        (np.array([1.0, 2.0]), 0.1, r"cw: expected a finite number, got array"),
+        (1 + 0j, 0.1, r"cw: expected a finite number, got \(1\+0j\)"),
+        (math.inf, 0.1, r"cw: expected a finite number, got inf"),
+        (0.1, math.nan, r"ccw: expected a finite number, got nan"),
+        (0.1, -0.5, r"ccw: expected a non-negative number, got -0\.5"),
+    ],
+)
+def test_widened_names_a_bad_extent(cw: object, ccw: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        HeadingWedge(0.0, 0.1, 0.1).widened(cw, ccw)  # type: ignore[arg-type]
+
+
+def test_widened_by_a_huge_extent_is_the_full_circle_and_rotated_keeps_its_bits() -> None:
+    wedge = HeadingWedge(0.5, 0.1, 0.2)
+    assert wedge.widened(1e300, 0.0) == HeadingWedge(0.5, math.pi, math.pi)
+    assert wedge.widened(1, np.float64(0.25)) == HeadingWedge(0.5, 0.1 + 1.0, 0.2 + 0.25)
+    assert wedge.rotated(np.float64(3.0)) == HeadingWedge(0.5 + 3.0, 0.1, 0.2)
+
+
+@pytest.mark.parametrize("heading", ["0.0", True, [0.0, 1 + 1j]])
+def test_contains_refuses_headings_that_are_no_numbers(heading: object) -> None:
+    with pytest.raises(
+        InputError, match=r"heading: expected numbers, got (strings|booleans|complex numbers)"
+    ):
+        HeadingWedge(0.0, 0.1, 0.1).contains(heading)  # type: ignore[call-overload]

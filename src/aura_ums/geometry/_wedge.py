@@ -162,12 +162,27 @@ class HeadingWedge:
         return inside
 
     def widened(self, cw: float, ccw: float) -> HeadingWedge:
-        """Return the wedge with ``cw`` and ``ccw`` radians (>= 0) added to its extents."""
-        return _normalized(self.center, self.cw + cw, self.ccw + ccw)
+        """Return the wedge with ``cw`` and ``ccw`` radians (finite, >= 0) added to its extents.
+
+        Extents that add up to ``2*pi`` or more are the full circle, however large (finite:
+        the constructor's extents are finite too).
+
+        Examples
+        --------
+        >>> HeadingWedge(0.0, 0.1, 0.1).widened(1e300, 0.0).is_full_circle
+        True
+        >>> HeadingWedge(0.0, 0.1, 0.1).widened(float("nan"), 0.0)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: cw: expected a finite number, got nan
+        """
+        more_cw = nonnegative_float(cw, "cw")
+        more_ccw = nonnegative_float(ccw, "ccw")
+        return _normalized(self.center, self.cw + more_cw, self.ccw + more_ccw)
 
     def rotated(self, angle: float) -> HeadingWedge:
-        """Return the wedge turned by ``angle`` radians (counter-clockwise positive)."""
-        return _normalized(self.center + angle, self.cw, self.ccw)
+        """Return the wedge turned by ``angle`` radians (finite; counter-clockwise positive)."""
+        return _normalized(self.center + finite_float(angle, "angle"), self.cw, self.ccw)
 
 
 def _heading_in(center: float, cw: float, ccw: float, heading: float) -> bool:
