@@ -23,7 +23,7 @@ from aura_ums.geometry import (
     regular_polygon,
     simplify_outer,
 )
-from aura_ums.geometry._convex import convexity_defect, remove_collinear
+from aura_ums.geometry._convex import ARC_STEP, FULL_DISK_SIDES, convexity_defect, remove_collinear
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap
 
 SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
@@ -385,7 +385,7 @@ def test_simplify_outer_adds_little_area_to_a_smooth_shape() -> None:
     simplified = circle.simplified_outer(32)
     assert simplified.vertex_count <= 32
     assert simplified.area / circle.area < 1.02
-    with pytest.raises(InputError, match=r"max_vertices: expected at least 3"):
+    with pytest.raises(InputError, match=r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 2"):
         circle.simplified_outer(2)
 
 
@@ -442,3 +442,204 @@ def test_a_repeated_vertex_constrains_nothing_in_the_point_test() -> None:
     assert np.array_equal(points_in_convex(square, points, 0.0), expected)
     assert expected.any()
     assert not expected.all()
+
+
+# Bad arguments to ConvexPolygon's methods and the polygon builders, refused by name.
+
+UNIT = ConvexPolygon([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)])
+
+
+@pytest.mark.parametrize(
+    ("dx", "dy", "message"),
+    [
+        (math.nan, 0.0, r"dx: expected a finite number, got nan"),
+        (0.0, math.inf, r"dy: expected a finite number, got inf"),
+        (None, 0.0, r"dx: expected a finite number, got None"),
+        ("1.0", 0.0, r"dx: expected a finite number, got '1\.0'"),
+        (1e300, 0.0, r"dx: expected a shift keeping the vertices in \[-1e\+06, 1e\+06\] m, got 1e\+300"),
+        (
+            0.0,
+            -1e6 - 0.5,
+            r"dy: expected a shift keeping the vertices in \[-1e\+06, 1e\+06\] m, got -1000000\.5",
+        ),
+    ],
+)
+def test_translated_refuses_a_bad_shift(dx: object, dy: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        UNIT.translated(dx, dy)  # type: ignore[arg-type]
+
+
+def test_translated_moves_to_the_edge_of_the_range_bit_for_bit() -> None:
+    moved = UNIT.translated(1e6 - 1.0, -1e6)
+    assert moved.vertices.tolist() == (UNIT.vertices + np.array([1e6 - 1.0, -1e6])).tolist()
+    assert (
+        UNIT.translated(np.float64(0.25), 1).vertices.tolist()
+        == (UNIT.vertices + np.array([0.25, 1.0])).tolist()
+    )
+
+
+@pytest.mark.parametrize(
+    ("tolerance", "message"),
+    [
+        (None, r"tolerance: expected a finite number, got None"),
+        (math.nan, r"tolerance: expected a finite number, got nan"),
+        (math.inf, r"tolerance: expected a finite number, got inf"),
+        (-1e-9, r"tolerance: expected a non-negative number, got -1e-09"),
+    ],
+)
+def test_contains_refuses_a_bad_tolerance(tolerance: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        UNIT.contains([(0.5, 0.5)], tolerance=tolerance)  # type: ignore[arg-type]
+
+
+def test_contains_takes_a_zero_tolerance() -> None:
+    assert UNIT.contains([(1.0, 0.5), (1.0 + 1e-12, 0.5)], tolerance=0).tolist() == [True, False]
+
+
+@pytest.mark.parametrize(
+    ("count", "message"),
+    [
+        (None, r"count: expected an integer >= 0, got None"),
+        (-1, r"count: expected an integer >= 0, got -1"),
+        (1.5, r"count: expected an integer >= 0, got 1\.5"),
+        (math.nan, r"count: expected an integer >= 0, got nan"),
+        (True, r"count: expected an integer >= 0, got True"),
+        (
+            10**12,
+            r"count: expected at most 10,000,000 points a call \(about 10 s and 0\.7 GB.*got 1000000000000",
+        ),
+    ],
+)
+def test_sample_refuses_a_bad_count(count: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        UNIT.sample(count, np.random.default_rng(0))  # type: ignore[arg-type]
+
+
+def test_sample_refuses_a_bad_rng_and_takes_zero_and_numpy_counts() -> None:
+    with pytest.raises(InputError, match=r"rng: expected a numpy\.random\.Generator, got NoneType"):
+        UNIT.sample(3, None)  # type: ignore[arg-type]
+    assert UNIT.sample(0, np.random.default_rng(0)).shape == (0, 2)
+    drawn = UNIT.sample(np.int64(5), np.random.default_rng(1))  # type: ignore[arg-type]
+    assert drawn.tolist() == UNIT.sample(5, np.random.default_rng(1)).tolist()
+
+
+@pytest.mark.parametrize("cap", [None, math.nan, 3.0, True, 2])
+def test_simplified_outer_refuses_a_bad_cap(cap: object) -> None:
+    with pytest.raises(InputError, match=r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got"):
+        UNIT.simplified_outer(cap)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("other", [None, "x", UNIT.vertices])
+def test_intersection_and_minkowski_sum_refuse_what_is_no_polygon(other: object) -> None:
+    with pytest.raises(InputError, match=r"other: expected a ConvexPolygon, got (NoneType|str|ndarray)"):
+        UNIT.intersection(other)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"other: expected a ConvexPolygon, got (NoneType|str|ndarray)"):
+        UNIT.minkowski_sum(other)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("sides", "message"),
+    [
+        (None, r"sides: expected an integer >= 3, got None"),
+        (math.nan, r"sides: expected an integer >= 3, got nan"),
+        (3.0, r"sides: expected an integer >= 3, got 3\.0"),
+        ("3", r"sides: expected an integer >= 3, got '3'"),
+        (2, r"sides: expected an integer >= 3, got 2"),
+        (10**12, r"sides: expected at most 1,000,000 vertices \(16 MB, 3 s\), got 1000000000000"),
+    ],
+)
+def test_polygon_builders_refuse_a_bad_side_count(sides: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        ConvexPolygon.disk((0.0, 0.0), 1.0, sides)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=message):
+        regular_polygon((0.0, 0.0), 1.0, sides)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=message):
+        outer_disk(np.zeros(2), 1.0, sides)  # type: ignore[arg-type]
+
+
+def test_polygon_builders_take_numpy_side_counts_bit_for_bit() -> None:
+    assert outer_disk(np.zeros(2), 1.0, np.int64(7)).tolist() == outer_disk(np.zeros(2), 1.0, 7).tolist()  # type: ignore[arg-type]
+    assert regular_polygon((1, 2), 3, np.int32(5)) == regular_polygon((1.0, 2.0), 3.0, 5)  # type: ignore[arg-type]
+    assert ConvexPolygon.disk(np.array([1.0, 2.0]), 0.0, 5).vertices.tolist() == [[1.0, 2.0]]
+
+
+@pytest.mark.parametrize(
+    ("center", "message"),
+    [
+        ([], r"center: expected at least 1 points, got 0"),
+        ({}, r"center: expected an \(n, 2\) array of numbers, got objects"),
+        ("ab", r"center: expected an \(n, 2\) array of numbers, got strings"),
+        ([(0.0, 0.0), (1.0, 1.0)], r"center: expected one point \(x, y\), got shape \(2, 2\)"),
+        ((math.nan, 0.0), r"center: expected finite coordinates"),
+    ],
+)
+def test_polygon_builders_refuse_a_bad_center(center: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        regular_polygon(center, 1.0, 6)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=message):
+        ConvexPolygon.disk(center, 1.0)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("radius", "phase", "message"),
+    [
+        (None, 0.0, r"radius: expected a finite number, got None"),
+        (math.inf, 0.0, r"radius: expected a finite number, got inf"),
+        (0.0, 0.0, r"radius: expected a number in \(0, 2e\+06\] m, got 0\.0"),
+        (math.nan, 0.0, r"radius: expected a finite number, got nan"),
+        (1.5e6, 0.0, r"radius: expected a circle around center \[0\.0, 0\.0\] inside \[-1e\+06, 1e\+06\] m"),
+        (1.0, math.nan, r"phase: expected a finite number, got nan"),
+        (1.0, 1e300, r"phase: expected a number in \[-1000, 1000\] rad, got 1e\+300"),
+        (1.0, [1.0], r"phase: expected a finite number, got \[1\.0\]"),
+    ],
+)
+def test_regular_polygon_names_a_bad_radius_or_phase(radius: object, phase: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        regular_polygon((0.0, 0.0), radius, 6, phase=phase)  # type: ignore[arg-type]
+
+
+def test_regular_polygon_names_a_radius_too_small_to_resolve() -> None:
+    with pytest.raises(
+        InputError, match=r"radius: expected 6 distinct vertices around center \[100000\.0, 0\.0\]"
+    ):
+        regular_polygon((1e5, 0.0), 1e-14, 6)
+
+
+@pytest.mark.parametrize(
+    ("start", "stop", "step", "message"),
+    [
+        (
+            0.0,
+            1e300,
+            ARC_STEP,
+            r"stop - start: expected at most 2 pi rad, got 1e\+300 \(start 0\.0, stop 1e\+300\)",
+        ),
+        (-1e300, 1.0, ARC_STEP, r"stop - start: expected at most 2 pi rad, got 1e\+300"),
+        (0.0, math.inf, ARC_STEP, r"stop - start: expected at most 2 pi rad, got inf"),
+        (math.nan, 1.0, ARC_STEP, r"stop - start: expected at most 2 pi rad, got nan"),
+        (
+            0.0,
+            1.0,
+            1e-300,
+            r"step: expected at most 1,000,000 pieces of the arc \(a vertex each: 16 MB, 3 s\)",
+        ),
+    ],
+)
+def test_outer_arc_refuses_what_would_never_return(
+    start: float, stop: float, step: float, message: str
+) -> None:
+    with pytest.raises(InputError, match=message):
+        outer_arc(1.0, start, stop, step)
+
+
+def test_outer_annular_sector_refuses_a_step_that_would_never_return() -> None:
+    with pytest.raises(InputError, match=r"step: expected at most 1,000,000 pieces of the arc"):
+        outer_annular_sector(1.0, 2.0, 0.0, 1.0, 1e-300)
+    # A sector of a turn or more is a disk, however wide (as documented).
+    assert len(outer_annular_sector(1.0, 2.0, 0.0, 1e300)) == FULL_DISK_SIDES
+
+
+def test_outer_arc_takes_a_turn_and_a_rounding_step_more() -> None:
+    lo, width = 1.3, math.tau - 1e-15
+    assert len(outer_arc(1.0, lo, lo + width)) == 34
+    assert len(outer_arc(1.0, 0.0, 1.0, 1.0 / 99_999)) == 100_001

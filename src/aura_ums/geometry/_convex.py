@@ -3,6 +3,14 @@
 Degenerate polygons are allowed everywhere: one vertex is a point, two are a
 segment. Every function that replaces an arc by a polygon returns an *outer*
 polygon (one that contains the arc), so that bounds built from them stay sound.
+
+These are the low-level kernels behind :class:`ConvexPolygon` and the maps' growth and
+reduction (the numpy references of the compiled kernels, on the hot path when those are
+off). They trust their arrays: float64 ``(n, 2)`` arrays of finite coordinates, polygons
+convex and counter-clockwise as documented, floats finite. Give them what a
+:class:`ConvexPolygon` holds; anything else gives garbage or numpy's errors. Only what
+could hang or exhaust memory is checked: the counts of :func:`outer_disk` and the span
+and step of :func:`outer_arc`.
 """
 
 from __future__ import annotations
@@ -14,6 +22,7 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from aura_ums._validate import bounded_count
 from aura_ums.errors import InputError
 from aura_ums.geometry._angles import TWO_PI
 
@@ -51,6 +60,11 @@ _MERGE_ROUNDING = 1e-14
 
 #: Sides of the outer polygon of a full-circle annular sector (a disk).
 FULL_DISK_SIDES = 32
+
+#: Most vertices a polygon built from a count may have (the sides of a disk, the pieces of an
+#: arc): 16 MB of vertices; a million took 0.2 s (a disk) to 3 s (an arc, a regular polygon).
+MAX_BUILT_VERTICES = 1_000_000
+_BUILT_COST = "vertices (16 MB, 3 s)"
 
 # Outward margin of a support polygon's half-planes, relative to the larger of the
 # polygon's extent and its distance from the origin: above their rounding.
@@ -417,14 +431,37 @@ def _clip_halfplane_masked(vertices: Array, normal: Array, offset: float) -> Arr
     return remove_collinear(candidates[mask])
 
 
+def side_count(sides: object, name: str = "sides") -> int:
+    """Return a polygon's number of sides, an integer in [3, :data:`MAX_BUILT_VERTICES`], or raise.
+
+    Integers only, numpy's too (not a bool, not a float such as 3.0), as every count of the library.
+    """
+    return bounded_count(sides, name, 3, MAX_BUILT_VERTICES, _BUILT_COST)
+
+
 def outer_disk(center: Array, radius: float, sides: int = 16) -> Array:
     """Return a regular polygon with ``sides`` vertices that contains the disk.
+
+    Parameters
+    ----------
+    center : ndarray, shape (2,)
+        The disk's centre, metres, finite (trusted, not checked).
+    radius : float
+        Metres, finite (trusted); <= 0 gives the centre alone.
+    sides : int
+        An integer in [3, 1,000,000] (checked: 10**12 asked for terabytes).
 
     Examples
     --------
     >>> outer_disk(np.zeros(2), 0.0).tolist()  # a zero radius gives the point
     [[0.0, 0.0]]
+    >>> outer_disk(np.zeros(2), 1.0, 10**12)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: sides: expected at most 1,000,000 vertices (16 MB, 3 s), got 1000000000000
     """
+    if type(sides) is not int or not 3 <= sides <= MAX_BUILT_VERTICES:  # a Python int: one test
+        sides = side_count(sides)
     if radius <= 0.0:
         return np.asarray(center, dtype=np.float64).reshape(1, 2).copy()
     angles = np.arange(sides) * (TWO_PI / sides)
@@ -435,13 +472,20 @@ def outer_disk(center: Array, radius: float, sides: int = 16) -> Array:
 #: Radians: the widest piece of an outer arc (a wider ``step`` is cut to it).
 _WIDEST_ARC_PIECE = math.pi / 2
 
+#: Radians: the longest span of an outer arc, one turn and a hair (``lo + width - lo`` may
+#: round a width just below a turn to above it).
+_LONGEST_ARC = TWO_PI * (1.0 + 1e-9)
+
 
 def outer_arc(radius: float, start: float, stop: float, step: float = ARC_STEP) -> Array:
     """Return points, counter-clockwise from ``start`` to ``stop``, of an outer polygon of an arc.
 
-    The arc is centred on the origin; ``0 < stop - start < 2*pi``. The returned
-    polyline runs from the arc's start point through tangent intersections to its
-    end point, so the region between it and the origin contains the arc.
+    The arc is centred on the origin; ``0 < stop - start < 2*pi`` (a span up to a hair
+    beyond one turn, as rounding gives one, is taken; more, or not finite, is refused: a
+    span of 1e300 rad never returned). The returned polyline runs from the arc's start
+    point through tangent intersections to its end point, so the region between it and the
+    origin contains the arc. ``radius`` is trusted (finite, >= 0); ``step`` must be
+    positive and cut the arc into at most 1,000,000 pieces.
 
     Examples
     --------
@@ -460,12 +504,26 @@ def outer_arc(radius: float, start: float, stop: float, step: float = ARC_STEP) 
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: step: expected a positive number, got 0.0
+    >>> outer_arc(1.0, 0.0, 1e300)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: stop - start: expected at most 2 pi rad, got 1e+300 (start 0.0, stop 1e+300)
     """
     if not step > 0.0:  # also NaN
         raise InputError(f"step: expected a positive number, got {step!r}")
     width = stop - start
+    if not -_LONGEST_ARC <= width <= _LONGEST_ARC:  # also NaN, from an infinite start or stop
+        raise InputError(
+            f"stop - start: expected at most 2 pi rad, got {width!r} (start {start!r}, stop {stop!r})"
+        )
     # A piece's corner lies at radius / cos(piece / 2): past pi it would be behind the origin.
-    count = max(1, math.ceil(width / min(step, _WIDEST_ARC_PIECE)))
+    pieces = width / min(step, _WIDEST_ARC_PIECE)
+    if pieces > MAX_BUILT_VERTICES:
+        raise InputError(
+            f"step: expected at most {MAX_BUILT_VERTICES:,} pieces of the arc (a vertex each: 16 MB, 3 s), "
+            f"got {pieces:.3g} ({width!r} rad in steps of {step!r} rad)"
+        )
+    count = max(1, math.ceil(pieces))
     half = width / (2 * count)
     reach = radius / math.cos(half)
     # Few points: plain floats beat numpy's per-call overhead here.
@@ -484,7 +542,8 @@ def outer_annular_sector(
 
     The sector holds the points at distance ``inner`` to ``outer`` (m) from the
     origin whose direction lies counter-clockwise from ``start`` to ``stop``
-    (radians, ``start <= stop``). A sector of ``2*pi`` or more is a disk.
+    (radians, ``start <= stop``). A sector of ``2*pi`` or more is a disk. The radii and
+    angles are trusted (finite); ``step`` must cut the arc into at most 1,000,000 pieces.
 
     Examples
     --------

@@ -10,7 +10,19 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import COORDINATE, Range, finite_float, points_array, read_only, world_points
+from aura_ums._validate import (
+    ANGLE,
+    COORDINATE,
+    Range,
+    bounded_count,
+    check_rng,
+    finite_float,
+    nonnegative_float,
+    points_array,
+    read_only,
+    vertex_cap,
+    world_points,
+)
 from aura_ums.errors import InputError
 from aura_ums.geometry import _convex
 
@@ -22,6 +34,11 @@ if TYPE_CHECKING:
 POSITION_TOLERANCE = 1e-9
 #: A disk's radius, metres: up to a world frame's width (``COORDINATE``).
 DISK_RADIUS = Range(0.0, 2.0 * COORDINATE.high, "m")
+#: A regular polygon's radius, metres: a disk's, but not zero (its vertices would be one).
+POLYGON_RADIUS = Range(0.0, DISK_RADIUS.high, "m", low_open=True)
+#: Most points :meth:`ConvexPolygon.sample` draws in one call: about 10 s and 0.7 GB (10 million
+#: from a square took 10.6 s and 630 MB at the peak); 10**12 asked numpy for 7.28 TiB.
+MAX_SAMPLES = 10_000_000
 
 
 @dataclass(frozen=True, slots=True, eq=False, init=False)
@@ -103,11 +120,9 @@ class ConvexPolygon:
 
         A zero radius gives the point itself.
         """
-        c = world_points(center, "center", min_rows=1)[0]
+        c = _one_point(center, "center")
         r = DISK_RADIUS.check(radius, "radius")
-        if sides < 3:
-            raise InputError(f"sides: expected at least 3, got {sides}")
-        return cls._trusted(_convex.outer_disk(c, r, sides))
+        return cls._trusted(_convex.outer_disk(c, r, _convex.side_count(sides)))
 
     @classmethod
     def from_shapely(cls, geometry: BaseGeometry) -> ConvexPolygon:
@@ -160,9 +175,9 @@ class ConvexPolygon:
         return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
 
     def contains(self, points: ArrayLike, *, tolerance: float = POSITION_TOLERANCE) -> NDArray[np.bool_]:
-        """Tell which points ``(n, 2)`` (m) lie in the polygon, boundary and ``tolerance`` included."""
+        """Tell which points ``(n, 2)`` (m) lie in the polygon or within ``tolerance`` m (>= 0) of it."""
         pts = points_array(points, "points")
-        return _convex.points_in_convex(self.vertices, pts, tolerance)
+        return _convex.points_in_convex(self.vertices, pts, nonnegative_float(tolerance, "tolerance"))
 
     def distance(self, points: ArrayLike) -> NDArray[np.float64]:
         """Return each point's distance (m) to the polygon: 0 inside, else to the boundary."""
@@ -171,11 +186,30 @@ class ConvexPolygon:
         return np.where(inside, 0.0, _convex.distance_to_boundary(self.vertices, pts))
 
     def translated(self, dx: float, dy: float) -> ConvexPolygon:
-        """Return the polygon moved by (dx, dy) metres."""
-        return ConvexPolygon._trusted(self.vertices + np.array([dx, dy]))
+        """Return the polygon moved by (dx, dy) metres; its vertices must stay in :data:`COORDINATE`.
+
+        Examples
+        --------
+        >>> ConvexPolygon([(0, 0), (1, 0), (0, 1)]).translated(2.0, -1.0).vertices.tolist()
+        [[2.0, -1.0], [3.0, -1.0], [2.0, 0.0]]
+        >>> ConvexPolygon([(0, 0), (1, 0), (0, 1)]).translated(1e300, 0.0)
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: dx: expected a shift keeping the vertices in [-1e+06, 1e+06] m, got 1e+300
+        """
+        shift = (finite_float(dx, "dx"), finite_float(dy, "dy"))
+        moved = self.vertices + np.array(shift)
+        for axis, name in enumerate(("dx", "dy")):
+            if not np.all(np.abs(moved[:, axis]) <= COORDINATE.high):
+                raise InputError(
+                    f"{name}: expected a shift keeping the vertices in {COORDINATE.interval()}, "
+                    f"got {shift[axis]!r}"
+                )
+        return ConvexPolygon._trusted(moved)
 
     def minkowski_sum(self, other: ConvexPolygon) -> ConvexPolygon:
         """Return the Minkowski sum with another convex polygon (exact)."""
+        _check_polygon(other)
         return ConvexPolygon._trusted(_convex.minkowski_sum(self.vertices, other.vertices))
 
     def clipped(self, normal: ArrayLike, offset: float) -> ConvexPolygon | None:
@@ -199,6 +233,7 @@ class ConvexPolygon:
 
     def intersection(self, other: ConvexPolygon) -> ConvexPolygon | None:
         """Return the intersection with another convex polygon, or None when empty."""
+        _check_polygon(other)
         if other.vertex_count < 3 or other.area <= 0.0:
             shapely_result = self.to_shapely().intersection(other.to_shapely())
             return None if shapely_result.is_empty else ConvexPolygon.from_shapely(shapely_result)
@@ -213,15 +248,19 @@ class ConvexPolygon:
 
     def simplified_outer(self, max_vertices: int) -> ConvexPolygon:
         """Return a polygon of at most ``max_vertices`` vertices (>= 3) that contains this one."""
-        if max_vertices < 3:
-            raise InputError(f"max_vertices: expected at least 3, got {max_vertices}")
-        return ConvexPolygon._trusted(_convex.simplify_outer(self.vertices, max_vertices))
+        cap = vertex_cap(max_vertices)
+        return ConvexPolygon._trusted(_convex.simplify_outer(self.vertices, cap))
 
     def sample(self, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
         """Return ``count`` points (m) drawn uniformly from the polygon, shape (count, 2).
 
         Degenerate polygons are sampled along their length (a segment) or at the point.
+        ``count`` is an integer in [0, 10,000,000] (``MAX_SAMPLES``), ``rng`` a numpy Generator.
         """
+        count = bounded_count(
+            count, "count", 0, MAX_SAMPLES, "points a call (about 10 s and 0.7 GB while they are drawn)"
+        )
+        check_rng(rng)
         v = self.vertices
         if self.vertex_count == 1:
             return np.repeat(v, count, axis=0)
@@ -254,6 +293,20 @@ class ConvexPolygon:
     __hash__ = None  # type: ignore[assignment]
 
 
+def _check_polygon(other: object) -> None:
+    """Refuse anything but a ConvexPolygon as the other operand (an AttributeError came from inside)."""
+    if not isinstance(other, ConvexPolygon):
+        raise InputError(f"other: expected a ConvexPolygon, got {type(other).__name__}")
+
+
+def _one_point(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    """Return one point (x, y) in :data:`COORDINATE`, shape (2,), or raise naming ``name``."""
+    points = world_points(value, name, min_rows=1)
+    if points.shape != (1, 2):
+        raise InputError(f"{name}: expected one point (x, y), got shape {np.shape(value)}")
+    return points.reshape(2)
+
+
 # Setters of the slots (frozen: the dataclass's own __setattr__ refuses).
 _set_vertices: Callable[[ConvexPolygon, NDArray[np.float64]], None] = ConvexPolygon.__dict__[
     "vertices"
@@ -266,14 +319,32 @@ def regular_polygon(
 ) -> ConvexPolygon:
     """Return the regular polygon with ``sides`` vertices on a circle of ``radius`` metres.
 
+    ``center`` is one point (x, y) in metres, ``radius`` > 0, ``sides`` an integer in
+    [3, 1,000,000] and ``phase`` the first vertex's direction, radians in [-1000, 1000]
+    (:data:`~aura_ums._validate.ANGLE`); every vertex must lie in the coordinate range.
+
     Examples
     --------
     >>> round(regular_polygon((0, 0), 1.0, 4).area, 12)
     2.0
+    >>> regular_polygon((0, 0), 1.0, 3.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: sides: expected an integer >= 3, got 3.0
     """
-    if sides < 3:
-        raise InputError(f"sides: expected at least 3, got {sides}")
-    angles = phase + np.arange(sides) * (2 * math.pi / sides)
-    return ConvexPolygon(
-        np.column_stack([center[0] + radius * np.cos(angles), center[1] + radius * np.sin(angles)])
-    )
+    c = _one_point(center, "center")
+    r = POLYGON_RADIUS.check(radius, "radius")
+    count = _convex.side_count(sides)
+    start = ANGLE.check(phase, "phase")
+    angles = start + np.arange(count) * (2 * math.pi / count)
+    vertices = np.column_stack([c[0] + r * np.cos(angles), c[1] + r * np.sin(angles)])
+    if not np.all(np.abs(vertices) <= COORDINATE.high):
+        raise InputError(
+            f"radius: expected a circle around center {c.tolist()} inside {COORDINATE.interval()}, got {r!r}"
+        )
+    try:
+        return ConvexPolygon(vertices)
+    except InputError as exc:  # vertices that rounding merges: a radius far below the centre's size
+        raise InputError(
+            f"radius: expected {count} distinct vertices around center {c.tolist()}, got {r!r} ({exc})"
+        ) from exc
