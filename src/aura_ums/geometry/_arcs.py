@@ -4,6 +4,12 @@ An arc is a pair ``(lo, width)`` in radians: every direction from ``lo``
 counter-clockwise to ``lo + width``. ``lo`` need not be wrapped; a ``width`` of
 ``2*pi`` or more is the whole circle. Every function here errs outward, so that
 set-membership bounds built from them stay sound.
+
+These are kernels of the maps' reduction (the numpy references of the compiled ones, on
+the hot path when those are off): they trust their input and check nothing. Arcs are
+pairs of finite floats; ``vertices`` a finite float64 ``(n, 2)`` convex counter-clockwise
+polygon, n >= 1, as a ``ConvexPolygon`` holds it; ``point`` a finite float64 ``(2,)``
+array. A NaN gives NaN out, not an error.
 """
 
 from __future__ import annotations

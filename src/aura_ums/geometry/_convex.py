@@ -4,13 +4,13 @@ Degenerate polygons are allowed everywhere: one vertex is a point, two are a
 segment. Every function that replaces an arc by a polygon returns an *outer*
 polygon (one that contains the arc), so that bounds built from them stay sound.
 
-These are the low-level kernels behind :class:`ConvexPolygon` and the maps' growth and
+These are the low-level kernels behind ``ConvexPolygon`` and the maps' growth and
 reduction (the numpy references of the compiled kernels, on the hot path when those are
 off). They trust their arrays: float64 ``(n, 2)`` arrays of finite coordinates, polygons
 convex and counter-clockwise as documented, floats finite. Give them what a
-:class:`ConvexPolygon` holds; anything else gives garbage or numpy's errors. Only what
-could hang or exhaust memory is checked: the counts of :func:`outer_disk` and the span
-and step of :func:`outer_arc`.
+``ConvexPolygon`` holds; anything else gives garbage or numpy's errors. Only what
+could hang or exhaust memory is checked: the counts of ``outer_disk`` and the span
+and step of ``outer_arc``.
 """
 
 from __future__ import annotations
@@ -126,6 +126,9 @@ def cross2(a: Array, b: Array) -> Array:
 
 def polygon_area(vertices: Array) -> float:
     """Return the signed area (m^2, positive when counter-clockwise) of a polygon.
+
+    ``vertices`` is a finite float64 ``(n, 2)`` array (trusted, not checked); a clockwise
+    polygon's area is negative, which ``convexity_defect`` reads to refuse one.
 
     Examples
     --------
@@ -306,8 +309,9 @@ def _pseudo_angle(edges: Array) -> Array:
 def minkowski_sum(*polygons: Array) -> Array:
     """Return the Minkowski sum of convex counter-clockwise polygons.
 
-    Merges the edges of all operands by direction, which is exact and linear in
-    the total vertex count (plus a sort). Parallel edges are joined. Each operand's
+    Each operand is a non-empty finite float64 ``(n, 2)`` convex counter-clockwise array
+    (trusted, not checked). Merges the edges of all operands by direction, which is exact
+    and linear in the total vertex count (plus a sort). Parallel edges are joined. Each operand's
     edges run from its lowest vertex, ties keep operand order, and the vertices are
     summed edge by edge from the start: the compiled kernel's arithmetic, to the bit.
 
@@ -689,7 +693,8 @@ def checks_every_edge(points: int, vertices: int) -> bool:
     Parameters
     ----------
     points, vertices : int
-        How many points are tested, against a polygon of how many vertices (>= 0).
+        How many points are tested, against a polygon of how many vertices (>= 0;
+        trusted, not checked: it is asked once per point tested).
 
     Examples
     --------

@@ -186,7 +186,7 @@ class ConvexPolygon:
         return np.where(inside, 0.0, _convex.distance_to_boundary(self.vertices, pts))
 
     def translated(self, dx: float, dy: float) -> ConvexPolygon:
-        """Return the polygon moved by (dx, dy) metres; its vertices must stay in :data:`COORDINATE`.
+        """Return the polygon moved by (dx, dy) metres; its vertices must stay in ``COORDINATE``.
 
         Examples
         --------
@@ -321,7 +321,7 @@ def regular_polygon(
 
     ``center`` is one point (x, y) in metres, ``radius`` > 0, ``sides`` an integer in
     [3, 1,000,000] and ``phase`` the first vertex's direction, radians in [-1000, 1000]
-    (:data:`~aura_ums._validate.ANGLE`); every vertex must lie in the coordinate range.
+    (``ANGLE``); every vertex must lie in the coordinate range.
 
     Examples
     --------

@@ -145,7 +145,7 @@ class ImageWindow:
     def expanded(self, margin: float) -> ImageWindow:
         """Return the window grown by ``margin`` pixels on every side, at most an image's longest side.
 
-        A margin beyond 20,000 px (:data:`~aura_ums._validate.IMAGE_SIDE`) reaches past any
+        A margin beyond 20,000 px (``IMAGE_SIDE``) reaches past any
         image: 1e300 made a window of area inf.
         """
         m = nonnegative_float(margin, "margin")
