@@ -56,11 +56,20 @@ def test_finite_float_refuses_what_is_not_a_finite_number(value: object, message
 @pytest.mark.parametrize(
     ("value", "message"),
     [
-        ([["0", "0"], ["1", "0"]], r"p: expected an \(n, 2\) array of numbers, got strings \(\[\['0', '0'\]"),
-        ([[True, False], [True, True]], r"p: expected an \(n, 2\) array of numbers, got booleans"),
-        (np.array([[0, 0], [1, 0]], dtype=complex), r"p: expected an \(n, 2\) array of numbers, got complex"),
-        ([[1, None]], r"p: expected an \(n, 2\) array of numbers, got objects"),
-        (np.zeros((2, 2), dtype="datetime64[s]"), r"p: expected an \(n, 2\) array of numbers, got dtype"),
+        (
+            [["0", "0"], ["1", "0"]],
+            r"p: expected an \(n, 2\) array of numbers, got \[\['0', '0'\], \['1', '0'\]\]",
+        ),
+        ([[True, False], [True, True]], r"p: expected an \(n, 2\) array of numbers, got \[\[True, False\]"),
+        (
+            np.array([[0, 0], [1, 0]], dtype=complex),
+            r"p: expected an \(n, 2\) array of numbers, got array\(\[\[0\.\+0\.j, 0\.\+0\.j\], \[1",
+        ),
+        ([[1, None]], r"p: expected an \(n, 2\) array of numbers, got \[\[1, None\]\]"),
+        (
+            np.zeros((2, 2), dtype="datetime64[s]"),
+            r"p: expected an \(n, 2\) array of numbers, got array\(\[\['1970-01-01T00:00:00'",
+        ),
     ],
 )
 def test_points_array_refuses_strings_bools_and_complex(value: object, message: str) -> None:
@@ -71,10 +80,10 @@ def test_points_array_refuses_strings_bools_and_complex(value: object, message: 
 @pytest.mark.parametrize(
     ("value", "message"),
     [
-        ("1.0", r"h: expected numbers, got strings \('1\.0'\)"),
-        (True, r"h: expected numbers, got booleans \(True\)"),
-        ([0.5, 1 + 2j], r"h: expected numbers, got complex numbers"),
-        (np.array(["x"] * 100), r"h: expected numbers, got strings \(array\(\['x', .*\.\.\.\)"),
+        ("1.0", r"h: expected numbers, got '1\.0'"),
+        (True, r"h: expected numbers, got True"),
+        ([0.5, 1 + 2j], r"h: expected numbers, got \[0\.5, \(1\+2j\)\]"),
+        (np.array(["x"] * 100), r"h: expected numbers, got array\(\['x', .*', \.\.\.$"),
     ],
 )
 def test_float_array_refuses_strings_bools_and_complex(value: object, message: str) -> None:

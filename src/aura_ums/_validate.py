@@ -298,10 +298,6 @@ PIXEL = Range(-1e5, 1e5, "px")
 BLUR = Range(0.0, 100.0, "px")
 
 
-#: What an array of a dtype kind that is no number holds, for messages.
-_NOT_NUMBERS = {"b": "booleans", "c": "complex numbers", "U": "strings", "S": "bytes", "O": "objects"}
-
-
 def _numbers(
     make: Callable[[object], NDArray[Any]], value: object, name: str, expected: str
 ) -> NDArray[np.float64]:
@@ -317,8 +313,7 @@ def _numbers(
         raise InputError(f"{name}: expected {expected}, got {value!r}") from exc
     kind = array.dtype.kind
     if kind not in "iuf" and not (kind == "O" and all(_real(item) for item in array.flat)):
-        what = _NOT_NUMBERS.get(kind, f"dtype {array.dtype}")
-        raise InputError(f"{name}: expected {expected}, got {what} ({_short(value)})")
+        raise InputError(f"{name}: expected {expected}, got {_short(value)}")
     try:
         return array.astype(np.float64, copy=False)
     except (TypeError, ValueError, OverflowError) as exc:  # an object no float holds
@@ -330,9 +325,9 @@ def _real(item: object) -> bool:
 
 
 def _short(value: object) -> str:
-    """``repr(value)``, cut to 80 characters: a refused array may be large."""
+    """``repr(value)`` on one line, cut to 200 characters: a refused array may be large."""
     text = " ".join(repr(value).split())
-    return text if len(text) <= 80 else text[:77] + "..."
+    return text if len(text) <= 200 else text[:197] + "..."
 
 
 def number_array(value: ArrayLike, name: str, expected: str = "numbers") -> NDArray[np.float64]:
@@ -348,7 +343,7 @@ def number_array(value: ArrayLike, name: str, expected: str = "numbers") -> NDAr
     >>> number_array([True, False], "pixels")
     Traceback (most recent call last):
     ...
-    aura_ums.errors.InputError: pixels: expected numbers, got booleans ([True, False])
+    aura_ums.errors.InputError: pixels: expected numbers, got [True, False]
     """
     return _numbers(np.asarray, value, name, expected)
 

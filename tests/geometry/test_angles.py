@@ -94,7 +94,7 @@ def test_wrap_angle_keeps_its_arithmetic_and_types(angle: float) -> None:
         (None, 0.0, r"a: expected a finite number, got None"),
         ("1.0", 0.1, r"a: expected a finite number, got '1\.0'"),
         (0.1, True, r"b: expected a finite number, got True"),
-        (np.array([0.1]), "0.2", r"b: expected numbers, got strings"),
+        (np.array([0.1]), "0.2", r"b: expected numbers, got '0\.2'"),
         (np.array([np.inf]), 0.2, r"a: expected finite numbers, got non-finite values"),
     ],
 )

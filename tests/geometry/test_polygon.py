@@ -567,8 +567,8 @@ def test_polygon_builders_take_numpy_side_counts_bit_for_bit() -> None:
     ("center", "message"),
     [
         ([], r"center: expected at least 1 points, got 0"),
-        ({}, r"center: expected an \(n, 2\) array of numbers, got objects"),
-        ("ab", r"center: expected an \(n, 2\) array of numbers, got strings"),
+        ({}, r"center: expected an \(n, 2\) array of numbers, got \{\}"),
+        ("ab", r"center: expected an \(n, 2\) array of numbers, got 'ab'"),
         ([(0.0, 0.0), (1.0, 1.0)], r"center: expected one point \(x, y\), got shape \(2, 2\)"),
         ((math.nan, 0.0), r"center: expected finite coordinates"),
     ],

@@ -229,6 +229,6 @@ def test_widened_by_a_huge_extent_is_the_full_circle_and_rotated_keeps_its_bits(
 @pytest.mark.parametrize("heading", ["0.0", True, [0.0, 1 + 1j]])
 def test_contains_refuses_headings_that_are_no_numbers(heading: object) -> None:
     with pytest.raises(
-        InputError, match=r"heading: expected numbers, got (strings|booleans|complex numbers)"
+        InputError, match=r"heading: expected numbers, got ('0\.0'|True|\[0\.0, \(1\+1j\)\])$"
     ):
         HeadingWedge(0.0, 0.1, 0.1).contains(heading)  # type: ignore[call-overload]

@@ -68,9 +68,12 @@ def test_refuses_what_is_not_points(pixels: object, message: str) -> None:
 @pytest.mark.parametrize(
     ("pixels", "message"),
     [
-        ([[True, False]], r"pixels: expected an \(n, 2\) array of numbers, got booleans"),
-        ([["1", "2"]], r"pixels: expected an \(n, 2\) array of numbers, got strings"),
-        (np.array([[1 + 0j, 2]]), r"pixels: expected an \(n, 2\) array of numbers, got complex numbers"),
+        ([[True, False]], r"pixels: expected an \(n, 2\) array of numbers, got \[\[True, False\]\]"),
+        ([["1", "2"]], r"pixels: expected an \(n, 2\) array of numbers, got \[\['1', '2'\]\]"),
+        (
+            np.array([[1 + 0j, 2]]),
+            r"pixels: expected an \(n, 2\) array of numbers, got array\(\[\[1\.\+0\.j, 2\.\+0\.j\]\]\)",
+        ),
         (5.0, r"pixels: expected shape \(\.\.\., 2\), got \(\)"),
         ([[1.0, 2.0, 3.0]], r"pixels: expected shape \(\.\.\., 2\), got \(1, 3\)"),
     ],
