@@ -506,7 +506,7 @@ class Camera:
         back onto the pixels of nearer rays, which this camera does not model.
 
         ``points_camera`` are finite metres, each coordinate within 1e7 m
-        (:data:`CAMERA_COORDINATE`).
+        ([-1e7, 1e7] m).
 
         Examples
         --------

@@ -97,7 +97,7 @@ def sample_points(segments: ArrayLike, step: float = 1.0) -> tuple[NDArray[np.fl
     """Points every ``step`` pixels along each segment, endpoints included, and their segment index.
 
     ``segments`` is a finite ``(n, 4)`` array (``x1, y1, x2, y2``, pixels); ``step`` > 0
-    pixels. At most :data:`MAX_SAMPLE_POINTS` points are made.
+    pixels. At most 10,000,000 points are made.
 
     Examples
     --------
