@@ -15,6 +15,7 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
+from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     Composite,
     Pose,
@@ -240,3 +241,18 @@ def test_intersection_with_a_disjoint_map_is_the_first() -> None:
     there = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 2.0), 0.5, 0.1)
     assert intersect_maps(here, [there], 64) is here
     assert intersect_maps(here, [here], 64) is here
+
+
+@pytest.mark.parametrize(
+    ("fields", "match"),
+    [
+        ({"x": math.nan}, "Composite.x: expected a finite number, got nan"),
+        ({"y": None}, "Composite.y: expected a finite number, got None"),
+        ({"heading": "a"}, "Composite.heading: expected a finite number, got 'a'"),
+        ({"path": math.nan}, "Composite.path: expected a finite number, got nan"),
+        ({"turning": -1.0}, "Composite.turning: expected a non-negative number, got -1.0"),
+    ],
+)
+def test_a_composite_refuses_what_is_not_a_move(fields: dict[str, object], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        Composite(**fields)  # type: ignore[arg-type]

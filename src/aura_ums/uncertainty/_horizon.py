@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import clamp_into
-from aura_ums._validate import SIGMAS, sequence_of, vertex_cap
+from aura_ums._validate import SIGMAS, finite_float, nonnegative_float, sequence_of, vertex_cap
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, convex_hull, intersect_arcs, nearest_on_polygon
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
@@ -76,6 +76,10 @@ class Composite:
     >>> moved = still.extended([TurnAndRun(math.pi / 2, 1.0)], TerrainStats.zero())
     >>> round(moved.x, 9), round(moved.y, 9), moved.turning, moved.is_still
     (0.0, 1.0, 1.5707963267948966, False)
+    >>> Composite(path=-1.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: Composite.path: expected a non-negative number, got -1.0
     """
 
     x: float = 0.0
@@ -83,6 +87,12 @@ class Composite:
     heading: float = 0.0
     path: float = 0.0
     turning: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("x", "y", "heading"):
+            object.__setattr__(self, name, finite_float(getattr(self, name), f"Composite.{name}"))
+        for name in ("path", "turning"):
+            object.__setattr__(self, name, nonnegative_float(getattr(self, name), f"Composite.{name}"))
 
     @property
     def is_still(self) -> bool:
