@@ -285,3 +285,19 @@ def test_bad_arguments_get_the_library_error() -> None:
         InputError, match=r"path: expected a terrain table TOML file's path \(str or path-like\)"
     ):
         TerrainTable.from_toml(nothing)
+
+
+def test_a_name_that_is_not_a_string_is_refused() -> None:
+    # unhashable type: 'list', a TypeError, before
+    table = TerrainTable.default()
+    wrong: Any = ["tile"]
+    nothing: Any = None
+    one: Any = 1
+    with pytest.raises(InputError, match="terrain: expected a terrain name \\(a str\\), got list"):
+        table[wrong]
+    with pytest.raises(InputError, match="w: expected a terrain name \\(a str\\), got list"):
+        table.require(wrong, where="w", whose="x")
+    with pytest.raises(InputError, match="where: expected a str, got NoneType"):
+        table.require("tile", where=nothing, whose="x")
+    with pytest.raises(InputError, match="whose: expected a str, got int"):
+        table.require("tile", where="w", whose=one)

@@ -347,6 +347,11 @@ class TerrainTable(Mapping[str, TerrainStats]):
         ...
         aura_ums.errors.UnknownTerrainError: t.toml: expected the terrain 'floor' of the log, got 'tile', ...
         """
+        for label, value in (("where", where), ("whose", whose)):
+            if not isinstance(value, str):
+                raise InputError(f"{label}: expected a str, got {type(value).__name__}")
+        if not isinstance(name, str):
+            raise InputError(f"{where}: expected a terrain name (a str), got {type(name).__name__}")
         if name in self.entries:
             return
         held = ", ".join(repr(entry) for entry in self.entries) or "none"
@@ -358,6 +363,8 @@ class TerrainTable(Mapping[str, TerrainStats]):
         except KeyError:
             known = ", ".join(sorted(self.entries))
             raise UnknownTerrainError(f"terrain: expected one of {known}, got {name!r}") from None
+        except TypeError:  # unhashable: checked only here, off the lookups' path
+            raise InputError(f"terrain: expected a terrain name (a str), got {type(name).__name__}") from None
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.entries)
