@@ -74,6 +74,11 @@ def test_the_defaults_are_the_library_defaults() -> None:
         ({"joint_above": 1e300}, r"joint_above: expected a number in \[0, 2 pi\] or none, got 1e\+300"),
         ({"joint_sector": 0.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 0.0"),
         ({"joint_sector": 7.0}, r"joint_sector: expected a number in \(0, 2 pi\], got 7.0"),
+        # 2 pi / 1e-300 sectors: an OverflowError from the joint reduction's kernel before
+        (
+            {"joint_sector": 1e-300},
+            r"joint_sector: expected at least 0\.00174533 rad \(0\.1 degree: .*got 1e-300",
+        ),
         ({"max_vertices": 2}, "max_vertices: expected an integer >= 3, got 2"),
         ({"max_vertices": 16.0}, "max_vertices: expected an integer >= 3, got 16.0"),
         ({"max_vertices": 10**9}, r"max_vertices: expected an integer in \[3, 100000\], got 1000000000"),
@@ -138,7 +143,7 @@ valid = st.builds(
     missed_limit=st.integers(1, 20),
     lost_window_scale=st.floats(1.0, 10.0),
     joint_above=st.none() | st.floats(0.0, 2 * math.pi),
-    joint_sector=st.floats(1e-3, 2 * math.pi),
+    joint_sector=st.floats(2e-3, 2 * math.pi),
     max_vertices=st.integers(3, 500),
     robust=st.booleans(),
     envelope_factor=st.floats(1.0, 10.0),

@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from aura_ums.errors import InputError
 from aura_ums.uncertainty import (
     MotionBounds,
     Pose,
@@ -114,3 +116,32 @@ def test_a_run_of_growths_is_bit_for_bit_a_loop_of_grow(
 def test_no_commands_keep_the_very_map() -> None:
     start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 3.0), 0.1, 0.05)
     assert start._grow_many([], TerrainTable.default()["grass"], 3.0) is start
+
+
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        (
+            (TerrainTable.default()["tile"], TurnAndRun(0.1, 1.0), math.nan),
+            "sigmas: expected a finite number, got nan",
+        ),
+        (
+            (TerrainTable.default()["tile"], TurnAndRun(0.1, 1.0), math.inf),
+            "sigmas: expected a finite number, got inf",
+        ),
+        ((TerrainTable.default()["tile"], TurnAndRun(0.1, 1.0), -math.inf), "sigmas: expected a finite"),
+        (
+            (TerrainTable.default()["tile"], TurnAndRun(0.1, 1.0), -1.0),
+            r"sigmas: expected a number in \[0\.1, 100\]",
+        ),
+        (
+            (TerrainTable.default()["tile"], TurnAndRun(0.1, 1.0), None),
+            "sigmas: expected a finite number, got None",
+        ),
+        ((TerrainTable.default()["tile"], None, 3.0), "command: expected a TurnAndRun, got NoneType"),
+        ((None, TurnAndRun(0.1, 1.0), 3.0), "stats: expected a TerrainStats, got NoneType"),
+    ],
+)
+def test_motion_bounds_refuses_bad_arguments(arguments: tuple[object, object, object], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        motion_bounds(*arguments)  # type: ignore[arg-type]

@@ -261,7 +261,14 @@ def test_the_cap_test_drives_the_joint_hull_past_the_cap() -> None:
         ({"sector": 0.0}, r"sector: expected radians in \(0, 2 pi\], got 0.0"),
         ({"sector": 7.0}, r"sector: expected radians in \(0, 2 pi\], got 7.0"),
         ({"sector": math.nan}, "sector: expected a finite number"),
-        ({"max_vertices": 2}, "max_vertices: expected an integer >= 3, got 2"),
+        ({"max_vertices": 2}, r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 2"),
+        # an OverflowError from the kernel before
+        ({"max_vertices": 2**63}, r"max_vertices: expected an integer in \[3, 2\*\*63 - 1\], got 92233"),
+        (
+            {"sector": 1e-300},
+            r"sector: expected at least 0\.00174533 rad \(0\.1 degree, at most 3600 sectors; .*"
+            r"got 1e-300 \(6\.28e\+300 sectors of a full circle\)",
+        ),
     ],
 )
 def test_bad_arguments_are_named(kwargs: dict[str, object], match: str) -> None:

@@ -378,3 +378,38 @@ def test_contains_takes_the_pose_arrays_the_library_gives(figure5_map: SpatialUn
     assert inside.tolist() == figure5_map.contains(rows[:, 0], rows[:, 1], rows[:, 2]).tolist()  # type: ignore[union-attr]
     assert inside.all()
     assert figure5_map.contains(rows[0]) is True
+
+
+def test_sample_poses_caps_the_count() -> None:
+    # 10**12 poses: a MemoryError asking for 7.28 TiB before
+    start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, 0.2)
+    with pytest.raises(
+        InputError, match=r"count: expected at most 10000000 poses \(about 240 MB\), got 1000000000000"
+    ):
+        start.sample_poses(10**12, np.random.default_rng(0))
+
+
+def test_the_monte_carlo_checks_name_their_own_arguments() -> None:
+    start = SpatialUncertaintyMap.from_pose(Pose(0, 0, 0), 0.5, 0.2)
+    rng = np.random.default_rng(0)
+    moves = [(TurnAndRun(0.1, 1.0), TERRAINS["tile"])]
+    anything: Any = None
+    half: Any = 1.5
+    with pytest.raises(InputError, match=r"samples: expected an integer >= 0, got 1\.5"):
+        growth_tightness(start, TurnAndRun(0.1, 1.0), TERRAINS["tile"], rng, samples=half)
+    with pytest.raises(InputError, match="start: expected a SpatialUncertaintyMap, got NoneType"):
+        growth_tightness(anything, TurnAndRun(0.1, 1.0), TERRAINS["tile"], rng)
+    with pytest.raises(InputError, match=r"poses: expected an integer >= 0, got 1\.5"):
+        simulate_containment(start, moves, rng, poses=half)
+    with pytest.raises(InputError, match="poses: expected at most 10000000 poses"):
+        simulate_containment(start, moves, rng, poses=10**12)
+    with pytest.raises(InputError, match=r"moves: expected a sequence of .*, got NoneType"):
+        simulate_containment(start, anything, rng)
+    with pytest.raises(
+        InputError, match=r"moves\[0\]: expected a \(TurnAndRun, TerrainStats\) pair, got None"
+    ):
+        simulate_containment(start, [anything], rng)
+    with pytest.raises(InputError, match="start: expected a SpatialUncertaintyMap, got NoneType"):
+        simulate_containment(anything, moves, rng)
+    with pytest.raises(InputError, match=r"rng: expected a numpy\.random\.Generator, got NoneType"):
+        simulate_containment(start, moves, anything)

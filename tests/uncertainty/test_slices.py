@@ -26,6 +26,7 @@ from aura_ums.uncertainty import (
     TerrainTable,
     TurnAndRun,
     VerticalLineLandmark,
+    cell_count,
     reduce_jointly,
 )
 from aura_ums.uncertainty._slices import SliceSet, distributed, split_product
@@ -413,3 +414,25 @@ def test_a_distribution_over_its_cell_budget_merges_neighbours_into_an_outer_bou
     assert merged.area <= 1.5 * exact.area
     truths = terrain.sample_motions(start.sample_poses(4000, rng), command, rng, truncate=3.0)
     assert np.all(merged.contains(truths[:, 0], truths[:, 1], truths[:, 2]))
+
+
+@pytest.mark.parametrize(
+    ("width", "match"),
+    [
+        (math.nan, "slice_width: expected a finite number, got nan"),
+        (math.inf, "slice_width: expected a finite number, got inf"),
+        (None, "slice_width: expected a finite number, got None"),
+    ],
+)
+def test_cell_count_refuses_what_is_not_a_width(width: object, match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        cell_count(width)  # type: ignore[arg-type]
+
+
+def test_with_slices_caps_the_slice_cap() -> None:
+    start = SpatialUncertaintyMap.from_pose(Pose(0.0, 0.0, 0.0), 0.1, 0.01)
+    with pytest.raises(
+        InputError, match=r"max_slices: expected at most 100000 slices .*, got 9223372036854775808"
+    ):
+        start.with_slices(0.035, 2**63)
+    assert len(start.with_slices(0.035, 100_000).slices) == len(start.with_slices(0.035).slices)

@@ -93,3 +93,29 @@ def test_the_union_of_sliced_maps_keeps_their_slices_and_every_pose() -> None:
     assert union.polygon.contains(np.array([[0.0, 0.0]]))[0]
     assert not union.contains(0.0, 0.0, 1.2)
     assert union.area <= union_of_maps([east.without_slices(), west]).area + 1e-9
+
+
+def test_union_of_maps_caps_the_vertex_cap() -> None:
+    start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+    other = SpatialUncertaintyMap.from_pose(Pose(3.0, 2.5, 0.0), 0.1, 0.01)
+    with pytest.raises(
+        InputError, match=r"max_vertices: expected at most 100000 .*got 1000000000000 \(about 1e\+05 GB\)"
+    ):
+        union_of_maps([start, other], max_vertices=10**12)
+    with pytest.raises(InputError, match="max_vertices: expected at most 100000"):
+        union_of_maps([start, other], max_vertices=2**63)
+
+
+@pytest.mark.parametrize(
+    ("wedges", "center", "match"),
+    [
+        ([], 0.0, "wedges: expected at least one HeadingWedge, got none"),
+        (None, 0.0, "wedges: expected a sequence of HeadingWedge, got NoneType"),
+        ([None], 0.0, r"wedges\[0\]: expected a HeadingWedge, got NoneType"),
+        ([HeadingWedge(0.0, 0.1, 0.1)], None, "center: expected a finite number, got None"),
+        ([HeadingWedge(0.0, 0.1, 0.1)], math.inf, "center: expected a finite number, got inf"),
+    ],
+)
+def test_union_of_wedges_refuses_bad_arguments(wedges: object, center: object, match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        union_of_wedges(wedges, center)  # type: ignore[arg-type]

@@ -19,7 +19,7 @@ from typing import Any
 
 from aura_ums._validate import SIGMAS, Choice
 from aura_ums.errors import InputError
-from aura_ums.uncertainty import cell_count
+from aura_ums.uncertainty import MAX_SLICES, MAX_VERTICES, MIN_SECTOR, cell_count
 
 #: What a setting holds.
 SettingValue = float | int | bool | None
@@ -280,7 +280,7 @@ relocalize_after (2), got 1
             "",
             int,
             low=3,
-            high=_MOST,
+            high=MAX_VERTICES,
         ),
     )
     # max_slices defaults to what SpatialUncertaintyMap.with_slices takes (tests/manager/
@@ -309,7 +309,7 @@ relocalize_after (2), got 1
             "",
             int,
             low=1,
-            high=_MOST,
+            high=MAX_SLICES,
         ),
     )
     anchor_growth: bool = _setting(
@@ -362,7 +362,7 @@ relocalize_after (2), got 1
             "",
             int,
             low=3,
-            high=_MOST,
+            high=MAX_VERTICES,
             nullable=True,
         ),
     )
@@ -489,6 +489,14 @@ def _checked(
             cells = cell_count(width)
         except InputError as exc:
             raise fail("slice_width", str(exc).partition(": ")[2]) from None
+    sector = checked["joint_sector"]
+    if isinstance(sector, float) and sector < MIN_SECTOR:
+        # 2 pi / 1e-300 sectors overflowed the joint reduction's kernel
+        raise fail(
+            "joint_sector",
+            f"expected at least {MIN_SECTOR:g} rad (0.1 degree: a joint reduction costs in proportion "
+            f"to its sectors), got {sector!r}",
+        )
     after, window = checked["relocalize_after"], checked["relocalize_window"]
     if isinstance(after, int) and isinstance(window, int) and window < after:
         if _blames_count("relocalize_after", "relocalize_window", given):

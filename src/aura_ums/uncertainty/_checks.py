@@ -12,9 +12,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from aura_ums._validate import SIGMAS, check_rng, items_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import convex_hull, polygon_area
-from aura_ums.uncertainty._map import SpatialUncertaintyMap
+from aura_ums.uncertainty._map import SpatialUncertaintyMap, sample_count
 from aura_ums.uncertainty._motion import TurnAndRun
 from aura_ums.uncertainty._terrain import TerrainStats
 
@@ -97,8 +98,20 @@ def simulate_containment(
     >>> simulate_containment(start, moves, np.random.default_rng(1), truncate=3.0).rate
     1.0
     """
-    if poses < 1:
+    _check_start(start)
+    steps = items_of(moves, "moves", "a sequence of (TurnAndRun, TerrainStats) pairs")
+    for index, move in enumerate(steps):
+        if (
+            not isinstance(move, tuple)
+            or len(move) != 2
+            or not isinstance(move[0], TurnAndRun)
+            or not isinstance(move[1], TerrainStats)
+        ):
+            raise InputError(f"moves[{index}]: expected a (TurnAndRun, TerrainStats) pair, got {move!r}")
+    if sample_count(poses, "poses") < 1:
         raise InputError(f"poses: expected at least 1, got {poses}")
+    check_rng(rng)
+    SIGMAS.check(sigmas, "sigmas")
     state = start.sample_poses(poses, rng)
     if include_extremes:
         wedge = start.wedge
@@ -109,7 +122,7 @@ def simulate_containment(
     inside = 0
     total = 0
     per_step: list[float] = []
-    for command, terrain in moves:
+    for command, terrain in steps:
         state = terrain.sample_motions(state, command, rng, truncate=truncate)
         current = current.grow(command, terrain, sigmas=sigmas)
         hits = int(np.count_nonzero(current.contains(state[:, 0], state[:, 1], state[:, 2])))
@@ -178,8 +191,16 @@ def growth_tightness(
     >>> 1.0 <= result.ratio < 2.0
     True
     """
+    _check_start(start)
+    sample_count(samples, "samples")
+    check_rng(rng)
     grown = start.grow(command, terrain, sigmas=sigmas)
     state = start.sample_poses(samples, rng)
     outcomes = terrain.sample_motions(state, command, rng, truncate=sigmas)
     hull = convex_hull(outcomes[:, :2])
     return TightnessResult(grown.area, polygon_area(hull), outcomes)
+
+
+def _check_start(start: object) -> None:
+    if not isinstance(start, SpatialUncertaintyMap):
+        raise InputError(f"start: expected a SpatialUncertaintyMap, got {type(start).__name__}")

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from aura_ums import _native
 from aura_ums._native import TOLERANCE, cap_inside
-from aura_ums._validate import finite_float, integer_at_least
+from aura_ums._validate import finite_float, vertex_cap
 from aura_ums.errors import InputError
 from aura_ums.geometry import Arc, ConvexPolygon, HeadingWedge, intersect_arcs
 from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
@@ -44,11 +44,16 @@ from aura_ums.uncertainty._reduce import (
     moved_landmark,
     reduce_checked,
 )
+from aura_ums.uncertainty._slices import MAX_CELLS, MIN_SLICE_WIDTH
 
 #: Default widest heading sector of :func:`reduce_jointly`, radians (5 degrees).
 DEFAULT_SECTOR = math.radians(5.0)
 
 _TWO_PI = 2.0 * math.pi
+#: Narrowest heading sector of :func:`reduce_jointly` (and the manager's ``joint_sector``): a
+#: sliced map's narrowest cell, :data:`MAX_CELLS` sectors round the circle (1e-300 rad asked
+#: the kernel for more sectors than it can count).
+MIN_SECTOR = MIN_SLICE_WIDTH
 
 #: Why a joint reduction is empty.
 JOINT_INCONSISTENT = "no heading of the map agrees with all the observations together"
@@ -123,7 +128,7 @@ def reduce_jointly(
         raise InputError(f"prior: expected a SpatialUncertaintyMap, got {type(prior).__name__}")
     pairs = _checked_sightings(sightings)
     width_limit = check_sector(sector, "sector")
-    cap = integer_at_least(max_vertices, "max_vertices", 3)
+    cap = vertex_cap(max_vertices)
     wedge = prior.wedge
     found = joint_reduced(prior, pairs, width_limit, cap)
     if isinstance(found, str):
@@ -200,10 +205,16 @@ def _sector_rows(pairs: Sequence[tuple[Observation, Landmark]], cap: int) -> lis
 
 
 def check_sector(value: object, name: str) -> float:
-    """Return a sector width (radians, in (0, 2 pi]) or raise naming ``name``."""
+    """Return a sector width (radians, in [:data:`MIN_SECTOR`, 2 pi]) or raise naming ``name``."""
     width = finite_float(value, name)
     if not 0.0 < width <= _TWO_PI:
         raise InputError(f"{name}: expected radians in (0, 2 pi], got {width!r}")
+    if width < MIN_SECTOR:
+        raise InputError(
+            f"{name}: expected at least {MIN_SECTOR:g} rad (0.1 degree, at most {MAX_CELLS} sectors; "
+            f"a reduction costs in proportion to the sectors), got {width!r} "
+            f"({_TWO_PI / width:.3g} sectors of a full circle)"
+        )
     return width
 
 

@@ -57,6 +57,7 @@ from aura_ums.uncertainty._slices import (
     heading_slices,
     packed,
     point_in,
+    slice_cap,
     split_product,
     summary_polygon,
 )
@@ -65,6 +66,20 @@ from aura_ums.uncertainty._slices import contains_one as slices_contain_one
 from aura_ums.uncertainty._terrain import TerrainStats
 
 _START_DISK_SIDES = 16
+#: Most poses :meth:`SpatialUncertaintyMap.sample_poses` draws at once (24 bytes each, 240 MB):
+#: 10**12 asked for 7.28 TiB.
+MAX_SAMPLES = 10_000_000
+
+
+def sample_count(value: object, name: str) -> int:
+    """Return a count of poses to draw, an integer in [0, :data:`MAX_SAMPLES`], or raise naming ``name``."""
+    count = integer_at_least(value, name, 0)
+    if count > MAX_SAMPLES:
+        raise InputError(
+            f"{name}: expected at most {MAX_SAMPLES} poses (about {24 * MAX_SAMPLES // 10**6} MB), "
+            f"got {count} (about {24 * count / 1e9:.3g} GB)"
+        )
+    return count
 
 
 @dataclass(frozen=True, slots=True, eq=False, init=False)
@@ -279,7 +294,7 @@ class SpatialUncertaintyMap:
         width = finite_float(slice_width, "slice_width")
         if not 0.0 < width <= 2.0 * math.pi:
             raise InputError(f"slice_width: expected radians in (0, 2 pi], got {width!r}")
-        cap = integer_at_least(max_slices, "max_slices", 1)
+        cap = slice_cap(max_slices)
         cells = cell_count(width)
         if self._slices is not None and self._cells == cells and self._max_slices == cap:
             return self
@@ -335,7 +350,7 @@ class SpatialUncertaintyMap:
         width = finite_float(slice_width, "slice_width")
         if not 0.0 < width <= 2.0 * math.pi:
             raise InputError(f"slice_width: expected radians in (0, 2 pi], got {width!r}")
-        cap = integer_at_least(max_slices, "max_slices", 1)
+        cap = slice_cap(max_slices)
         if not isinstance(wedge, HeadingWedge):
             raise InputError(f"wedge: expected a HeadingWedge, got {type(wedge).__name__}")
         if not 1 <= len(slices) <= cap:
@@ -694,7 +709,7 @@ class SpatialUncertaintyMap:
         A sliced map draws a slice for each pose with a chance proportional to its area times
         its heading width (a small floor keeps degenerate slices possible), then a pose in it.
         """
-        count = integer_at_least(count, "count", 0)
+        count = sample_count(count, "count")
         check_rng(rng)
         slices = self._slices
         if slices is not None:

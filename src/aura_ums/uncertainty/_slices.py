@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from aura_ums import _native
+from aura_ums._validate import finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, checks_every_edge, points_in_convex, polygon_area
 
@@ -113,6 +114,20 @@ class HeadingSlice(NamedTuple):
 #: memory. No odometry resolves a heading finer than a tenth of a degree.
 MAX_CELLS = 3600
 MIN_SLICE_WIDTH = _TWO_PI / MAX_CELLS
+#: Largest slice cap a sliced map takes (and the manager settings' ``max_slices``): the grid has
+#: at most :data:`MAX_CELLS` cells, so no cap above it caps anything (2**63 overflowed the kernel).
+MAX_SLICES = 100_000
+
+
+def slice_cap(value: object, name: str = "max_slices") -> int:
+    """Return a slice cap, an integer in [1, :data:`MAX_SLICES`], or raise naming ``name``."""
+    cap = integer_at_least(value, name, 1)
+    if cap > MAX_SLICES:
+        raise InputError(
+            f"{name}: expected at most {MAX_SLICES} slices (the grid has at most {MAX_CELLS} cells), "
+            f"got {cap}"
+        )
+    return cap
 
 
 def cell_count(width: float) -> int:
@@ -129,7 +144,12 @@ def cell_count(width: float) -> int:
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: slice_width: expected at least 0.00174533 rad (...), got 1e-12
+    >>> cell_count(float("inf"))
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: slice_width: expected a finite number, got inf
     """
+    width = finite_float(width, "slice_width")
     if width < MIN_SLICE_WIDTH:
         raise InputError(
             f"slice_width: expected at least {MIN_SLICE_WIDTH:g} rad (0.1 degree, {MAX_CELLS} heading "

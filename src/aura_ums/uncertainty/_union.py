@@ -9,10 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import sequence_of
+from aura_ums._validate import finite_float, sequence_of
 from aura_ums.errors import InputError
 from aura_ums.geometry import ConvexPolygon, HeadingWedge
-from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES
+from aura_ums.uncertainty._growth import DEFAULT_MAX_VERTICES, MAX_VERTICES
 from aura_ums.uncertainty._map import SpatialUncertaintyMap
 from aura_ums.uncertainty._slices import distributed, split_product
 
@@ -71,6 +71,11 @@ def union_of_maps(
     """
     if isinstance(max_vertices, bool) or not isinstance(max_vertices, int) or max_vertices < 3:
         raise InputError(f"max_vertices: expected an integer >= 3, got {max_vertices!r}")
+    if max_vertices > MAX_VERTICES:
+        raise InputError(
+            f"max_vertices: expected at most {MAX_VERTICES} (the hull is built from that many supporting "
+            f"directions, about 100 bytes each), got {max_vertices} (about {max_vertices * 100 / 1e9:.3g} GB)"
+        )
     items = sequence_of(maps, SpatialUncertaintyMap, "maps")
     if not items:
         raise InputError("maps: expected at least one SpatialUncertaintyMap, got none")
@@ -80,7 +85,7 @@ def union_of_maps(
     if primary.is_sliced:
         return _sliced_union(primary, items, max_vertices)
     polygon = _support_hull([item.polygon.vertices for item in items], max_vertices)
-    wedge = union_of_wedges([item.wedge for item in items], primary.wedge.center)
+    wedge = _union_of_wedges([item.wedge for item in items], primary.wedge.center)
     return SpatialUncertaintyMap._trusted(polygon, primary.center.copy(), wedge)
 
 
@@ -139,7 +144,19 @@ def union_of_wedges(wedges: Sequence[HeadingWedge], center: float) -> HeadingWed
     (0.1, 1.1)
     >>> union_of_wedges([a, HeadingWedge.full_circle()], 0.0).is_full_circle
     True
+    >>> union_of_wedges([], 0.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: wedges: expected at least one HeadingWedge, got none
     """
+    wedges = sequence_of(wedges, HeadingWedge, "wedges")
+    if not wedges:
+        raise InputError("wedges: expected at least one HeadingWedge, got none")
+    return _union_of_wedges(wedges, finite_float(center, "center"))
+
+
+def _union_of_wedges(wedges: Sequence[HeadingWedge], center: float) -> HeadingWedge:
+    """:func:`union_of_wedges` for checked arguments (at least one wedge, a finite centre)."""
     if any(wedge.is_full_circle for wedge in wedges):
         return HeadingWedge.full_circle(center)
     starts = np.array([wedge.center - wedge.cw for wedge in wedges]) % _TWO_PI
