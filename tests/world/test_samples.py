@@ -147,3 +147,28 @@ def test_grid_world_random_terrains_are_reproducible() -> None:
 def test_grid_world_validates(args: tuple[object, ...], kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(InputError, match=message):
         make_grid_world(*args, **kwargs)  # type: ignore[arg-type]
+
+
+def test_a_grid_world_is_bounded_in_size() -> None:
+    # 10**12 cells never ended (1000 x 1000 ran past 20 s)
+    with pytest.raises(
+        InputError,
+        match=r"rows, cols: expected at most 10000 cells .*got 1000000000000 x 1 = 1000000000000 cells",
+    ):
+        make_grid_world(10**12, 1)
+
+
+@pytest.mark.parametrize(
+    ("remove", "match"),
+    [
+        ([(5, 5)], r"remove\[0\]: expected a \(row, col\) cell of the 1 x 2 grid, got \(5, 5\)"),
+        ([(0, -1)], r"remove\[0\]: expected a \(row, col\) cell of the 1 x 2 grid, got \(0, -1\)"),
+        ([None], r"remove\[0\]: expected a \(row, col\) cell of the 1 x 2 grid, got None"),
+        ([(0, 0), (0, 1, 2)], r"remove\[1\]: expected a \(row, col\) cell .*, got \(0, 1, 2\)"),
+        ([(0.5, 0)], r"remove\[0\]: expected a \(row, col\) cell .*, got \(0\.5, 0\)"),
+    ],
+)
+def test_a_removed_cell_must_be_a_cell_of_the_grid(remove: list[object], match: str) -> None:
+    # (5, 5) was ignored without a word, None a TypeError
+    with pytest.raises(InputError, match=match):
+        make_grid_world(1, 2, remove=remove)  # type: ignore[arg-type]

@@ -14,6 +14,12 @@ from aura_ums.geometry import ConvexPolygon
 from aura_ums.uncertainty import TerrainTable, VerticalLineLandmark
 from aura_ums.world._ltm import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy
 
+#: Most cells of :func:`make_grid_world` (rows times cols): each meadow takes about 0.6 ms to
+#: build and check, so 10,000 take about 6 s (1000 x 1000 ran past 20 s, 10**12 never ended).
+MAX_GRID_CELLS = 10_000
+#: Seconds to build one meadow of a grid world, for the estimate in the message.
+_SECONDS_PER_CELL = 6e-4
+
 #: Names of the sample worlds in ``aura_ums/world/data`` (GeoJSON files).
 SAMPLE_WORLDS = ("indoor_corridor", "paper_sidewalk")
 
@@ -91,15 +97,28 @@ def make_grid_world(
     Traceback (most recent call last):
     ...
     aura_ums.errors.InputError: rows: expected an integer >= 1, got 0
+    >>> make_grid_world(1, 2, remove=[(5, 5)])
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: remove[0]: expected a (row, col) cell of the 1 x 2 grid, got (5, 5)
     """
     for name, value in (("rows", rows), ("cols", cols)):
         integer_at_least(value, name, 1)
+    if rows * cols > MAX_GRID_CELLS:
+        raise InputError(
+            f"rows, cols: expected at most {MAX_GRID_CELLS} cells (about {_SECONDS_PER_CELL * 1e3:g} ms "
+            f"each to build), got {rows} x {cols} = {rows * cols} cells "
+            f"(about {rows * cols * _SECONDS_PER_CELL:.3g} s)"
+        )
     side = finite_float(cell, "cell")
     if side <= 0.0:
         raise InputError(f"cell: expected a positive number, got {side!r}")
     if rng is not None:
         check_rng(rng)
-    holes = {(int(r), int(c)) for r, c in items_of(remove, "remove", "a sequence of (row, col) cells")}
+    holes = {
+        _grid_cell(item, f"remove[{index}]", rows, cols)
+        for index, item in enumerate(items_of(remove, "remove", "a sequence of (row, col) cells"))
+    }
     names = sorted(TerrainTable.default())
     meadows: list[Meadow] = []
     poles: dict[str, tuple[int, int]] = {}
@@ -127,3 +146,16 @@ def make_grid_world(
         for pole, (i, j) in poles.items()
     ]
     return MeadowMap(meadows, records, terrain_table=TerrainTable.default())
+
+
+def _grid_cell(item: object, name: str, rows: int, cols: int) -> tuple[int, int]:
+    """Return ``item`` as a ``(row, col)`` cell of a ``rows`` x ``cols`` grid, or raise naming ``name``."""
+    if (
+        isinstance(item, (tuple, list))
+        and len(item) == 2
+        and all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in item)
+        and 0 <= item[0] < rows
+        and 0 <= item[1] < cols
+    ):
+        return int(item[0]), int(item[1])
+    raise InputError(f"{name}: expected a (row, col) cell of the {rows} x {cols} grid, got {item!r}")
