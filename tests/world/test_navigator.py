@@ -4,6 +4,7 @@ import inspect
 import itertools
 import math
 import time
+from typing import Any
 
 import numpy as np
 import pytest
@@ -698,3 +699,70 @@ def test_a_map_off_every_meadow_reaches_as_far_as_its_skitter() -> None:
         robot.execute(TurnAndRun(0.0, 41.0))  # 40 m: 1 m of it lost
         outside += not grown.contains(robot.execute(spin))
     assert outside == 0
+
+
+def test_a_route_of_one_waypoint_names_one_meadow() -> None:
+    # no leg, one id: Route([p], []) was refused as "expected 1 ids (one per leg)"
+    assert Route([(1.0, 2.0)], ["a"]).meadow_ids == ("a",)
+    with pytest.raises(
+        InputError, match=r"meadow_ids: expected 1 id \(a route of one waypoint, no leg, .*got 0"
+    ):
+        Route([(1.0, 2.0)], [])
+    with pytest.raises(InputError, match=r"meadow_ids: expected 1 id \(a route of one waypoint.*got 2"):
+        Route([(1.0, 2.0)], ["a", "b"])
+
+
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        ((1.0, None, "a"), "RunPiece.terrain: expected a non-empty string, got None"),
+        ((1.0, "grass", ["a"]), r"RunPiece.meadow_id: expected a non-empty string, got \['a'\]"),
+        ((1.0, "", "a"), "RunPiece.terrain: expected a non-empty string, got ''"),
+    ],
+)
+def test_a_run_piece_names_a_terrain_and_a_meadow(arguments: tuple[object, ...], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        RunPiece(*arguments)  # type: ignore[arg-type]
+
+
+_TABLE = TerrainTable.default()
+_CMD = TurnAndRun(0.1, 1.0)
+_TILE = _TABLE["tile"]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        (([_TILE], 1, _CMD, 0.0), r"sigmas: expected a number in \[0\.1, 100\], got 0\.0"),
+        (([_TILE], 1, _CMD, math.nan), "sigmas: expected a finite number, got nan"),
+        (([], 1, _CMD, 3.0), "terrains: expected at least one TerrainStats, got none"),
+        ((None, 1, _CMD, 3.0), "terrains: expected a sequence of TerrainStats, got NoneType"),
+        (([None], 1, _CMD, 3.0), r"terrains\[0\]: expected a TerrainStats, got NoneType"),
+        (([_TILE], math.nan, _CMD, 3.0), "pieces: expected an integer >= 1, got nan"),
+        (([_TILE], None, _CMD, 3.0), "pieces: expected an integer >= 1, got None"),
+        (([_TILE], 0, _CMD, 3.0), "pieces: expected an integer >= 1, got 0"),
+        (([_TILE], 1, None, 3.0), "command: expected a TurnAndRun, got NoneType"),
+    ],
+)
+def test_outer_terrain_refuses_bad_arguments(arguments: tuple[object, ...], match: str) -> None:
+    # 0.0 sigmas divided by zero, [] took min() of nothing, None an AttributeError, nan pieces passed
+    with pytest.raises(InputError, match=match):
+        outer_terrain(*arguments)  # type: ignore[arg-type]
+
+
+def test_meadows_in_reach_refuses_bad_arguments() -> None:
+    world = make_grid_world(1, 2)
+    start = SpatialUncertaintyMap.from_pose(Pose(2.5, 2.5, 0.0), 0.1, 0.01)
+    nothing: Any = None
+    with pytest.raises(InputError, match="sigmas: expected a finite number, got nan"):
+        meadows_in_reach(world, start, _CMD, _TABLE, math.nan)
+    with pytest.raises(InputError, match="sigmas: expected a finite number, got None"):
+        meadows_in_reach(world, start, _CMD, _TABLE, nothing)
+    with pytest.raises(InputError, match="meadow_map: expected a MeadowMap, got NoneType"):
+        meadows_in_reach(nothing, start, _CMD, _TABLE, 3.0)
+    with pytest.raises(InputError, match="uncertainty_map: expected a SpatialUncertaintyMap, got NoneType"):
+        meadows_in_reach(world, nothing, _CMD, _TABLE, 3.0)
+    with pytest.raises(InputError, match="command: expected a TurnAndRun, got NoneType"):
+        meadows_in_reach(world, start, nothing, _TABLE, 3.0)
+    with pytest.raises(InputError, match="table: expected a TerrainTable, got NoneType"):
+        meadows_in_reach(world, start, _CMD, nothing, 3.0)

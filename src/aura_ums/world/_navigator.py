@@ -20,7 +20,16 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 from shapely.geometry.base import BaseGeometry
 
-from aura_ums._validate import SIGMAS, finite_float, items_of, nonnegative_float, points_array, read_only
+from aura_ums._validate import (
+    SIGMAS,
+    finite_float,
+    integer_at_least,
+    items_of,
+    nonnegative_float,
+    points_array,
+    read_only,
+    sequence_of,
+)
 from aura_ums.errors import InputError, OutsideMapError
 from aura_ums.geometry import POSITION_TOLERANCE, outer_annular_sector
 from aura_ums.uncertainty import Pose, SpatialUncertaintyMap, TerrainStats, TerrainTable, TurnAndRun
@@ -74,9 +83,13 @@ class Route:
     def __init__(self, waypoints: ArrayLike, meadow_ids: tuple[str, ...] | list[str]) -> None:
         points = points_array(waypoints, "waypoints", min_rows=1)
         ids = items_of(meadow_ids, "meadow_ids", "a sequence of meadow ids")
-        expected = max(len(points) - 1, 1)
-        if len(ids) != expected:
-            raise InputError(f"meadow_ids: expected {expected} ids (one per leg), got {len(ids)}")
+        if len(points) == 1 and len(ids) != 1:
+            raise InputError(
+                f"meadow_ids: expected 1 id (a route of one waypoint, no leg, names the meadow it is in), "
+                f"got {len(ids)}"
+            )
+        if len(points) > 1 and len(ids) != len(points) - 1:
+            raise InputError(f"meadow_ids: expected {len(points) - 1} ids (one per leg), got {len(ids)}")
         for index, ident in enumerate(ids):
             if not isinstance(ident, str) or not ident:
                 raise InputError(f"meadow_ids[{index}]: expected a non-empty string, got {ident!r}")
@@ -248,6 +261,10 @@ class RunPiece:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "distance", nonnegative_float(self.distance, "RunPiece.distance"))
+        for name in ("terrain", "meadow_id"):
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value:
+                raise InputError(f"RunPiece.{name}: expected a non-empty string, got {value!r}")
 
 
 def split_run(meadow_map: MeadowMap, start: ArrayLike, heading: float, distance: float) -> list[RunPiece]:
@@ -527,17 +544,7 @@ def grow_through(
     ...
     aura_ums.errors.OutsideMapError: uncertainty_map, command: expected a map within reach of a meadow, ...
     """
-    if not isinstance(uncertainty_map, SpatialUncertaintyMap):
-        raise InputError(
-            f"uncertainty_map: expected a SpatialUncertaintyMap, got {type(uncertainty_map).__name__}"
-        )
-    if not isinstance(meadow_map, MeadowMap):
-        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
-    if not isinstance(table, TerrainTable):
-        raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
-    if not isinstance(command, TurnAndRun):
-        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
-    bound = SIGMAS.check(sigmas, "sigmas")
+    bound = _checked_growth_arguments(meadow_map, uncertainty_map, command, table, sigmas)
     meadow, prefix = _first_meadow_run(meadow_map, uncertainty_map, command, table, bound)
     if meadow is not None and meadow_map._meadow_index[meadow.id] in meadow_map._overlapping:
         # A meadow earlier in map order may take part of it: a run in it can leave it and come back.
@@ -557,7 +564,7 @@ def grow_through(
         return uncertainty_map.grow(command, terrains[0], sigmas=bound, max_vertices=max_vertices)
     pieces = _most_pieces(meadow_map, uncertainty_map, command, near, terrains, bound)
     if meadow is None or prefix <= RUN_TOLERANCE:
-        terrain = outer_terrain(terrains, pieces, command, bound)
+        terrain = _outer_terrain(terrains, pieces, command, bound)
         return uncertainty_map.grow(command, terrain, sigmas=bound, max_vertices=max_vertices)
     # Every true run stays in the meadow it starts in for its first `prefix` metres: that
     # part grows on the meadow's terrain, the rest on the outer terrain of every meadow in
@@ -566,7 +573,7 @@ def grow_through(
     # fraction less that loss (the robot may have lost it all before the next meadow's
     # drift takes over), and at most its largest kept fraction, no more than its length.
     rest = TurnAndRun(0.0, command.run - prefix)
-    terrain = outer_terrain(terrains, pieces, rest, bound, first=False)
+    terrain = _outer_terrain(terrains, pieces, rest, bound, first=False)
     own = table[meadow.terrain]
     low, high = _kept_interval([own], bound)
     shortest = max(0.0, prefix * low - own.translation_inertial_loss)
@@ -765,7 +772,25 @@ def meadows_in_reach(
     >>> [m.id for m in meadows_in_reach(world, start, TurnAndRun(math.pi, 2.5), table, 3.0)]   # west: none
     ['cell_0_0']
     """
-    return _reach(meadow_map, uncertainty_map, command, table, sigmas)[0]
+    bound = _checked_growth_arguments(meadow_map, uncertainty_map, command, table, sigmas)
+    return _reach(meadow_map, uncertainty_map, command, table, bound)[0]
+
+
+def _checked_growth_arguments(
+    meadow_map: object, uncertainty_map: object, command: object, table: object, sigmas: object
+) -> float:
+    """Refuse arguments of grow_through or meadows_in_reach of the wrong type; return sigmas checked."""
+    if not isinstance(uncertainty_map, SpatialUncertaintyMap):
+        raise InputError(
+            f"uncertainty_map: expected a SpatialUncertaintyMap, got {type(uncertainty_map).__name__}"
+        )
+    if not isinstance(meadow_map, MeadowMap):
+        raise InputError(f"meadow_map: expected a MeadowMap, got {type(meadow_map).__name__}")
+    if not isinstance(table, TerrainTable):
+        raise InputError(f"table: expected a TerrainTable, got {type(table).__name__}")
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+    return SIGMAS.check(sigmas, "sigmas")
 
 
 def _reach(
@@ -840,7 +865,26 @@ def outer_terrain(
     (True, 0.0)
     >>> outer_terrain([table["concrete"]], 1, TurnAndRun(0.0, 0.0), 3.0).translation_sd   # nothing to run
     0.0
+    >>> outer_terrain([], 1, TurnAndRun(0.0, 1.0), 3.0)
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.InputError: terrains: expected at least one TerrainStats, got none
     """
+    stats = sequence_of(terrains, TerrainStats, "terrains")
+    if not stats:
+        raise InputError("terrains: expected at least one TerrainStats, got none")
+    count = integer_at_least(pieces, "pieces", 1)
+    if not isinstance(command, TurnAndRun):
+        raise InputError(f"command: expected a TurnAndRun, got {type(command).__name__}")
+    if not isinstance(first, bool):
+        raise InputError(f"first: expected a bool, got {type(first).__name__}")
+    return _outer_terrain(stats, count, command, SIGMAS.check(sigmas, "sigmas"), first=first)
+
+
+def _outer_terrain(
+    terrains: Sequence[TerrainStats], pieces: int, command: TurnAndRun, sigmas: float, *, first: bool = True
+) -> TerrainStats:
+    """:func:`outer_terrain` for checked arguments (at least one terrain, pieces >= 1, sigmas in range)."""
     run = command.run
     low, high = _kept_interval(terrains, sigmas)
     losses = [t.translation_inertial_loss for t in terrains]
