@@ -344,3 +344,19 @@ def test_the_strategy_lives_with_the_records_and_the_expecter_re_exports_it() ->
     assert world.PerceptualStrategy is PerceptualStrategy
     assert expecter.PerceptualStrategy is PerceptualStrategy
     assert PerceptualStrategy("region_segmenter") is PerceptualStrategy.REGION_SEGMENTER
+
+
+def test_a_lookup_by_what_is_not_an_id_is_refused() -> None:
+    # unhashable type: 'list', a TypeError, before
+    grid = make_grid_world(1, 2)
+    wrong: Any = ["a"]
+    with pytest.raises(InputError, match=r"meadow: expected a meadow id \(a str\), got list"):
+        grid.meadow(wrong)
+    with pytest.raises(InputError, match=r"landmark: expected a landmark id \(a str\), got list"):
+        grid.landmark(wrong)
+    with pytest.raises(InputError, match=r"meadow: expected a meadow id \(a str\), got list"):
+        grid.portal(wrong, "cell_0_1")
+    with pytest.raises(
+        UnknownTerrainError, match="meadow: expected the id of a meadow of this map, got 'nope'"
+    ):
+        grid.meadow("nope")

@@ -567,7 +567,12 @@ expected the id of a landmark feature, got 'pole'
         UnknownTerrainError
             (a ``KeyError``) when the map has no such meadow.
         """
-        index = self._meadow_index.get(meadow_id)
+        try:
+            index = self._meadow_index.get(meadow_id)
+        except TypeError:  # unhashable: checked only here, off the lookups' path
+            raise InputError(
+                f"meadow: expected a meadow id (a str), got {type(meadow_id).__name__}"
+            ) from None
         if index is None:
             raise UnknownTerrainError(f"meadow: expected the id of a meadow of this map, got {meadow_id!r}")
         return self.meadows[index]
@@ -580,7 +585,12 @@ expected the id of a landmark feature, got 'pole'
         UnknownLandmarkError
             (a ``KeyError``) when the map has no such landmark.
         """
-        index = self._landmark_index.get(landmark_id)
+        try:
+            index = self._landmark_index.get(landmark_id)
+        except TypeError:  # unhashable: checked only here, off the lookups' path
+            raise InputError(
+                f"landmark: expected a landmark id (a str), got {type(landmark_id).__name__}"
+            ) from None
         if index is None:
             raise UnknownLandmarkError(
                 f"landmark: expected the id of a landmark of this map, got {landmark_id!r}"
