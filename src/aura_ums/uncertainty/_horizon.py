@@ -111,13 +111,21 @@ class Composite:
         runs = np.array([c.run for c in commands], dtype=np.float64)
         headings = self.heading + np.cumsum(turns * (1.0 - terrain.rotation_loss))
         ahead = runs * (1.0 - terrain.translation_loss)
-        return Composite(
+        return Composite._trusted(
             self.x + float(np.sum(ahead * np.cos(headings))),
             self.y + float(np.sum(ahead * np.sin(headings))),
             float(headings[-1]),
             self.path + float(runs.sum()),
             self.turning + float(np.abs(turns).sum()),
         )
+
+    @classmethod
+    def _trusted(cls, x: float, y: float, heading: float, path: float, turning: float) -> Composite:
+        """Return the composite of checked moves, without the checks (extended once a step in replays)."""
+        composite = object.__new__(cls)
+        for name, value in (("x", x), ("y", y), ("heading", heading), ("path", path), ("turning", turning)):
+            object.__setattr__(composite, name, value)
+        return composite
 
 
 def anchor_bounds(terrain: TerrainStats, composite: Composite, sigmas: float) -> tuple[float, float]:
