@@ -6,11 +6,15 @@ import math
 
 import numpy as np
 
-from aura_ums._validate import check_rng, finite_float, integer_at_least
+from aura_ums._validate import LENGTH, SPEED, check_rng, finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.logs._log import GroundTruth, LogLandmark, LogMeta, LogObservation, RobotLog
+from aura_ums.logs._odometry import MAX_REPORTS
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import Pose, TerrainStats, TerrainTable, TurnAndRun
+
+#: Seconds to drive and log one command, for the estimate in a refusal.
+_SECONDS_PER_COMMAND = 1.1e-4
 
 #: The eight landmarks of :func:`synthetic_log`, around a 10 m x 10 m arena centred on the origin.
 _SYNTHETIC_LANDMARKS: tuple[tuple[str, float, float], ...] = (
@@ -114,12 +118,24 @@ def synthetic_log(
     reach = finite_float(max_range, "max_range")
     if not 0.0 < fov <= 2.0 * math.pi or not reach > 0.0:
         raise InputError(f"field_of_view, max_range: expected in (0, 2 pi] and > 0, got {fov!r}, {reach!r}")
-    run_speed = finite_float(speed, "speed")
+    run_speed = SPEED.check(speed, "speed")
     if run_speed < 0.0:
         raise InputError(f"speed: expected a number >= 0, got {run_speed!r}")
+    commands = seconds * hz  # inf when both are huge: refused below
+    if not commands < MAX_REPORTS - 0.5:
+        raise InputError(
+            f"duration, rate: expected at most {MAX_REPORTS} commands (duration x rate; about "
+            f"{_SECONDS_PER_COMMAND * 1e6:g} us each to drive and log), got {commands:.3g} "
+            f"(about {commands * _SECONDS_PER_COMMAND:.3g} s)"
+        )
 
     dt = 1.0 / hz
-    steps = max(1, round(seconds * hz))
+    if run_speed * dt > LENGTH.high:
+        raise InputError(
+            f"speed, rate: expected at most {LENGTH.high:g} m a command (speed / rate), "
+            f"got {run_speed * dt:g} m ({run_speed!r} m/s at {hz!r} Hz)"
+        )
+    steps = max(1, round(commands))
     pose = Pose(0.0, 0.0, float(rng.uniform(-math.pi, math.pi)))
     times, xs, ys, headings = [0.0], [pose.x], [pose.y], [pose.heading]
     reports: list[PositionReport] = []
