@@ -240,3 +240,22 @@ def test_bad_arguments(kwargs: dict[str, Any], pattern: str) -> None:
     values.update(kwargs)
     with pytest.raises(InputError, match=pattern):
         odometry_to_commands(**values)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (
+            {"run_scale": 1e6},
+            r"run_scale: expected runs of at most 10000 m a report .*got 20000 m \(run_scale 1000000\.0\)",
+        ),
+        (
+            {"turn_scale": 1e6},
+            r"turn_scale: expected turns of at most 1000 rad a report .*\(turn_scale 1000000\.0\)",
+        ),
+    ],
+)
+def test_a_scale_past_the_commands_range_is_named(kwargs: dict[str, Any], match: str) -> None:
+    # named TurnAndRun.run (or turn) before
+    with pytest.raises(InputError, match=match):
+        odometry_to_commands([0.0, 0.1, 0.2], [0.1] * 3, [0.1] * 3, **kwargs)

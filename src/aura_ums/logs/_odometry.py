@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import Choice, finite_float, float_array
+from aura_ums._validate import ANGLE, LENGTH, Choice, finite_float, float_array
 from aura_ums.errors import InputError
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import TurnAndRun
@@ -239,7 +239,27 @@ def odometry_report_arrays(
     turn = np.diff(cumulative_integral(t, angular, edges)) * turn_scale
     ahead = np.maximum(np.diff(cumulative_integral(t, np.maximum(forward, 0.0), edges)) * run_scale, 0.0)
     back = np.maximum(np.diff(cumulative_integral(t, np.maximum(-forward, 0.0), edges)) * run_scale, 0.0)
-    return piece_commands(times, turn, ahead, back)
+    out_times, out_turns, out_runs = piece_commands(times, turn, ahead, back)
+    _check_report_ranges(out_turns, out_runs, run_scale, turn_scale)
+    return out_times, out_turns, out_runs
+
+
+def _check_report_ranges(
+    turns: NDArray[np.float64], runs: NDArray[np.float64], run_scale: float, turn_scale: float
+) -> None:
+    """Refuse reports a TurnAndRun would refuse, naming the scale: not ``TurnAndRun.run`` deep inside."""
+    longest = float(runs.max())
+    if longest > LENGTH.high:
+        raise InputError(
+            f"run_scale: expected runs of at most {LENGTH.high:g} m a report (run_scale times the "
+            f"odometry's distance over at most max_interval), got {longest:g} m (run_scale {run_scale!r})"
+        )
+    widest = float(np.abs(turns).max())
+    if widest > ANGLE.high:
+        raise InputError(
+            f"turn_scale: expected turns of at most {ANGLE.high:g} rad a report (turn_scale times the "
+            f"odometry's turn over at most max_interval), got {widest:g} rad (turn_scale {turn_scale!r})"
+        )
 
 
 def piece_commands(
