@@ -345,3 +345,13 @@ def test_a_files_span_is_not_probed_through_a_named_pipe(tmp_path: Path) -> None
     pipe = tmp_path / "observations.csv"
     os.mkfifo(pipe)
     assert _file_span(pipe, Units()) is None
+
+
+@pytest.mark.parametrize("block_bytes", [10**12, 2**63])
+def test_a_block_is_at_most_a_whole_log_file(tmp_path: Path, block_bytes: int) -> None:
+    # a MemoryError (10**12) and an OverflowError (2**63) before
+    folder = write_log(synthetic_log(np.random.default_rng(1), duration=2.0), tmp_path / "log")
+    with pytest.raises(
+        InputError, match=r"block_bytes: expected at most 268435456 \(256 MiB, .*got " + str(block_bytes)
+    ):
+        open_log(folder, block_bytes=block_bytes)

@@ -34,6 +34,7 @@ from aura_ums.logs._io import (
     COMMANDS,
     GROUNDTRUTH,
     LANDMARKS,
+    LOG_CSV_MAX_BYTES,
     META,
     OBSERVATIONS,
     ODOMETRY,
@@ -205,8 +206,8 @@ def open_log(
     max_gap : float
         Seconds, > 0: the ground truth's :attr:`~aura_ums.logs.GroundTruth.max_gap`.
     block_bytes : int
-        Bytes read of a CSV file at a time, >= 1 (default 512 KiB): what the replay's
-        memory holds of each file beyond the rows it needs.
+        Bytes read of a CSV file at a time, >= 1 (default 512 KiB) and at most 256 MiB (the
+        largest log CSV file): what the replay's memory holds of each file beyond the rows it needs.
 
     Returns
     -------
@@ -237,6 +238,12 @@ def open_log(
     gap = gap_seconds(max_gap, "max_gap")
     if isinstance(block_bytes, bool) or not isinstance(block_bytes, int) or block_bytes < 1:
         raise InputError(f"block_bytes: expected an integer >= 1, got {block_bytes!r}")
+    if block_bytes > LOG_CSV_MAX_BYTES:
+        # A block is read into memory at once (10**12 bytes was a MemoryError, 2**63 an OverflowError).
+        raise InputError(
+            f"block_bytes: expected at most {LOG_CSV_MAX_BYTES} ({LOG_CSV_MAX_BYTES // 2**20} MiB, the "
+            f"largest log CSV file, read at once), got {block_bytes} ({block_bytes / 2**30:.3g} GiB)"
+        )
     # Before any is read: what open_log checks (spans, extent) holds for these versions only.
     versions = {name: v for name in (OBSERVATIONS, ODOMETRY, GROUNDTRUTH) if (v := file_version(base / name))}
     meta, units = _MetaReader(base / META).read(base.name)
