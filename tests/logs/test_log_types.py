@@ -20,6 +20,7 @@ from aura_ums.logs import (
     Odometry,
     RobotLog,
     odometry_to_commands,
+    synthetic_log,
 )
 from aura_ums.manager import PositionReport
 from aura_ums.uncertainty import TurnAndRun
@@ -282,3 +283,30 @@ def test_odometry_reports_use_the_meta() -> None:
     assert log.position_reports([0.3], max_interval=0.1) == expected
     assert expected[0].time > meta.delay_s  # the delay shifted the first motion time
     assert log.motion_span == (0.0, 0.35)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"max_interval": None}, r"max_interval: expected a positive number of seconds \(or inf\), got None"),
+        (
+            {"max_interval": -1.0},
+            r"max_interval: expected a positive number of seconds \(or inf\), got -1\.0",
+        ),
+        (
+            {"max_interval": math.nan},
+            r"max_interval: expected a positive number of seconds \(or inf\), got nan",
+        ),
+        ({"cut_times": "abc"}, "cut_times: expected numbers, got 'abc'"),
+        ({"cut_times": [math.nan]}, "cut_times: expected finite numbers"),
+        ({"reverse": "flip"}, "reverse: expected a ReverseMotion, got 'flip'"),
+    ],
+)
+def test_a_log_of_commands_checks_the_odometry_arguments_too(kwargs: dict[str, Any], match: str) -> None:
+    # ignored before when the log has recorded commands (every value gave its 50 reports)
+    log = synthetic_log(np.random.default_rng(1), duration=5.0)
+    assert log.odometry is None
+    with pytest.raises(InputError, match=match):
+        log.position_reports(**kwargs)
+    with pytest.raises(InputError, match=match):
+        log.position_report_arrays(**kwargs)

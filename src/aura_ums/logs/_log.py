@@ -741,6 +741,11 @@ class RobotLog:
         """
         if self.odometry is None:
             assert self.commands is not None
+            # Not applied to recorded commands, but checked all the same: a bad value is a mistake.
+            float_array(cut_times, "cut_times")
+            gap_seconds(max_interval, "max_interval")
+            if not isinstance(reverse, ReverseMotion):
+                raise InputError(f"reverse: expected a ReverseMotion, got {reverse!r}")
             low, high = self._span(start, end)
             meta = self.meta
             reports = []
@@ -803,7 +808,9 @@ class RobotLog:
                 end=end,
                 reverse=reverse,
             )
-        reports = self.position_reports(start=start, end=end)
+        reports = self.position_reports(
+            cut_times, max_interval=max_interval, start=start, end=end, reverse=reverse
+        )
         return (
             np.array([report.time for report in reports], dtype=np.float64),
             np.array([report.command.turn for report in reports], dtype=np.float64),
