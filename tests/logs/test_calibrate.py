@@ -6,6 +6,7 @@ import dataclasses
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -349,3 +350,19 @@ def test_the_bound_check_grows_a_move_backing_up_as_a_flipped_replay_does(move: 
     checks = horizon_checks([log], LOSSLESS, MotionCalibration(), horizons=(1.0, 2.0, 10.0), move=move)
     assert [c.windows > 0 for c in checks] == [True, True, True]
     assert [c.containment for c in checks] == [1.0, 1.0, 1.0]
+
+
+def test_no_log_is_refused_where_it_gave_nan_checks() -> None:
+    with pytest.raises(InputError, match="logs: expected at least one RobotLog, got none"):
+        horizon_checks([], TerrainTable.default()["tile"], MotionCalibration())
+    with pytest.raises(InputError, match=r"logs\[0\]: expected a RobotLog, got NoneType"):
+        horizon_checks([None], TerrainTable.default()["tile"], MotionCalibration())  # type: ignore[list-item]
+
+
+def test_observation_errors_refuses_what_is_not_logs() -> None:
+    # a TypeError and an AttributeError before
+    nothing: Any = None
+    with pytest.raises(InputError, match="logs: expected a sequence of RobotLog, got NoneType"):
+        observation_errors(nothing)
+    with pytest.raises(InputError, match=r"logs\[0\]: expected a RobotLog, got NoneType"):
+        observation_errors([nothing])

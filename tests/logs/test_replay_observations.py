@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from aura_ums.errors import InputError
 from aura_ums.logs import LogObservation, SensorBounds, observation_for, synthetic_log
 from aura_ums.logs._replay import _observations, _row_of
 from aura_ums.uncertainty import LandmarkClass
@@ -32,3 +33,13 @@ def test_the_replays_observations_are_observation_for_of_each_row(
     )
     assert found == expected
     assert [type(o) for o in found] == [type(o) for o in expected]
+
+
+def test_a_factor_that_is_not_a_number_is_refused() -> None:
+    # an array leaked numpy's "truth value of an array is ambiguous"
+    row = LogObservation(2.5, "pole", 0.25, range=4.0)
+    bounds = SensorBounds(0.05, 0.0, 0.1, 0.1)
+    with pytest.raises(InputError, match=r"factor: expected a finite number, got array\(\[1\., 2\.\]\)"):
+        observation_for(row, LandmarkClass.VERTICAL_LINE, bounds, factor=np.array([1.0, 2.0]))  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="factor: expected a finite number, got None"):
+        observation_for(row, LandmarkClass.VERTICAL_LINE, bounds, factor=None)  # type: ignore[arg-type]

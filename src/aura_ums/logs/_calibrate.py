@@ -35,6 +35,7 @@ from aura_ums._validate import (
     finite_float,
     items_of,
     positive_float,
+    sequence_of,
 )
 from aura_ums.errors import InputError
 from aura_ums.logs._io import COMMANDS, GROUNDTRUTH, ODOMETRY
@@ -963,6 +964,10 @@ def horizon_checks(
     >>> horizon_checks([log], calibration.stats, calibration.motion, horizons=(120.0,))[0].windows
     0
     """
+    items = sequence_of(logs, RobotLog, "logs")
+    if not items:
+        # the checks of no log were NaN-filled
+        raise InputError("logs: expected at least one RobotLog, got none")
     q = finite_float(quantile, "quantile")
     if not 0.0 < q < 1.0:
         raise InputError(f"quantile: expected a number in (0, 1), got {q!r}")
@@ -972,7 +977,7 @@ def horizon_checks(
     sigma = SIGMAS.check(sigmas, "sigmas")
     rows: list[list[tuple[bool, float, float, float, float]]] = [[] for _ in lengths]
     longest = max(lengths, default=0)
-    for log in logs:
+    for log in items:
         m = _moves(log, motion.delay_s, step)
         commands = [
             _move_commands(turn, run, back, backing_first, motion)
@@ -1318,7 +1323,7 @@ def observation_errors(logs: Sequence[RobotLog]) -> tuple[NDArray[np.float64], N
     >>> observation_errors([])                                    # no log: no error
     (array([], dtype=float64), array([], dtype=float64))
     """
-    bearing, error, measured = _observation_errors(logs)
+    bearing, error, measured = _observation_errors(sequence_of(logs, RobotLog, "logs"))
     return bearing, error / measured
 
 

@@ -756,10 +756,9 @@ def observation_for(
     if not isinstance(bounds, SensorBounds):
         raise InputError(f"bounds: expected SensorBounds, got {type(bounds).__name__}")
     _require_replay_class(landmark_class)
-    if factor != 1.0:
-        factor = finite_float(factor, "factor")
-        if factor < 1.0:
-            raise InputError(f"factor: expected a number >= 1, got {factor!r}")
+    factor = finite_float(factor, "factor")  # an array compared with != 1.0 leaked numpy's ValueError
+    if factor < 1.0:
+        raise InputError(f"factor: expected a number >= 1, got {factor!r}")
     return _observation_for(row, landmark_class, bounds, factor, sensor_offset)
 
 
