@@ -419,6 +419,19 @@ def test_an_update_to_before_the_maps_time_is_refused_and_changes_nothing() -> N
     assert manager.update(board, now=2.0).map is grown  # the same time again is no change
 
 
+def test_an_update_to_before_the_last_update_is_refused_with_no_report_grown() -> None:
+    """Before any report the map has no time; the steps still must not go back (gave step.time 1.0)."""
+    manager = manager_for()
+    board = Blackboard()
+    assert manager.update(board, now=5.0).time == 5.0
+    assert manager.map_time is None
+    with pytest.raises(
+        InputError, match=r"^now: expected a time at or after the last update's \(5\.0 s\), got 1\.0$"
+    ):
+        manager.update(board, now=1.0)
+    assert manager.update(board, now=5.0).time == 5.0  # the same time again is fine
+
+
 def test_bad_arguments_are_refused() -> None:
     with pytest.raises(InputError, match="initial_map: expected a SpatialUncertaintyMap, got Pose"):
         UncertaintyMapManager(START, WORLD, TABLE)  # type: ignore[arg-type]

@@ -409,6 +409,7 @@ class UncertaintyMapManager:
         "_joint_above",
         "_joint_sector",
         "_landmarks",
+        "_last_now",
         "_latest",
         "_latest_committed",
         "_lineages",
@@ -479,6 +480,8 @@ class UncertaintyMapManager:
         self._excluded = 0
         self._map_time: float | None = None
         self._consumed = 0
+        #: The ``now`` of the last update (None before the first, and in a restored manager).
+        self._last_now: float | None = None
         self._state = ManagerState.NOMINAL
         self._lost_reason = ""
         self._accepted = 0
@@ -652,7 +655,8 @@ class UncertaintyMapManager:
             For a bad argument (an ``envelope`` that does not pair with the drained
             observations); for a blackboard that is not the one this manager has been
             reading (fewer reports than consumed, or a different last consumed report); for a
-            ``now`` before :attr:`map_time` (the map cannot go back in time). A
+            ``now`` before :attr:`map_time` (the map cannot go back in time) or before the
+            last update's ``now`` (its steps cannot either, even with no report grown yet). A
             map beyond reach of every meadow (it left the mapped free space; the meadow map
             knows no walls) is not refused: it grows on the outer terrain of every terrain of
             the meadow map (:func:`~aura_ums.world.outer_terrain`).
@@ -682,6 +686,11 @@ class UncertaintyMapManager:
             raise InputError(
                 f"now: expected a time at or after the map's ({self._map_time!r} s, its last position "
                 f"report grown), got {time!r}"
+            )
+        if self._last_now is not None and time < self._last_now:
+            # Before any report is grown the map has no time, but the steps must not go back.
+            raise InputError(
+                f"now: expected a time at or after the last update's ({self._last_now!r} s), got {time!r}"
             )
 
         identified = blackboard.identified
@@ -730,6 +739,7 @@ class UncertaintyMapManager:
                 recent.clear()
                 relocalized = True
         self._update_state(found, missed_in_a_row)
+        self._last_now = time
         return ManagerStep._made(
             time,
             self._map,
