@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -132,4 +133,24 @@ def test_a_particle_filter_too_costly_is_refused_with_the_estimate_before_any_wo
             range_sd_fraction=0.01,
             rng=np.random.default_rng(0),
             particles=0,
+        )
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"bearing_sd": 1e300}, r"bearing_sd: expected a number in \[1e-06, 1000\] rad, got 1e\+300"),
+        ({"range_sd_fraction": 1e300}, r"range_sd_fraction: expected a number in \(0, 100\], got 1e\+300"),
+    ],
+)
+def test_noise_past_its_range_is_refused(log: RobotLog, kwargs: dict[str, Any], match: str) -> None:
+    # an OverflowError from the EKF's variances before
+    arguments = {"bearing_sd": 0.006, "range_sd_fraction": 0.012, **kwargs}
+    with pytest.raises(InputError, match=match):
+        compare_on_log(
+            log,
+            TerrainTable({"floor": TerrainTable.default()["tile"]}),
+            rng=np.random.default_rng(0),
+            particles=10,
+            **arguments,
         )

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from aura_ums._metrics import Metrics
-from aura_ums._validate import finite_float, positive_float
+from aura_ums._validate import ANGLE_ERROR, FACTOR, finite_float, positive_float
 from aura_ums.baselines import CodacLocalizer, Estimator, ExtendedKalmanFilter, ParticleFilter
 from aura_ums.errors import InputError
 from aura_ums.logs._log import RobotLog
@@ -247,6 +247,10 @@ def compare_on_log(
     r_sd = finite_float(range_sd_fraction, "range_sd_fraction")
     if not b_sd > 0.0 or not r_sd > 0.0:
         raise InputError(f"bearing_sd, range_sd_fraction: expected positive numbers, got {b_sd!r}, {r_sd!r}")
+    # 1e300 overflowed the filters' variances (an OverflowError from the EKF)
+    for name, value, limits in (("bearing_sd", b_sd, ANGLE_ERROR), ("range_sd_fraction", r_sd, FACTOR)):
+        if value > limits.high:
+            raise InputError(f"{name}: expected {limits.text()}, got {value!r}")
     if not isinstance(codac, bool):
         raise InputError(f"codac: expected True or False, got {codac!r}")
     extra = _check_others(others, {"aura-ums", "EKF", f"PF ({particles})", *(("codac",) if codac else ())})
