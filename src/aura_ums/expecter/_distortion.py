@@ -32,7 +32,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums.camera import fold_radius
+# camera.distort checks its arguments; the points here always pass: in front of the near plane
+# (1e-6 m) and within the world's coordinates they lie within about 1e13 of the axis, far
+# inside the 1e30 it takes. One formula for the projections and their bounds.
+from aura_ums.camera import distort, fold_radius
 from aura_ums.geometry import clip_halfplane, convex_hull, polygon_area, simplify_outer
 
 Array = NDArray[np.float64]
@@ -107,19 +110,6 @@ def distorted_range(
             lower = np.where(free, lower, box_lower)
             upper = np.where(free, upper, box_upper)
         return lower, upper
-
-
-def _distort(x: Array, y: Array, coefficients: Coefficients) -> tuple[Array, Array]:
-    """:func:`~aura_ums.camera.distort` without its checks of the arguments (per frame, on checked hulls).
-
-    The same arithmetic, term for term (bit-identical results).
-    """
-    k1, k2, p1, p2, k3 = coefficients
-    r2 = x * x + y * y
-    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
-    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
-    return xd, yd
 
 
 def _within_fold(hull: Array, limit: float) -> Array:
@@ -242,7 +232,7 @@ def _boundary_range(hull: Array, c: Coefficients, tolerance: float) -> tuple[Arr
     ``tolerance`` of a value attained at a piece's end.
     """
     if len(hull) == 1:
-        x, y = _distort(hull[:, 0], hull[:, 1], c)
+        x, y = distort(hull[:, 0], hull[:, 1], c)
         slack = _ROUNDING * _magnitude((hull[:, 0], hull[:, 0]), (hull[:, 1], hull[:, 1]), c)
         value = np.array([x[0], y[0]])
         return value - slack[0], value + slack[0]
@@ -331,7 +321,7 @@ def _box_range(hull: Array, coefficients: Coefficients, tolerance: float) -> tup
     """Bound the distortion over the hull by 2-D branch and bound on cells (see module doc)."""
     axes, hull_lo, hull_hi = _separating_axes(hull)
     cells = _grid(hull, _INITIAL_SPLIT)
-    hx, hy = _distort(hull[:, 0], hull[:, 1], coefficients)
+    hx, hy = distort(hull[:, 0], hull[:, 1], coefficients)
     attained = np.array([hx.min(), hx.max(), hy.min(), hy.max()])
     for round_index in range(_MAX_ROUNDS + 1):
         cells = cells[_touches(cells, axes, hull_lo, hull_hi)]
@@ -340,7 +330,7 @@ def _box_range(hull: Array, coefficients: Coefficients, tolerance: float) -> tup
         centres_y = 0.5 * (cells[:, 2] + cells[:, 3])
         inside = _inside(np.column_stack([centres_x, centres_y]), hull)
         if np.any(inside):
-            cx, cy = _distort(centres_x[inside], centres_y[inside], coefficients)
+            cx, cy = distort(centres_x[inside], centres_y[inside], coefficients)
             attained = _widened(attained, cx, cx, cy, cy)
         result, gaps, keep = _round_outcome(bounds, attained)
         if round_index == _MAX_ROUNDS or bool(np.all(gaps <= tolerance)) or 4 * int(keep.sum()) > _MAX_CELLS:
