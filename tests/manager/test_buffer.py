@@ -105,3 +105,6 @@ def test_rejects_what_is_not_an_observation() -> None:
         buffer.peek(until="soon")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="observations: expected an iterable of observations, got one"):
         IdentifiedLandmarkBuffer(bearing("a", 1.0))  # type: ignore[arg-type]
+    # A dict iterates its keys: an empty one was taken as no observation, a full one failed on a key.
+    with pytest.raises(InputError, match=r"^observations: expected an iterable of observations, got dict$"):
+        IdentifiedLandmarkBuffer({})

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import bisect
 import operator
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 from aura_ums._validate import finite_float, items_of
 from aura_ums.errors import InputError
@@ -74,6 +74,11 @@ or GroundLineObservation, got str
         if isinstance(observations, _OBSERVATION_TYPES):
             raise InputError(
                 f"observations: expected an iterable of observations, got one {type(observations).__name__}"
+            )
+        if isinstance(observations, Mapping):
+            # Iterating a dict gives its keys: an empty one was taken as no observation.
+            raise InputError(
+                f"observations: expected an iterable of observations, got {type(observations).__name__}"
             )
         for observation in items_of(observations, "observations", "an iterable of observations"):
             self.post(observation)
