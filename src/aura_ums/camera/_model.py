@@ -24,6 +24,7 @@ from aura_ums._validate import (
     Range,
     finite_float,
     float_array,
+    number_array,
 )
 from aura_ums.errors import InputError
 from aura_ums.geometry import Pose
@@ -73,22 +74,11 @@ NORMALIZED = Range(-1e30, 1e30)
 CAMERA_COORDINATE = Range(-1e7, 1e7, "m")
 
 
-def real_array(value: object, name: str) -> Array:
-    """Return ``value`` as a float array (NaN allowed), refusing what is not numbers (None, strings)."""
-    try:
-        array = np.asarray(value)
-    except (TypeError, ValueError) as exc:  # ragged sequences
-        raise InputError(f"{name}: expected numbers, got {value!r}") from exc
-    if array.dtype.kind not in "iuf":
-        raise InputError(f"{name}: expected numbers, got {value!r}")
-    return np.asarray(array, dtype=np.float64)
-
-
-def _coefficients(value: object, name: str) -> tuple[float, float, float, float, float]:
+def _coefficients(value: ArrayLike, name: str) -> tuple[float, float, float, float, float]:
     """Return distortion coefficients as (k1, k2, p1, p2, k3), checked as :class:`CameraIntrinsics` does."""
     if value is None or isinstance(value, (str, bytes)):
         raise InputError(f"{name}: expected 4, 5, 8, 12 or 14 distortion coefficients, got {value!r}")
-    return opencv_distortion(float_array(real_array(value, name), name), name)
+    return opencv_distortion(float_array(value, name), name)
 
 
 def distort(
@@ -118,9 +108,9 @@ def distort(
     return _distort(xs, ys, k)
 
 
-def _normalized(value: object, name: str) -> Array:
+def _normalized(value: ArrayLike, name: str) -> Array:
     """Return finite normalized coordinates in :data:`NORMALIZED`, or raise naming ``name``."""
-    array = float_array(real_array(value, name), name)
+    array = float_array(value, name)
     if np.any(np.abs(array) > NORMALIZED.high):
         raise InputError(
             f"{name}: expected coordinates {NORMALIZED.text()}, got {float(np.max(np.abs(array)))!r}"
@@ -230,7 +220,7 @@ def within_fold(
     aura_ums.errors.InputError: x: expected numbers, got None
     """
     limit = fold_radius(distortion)
-    xs, ys = real_array(x, "x"), real_array(y, "y")
+    xs, ys = number_array(x, "x"), number_array(y, "y")
     if xs.shape != ys.shape:
         raise InputError(f"y: expected the shape of x {xs.shape}, got {ys.shape}")
     return _within_fold(xs, ys, limit)
@@ -521,7 +511,7 @@ class Camera:
         ...
         aura_ums.errors.InputError: points_camera: expected shape (..., 3), got (1, 2)
         """
-        pts = float_array(real_array(points_camera, "points_camera"), "points_camera")
+        pts = float_array(points_camera, "points_camera")
         if pts.ndim == 0 or pts.shape[-1] != 3:
             raise InputError(f"points_camera: expected shape (..., 3), got {pts.shape}")
         if np.any(np.abs(pts) > CAMERA_COORDINATE.high):

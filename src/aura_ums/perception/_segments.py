@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from aura_ums._validate import ANGLE, float_array, nonnegative_float
+from aura_ums._validate import ANGLE, float_array, nonnegative_float, number_array
 from aura_ums.errors import InputError
 from aura_ums.geometry import angle_difference
 
@@ -88,13 +88,7 @@ def orientation_difference(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
 
 def _orientations(value: ArrayLike, name: str) -> NDArray[np.float64]:
     """Return orientations as a float array, each finite and in :data:`~aura_ums._validate.ANGLE`."""
-    try:
-        array = np.asarray(value)
-    except (TypeError, ValueError) as exc:  # ragged sequences
-        raise InputError(f"{name}: expected orientations (numbers), got {value!r}") from exc
-    if array.dtype.kind not in "iuf":
-        raise InputError(f"{name}: expected orientations (numbers), got {value!r}")
-    array = float_array(array, name)
+    array = float_array(number_array(value, name, "orientations (numbers)"), name)
     if np.any(np.abs(array) > ANGLE.high):
         raise InputError(
             f"{name}: expected orientations {ANGLE.text()}, got {float(np.max(np.abs(array)))!r}"
