@@ -9,7 +9,7 @@ import pytest
 
 from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import InputError
-from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy
+from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy, disk_model_window
 from aura_ums.expecter._window import DEFAULT_MARGINS
 from aura_ums.geometry import UNBOUNDED_PIXELS, ConvexPolygon, HeadingWedge
 from aura_ums.uncertainty import (
@@ -134,7 +134,7 @@ def test_margins_by_strategy() -> None:
     landmark = PointLandmark("corner", 12.0, 0.5, 1.0)
     expecter = Expecter(CAMERAS["plain"])
     bounds = expecter.bounds(the_map, landmark)
-    lines = expecter.window(the_map, landmark)  # default: line finder
+    lines = expecter.window(the_map, landmark, margin=PerceptualStrategy.LINE_FINDER)
     corners = expecter.window(the_map, landmark, margin=PerceptualStrategy.INTEREST_OPERATOR)
     assert bounds is not None
     assert lines is not None
@@ -142,6 +142,29 @@ def test_margins_by_strategy() -> None:
     assert lines.area > corners.area > bounds.area
     assert lines.width - corners.width == pytest.approx(2 * (24.0 - 4.0))
     assert expecter.window(the_map, landmark, margin=0.0) == bounds
+
+
+def test_the_default_margin_is_that_of_the_strategy_usual_for_the_class() -> None:
+    # A point is looked for with an interest operator (4 px of context), not a line finder's 24.
+    the_map = _map(HeadingWedge(0.0, 0.02, 0.02))
+    expecter = Expecter(CAMERAS["plain"])
+    corner = PointLandmark("corner", 12.0, 0.5, 1.0)
+    pole = VerticalLineLandmark("pole", 12.0, 0.5, 0.0, 1.5)
+    for landmark, strategy in (
+        (corner, PerceptualStrategy.INTEREST_OPERATOR),
+        (pole, PerceptualStrategy.LINE_FINDER),
+    ):
+        default = expecter.window(the_map, landmark)
+        assert default is not None
+        assert default == expecter.window(the_map, landmark, margin=strategy)
+        assert disk_model_window(expecter, the_map, landmark) == disk_model_window(
+            expecter, the_map, landmark, margin=strategy
+        )
+        assert disk_model_window(expecter, the_map, landmark, clip=False) == disk_model_window(
+            expecter, the_map, landmark, margin=strategy, clip=False
+        )
+    # Behind the camera there is no window, whatever the margin.
+    assert expecter.window(the_map, PointLandmark("behind", -12.0, 0.0, 1.0)) is None
 
 
 def test_unbounded_sentinel_is_finite() -> None:

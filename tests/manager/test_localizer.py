@@ -48,7 +48,10 @@ WORLD = MeadowMap(
             "floor", ConvexPolygon([(0, -5), (20, -5), (20, 8), (0, 8)]), "floor", ("pole", "corner", "edge")
         )
     ],
-    [LandmarkRecord(lm, PerceptualStrategy.LINE_FINDER, {}, 30.0, 0.5) for lm in (POLE, CORNER, EDGE)],
+    [
+        LandmarkRecord(lm, PerceptualStrategy.for_class(lm.landmark_class)[0], {}, 30.0, 0.5)
+        for lm in (POLE, CORNER, EDGE)
+    ],
 )
 START = SpatialUncertaintyMap.from_pose(Pose(2.0, 0.0, 0.0), 0.2, 0.03)
 STRIDE = TurnAndRun(0.0, 1.0)

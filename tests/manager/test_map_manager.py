@@ -57,7 +57,7 @@ def box(x0: float, y0: float, x1: float, y1: float) -> ConvexPolygon:
 
 
 def record(landmark: Landmark) -> LandmarkRecord:
-    return LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, 30.0, 0.5)
+    return LandmarkRecord(landmark, PerceptualStrategy.for_class(landmark.landmark_class)[0], {}, 30.0, 0.5)
 
 
 def world_of(meadows: list[tuple[str, ConvexPolygon, str]], landmarks: tuple[Landmark, ...]) -> MeadowMap:

@@ -55,7 +55,10 @@ WORLD = MeadowMap(
             tuple(p.id for p in POLES),
         )
     ],
-    [LandmarkRecord(pole, PerceptualStrategy.LINE_FINDER, {}, 50.0, 0.5) for pole in POLES],
+    [
+        LandmarkRecord(pole, PerceptualStrategy.for_class(pole.landmark_class)[0], {}, 50.0, 0.5)
+        for pole in POLES
+    ],
 )
 START_POSE = Pose(2.0, 0.0, 0.0)
 START = SpatialUncertaintyMap.from_pose(START_POSE, 0.6, 0.15)
@@ -405,7 +408,10 @@ def test_growth_merges_branches_left_with_the_same_choices_and_keeps_both_maps()
 TWO_POINTS = (PointLandmark("A", 58.0, 20.0, 1.0), PointLandmark("B", 20.0, 30.0, 1.0))
 TWO_POINT_WORLD = MeadowMap(
     [Meadow("floor", ConvexPolygon([(0, 0), (60, 0), (60, 40), (0, 40)]), "floor", ("A", "B"))],
-    [LandmarkRecord(lm, PerceptualStrategy.LINE_FINDER, {}, 80.0, 0.5) for lm in TWO_POINTS],
+    [
+        LandmarkRecord(lm, PerceptualStrategy.for_class(lm.landmark_class)[0], {}, 80.0, 0.5)
+        for lm in TWO_POINTS
+    ],
 )
 
 

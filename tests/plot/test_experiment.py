@@ -9,11 +9,14 @@ import numpy as np
 import pytest
 
 from aura_ums._metrics import Metrics
+from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy, disk_model_window, margin_pixels
+from aura_ums.manager import ManagerState
 from aura_ums.plot._experiment import (
     PositionCounts,
     TableRow,
     _table_markdown,
     class2_paragraph,
+    experiment_table,
     misidentified,
     monte_carlo_markdown,
     position_counts,
@@ -21,7 +24,7 @@ from aura_ums.plot._experiment import (
     position_counts_sentences,
     position_sentences,
 )
-from aura_ums.sim import RunResult, Scenario, run_scenario, summarize_runs
+from aura_ums.sim import FrameRecord, RunResult, Scenario, run_scenario, summarize_runs
 from aura_ums.world import sample_world
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -291,3 +294,36 @@ def test_with_three_confirming_frames_the_first_two_positions_cannot_prune() -> 
     results = [run_scenario(confirmed, g) for g in np.random.default_rng(1).spawn(5)]
     counts = position_counts(confirmed, results)
     assert counts[0].pruned == counts[1].pruned == 0
+
+
+def test_the_table_windows_have_the_margin_of_each_landmarks_strategy() -> None:
+    # The corner (Class II) is searched with an interest operator's margin, the poles with a
+    # line finder's: the table reports the windows the schemas search, not one margin for all.
+    scenario = Scenario.from_toml(SCENARIOS / "paper_sidewalk_class2.toml")
+    start = scenario.initial_map()
+    expecter = Expecter(scenario.camera)
+    ids = ("east_engineering_corner", "lamppost_107")
+    frame = FrameRecord(
+        0, 0.0, None, True, scenario.start.pose, True, start, start,
+        tuple((ident, ImageWindow(0, 0, 1, 1)) for ident in ids), (), (), 0, (),
+        ManagerState.NOMINAL, 3.0,
+    )  # fmt: skip
+    [row] = experiment_table(scenario, RunResult(scenario.name, (frame,), start, True, None, 1, 1))
+    ours = disk = 0.0
+    corner_window = 0.0
+    for ident in ids:
+        entry = scenario.meadow_map.landmark(ident)
+        window = expecter.window(start, entry.landmark, margin=margin_pixels(entry.strategy))
+        around = disk_model_window(expecter, start, entry.landmark, margin=margin_pixels(entry.strategy))
+        assert window is not None
+        assert around is not None
+        ours, disk = ours + window.area, disk + around.area
+        if ident == ids[0]:
+            corner_window = window.area
+    assert scenario.meadow_map.landmark(ids[0]).strategy is PerceptualStrategy.INTEREST_OPERATOR
+    assert row.window_polygon == pytest.approx(ours, rel=1e-12)
+    assert row.window_disk == pytest.approx(disk, rel=1e-12)
+    # With a line finder's margin for the corner too, the sum would be larger.
+    lined = expecter.window(start, scenario.meadow_map.landmark(ids[0]).landmark, margin=24.0)
+    assert lined is not None
+    assert row.window_polygon < ours - corner_window + lined.area

@@ -73,7 +73,11 @@ def test_record_parameters_are_a_read_only_copy() -> None:
 
 
 def test_record_class_follows_the_landmark_type() -> None:
-    point = record(landmark=PointLandmark("corner", 0.0, 0.0, 7.0))
+    point = record(
+        landmark=PointLandmark("corner", 0.0, 0.0, 7.0),
+        strategy=PerceptualStrategy.INTEREST_OPERATOR,
+        parameters={},
+    )
     line = record(landmark=GroundLineLandmark("edge", (0, 0), (5, 0)))
     assert point.landmark_class is LandmarkClass.POINT
     assert line.landmark_class is LandmarkClass.GROUND_LINE
@@ -116,6 +120,34 @@ _ACTIVATION = r"lamppost_107.activation_range: expected a number in \(0, 10000\]
         ({"confirm_frames": 10**9}, _FRAMES + r" 1000000000"),
         ({"confirm_frames": 2.0}, _FRAMES + r" 2.0"),
         ({"confirm_frames": True}, _FRAMES + r" True"),
+        # Refused where the record is made (a map file's landmark: naming the file), not when
+        # a run builds the landmark's schema.
+        (
+            {"strategy": PerceptualStrategy.INTEREST_OPERATOR, "parameters": {}},
+            "lamppost_107.strategy: expected line_finder, region_segmenter for a Class I landmark, got "
+            "interest_operator",
+        ),
+        (
+            {"landmark": PointLandmark("corner", 12.0, 2.0, 3.0), "parameters": {}},
+            "corner.strategy: expected interest_operator for a Class II landmark, got line_finder",
+        ),
+        (
+            {
+                "landmark": GroundLineLandmark("edge", (0.0, -1.0), (20.0, -1.0)),
+                "strategy": PerceptualStrategy.REGION_SEGMENTER,
+                "parameters": {},
+            },
+            "edge.strategy: expected line_finder for a Class III landmark, got region_segmenter",
+        ),
+        (
+            {"parameters": {"orientaton": 1.0}},
+            "lamppost_107.parameters: expected names among orientation, tolerance, min_length, "
+            "min_gradient, min_contrast, smoothing, buckets, got 'orientaton'",
+        ),
+        (
+            {"strategy": PerceptualStrategy.REGION_SEGMENTER, "parameters": {"window": 5.0}},
+            "lamppost_107.parameters: expected names among threshold, min_area, min_aspect, got 'window'",
+        ),
     ],
 )
 def test_record_validates_on_construction(overrides: dict[str, Any], message: str) -> None:
@@ -136,7 +168,7 @@ def test_record_distance_to_points(
     points: list[tuple[float, float]],
     expected: list[float],
 ) -> None:
-    rec = LandmarkRecord(landmark, LINE, {}, 10.0, 0.5)
+    rec = LandmarkRecord(landmark, PerceptualStrategy.for_class(landmark.landmark_class)[0], {}, 10.0, 0.5)
     np.testing.assert_allclose(rec.distance(points), expected)
 
 
@@ -360,3 +392,13 @@ def test_a_lookup_by_what_is_not_an_id_is_refused() -> None:
         UnknownTerrainError, match="meadow: expected the id of a meadow of this map, got 'nope'"
     ):
         grid.meadow("nope")
+
+
+def test_every_class_has_a_usual_strategy_and_every_strategy_its_parameters() -> None:
+    found = {LandmarkClass(c): PerceptualStrategy.for_class(LandmarkClass(c)) for c in ("I", "II", "III")}
+    assert all(strategies for strategies in found.values())
+    # Every strategy finds some class.
+    assert {s for strategies in found.values() for s in strategies} == set(PerceptualStrategy)
+    assert all(strategy.parameters for strategy in PerceptualStrategy)
+    with pytest.raises(InputError, match="landmark_class: expected a LandmarkClass, got 'II'"):
+        PerceptualStrategy.for_class("II")  # type: ignore[arg-type]

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from aura_ums._validate import COORDINATE, Range, finite_float, integer_at_least
 from aura_ums.errors import InputError
 from aura_ums.expecter._expecter import Expecter
-from aura_ums.expecter._window import margin_pixels
+from aura_ums.expecter._window import class_margin, margin_pixels
 from aura_ums.geometry import ConvexPolygon, HeadingWedge, ImageWindow, outer_disk
 from aura_ums.uncertainty import Landmark, Pose, SpatialUncertaintyMap
 from aura_ums.world import PerceptualStrategy
@@ -61,7 +61,7 @@ def disk_model_window(
     map: SpatialUncertaintyMap,
     landmark: Landmark,
     *,
-    margin: float | PerceptualStrategy = PerceptualStrategy.LINE_FINDER,
+    margin: float | PerceptualStrategy | None = None,
     clip: bool = True,
 ) -> ImageWindow | None:
     """Return the window the disk model gives: :meth:`Expecter.window` on :func:`disk_model_map`.
@@ -74,8 +74,8 @@ def disk_model_window(
         The polygonal map whose disk model is compared.
     landmark : VerticalLineLandmark, PointLandmark or GroundLineLandmark
         The expected landmark.
-    margin : float or PerceptualStrategy
-        As in :meth:`Expecter.window`.
+    margin : float, PerceptualStrategy or None
+        As in :meth:`Expecter.window` (None: the landmark class's usual strategy's).
     clip : bool
         Clip to the image (as :meth:`Expecter.window`); False returns the guaranteed
         window grown by the margin, for comparing areas beyond the image. A bool.
@@ -177,7 +177,7 @@ def gaussian_window(
     landmark: Landmark,
     sigmas: float = 3.0,
     *,
-    margin: float | PerceptualStrategy = PerceptualStrategy.LINE_FINDER,
+    margin: float | PerceptualStrategy | None = None,
     clip: bool = True,
 ) -> ImageWindow | None:
     """Return the window an EKF's ``sigmas`` box of (x, y, heading) gives.
@@ -197,8 +197,8 @@ def gaussian_window(
         The expected landmark.
     sigmas : float
         Half-width of the box in standard deviations, in (0, 100].
-    margin : float or PerceptualStrategy
-        As in :meth:`Expecter.window`.
+    margin : float, PerceptualStrategy or None
+        As in :meth:`Expecter.window` (None: the landmark class's usual strategy's).
     clip : bool
         Clip to the image; False keeps the whole window, for comparing areas. A bool.
 
@@ -234,14 +234,16 @@ def _window(
     expecter: Expecter,
     map: SpatialUncertaintyMap,
     landmark: Landmark,
-    margin: float | PerceptualStrategy,
+    margin: float | PerceptualStrategy | None,
     clip: bool,
 ) -> ImageWindow | None:
     if clip:
         return expecter.window(map, landmark, margin=margin)
-    pixels = margin_pixels(margin)
-    guaranteed = expecter.bounds(map, landmark)
-    return None if guaranteed is None else guaranteed.expanded(pixels)
+    pixels = None if margin is None else margin_pixels(margin)
+    guaranteed = expecter.bounds(map, landmark)  # checks the landmark
+    if guaranteed is None:
+        return None
+    return guaranteed.expanded(class_margin(landmark.landmark_class) if pixels is None else pixels)
 
 
 def _check_expecter(expecter: object) -> None:

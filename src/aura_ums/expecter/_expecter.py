@@ -69,7 +69,7 @@ from aura_ums import _native
 from aura_ums.camera import NEAR_PLANE, CalibrationBounds, Camera
 from aura_ums.errors import InputError
 from aura_ums.expecter._distortion import distorted_range
-from aura_ums.expecter._window import margin_pixels
+from aura_ums.expecter._window import class_margin, margin_pixels
 from aura_ums.geometry import UNBOUNDED_PIXELS, ImageWindow
 from aura_ums.uncertainty import (
     GroundLineLandmark,
@@ -202,7 +202,7 @@ class Expecter:
         map: SpatialUncertaintyMap,
         landmark: Landmark,
         *,
-        margin: float | PerceptualStrategy = PerceptualStrategy.LINE_FINDER,
+        margin: float | PerceptualStrategy | None = None,
     ) -> ImageWindow | None:
         """Return the window to search: :meth:`bounds` grown by a margin, clipped to the image.
 
@@ -212,9 +212,12 @@ class Expecter:
             Where the robot may be and which way it may face.
         landmark : VerticalLineLandmark, PointLandmark or GroundLineLandmark
             The expected landmark.
-        margin : float or PerceptualStrategy
+        margin : float, PerceptualStrategy or None
             Pixels (>= 0) added on every side, or the strategy whose
-            :data:`DEFAULT_MARGINS` entry to use.
+            :data:`DEFAULT_MARGINS` entry to use. None: the entry of the strategy that
+            usually looks for the landmark's class (:meth:`PerceptualStrategy.for_class`:
+            a line finder's 24 px for Class I and III, an interest operator's 4 px for
+            Class II). Pass the landmark record's own ``strategy`` when it names another.
 
         Returns
         -------
@@ -228,10 +231,12 @@ class Expecter:
         InputError
             On a map or landmark of the wrong type, or a negative or non-finite margin.
         """
-        pixels = margin_pixels(margin)
-        guaranteed = self.bounds(map, landmark)
+        pixels = None if margin is None else margin_pixels(margin)
+        guaranteed = self.bounds(map, landmark)  # checks the landmark
         if guaranteed is None:
             return None
+        if pixels is None:
+            pixels = class_margin(landmark.landmark_class)
         k = self.camera.intrinsics
         return guaranteed.expanded(pixels).clipped(k.width, k.height)
 

@@ -6,6 +6,7 @@ import types
 from collections.abc import Mapping
 
 from aura_ums._validate import nonnegative_float
+from aura_ums.uncertainty import LandmarkClass
 from aura_ums.world import PerceptualStrategy
 
 #: Margin (pixels, added on every side) that each perceptual strategy needs around the
@@ -46,6 +47,21 @@ def margin_pixels(margin: float | PerceptualStrategy) -> float:
     if isinstance(margin, PerceptualStrategy):
         return DEFAULT_MARGINS[margin]
     return nonnegative_float(margin, "margin")
+
+
+def class_margin(landmark_class: LandmarkClass) -> float:
+    """Return the margin (pixels) of the usual strategy for a landmark class (its ``for_class`` first).
+
+    The window's margin when none is given: the context the strategy that usually looks
+    for that class needs (a line finder's for Class I and III, an interest operator's for
+    Class II).
+
+    Examples
+    --------
+    >>> {c.name: class_margin(c) for c in LandmarkClass}
+    {'VERTICAL_LINE': 24.0, 'POINT': 4.0, 'GROUND_LINE': 24.0}
+    """
+    return DEFAULT_MARGINS[PerceptualStrategy.for_class(landmark_class)[0]]
 
 
 #: :meth:`ImageWindow._trusted`, under the name expecter/_expecter.py and schemas/_perceive.py

@@ -21,7 +21,6 @@ from aura_ums._files import as_path, atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
 from aura_ums._validate import ACTIVATION_RANGE, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.expecter import PerceptualStrategy
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, edge_distances, polygon_area, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
 from aura_ums.logs._io import ODOMETRY, _given, reversed_at
@@ -49,7 +48,7 @@ from aura_ums.uncertainty import (
     TurnAndRun,
     VerticalLineLandmark,
 )
-from aura_ums.world import LandmarkRecord, Meadow, MeadowMap
+from aura_ums.world import LandmarkRecord, Meadow, MeadowMap, PerceptualStrategy
 
 LogT = TypeVar("LogT", RobotLog, LogStream)
 
@@ -709,7 +708,9 @@ def _meadow_map(
             )
         # Every landmark always awake: a log's sightings come from its own sensor, not from schemas.
         records.append(
-            LandmarkRecord(landmark, PerceptualStrategy.LINE_FINDER, {}, ACTIVATION_RANGE.high, 0.0)
+            LandmarkRecord(
+                landmark, PerceptualStrategy.for_class(landmark_class)[0], {}, ACTIVATION_RANGE.high, 0.0
+            )
         )
     arena = ConvexPolygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
     meadow = Meadow("arena", arena, meta.terrain, tuple(lm.id for lm in landmarks))

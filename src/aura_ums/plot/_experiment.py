@@ -14,7 +14,7 @@ from matplotlib.patches import Rectangle
 from aura_ums._metrics import Metrics
 from aura_ums._validate import integer_at_least
 from aura_ums.errors import InputError
-from aura_ums.expecter import Expecter, ImageWindow, disk_model_window
+from aura_ums.expecter import Expecter, ImageWindow, PerceptualStrategy, disk_model_window, margin_pixels
 from aura_ums.plot._draw import draw_map
 from aura_ums.schemas import FindLandmarkSchema
 from aura_ums.sim import FrameRecord, RunResult, Scenario, run_scenario, summarize_runs
@@ -70,7 +70,8 @@ def experiment_table(scenario: Scenario, result: RunResult) -> list[TableRow]:
     Examples
     --------
     The windows are computed again from each frame's map before pruning, for the landmarks
-    the frame searched (only their ids are read from the record):
+    the frame searched (only their ids are read from the record), each with the margin of
+    its own strategy (the map's record), as its schema searched:
 
     >>> from aura_ums.manager import ManagerState
     >>> scenario = paper_scenario()
@@ -100,9 +101,11 @@ def experiment_table(scenario: Scenario, result: RunResult) -> list[TableRow]:
             distance += record.command.run
         polygon_area = disk_area = 0.0
         for ident, _ in record.windows:
-            landmark = scenario.meadow_map.landmark(ident).landmark
-            ours = expecter.window(record.map_before, landmark)
-            disk = disk_model_window(expecter, record.map_before, landmark)
+            # With the margin of the landmark's own strategy, as its schema searched.
+            entry = scenario.meadow_map.landmark(ident)
+            landmark, margin = entry.landmark, entry.strategy
+            ours = expecter.window(record.map_before, landmark, margin=margin)
+            disk = disk_model_window(expecter, record.map_before, landmark, margin=margin)
             polygon_area += 0.0 if ours is None else ours.area
             disk_area += 0.0 if disk is None else disk.area
         rows.append(
@@ -353,7 +356,10 @@ def write_experiment_report(out: str | Path, *, seed: int = 0, runs: int = 40) -
         *position_sentences(rows),
         "",
         "Window areas are summed over the landmarks predicted in the frame, both computed on the",
-        "map before pruning (the disk model: the smallest disk around the polygon).",
+        "map before pruning (the disk model: the smallest disk around the polygon), each grown by",
+        "the margin its landmark's strategy needs (a line finder "
+        f"{margin_pixels(PerceptualStrategy.LINE_FINDER):g} px, an interest operator "
+        f"{margin_pixels(PerceptualStrategy.INTEREST_OPERATOR):g} px).",
         "",
         "### Building corner as a Class II landmark",
         "",

@@ -22,7 +22,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Mapping
 
 import numpy as np
 
@@ -68,22 +67,6 @@ from aura_ums.world import LandmarkRecord
 #: A perceptual strategy, parameterized.
 Detector = FastLineFinder | MoravecOperator | RegionSegmenter
 
-_LINE_KEYS = (
-    "orientation",
-    "tolerance",
-    "min_length",
-    "min_gradient",
-    "min_contrast",
-    "smoothing",
-    "buckets",
-)
-_MORAVEC_KEYS = ("window", "min_interest", "suppression")
-_REGION_KEYS = ("threshold", "min_area", "min_aspect")
-_SUPPORTED: Mapping[LandmarkClass, tuple[PerceptualStrategy, ...]] = {
-    LandmarkClass.VERTICAL_LINE: (PerceptualStrategy.LINE_FINDER, PerceptualStrategy.REGION_SEGMENTER),
-    LandmarkClass.POINT: (PerceptualStrategy.INTEREST_OPERATOR,),
-    LandmarkClass.GROUND_LINE: (PerceptualStrategy.LINE_FINDER,),
-}
 #: Default ``min_aspect`` (height over width) of a Class I region.
 DEFAULT_MIN_ASPECT = 3.0
 #: Ground-line samples used to predict its image direction.
@@ -117,23 +100,12 @@ _MORAVEC_PARAMETERS = {"size": "window", "threshold": "min_interest"}
 
 
 def _build_detector(record: LandmarkRecord) -> Detector:
+    # The record checked its strategy against its class and its parameters' names
+    # (PerceptualStrategy.for_class and .parameters); the values' ranges are the detectors'.
     cls, strategy, params = record.landmark_class, record.strategy, record.parameters
     name = f"{record.id}.parameters"
-    if strategy not in _SUPPORTED[cls]:
-        allowed = ", ".join(s.value for s in _SUPPORTED[cls])
-        raise InputError(
-            f"{record.id}.strategy: expected {allowed} for a Class {cls.value} landmark, got {strategy.value}"
-        )
-    keys = {
-        PerceptualStrategy.LINE_FINDER: _LINE_KEYS,
-        PerceptualStrategy.INTEREST_OPERATOR: _MORAVEC_KEYS,
-        PerceptualStrategy.REGION_SEGMENTER: _REGION_KEYS,
-    }[strategy]
-    for key in params:
-        if key not in keys:
-            raise InputError(f"{name}: expected names among {', '.join(keys)}, got {key!r}")
     if strategy is PerceptualStrategy.LINE_FINDER:
-        options: dict[str, float | int | None] = {k: params[k] for k in _LINE_KEYS if k in params}
+        options: dict[str, float | int | None] = {k: params[k] for k in strategy.parameters if k in params}
         if "buckets" in options:
             options["buckets"] = _integer(f"{name}.buckets", params["buckets"])
         if cls is LandmarkClass.VERTICAL_LINE:

@@ -29,8 +29,11 @@ positions, start and end (Class III), with properties:
   (point: ``z`` in metres) or ``"III"`` (ground line);
 - ``symbol``: symbolic class (default ``""``); ``position_uncertainty``: metres
   (default 0);
-- ``strategy``: ``"line_finder"``, ``"interest_operator"`` or ``"region_segmenter"``;
-  ``parameters``: object of numbers for the strategy (default ``{}``);
+- ``strategy``: ``"line_finder"``, ``"interest_operator"`` or ``"region_segmenter"``, one
+  its class supports (:meth:`PerceptualStrategy.for_class`: Class I a line finder or region
+  segmenter, Class II an interest operator, Class III a line finder); ``parameters``: object
+  of numbers for the strategy, named as :attr:`PerceptualStrategy.parameters` lists (default
+  ``{}``);
 - ``activation_range`` (m, in (0, 10000]), ``recognition_threshold`` (>= 0),
   ``confirm_frames`` (integer in [1, 10000], default 3).
 

@@ -81,6 +81,68 @@ class PerceptualStrategy(Choice):
     #: Region segmenter: needs some surrounding region to compare against.
     REGION_SEGMENTER = "region_segmenter"
 
+    @classmethod
+    def for_class(cls, landmark_class: LandmarkClass) -> tuple[PerceptualStrategy, ...]:
+        """Return the strategies that can find a landmark class, its usual one first.
+
+        The paper's: a line finder for vertical and ground lines (a region segmenter also
+        finds a vertical line), an interest operator for points. A :class:`LandmarkRecord`
+        must name one of its class's; the Expecter's default margin is that of the usual one.
+
+        Examples
+        --------
+        >>> from aura_ums.uncertainty import LandmarkClass
+        >>> [s.value for s in PerceptualStrategy.for_class(LandmarkClass.POINT)]
+        ['interest_operator']
+        >>> PerceptualStrategy.for_class("II")
+        Traceback (most recent call last):
+        ...
+        aura_ums.errors.InputError: landmark_class: expected a LandmarkClass, got 'II'
+        """
+        if not isinstance(landmark_class, LandmarkClass):
+            raise InputError(f"landmark_class: expected a LandmarkClass, got {landmark_class!r}")
+        return _CLASS_STRATEGIES[landmark_class]
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """The names this strategy reads from a :attr:`LandmarkRecord.parameters`.
+
+        What each means, and its range, is the perceptual algorithm's (see
+        :mod:`aura_ums.schemas`).
+
+        Examples
+        --------
+        >>> PerceptualStrategy.REGION_SEGMENTER.parameters
+        ('threshold', 'min_area', 'min_aspect')
+        """
+        return _STRATEGY_PARAMETERS[self]
+
+
+# The strategies that can find each landmark class, its usual one first; and the parameter
+# names each strategy reads (PerceptualStrategy.for_class and .parameters read them).
+_CLASS_STRATEGIES: Mapping[LandmarkClass, tuple[PerceptualStrategy, ...]] = types.MappingProxyType(
+    {
+        LandmarkClass.VERTICAL_LINE: (PerceptualStrategy.LINE_FINDER, PerceptualStrategy.REGION_SEGMENTER),
+        LandmarkClass.POINT: (PerceptualStrategy.INTEREST_OPERATOR,),
+        LandmarkClass.GROUND_LINE: (PerceptualStrategy.LINE_FINDER,),
+    }
+)
+_STRATEGY_PARAMETERS: Mapping[PerceptualStrategy, tuple[str, ...]] = types.MappingProxyType(
+    {
+        PerceptualStrategy.LINE_FINDER: (
+            "orientation",
+            "tolerance",
+            "min_length",
+            "min_gradient",
+            "min_contrast",
+            "smoothing",
+            "buckets",
+        ),
+        PerceptualStrategy.INTEREST_OPERATOR: ("window", "min_interest", "suppression"),
+        PerceptualStrategy.REGION_SEGMENTER: ("threshold", "min_area", "min_aspect"),
+    }
+)
+
 
 class _MapError(InputError):
     """An inconsistency between several items of a meadow map; ``ids`` names them."""
@@ -162,9 +224,20 @@ class LandmarkRecord:
             raise InputError(
                 f"{name}.parameters: expected a mapping of names to numbers, got {self.parameters!r}"
             )
+        landmark_class = self.landmark.landmark_class
+        supported = _CLASS_STRATEGIES[landmark_class]
+        if self.strategy not in supported:
+            allowed = ", ".join(strategy.value for strategy in supported)
+            raise InputError(
+                f"{name}.strategy: expected {allowed} for a Class {landmark_class.value} landmark, "
+                f"got {self.strategy.value}"
+            )
+        known = _STRATEGY_PARAMETERS[self.strategy]
         checked: dict[str, float] = {}
         for key, value in self.parameters.items():
             _identifier(key, f"{name}.parameters key")
+            if key not in known:
+                raise InputError(f"{name}.parameters: expected names among {', '.join(known)}, got {key!r}")
             checked[key] = finite_float(value, f"{name}.parameters.{key}")
         object.__setattr__(self, "parameters", types.MappingProxyType(checked))
         object.__setattr__(
