@@ -366,16 +366,33 @@ def test_bad_observations_name_the_message(
         read(path)
 
 
-def test_repeated_odometry_stamps(run: Run, tmp_path: Path) -> None:
+def test_a_repeated_stamp_keeps_the_last_message_and_says_so(run: Run, tmp_path: Path) -> None:
+    # As the MRCLAM importer keeps the last row of a repeated time (it refused the bag before).
     store = get_typestore(Stores.ROS2_HUMBLE)
     topics = standard_topics(run, store)
     kind, odometry = topics["/odom"]
-    topics["/odom"] = (kind, [*odometry, (odometry[-1][0] + 1, odometry_message(store, run, 4))])
+    again = odometry_message(store, run, 4)
+    again.twist.twist.linear.x = 0.123  # republished with another value: the later one counts
+    topics["/odom"] = (kind, [*odometry, (odometry[-1][0] + 1, again)])
+    truth_kind, truth = topics["/truth"]
+    topics["/truth"] = (
+        truth_kind,
+        [*truth, (truth[-1][0] + 1, truth[2][1]), (truth[-1][0] + 2, truth[2][1])],
+    )
     path = write_bag(tmp_path / "again", topics)
-    with pytest.raises(
-        FileFormatError, match=r"topic /odom, message 30: expected motion messages at distinct times"
-    ):
-        read(path)
+    log = read(path)
+    clean = read(write_bag(tmp_path / "clean", standard_topics(run, store)))
+    assert len(log.odometry.time) == len(clean.odometry.time)
+    assert log.odometry.v[4] == 0.123
+    np.testing.assert_array_equal(np.delete(log.odometry.v, 4), np.delete(clean.odometry.v, 4))
+    np.testing.assert_array_equal(log.groundtruth.x, clean.groundtruth.x)
+    assert log.meta.source.endswith(
+        "; dropped 1 repeated motion time on /odom (kept the last message)"
+        "; dropped 2 repeated ground truth times on /truth (kept the last message)"
+    )
+    # A meta of the user's keeps its source, with the notes after it.
+    mine = read(path, meta=LogMeta("mine", source="lab run 7"))
+    assert mine.meta.source.startswith("lab run 7; dropped 1 repeated motion time on /odom")
 
 
 def test_bad_arguments(bag: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

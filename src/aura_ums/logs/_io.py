@@ -417,6 +417,11 @@ class _CsvFile:
             self.fail("", "expected at least one data row, got none")
 
 
+def plural(count: int, word: str) -> str:
+    """Return ``"1 word"`` or ``"n words"`` (an importer's notes)."""
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
 def clock_jump(time: NDArray[np.float64], lines: NDArray[np.int64], *, held: bool) -> tuple[int, str] | None:
     """Find the first gap between two rows longer than :data:`~aura_ums._validate.ROW_GAP` allows.
 

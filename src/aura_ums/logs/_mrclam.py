@@ -31,7 +31,7 @@ from aura_ums._validate import (
     Range,
 )
 from aura_ums.errors import FileFormatError, InputError
-from aura_ums.logs._io import clock_jump, renumbered, write_log
+from aura_ums.logs._io import clock_jump, plural, renumbered, write_log
 from aura_ums.logs._log import (
     GroundTruth,
     LogLandmark,
@@ -172,10 +172,6 @@ def _dataset_label(folder: Path) -> str:
     return f"UTIAS MRCLAM Dataset{match.group(1)}" if match else f"UTIAS MRCLAM dataset {folder.name!r}"
 
 
-def _plural(count: int, word: str) -> str:
-    return f"{count} {word}{'' if count == 1 else 's'}"
-
-
 def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     """Read one robot's run from a UTIAS MRCLAM dataset folder (any of its datasets).
 
@@ -296,16 +292,16 @@ def read_mrclam(dataset_dir: str | os.PathLike[str], robot: int) -> RobotLog:
     if earlier:
         # Sorted by time above: said, so that a reader of the log knows its file was not in order.
         notes.append(
-            f"sorted {prefix}Measurement.dat by time ({_plural(earlier, 'row')} earlier than the one above)"
+            f"sorted {prefix}Measurement.dat by time ({plural(earlier, 'row')} earlier than the one above)"
         )
     if not len(measurements.data):
         # As an observations.csv with its header alone: a log without observations is one
         # to replay on odometry alone, so it is kept, but said (a truncated download?).
         notes.append(f"no measurement rows in {prefix}Measurement.dat: a log without observations")
     if odometry_repeats:
-        notes.append(f"dropped {_plural(odometry_repeats, 'repeated odometry time')} (kept the last row)")
+        notes.append(f"dropped {plural(odometry_repeats, 'repeated odometry time')} (kept the last row)")
     if truth_repeats:
-        notes.append(f"dropped {_plural(truth_repeats, 'repeated ground-truth time')} (kept the last row)")
+        notes.append(f"dropped {plural(truth_repeats, 'repeated ground-truth time')} (kept the last row)")
     source = f"{_dataset_label(folder)} robot {robot} ({CITATION}); {'; '.join(notes)}"
     name = printable(f"{folder.name}-robot{robot}").strip()
     meta = LogMeta(name=name, terrain="floor", source=printable(source))

@@ -60,6 +60,7 @@ from aura_ums.logs._io import (
     _read_landmarks,
     _within,
     clock_jump,
+    plural,
     renumbered,
     write_log,
 )
@@ -167,6 +168,8 @@ class _Bag:
         self.error = error
         self.topics: dict[str, str | None] = {name: info.msgtype for name, info in reader.topics.items()}
         self.counts: dict[str, int] = {name: info.msgcount for name, info in reader.topics.items()}
+        #: What the reading changed, for the log's ``source`` (repeated times dropped).
+        self.notes: list[str] = []
 
     def fail(self, where: str, message: str) -> FileFormatError:
         return FileFormatError(str(self.path), where, message)
@@ -213,17 +216,18 @@ def _time(header: Any, received: int) -> float:
 
 def _sorted_rows(
     bag: _Bag, topic: str, rows: list[tuple[float, int, tuple[float, ...]]], role: str
-) -> np.ndarray[Any, np.dtype[np.float64]]:
-    """Rows (time, values...) sorted by time, after checking times are distinct and finite."""
+) -> tuple[np.ndarray[Any, np.dtype[np.float64]], int]:
+    """Rows (time, values...) sorted by time, and how many repeated times were dropped.
+
+    Of the messages stamped with one time the last in the topic is kept, as the MRCLAM
+    importer keeps the last row of a repeated time: a republished or re-stamped message.
+    """
     rows.sort(key=lambda row: (row[0], row[1]))
-    for (t0, i0, _), (t1, i1, _) in itertools.pairwise(rows):
-        if t1 == t0:
-            raise bag.fail(
-                f"topic {topic}, message {i1}",
-                f"expected {role} messages at distinct times, got time {t1!r} s again (message {i0})",
-            )
     _no_clock_jump(bag, topic, [(time, index) for time, index, _ in rows], role)
-    return np.array([(t, *values) for t, _, values in rows], dtype=np.float64)
+    kept = [
+        row for row, after in itertools.zip_longest(rows, rows[1:]) if after is None or after[0] != row[0]
+    ]
+    return np.array([(t, *values) for t, _, values in kept], dtype=np.float64), len(rows) - len(kept)
 
 
 def _no_clock_jump(bag: _Bag, topic: str, times: list[tuple[float, int]], role: str) -> None:
@@ -260,7 +264,11 @@ def _motion(bag: _Bag, topic: str, kind: str) -> Odometry:
             )
         _in_range(bag, f"topic {topic}, message {index}", {"v": v, "omega": omega})
         rows.append((time, index, (v, omega)))
-    table = _sorted_rows(bag, topic, rows, "motion")
+    table, repeats = _sorted_rows(bag, topic, rows, "motion")
+    if repeats:
+        bag.notes.append(
+            f"dropped {plural(repeats, 'repeated motion time')} on {topic} (kept the last message)"
+        )
     return Odometry(table[:, 0], table[:, 1], table[:, 2])
 
 
@@ -282,7 +290,11 @@ def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
             )
         _in_range(bag, f"topic {topic}, message {index}", {"x": x, "y": y})
         rows.append((_time(message.header, received), index, (x, y, heading)))
-    table = _sorted_rows(bag, topic, rows, "ground truth")
+    table, repeats = _sorted_rows(bag, topic, rows, "ground truth")
+    if repeats:
+        bag.notes.append(
+            f"dropped {plural(repeats, 'repeated ground truth time')} on {topic} (kept the last message)"
+        )
     return GroundTruth(table[:, 0], table[:, 1], table[:, 2], table[:, 3])
 
 
@@ -369,7 +381,9 @@ def read_rosbag(
     FileFormatError
         Naming the bag and topic: a missing bag, a missing topic (listing those present),
         a topic of another message type, an empty topic, a bad message (with its index:
-        unknown landmark id, negative range, non-finite values, repeated times).
+        unknown landmark id, negative range, non-finite values, a clock jump). Of motion or
+        ground-truth messages stamped with one time the last is kept, and the log's ``source``
+        says how many were dropped.
 
     Examples
     --------
@@ -409,6 +423,7 @@ def read_rosbag(
             odometry = _motion(bag, odom, kinds[odom])
             observations = _observations(bag, observed, {item.id: item for item in listed})
             groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
+            notes = bag.notes
     except AuraUmsError:
         raise
     except (AnyReaderError, Bag1Error, Bag2Error, OSError) as exc:  # no metadata.yaml, unreadable, damaged
@@ -424,7 +439,11 @@ def read_rosbag(
         topics = f"motion {odom}, observations {observed}" + (f", ground truth {truth}" if truth else "")
         # A file name may hold what a log name may not (a line break): kept readable, as printed.
         name = printable(path.stem or path.name).strip() or "bag"
-        meta = LogMeta(name, source=printable(f"ROS bag {path.name} ({topics})"))
+        meta = LogMeta(name, source=printable("; ".join([f"ROS bag {path.name} ({topics})", *notes])))
+    elif notes:
+        meta = replace(
+            meta, source=printable("; ".join([meta.source, *notes]) if meta.source else "; ".join(notes))
+        )
     try:
         log = RobotLog(meta, listed, observations, odometry=odometry, groundtruth=groundtruth)
     except InputError as exc:  # e.g. duplicate landmark ids in the list
