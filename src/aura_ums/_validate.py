@@ -271,6 +271,10 @@ SPEED = Range(-100.0, 100.0, "m/s")
 ANGULAR_SPEED = Range(-100.0, 100.0, "rad/s")
 #: A dimensionless factor (scales, fractions of a range), > 0.
 FACTOR = Range(0.0, 100.0, "", low_open=True)
+#: The particle filter's roughening constant K (each resampling jitters the particles by K
+#: times the cloud's spread over the cube root of their count; Gordon et al. suggest about
+#: 0.2): at 10 the jitter is ten times the cloud; 1e300 put the particles at 1e298 m.
+ROUGHENING = Range(0.0, 10.0, "")
 #: A scale on recorded odometry (``run_scale``, ``turn_scale``): near 1 when calibrated, 1e-3
 #: or 1e3 for odometry in other units (millimetres, milliradians); 1e-300 passed and stopped
 #: the map growing.

@@ -275,7 +275,12 @@ def test_landmark_at_the_sensor_is_rejected() -> None:
         ({"range_sd_fraction": -0.1}, r"range_sd_fraction: expected a number in \[0, 10\], got -0.1"),
         ({"range_sd_fraction": 1e300}, r"range_sd_fraction: expected a number in \[0, 10\], got 1e\+300"),
         ({"gate_probability": 1.0}, r"gate_probability: expected a probability in \(0, 1\)"),
-        ({"process_noise_scale": 0.0}, "process_noise_scale: expected a positive number"),
+        ({"process_noise_scale": 0.0}, r"process_noise_scale: expected a number in \(0, 100\], got 0.0"),
+        # 1e300 gave a covariance of 1e296 m^2 after three predictions, and inf after a fourth
+        (
+            {"process_noise_scale": 1e300},
+            r"process_noise_scale: expected a number in \(0, 100\], got 1e\+300",
+        ),
     ],
 )
 def test_bad_constructor_arguments(overrides: dict[str, object], match: str) -> None:

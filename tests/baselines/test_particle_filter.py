@@ -239,7 +239,9 @@ def test_region_holds_its_weight(terrains: TerrainTable) -> None:
         ({"outlier_floor": -1e-3}, "outlier_floor: expected a non-negative number"),
         ({"gate_probability": 0.0}, r"gate_probability: expected a probability in \(0, 1\)"),
         ({"resample_threshold": 1.5}, r"resample_threshold: expected a fraction in \[0, 1\]"),
-        ({"roughening": -0.1}, "roughening: expected a non-negative number"),
+        ({"roughening": -0.1}, r"roughening: expected a number in \[0, 10\], got -0.1"),
+        # 1e300 put the resampled particles at 1e298 m: the mean was refused as a Pose
+        ({"roughening": 1e300}, r"roughening: expected a number in \[0, 10\], got 1e\+300"),
     ],
 )
 def test_bad_constructor_arguments(overrides: dict[str, object], match: str) -> None:

@@ -44,7 +44,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import ANGLE_ERROR, LENGTH, START_RADIUS, Range, finite_float, positive_float
+from aura_ums._validate import ANGLE_ERROR, FACTOR, LENGTH, START_RADIUS, Range, finite_float
 from aura_ums.baselines._moments import check_motion, motion_moments
 from aura_ums.baselines._region import ConfidenceRegion, check_probability, chi2_quantile, gaussian_region
 from aura_ums.errors import InputError
@@ -153,14 +153,14 @@ class ExtendedKalmanFilter:
         Reject an update whose squared Mahalanobis innovation exceeds the chi-square
         quantile of this probability (1 or 2 degrees of freedom); None accepts all.
     process_noise_scale : float
-        Multiplier of the process noise covariance Q, > 0 (1 is the model as derived;
-        larger values are the usual tuning against unmodelled error).
+        Multiplier of the process noise covariance Q, in (0, 100] (1 is the model as
+        derived; larger values are the usual tuning against unmodelled error).
 
     Raises
     ------
     InputError
         For a non-Pose initial state, standard deviations outside their ranges above, a
-        non-positive ``process_noise_scale``, or a gate probability outside (0, 1).
+        ``process_noise_scale`` outside (0, 100], or a gate probability outside (0, 1).
 
     Examples
     --------
@@ -219,7 +219,8 @@ class ExtendedKalmanFilter:
         )
         self._bearing_gate = _gate_threshold(gate_probability, 1)
         self._range_bearing_gate = _gate_threshold(gate_probability, 2)
-        self._scale = positive_float(process_noise_scale, "process_noise_scale")
+        # Beyond FACTOR's 100 the covariance is no estimate (1e300 gave 1e296 m^2 after three steps).
+        self._scale = FACTOR.check(process_noise_scale, "process_noise_scale")
         self._x, self._y, self._h = initial.x, initial.y, initial.heading
         # Upper triangle of P: xx, xy, xh, yy, yh, hh.
         self._p = (position_var, 0.0, 0.0, position_var, 0.0, heading_var)

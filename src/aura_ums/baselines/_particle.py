@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from aura_ums._validate import check_rng, finite_float, nonnegative_float
+from aura_ums._validate import ROUGHENING, check_rng, finite_float, nonnegative_float
 from aura_ums.baselines._ekf import (
     HEADING_SD,
     POSITION_SD,
@@ -123,7 +123,7 @@ class ParticleFilter:
         Resample (at the next :meth:`predict`) when the effective sample size is below this
         fraction of the particle count, in [0, 1] (0 never resamples, 1 always does).
     roughening : float
-        Roughening constant K >= 0 (Gordon, Salmond and Smith 1993): after resampling,
+        Roughening constant K in [0, 10] (Gordon, Salmond and Smith 1993): after resampling,
         each coordinate gets Gaussian jitter of standard deviation ``K * E * n**(-1/3)``,
         E the coordinate's spread across the particles (heading: around the circular
         mean). 0 (default) disables it.
@@ -209,7 +209,7 @@ class ParticleFilter:
         if not 0.0 <= threshold <= 1.0:
             raise InputError(f"resample_threshold: expected a fraction in [0, 1], got {threshold!r}")
         self._resample_below = threshold * n
-        self._roughening = nonnegative_float(roughening, "roughening")
+        self._roughening = ROUGHENING.check(roughening, "roughening")
         self._rng = rng
         noise = rng.standard_normal((n, 3))
         cloud = np.empty((n, 3))
