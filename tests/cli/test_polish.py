@@ -547,3 +547,13 @@ def test_a_state_is_not_saved_from_a_replay_growing_from_anchors(
     assert result.exit_code == 2, result.output
     assert "--save-state: expected a replay without --anchor-growth" in result.stderr
     assert not state.exists()
+
+
+def test_an_until_after_the_last_frame_is_said(walk: tuple[Path, Path]) -> None:
+    # A log kept in milliseconds: --until 30000 meant 30 s, and replayed all 40 s without a word.
+    folder, terrain = walk
+    after = invoke("replay", folder, "--terrain", terrain, "--quiet", "--until", "30000")
+    assert "--until: 30000 s is after the last frame of" in after.stderr
+    assert "every frame was replayed (--until is in seconds" in after.stderr
+    for cut in (("--until", "20"), ()):
+        assert "--until:" not in invoke("replay", folder, "--terrain", terrain, "--quiet", *cut).stderr

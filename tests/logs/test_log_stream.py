@@ -355,3 +355,11 @@ def test_a_block_is_at_most_a_whole_log_file(tmp_path: Path, block_bytes: int) -
         InputError, match=r"block_bytes: expected at most 268435456 \(256 MiB, .*got " + str(block_bytes)
     ):
         open_log(folder, block_bytes=block_bytes)
+
+
+def test_a_replay_says_whether_until_left_frames(folder: Path) -> None:
+    # The log's frames run to 80 s; a stream read in small blocks finds the cut as it reads.
+    for open_it in (load_log, lambda path: open_log(path, block_bytes=300)):
+        assert replay_log(open_it(folder), FLOOR, until=50.0).cut_short
+        assert not replay_log(open_it(folder), FLOOR, until=1e6).cut_short
+        assert not replay_log(open_it(folder), FLOOR).cut_short

@@ -498,7 +498,11 @@ def replay(
     ] = None,
     until: Annotated[
         float | None,
-        typer.Option("--until", help="Stop after the last frame at or before this log time, in s."),
+        typer.Option(
+            "--until",
+            help="Stop after the last frame at or before this log time, in s (whatever the time unit of "
+            "the log's files; a time after its last frame is said).",
+        ),
     ] = None,
     live: Live = False,
     live_host: LiveHost = LIVE_DEFAULTS.host,
@@ -690,6 +694,7 @@ def replay(
         _warn_unseen(windows, camera)
     _warn_unscored(log, log_dir, metrics)
     _warn_early(result.early_observations, result.start_time, log_dir)
+    _warn_until_after_the_end(until, result, log_dir)
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if json_target is not None:
@@ -744,6 +749,16 @@ def _warn_early(early: int, start: float, log_dir: Path) -> None:
             f"{log_dir}: {early} observation{'s' if early != 1 else ''} at or before the replay's start "
             f"({start!r} s: the first motion, or the first ground truth when later) not replayed "
             "(observations_before_start)"
+        )
+
+
+def _warn_until_after_the_end(until: float | None, result: ReplayResult, log_dir: Path) -> None:
+    """Say so when ``--until`` cut nothing: a value meant in another unit (ms) replays the whole log."""
+    if until is not None and not result.cut_short and result.trace.time.size:
+        last = float(result.trace.time[-1])
+        warn(
+            f"--until: {until:g} s is after the last frame of {log_dir} ({last:g} s): every frame was "
+            "replayed (--until is in seconds, whatever the time unit of the log's files)"
         )
 
 

@@ -397,6 +397,9 @@ class ReplayResult:
     early_observations : int
         Observations at or before :attr:`start_time`, which no frame replays (of a log
         opened block by block: those read).
+    cut_short : bool
+        Whether ``until`` left frames of the log unreplayed (False: the replay reached the
+        log's last frame).
 
     Examples
     --------
@@ -470,6 +473,7 @@ class ReplayResult:
     state: ReplayState | None = None
     start_time: float = math.nan
     early_observations: int = 0
+    cut_short: bool = False
 
     def require_steps(self, until: float | None = None) -> None:
         """Refuse a replay that made no step: its figures would all be undefined.
@@ -1131,6 +1135,7 @@ def replay_log(
         state,
         source.start_time,
         source.early[0],
+        source.cut[0],
     )
 
 
@@ -1241,6 +1246,8 @@ class _Source:
     frame_times: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
     # Observations at or before the start, which no frame replays (a stream counts them as read).
     early: list[int] = field(default_factory=lambda: [0])
+    # Whether ``until`` left frames unreplayed (a stream finds out as it reads them).
+    cut: list[bool] = field(default_factory=lambda: [False])
 
     def finish(self) -> None:
         self.reports.finish()
@@ -1300,6 +1307,7 @@ def _whole_source(log: RobotLog, opts: ReplayOptions, stop: float, resume: Repla
         frames,
         frame_times,
         [sum(row.time <= start_time for row in log.observations)],
+        [last < frame_times.size],
     )
 
 
@@ -1339,25 +1347,27 @@ def _stream_source(stream: LogStream, opts: ReplayOptions, stop: float, *, keep_
         whole = RobotLog(meta, stream.landmarks, (), commands=stream.commands)
         reports = _WholeReports(*whole.position_report_arrays(start=start_time), 0)
 
-    early = [0]
+    early, cut = [0], [False]
     return _Source(
         start_time,
         start_pose,
         meadow_map,
-        _stream_chunks(stream, start_time, stop, keep_rows, early),
+        _stream_chunks(stream, start_time, stop, keep_rows, early, cut),
         reports,
         _truth_at(truth),
         0,
         early=early,
+        cut=cut,
     )
 
 
 def _stream_chunks(
-    stream: LogStream, start: float, stop: float, keep_rows: bool, early: list[int]
+    stream: LogStream, start: float, stop: float, keep_rows: bool, early: list[int], cut: list[bool]
 ) -> Iterator[_FrameChunk]:
     """Yield the frames after ``start`` up to ``stop`` of a streamed log, :data:`_CHUNK` at a time.
 
-    ``early[0]`` counts the observations read at or before ``start``.
+    ``early[0]`` counts the observations read at or before ``start``; ``cut[0]`` becomes
+    True when an observation after ``stop`` is read.
     """
     pending: list[_Row] = []
     lines: list[int] = []
@@ -1393,6 +1403,7 @@ def _stream_chunks(
                 break
             yield chunk
         if beyond:
+            cut[0] = True
             break
     while pending:
         chunk, pending, lines = _take_frames(pending, lines, keep_rows, ended=True)
