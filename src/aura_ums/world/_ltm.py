@@ -170,11 +170,13 @@ class LandmarkRecord:
         The landmark: its ``id`` is the instance (``"lamppost_107"``), its ``symbol`` the
         symbolic class (``"lamppost"``), its type the landmark class (I, II or III).
     strategy : PerceptualStrategy
-        Means of identification: the perceptual algorithm its find-landmark schema runs.
+        Means of identification: the perceptual algorithm its find-landmark schema runs,
+        one that can find the landmark's class (:meth:`PerceptualStrategy.for_class`).
     parameters : Mapping[str, float]
         The strategy's parameters (e.g. ``orientation``: expected image-line angle in
-        radians, ``tolerance``: radians, ``min_length``: pixels). Names are non-empty
-        strings, values finite numbers. Stored as a read-only mapping.
+        radians, ``tolerance``: radians, ``min_length``: pixels), named among those it
+        reads (:attr:`PerceptualStrategy.parameters`); values finite numbers (their ranges
+        are the algorithm's, checked when a schema is built). Stored as a read-only mapping.
     activation_range : float
         Metres, in (0, 10,000]: the find-landmark schema wakes from hibernation when the robot may be
         within this distance of the landmark.
@@ -188,7 +190,9 @@ class LandmarkRecord:
     Raises
     ------
     InputError
-        For a value of the wrong type or out of range, naming the landmark and the field.
+        For a value of the wrong type or out of range, a strategy that cannot find the
+        landmark's class, or a parameter the strategy does not read, naming the landmark and
+        the field.
 
     Examples
     --------
