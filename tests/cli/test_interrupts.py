@@ -6,6 +6,8 @@ where a user's Ctrl-C would land.
 
 from __future__ import annotations
 
+import contextlib
+import os
 import signal
 import subprocess
 import sys
@@ -267,3 +269,59 @@ def test_a_request_to_stop_while_the_arguments_are_read_keeps_its_exit_code(stop
     done = subprocess.run(command, capture_output=True, text=True, check=False, timeout=60)
     assert done.returncode == 128 + getattr(signal, stop), done.stderr
     assert done.stderr == f"error: terminated ({stop}): nothing was written\n"
+
+
+def _group(leader: int) -> dict[int, str]:
+    """Return the processes of ``leader``'s process group, each with its command line (Linux's /proc)."""
+    found = {}
+    for entry in Path("/proc").iterdir():
+        try:
+            # the fields after the command's name, which is in parentheses and may hold spaces
+            fields = (entry / "stat").read_text().rpartition(")")[2].split()
+            # a zombie is gone, only not yet reaped by whoever inherited it
+            if entry.name.isdigit() and int(fields[2]) == leader and fields[0] != "Z":
+                found[int(entry.name)] = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except (OSError, IndexError, ValueError):  # gone meanwhile, or no process
+            continue
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux's /proc")
+@pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM", "SIGHUP"])
+def test_a_stop_while_local_dask_workers_start_leaves_no_traceback_and_no_worker(
+    stop: str, tmp_path: Path
+) -> None:
+    """Sent to the whole process group, as a terminal's Ctrl-C is, the moment a worker process starts.
+
+    The workers printed their KeyboardInterrupt tracebacks while they imported, and the
+    half-started cluster Dask's ("Nanny failed to start", an AssertionError at exit).
+    """
+    pytest.importorskip("distributed", reason="the dask extra is not installed")
+    cli = Path(sys.executable).with_name("aura-ums")
+    out = tmp_path / "out"
+    out.mkdir()
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_sidewalk.toml"
+    command = [str(cli), "simulate", str(scenario), "--runs", "20", "--workers", "2"]
+    command += ["--metrics-json", str(out / "metrics.json")]
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
+    )
+    try:
+        waited = time.monotonic()
+        while process.poll() is None and time.monotonic() - waited < 60:
+            if any("spawn_main" in line for line in _group(process.pid).values()):
+                break  # a worker process is starting: the cluster is half-started
+            time.sleep(0.005)
+        os.killpg(process.pid, getattr(signal, stop))
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)  # whatever is left, for the next tests
+    assert process.returncode == 128 + getattr(signal, stop), stderr
+    said = "interrupted" if stop == "SIGINT" else f"terminated ({stop})"
+    assert stderr == f"error: {said}: nothing was written\n"
+    assert list(out.iterdir()) == []
+    waited = time.monotonic()
+    while _group(process.pid) and time.monotonic() - waited < 10:
+        time.sleep(0.05)  # the workers the cluster stopped may take a moment to be gone
+    assert _group(process.pid) == {}

@@ -16,6 +16,7 @@ instead of retrying silently and aura-ums counts every retry.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import logging
 import os
@@ -222,22 +223,27 @@ def _client(settings: CampaignSettings) -> Iterator[Client]:
         # Loopback only; no dashboard; the workers' log lines stay out of the terminal: a task's
         # error comes back to the caller, who words it (a worker's 'Compute Failed' and a
         # traceback printed before the clean message was noise).
+        held: list[int] = []
         try:
-            cluster = LocalCluster(
-                n_workers=settings.workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                dashboard_address=None,
-                silence_logs=logging.CRITICAL,
-                # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
-                scheduler_kwargs={
-                    "allowed_failures": 0,
-                    "dashboard": False,
-                    "dashboard_address": "127.0.0.1:0",
-                },
-            )
+            with _stops_held(held):
+                cluster = LocalCluster(
+                    n_workers=settings.workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    dashboard_address=None,
+                    silence_logs=logging.CRITICAL,
+                    # Its HTTP server on a free loopback port: 8787, Dask's default, may be taken.
+                    scheduler_kwargs={
+                        "allowed_failures": 0,
+                        "dashboard": False,
+                        "dashboard_address": "127.0.0.1:0",
+                    },
+                )
         except (RuntimeError, OSError, ValueError, TypeError, TimeoutError) as exc:
+            # A stop that came meanwhile may be why (the workers met a SIGTERM sent to the whole
+            # process group): it is what ends the command, not the failure it caused.
+            _deliver(held)
             # "Nanny failed to start", from a worker that could not: a Dask setting it read
             # (DASK_... in the environment, a configuration file) or the machine refusing it.
             raise AuraUmsError(
@@ -245,8 +251,73 @@ def _client(settings: CampaignSettings) -> Iterator[Client]:
                 f"{type(exc).__name__}: {exc} (look at Dask's settings: DASK_* variables in the "
                 "environment, files in ~/.config/dask)"
             ) from None
-        with cluster, Client(cluster, set_as_default=False) as client:
-            yield client
+        with cluster:
+            _deliver(held)  # inside the block: the cluster is stopped before the stop goes on
+            with Client(cluster, set_as_default=False) as client:
+                yield client
+
+
+#: The signals that stop a command line as a Ctrl-C does: Ctrl-C itself, ``kill`` and
+#: ``timeout`` (SIGTERM), a closed terminal (SIGHUP).
+_STOPS = ("SIGINT", "SIGTERM", "SIGHUP")
+#: The ones the local workers never receive: a terminal's Ctrl-C or hangup goes to every
+#: process of its group, workers too, which then printed their own KeyboardInterrupt
+#: tracebacks. They are stopped by their cluster instead. SIGTERM still reaches them: Dask
+#: and multiprocessing end a worker with it.
+_SPARED = ("SIGINT", "SIGHUP")
+
+
+@contextmanager
+def _stops_held(held: list[int]) -> Iterator[None]:
+    """Hold a stop (Ctrl-C, SIGTERM, SIGHUP) while a local cluster starts, and keep it from its workers.
+
+    A KeyboardInterrupt raised inside ``LocalCluster(...)`` left a half-started cluster
+    whose tasks and exit function printed Dask's tracebacks, and its workers still
+    starting. Here the handlers that would raise are replaced by one that appends the
+    signal's number to ``held``; the caller delivers it (:func:`_deliver`) once the cluster
+    can be stopped. The signals of :data:`_SPARED` are also blocked in this thread meanwhile:
+    the threads the cluster starts inherit the mask, and the worker processes they spawn
+    keep it through ``exec`` (as multiprocessing's resource tracker protects its own
+    process), so a Ctrl-C reaches this process alone, which stops the workers itself.
+    Outside the main thread (an embedding caller's) the handlers stay as they are.
+    """
+    import signal
+
+    def hold(signum: int, frame: object) -> None:
+        held.append(signum)
+
+    numbers = [getattr(signal, name) for name in _STOPS if hasattr(signal, name)]
+    handlers: dict[int, Any] = {}
+    with contextlib.suppress(ValueError):  # not the main thread
+        for number in numbers:
+            if callable(signal.getsignal(number)):  # one that raises here (the default kills, ignores)
+                handlers[number] = signal.signal(number, hold)
+    masks = hasattr(signal, "pthread_sigmask")  # not on Windows, which has no process groups either
+    spared = {getattr(signal, name) for name in _SPARED if hasattr(signal, name)}
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, spared) if masks else set()
+    try:
+        if masks:
+            from multiprocessing import resource_tracker
+
+            # Started here, not by the cluster from its own thread: starting it unblocks SIGINT
+            # in the thread that does (resource_tracker.py), and that thread's workers would
+            # receive the Ctrl-C again. It inherits the mask too (a SIGHUP ended it).
+            resource_tracker.ensure_running()
+            signal.pthread_sigmask(signal.SIG_BLOCK, spared)
+        yield
+    finally:
+        if masks:  # unblocked first: a signal pending meanwhile is handled now, by hold
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
+
+
+def _deliver(held: list[int]) -> None:
+    """Deliver the first stop :func:`_stops_held` held: its own handler raises it here."""
+    if held:
+        import signal
+
+        signal.raise_signal(held[0])
 
 
 class _Runs(Generic[_T, _R]):
