@@ -1456,10 +1456,25 @@ def atomic_path(target: str | os.PathLike[str], *, replace: bool = True) -> Iter
     FileExistsError: ...
     >>> (folder / "a.txt").read_text(), len(list(folder.iterdir()))
     ('whole', 1)
+
+    A ``target`` that is the scratch path of an enclosing ``atomic_path`` (a writer that
+    writes atomically itself, given the scratch file of a caller that does too) is yielded
+    as it is: the enclosing one moves it whole onto its own target, or removes it.
+
+    >>> with atomic_path(folder / "b.txt") as outer, atomic_path(outer) as inner:
+    ...     _ = inner.write_text("once")
+    >>> inner == outer, (folder / "b.txt").read_text()
+    (True, 'once')
     """
     final = Path(target)
+    if final in _scratch_in_use:
+        # A second scratch file beside the first wrote everything twice, and a kill left
+        # a scratch of a scratch behind (.r.mcap.<hex>.tmp.<hex>.tmp).
+        yield final
+        return
     made = make_folders(final.parent)
     scratch = scratch_path(final)
+    _scratch_in_use.add(scratch)
     try:
         yield scratch
         if replace:
@@ -1470,6 +1485,12 @@ def atomic_path(target: str | os.PathLike[str], *, replace: bool = True) -> Iter
         scratch.unlink(missing_ok=True)
         remove_made(made)
         raise
+    finally:
+        _scratch_in_use.discard(scratch)
+
+
+# The scratch paths atomic_path has yielded and not yet moved or removed (see there).
+_scratch_in_use: set[Path] = set()
 
 
 def make_folders(folder: Path) -> list[Path]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -325,3 +326,64 @@ def test_a_stop_while_local_dask_workers_start_leaves_no_traceback_and_no_worker
     while _group(process.pid) and time.monotonic() - waited < 10:
         time.sleep(0.05)  # the workers the cluster stopped may take a moment to be gone
     assert _group(process.pid) == {}
+
+
+# A SIGKILL half-way through an output a library writer streams to disk itself: after the
+# 25th scene of the MCAP file, or the first rows of the per-step CSV.
+_KILLED_WHILE_WRITING = {
+    "--mcap": (
+        "from foxglove import channels\n"
+        "original = channels.SceneUpdateChannel.log\n"
+        "calls = []\n"
+        "def log(self, *args, **kwargs):\n"
+        "    calls.append(1)\n"
+        "    if len(calls) == 25:\n"
+        "        os.kill(os.getpid(), signal.SIGKILL)\n"
+        "    original(self, *args, **kwargs)\n"
+        "channels.SceneUpdateChannel.log = log\n"
+    ),
+    "--steps-csv": (
+        "from aura_ums.logs import _replay\n"
+        "original = _replay._StepsCsv.write\n"
+        "def write(self, trace):\n"
+        "    original(self, trace)\n"
+        "    self.stream.flush()\n"
+        "    os.kill(os.getpid(), signal.SIGKILL)\n"
+        "_replay._StepsCsv.write = write\n"
+    ),
+}
+
+
+@pytest.mark.parametrize("option", sorted(_KILLED_WHILE_WRITING))
+def test_a_kill_while_an_output_is_written_leaves_one_scratch_file_and_the_old_output(
+    option: str, inputs: Path, tmp_path: Path
+) -> None:
+    # The MCAP writer and the per-step CSV wrote a scratch file of the command's scratch file:
+    # twice the writing, and a kill left .replay.mcap.<hex>.tmp.<hex>.tmp behind.
+    if option == "--mcap":
+        pytest.importorskip("foxglove", reason="the foxglove extra is not installed")
+    out = tmp_path / "out"
+    out.mkdir()
+    name = "replay.mcap" if option == "--mcap" else "steps.csv"
+    (out / name).write_text("the old file")
+    arguments = ["replay", str(inputs / "log"), "--terrain", str(inputs / "terrain.toml")]
+    arguments += [option, str(out / name), "--overwrite", "--quiet"]
+    script = (
+        "import os, signal, sys\n"
+        + _KILLED_WHILE_WRITING[option]
+        + f"sys.argv = ['aura-ums', *{arguments!r}]\nfrom aura_ums.cli import main\nmain()\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == -signal.SIGKILL, done.stderr
+    left = sorted(path.name for path in out.iterdir() if path.name != name)
+    assert len(left) == 1, left
+    assert (out / name).read_text() == "the old file"
+    scratch = out / left[0]
+    assert re.fullmatch(rf"\.{re.escape(name)}\.[0-9a-f]{{16}}\.tmp", scratch.name), scratch.name
+    assert scratch.stat().st_size > 0  # killed while writing it, not before
+    # Run again, the scratch file is no output: the output is written whole, the scratch
+    # file left to the user (another run might still be writing it).
+    again = runner.invoke(app, arguments)
+    assert again.exit_code == 0, again.output
+    assert sorted(path.name for path in out.iterdir()) == [scratch.name, name]
+    assert (out / name).read_bytes() != b"the old file"

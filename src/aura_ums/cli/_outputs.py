@@ -16,7 +16,6 @@ Ctrl-C into exit code 130 and says what was (not) written.
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import os
 import re
@@ -31,7 +30,15 @@ from typing import Annotated, Any
 
 import typer
 
-from aura_ums._files import NAME_MAX, make_folders, place_new, remove_made, scratch_path, write_text_atomic
+from aura_ums._files import (
+    NAME_MAX,
+    atomic_path,
+    make_folders,
+    place_new,
+    remove_made,
+    scratch_path,
+    write_text_atomic,
+)
 from aura_ums.cli._common import err_console, fail
 from aura_ums.cli._interrupt import announce, exit_code, nothing_written, stopped
 from aura_ums.errors import FileFormatError
@@ -349,13 +356,12 @@ def placed(target: Target) -> Iterator[Path]:
     final move keeps an output that appeared meanwhile unless ``--overwrite`` was given.
     """
     final = resolved(target.path)
-    scratch = scratch_path(final)
+    scratch = final
     try:
-        yield scratch
-        if _replacing[0]:
-            os.replace(scratch, final)
-        else:
-            place_new(scratch, final)
+        # The one scratch file: the library's writers, which write atomically themselves,
+        # write into it as it is (see atomic_path).
+        with atomic_path(final, replace=_replacing[0]) as scratch:
+            yield scratch
     except FileExistsError:
         raise appeared(target, target.path) from None
     except OSError as exc:
@@ -368,9 +374,6 @@ def placed(target: Target) -> Iterator[Path]:
         if reason == exc.message:
             raise fail(f"{target.option}: {target.path}: {reason}") from None
         raise fail(f"{target.option}: expected a writable place, got {target.path}: {reason}") from None
-    finally:
-        with contextlib.suppress(OSError):  # gone, or its folder never was
-            scratch.unlink()
 
 
 @contextmanager
