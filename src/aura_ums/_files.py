@@ -60,6 +60,7 @@ __all__ = [
     "csv_blocks",
     "decode",
     "describe",
+    "is_scratch",
     "key_path",
     "load_csv",
     "load_json",
@@ -1420,6 +1421,26 @@ def scratch_path(target: Path) -> Path:
     # (at a whole character) so that the scratch name stays within a file name's 255 bytes.
     kept = os.fsencode(target.name)[: NAME_MAX - 18 - len(SCRATCH_SUFFIX)].decode("utf-8", "ignore")
     return target.with_name(f".{kept}.{secrets.token_hex(8)}{SCRATCH_SUFFIX}")
+
+
+def is_scratch(path: Path) -> bool:
+    """Whether ``path`` is named as :func:`scratch_path` names: a write's scratch file or folder.
+
+    One found where no command runs was left by a process killed outright (``SIGKILL``):
+    never an output, and safe to delete.
+
+    Examples
+    --------
+    >>> is_scratch(scratch_path(Path("out/r.mcap"))), is_scratch(Path("out/r.mcap"))
+    (True, False)
+    >>> is_scratch(Path(".r.mcap.tmp")), is_scratch(Path(".r.mcap.0123456789abcdef.tmp"))
+    (False, True)
+    """
+    return _SCRATCH_NAME.fullmatch(path.name) is not None
+
+
+#: The names :func:`scratch_path` gives.
+_SCRATCH_NAME = re.compile(r"\..*\.[0-9a-f]{16}" + re.escape(SCRATCH_SUFFIX), re.DOTALL)
 
 
 @contextmanager

@@ -903,3 +903,27 @@ def test_the_write_probe_is_removed_when_a_stop_lands_while_it_exists(
         _outputs._writable(_outputs.Target("--metrics-json", tmp_path / "m.json"), tmp_path / "m.json")
     monkeypatch.undo()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_folder_holding_only_a_killed_commands_scratch_files_is_refused_saying_so(tmp_path: Path) -> None:
+    # A SIGKILL leaves a hidden scratch file (.NAME.<16 hex digits>.tmp): not an output, but
+    # the folder is not empty either; "holds files" sent the user looking for outputs.
+    from tests.cli.test_logs_cli import DATASET
+
+    dataset = tmp_path / "dataset"
+    dataset.mkdir()
+    for name, text in DATASET.items():
+        (dataset / name).write_text(text)
+    out = tmp_path / "robot1"
+    out.mkdir()
+    (out / ".meta.toml.0123456789abcdef.tmp").write_text("a part")
+    arguments = ("import", "mrclam", dataset, out, "--robot", "1")
+    refused(
+        invoke(*arguments),
+        f"OUT_DIR: expected a new or empty folder, got {out}, which holds only the scratch files of "
+        "unfinished writes (.meta.toml.0123456789abcdef.tmp: a killed command's leftovers can be deleted; "
+        "or pass --overwrite)",
+    )
+    (out / "notes.txt").write_text("mine")
+    refused(invoke(*arguments), f"got {out}, which holds files (pass --overwrite")
+    assert sorted(path.name for path in out.iterdir()) == [".meta.toml.0123456789abcdef.tmp", "notes.txt"]

@@ -33,6 +33,7 @@ import typer
 from aura_ums._files import (
     NAME_MAX,
     atomic_path,
+    is_scratch,
     make_folders,
     place_new,
     remove_made,
@@ -238,10 +239,21 @@ def _replaceable(target: Target, where: Path, overwrite: bool) -> None:
     if target.folder:
         if where.exists() and not where.is_dir():
             raise fail(f"{target.option}: expected a folder, got {target.path}, which is a file")
-        if where.is_dir() and any(where.iterdir()) and not overwrite:
+        leftovers: list[str] = []
+        for path in where.iterdir() if where.is_dir() and not overwrite else ():
+            if not is_scratch(path):
+                raise fail(
+                    f"{target.option}: expected a new or empty folder, got {target.path}, which holds files "
+                    "(pass --overwrite to replace what is written there)"
+                )
+            leftovers.append(path.name)
+        if leftovers:
+            # Not outputs, but not ours to delete either: a command writing there may still run.
+            shown = ", ".join(sorted(leftovers)[:3]) + (", ..." if len(leftovers) > 3 else "")
             raise fail(
-                f"{target.option}: expected a new or empty folder, got {target.path}, which holds files "
-                "(pass --overwrite to replace what is written there)"
+                f"{target.option}: expected a new or empty folder, got {target.path}, which holds only the "
+                f"scratch files of unfinished writes ({shown}: a killed command's leftovers can be deleted; "
+                "or pass --overwrite)"
             )
         return
     if where.is_dir():
