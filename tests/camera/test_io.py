@@ -485,3 +485,188 @@ def test_a_focal_bound_not_below_the_focal_length_is_refused_by_the_file(tmp_pat
             r"\(400\.0 px\), got 400\.0$",
         ):
             read(path)
+
+
+# -------------------------------------------------------------------- ROS calibration YAML
+
+# As ROS's camera_calibration_parsers writes it (camera_info_manager's files, the calibrator's
+# ost.yaml): no '%YAML' header, matrices as plain {rows, cols, data} mappings.
+ROS_YAML = """\
+image_width: 640
+image_height: 480
+camera_name: narrow_stereo
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.1, 0.01, 0, 0, 0]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+projection_matrix:
+  rows: 3
+  cols: 4
+  data: [554.25, 0, 320.5, 0, 0, 554.25, 240.5, 0, 0, 0, 1, 0]
+"""
+# The same camera in aura-ums' TOML.
+ROS_AS_TOML = """\
+[intrinsics]
+fx = 554.25
+fy = 554.25
+cx = 320.5
+cy = 240.5
+width = 640
+height = 480
+distortion = [-0.1, 0.01, 0.0, 0.0, 0.0]
+
+[mount]
+height = 0.3
+"""
+ROS_MOUNT = CameraMount(0.3)
+
+
+def ros_edit(old: str, new: str) -> str:
+    assert old in ROS_YAML
+    return ROS_YAML.replace(old, new, 1)
+
+
+def test_ros_calibration_reads_as_the_equivalent_toml(tmp_path: Path) -> None:
+    camera = load_opencv_calibration(write(tmp_path, "ost.yaml", ROS_YAML), ROS_MOUNT)
+    assert camera == load_camera(write(tmp_path, "cam.toml", ROS_AS_TOML))
+    assert camera.intrinsics.distortion == (-0.1, 0.01, 0.0, 0.0, 0.0)
+
+
+def test_ros_calibration_as_the_python_calibrator_writes_it(tmp_path: Path) -> None:
+    # camera_calibration's cameracalibrator writes "%8f" numbers and padded brackets.
+    text = ROS_YAML.replace(
+        "data: [554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1]",
+        "data: [ 554.250000, 0.000000, 320.500000,\n          0.000000, 554.250000, 240.500000,\n"
+        "          0.000000, 0.000000, 1.000000]",
+    ).replace("data: [-0.1, 0.01, 0, 0, 0]", "data: [-0.100000, 0.010000, 0.000000, 0.000000, 0.000000]")
+    # Told by its content, whatever its name (a file without distortion_model is plumb_bob, as ROS reads it).
+    path = write(tmp_path, "left.calibration", text.replace("distortion_model: plumb_bob\n", ""))
+    assert load_opencv_calibration(path, ROS_MOUNT) == load_camera(write(tmp_path, "c.toml", ROS_AS_TOML))
+
+
+def test_ros_rational_polynomial_with_zero_extra_terms(tmp_path: Path) -> None:
+    text = ros_edit("distortion_model: plumb_bob", "distortion_model: rational_polynomial").replace(
+        "cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 8\n  data: [-0.1, 0.01, 0.001, 0, 0.002, 0, 0, 0]"
+    )
+    camera = load_opencv_calibration(write(tmp_path, "ost.yaml", text), ROS_MOUNT)
+    assert camera.intrinsics.distortion == (-0.1, 0.01, 0.001, 0.0, 0.002)
+
+
+@pytest.mark.parametrize(
+    ("text", "where", "match"),
+    [
+        (
+            ros_edit("distortion_model: plumb_bob", "distortion_model: equidistant")
+            .replace("cols: 5", "cols: 4")
+            .replace("data: [-0.1, 0.01, 0, 0, 0]", "data: [-0.1, 0.01, 0, 0]"),
+            "distortion_model",
+            "expected distortion_model plumb_bob or rational_polynomial, got 'equidistant'$",
+        ),
+        (
+            ros_edit("distortion_model: plumb_bob", "distortion_model: [plumb_bob]"),
+            "distortion_model",
+            "expected distortion_model plumb_bob or rational_polynomial, got an array$",
+        ),
+        (
+            ros_edit(
+                "data: [1, 0, 0, 0, 1, 0, 0, 0, 1]", "data: [0.9998, 0.02, 0, -0.02, 0.9998, 0, 0, 0, 1]"
+            ),
+            "rectification_matrix",
+            r"expected the identity \(a monocular camera: aura-ums models no rectification\), "
+            r"got \[\[0\.9998",
+        ),
+        (
+            ros_edit("rows: 3\n  cols: 3\n  data: [1, 0, 0,", "rows: 1\n  cols: 9\n  data: [1, 0, 0,"),
+            "rectification_matrix",
+            r"expected the identity .*, got \[\[1\.0, 0\.0",
+        ),
+        (
+            ros_edit("distortion_model: plumb_bob", "distortion_model: rational_polynomial").replace(
+                "cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 8\n  data: [-0.1, 0.01, 0, 0, 0, 0.5, 0, 0]"
+            ),
+            "distortion_coefficients",
+            r"expected the coefficients beyond k3 \(k4-k6, s1-s4, tau\) to be zero",
+        ),
+        (
+            ros_edit(
+                "cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 8\n  data: [-0.1, 0.01, 0, 0, 0, 0, 0, 0]"
+            ),
+            "distortion_coefficients",
+            r"expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients for distortion_model plumb_bob, got 8$",
+        ),
+        (
+            ros_edit("distortion_model: plumb_bob", "distortion_model: rational_polynomial"),
+            "distortion_coefficients",
+            r"expected 8 \(k1, k2, p1, p2, k3, k4, k5, k6\) coefficients for distortion_model "
+            r"rational_polynomial, got 5$",
+        ),
+        (
+            ros_edit("camera_matrix:", "K:"),
+            "camera_matrix",
+            "expected the key camera_matrix, got no such key",
+        ),
+        (
+            ros_edit("image_height: 480\n", ""),
+            "image_height",
+            "expected the key image_height, got no such key",
+        ),
+        (ros_edit("image_width: 640", "image_width: 0"), "image_width", "expected an integer >= 1, got 0"),
+        (
+            ros_edit("  cols: 3\n  data: [554", "  data: [554"),
+            "camera_matrix.cols",
+            "expected this field of a matrix",
+        ),
+        (
+            ros_edit("554.25, 0, 320.5, 0, 554.25", "554.25, 3, 320.5, 0, 554.25"),
+            "camera_matrix",
+            "zero skew",
+        ),
+        (
+            ros_edit("554.25, 0, 320.5, 0, 554.25", "0.5, 0, 320.5, 0, 554.25"),
+            "camera_matrix fx",
+            "expected a number in",
+        ),
+        (
+            ros_edit("data: [-0.1, 0.01, 0, 0, 0]", "data: [-0.1, .nan, 0, 0, 0]"),
+            "distortion_coefficients.data[1]",
+            "finite",
+        ),
+        (
+            ros_edit("camera_matrix:\n", "camera_matrix: 3\n").replace(
+                "  rows: 3\n  cols: 3\n  data: [554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1]\n", "", 1
+            ),
+            "camera_matrix",
+            "expected a matrix mapping, got 3$",
+        ),
+        (
+            ros_edit("image_width: 640", "image_width 640"),
+            "ost.yaml:1",
+            "expected 'key: value', got 'image_width 640'",
+        ),
+    ],
+)
+def test_ros_calibration_errors(tmp_path: Path, text: str, where: str, match: str) -> None:
+    path = write(tmp_path, "ost.yaml", text)
+    with pytest.raises(FileFormatError, match=match) as caught:
+        load_opencv_calibration(path, ROS_MOUNT)
+    assert caught.value.path == str(path)
+    assert where in location(caught.value)
+
+
+def test_a_header_less_yaml_of_neither_kind_is_refused(tmp_path: Path) -> None:
+    path = write(tmp_path, "notes.yaml", "# a calibration?\nfocal: 500\n")
+    with pytest.raises(
+        FileFormatError,
+        match=r"notes\.yaml:1: expected the '%YAML:1\.0' header of an OpenCV FileStorage file, or a ROS "
+        r"calibration \(camera_matrix: rows, cols, data\), got '# a calibration\?'$",
+    ):
+        load_opencv_calibration(path, ROS_MOUNT)

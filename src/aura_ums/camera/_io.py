@@ -1,8 +1,10 @@
-"""Camera files: aura-ums' TOML, and OpenCV ``cv::FileStorage`` calibrations in YAML or JSON.
+"""Camera files: aura-ums' TOML, OpenCV ``cv::FileStorage`` calibrations, ROS calibrations.
 
-Neither OpenCV nor a YAML library is needed: the FileStorage YAML subset (a ``%YAML:1.0``
-header, block mappings and sequences, flow ``[...]``/``{...}`` collections over several
-lines, ``!!opencv-matrix`` tags, quoted and plain scalars, comments) is parsed here.
+Neither OpenCV, ROS nor a YAML library is needed: the FileStorage YAML subset (a
+``%YAML:1.0`` header, block mappings and sequences, flow ``[...]``/``{...}`` collections
+over several lines, ``!!opencv-matrix`` tags, quoted and plain scalars, comments) is
+parsed here, and so are ROS's calibration files (camera_calibration_parsers' YAML, which
+camera_info_manager and the ROS calibrator write: the same subset without the header).
 Every error is a :class:`~aura_ums.errors.FileFormatError` naming the file and the place.
 
 The TOML camera file::
@@ -520,20 +522,16 @@ def _balance(text: str, depth: int = 0, quote: str = "") -> tuple[int, str]:
 class _YamlReader:
     """Block structure of a FileStorage YAML document: (line number, indent, text) items."""
 
-    def __init__(self, text: str, source: str) -> None:
+    def __init__(self, text: str, source: str, *, header: bool = True) -> None:
         self.source = source
         raw = text.splitlines()
-        first = next((i for i, line in enumerate(raw) if line.strip()), None)
-        if first is None or not re.match(r"%YAML[: ]1\.\d", raw[first].strip()):
-            found = describe(raw[first].strip()) if first is not None else "an empty file"
-            raise FileFormatError(
-                source,
-                "",
-                f"expected the '%YAML:1.0' header of an OpenCV FileStorage file, got {found}",
-                line=1 if first is None else first + 1,
-            )
+        i = 0
+        if header:  # FileStorage's own files; a ROS calibration has none
+            first = next((i for i, line in enumerate(raw) if line.strip()), None)
+            if first is None or not re.match(r"%YAML[: ]1\.\d", raw[first].strip()):
+                raise _no_header(source, raw, first)
+            i = first + 1
         self.lines: list[tuple[int, int, str]] = []
-        i = first + 1
         while i < len(raw):
             number, content = i + 1, _strip_comment(raw[i])
             i += 1
@@ -624,8 +622,19 @@ class _YamlReader:
         return items
 
 
-def _parse_yaml(text: str, source: str) -> dict[str, object]:
-    reader = _YamlReader(text, source)
+def _no_header(source: str, raw: list[str], first: int | None) -> FileFormatError:
+    found = describe(raw[first].strip()) if first is not None else "an empty file"
+    return FileFormatError(
+        source,
+        "",
+        f"expected the '%YAML:1.0' header of an OpenCV FileStorage file, or a ROS calibration "
+        f"(camera_matrix: rows, cols, data), got {found}",
+        line=1 if first is None else first + 1,
+    )
+
+
+def _parse_yaml(text: str, source: str, *, header: bool = True) -> dict[str, object]:
+    reader = _YamlReader(text, source, header=header)
     if not reader.lines:
         return {}
     try:
@@ -682,25 +691,30 @@ def _find(document: Mapping[str, object], label: str, source: str) -> tuple[str,
     return found[0]
 
 
-def _matrix(value: object, source: str, key: str) -> Array:
+def _matrix(value: object, source: str, key: str, *, opencv: bool = True) -> Array:
+    """Return a matrix mapping's ``data`` as rows x cols.
+
+    With ``opencv`` FileStorage's ``opencv-matrix`` (``type_id`` and ``dt`` too), else ROS's
+    mapping (rows, cols and data alone).
+    """
+    kind = "an opencv-matrix" if opencv else "a matrix"
     if not isinstance(value, dict):
-        raise FileFormatError(source, key, f"expected an opencv-matrix mapping, got {describe(value)}")
-    if value.get("type_id") != "opencv-matrix":
+        raise FileFormatError(source, key, f"expected {kind} mapping, got {describe(value)}")
+    if opencv and value.get("type_id") != "opencv-matrix":
         raise FileFormatError(
             source, key, f"expected type_id opencv-matrix, got {describe(value.get('type_id'))}"
         )
-    for field in ("rows", "cols", "dt", "data"):
+    for field in ("rows", "cols", "dt", "data") if opencv else ("rows", "cols", "data"):
         if field not in value:
-            raise FileFormatError(
-                source, f"{key}.{field}", "expected this field of an opencv-matrix, got none"
-            )
+            raise FileFormatError(source, f"{key}.{field}", f"expected this field of {kind}, got none")
     rows = _integer(value["rows"], source, f"{key}.rows")
     cols = _integer(value["cols"], source, f"{key}.cols")
-    dt = value["dt"]
-    if not isinstance(dt, str) or not re.fullmatch(r"[ucswifd]", dt):
-        raise FileFormatError(
-            source, f"{key}.dt", f"expected a one-channel element type (d, f, i...), got {describe(dt)}"
-        )
+    if opencv:
+        dt = value["dt"]
+        if not isinstance(dt, str) or not re.fullmatch(r"[ucswifd]", dt):
+            raise FileFormatError(
+                source, f"{key}.dt", f"expected a one-channel element type (d, f, i...), got {describe(dt)}"
+            )
     data = value["data"]
     if not isinstance(data, list):
         raise FileFormatError(source, f"{key}.data", f"expected a list of numbers, got {describe(data)}")
@@ -712,9 +726,8 @@ def _matrix(value: object, source: str, key: str) -> Array:
     return np.array(numbers, dtype=np.float64).reshape(rows, cols)
 
 
-def _camera_from_filestorage(document: Mapping[str, object], source: str, mount: CameraMount) -> Camera:
-    key, value = _find(document, "camera_matrix", source)
-    k = _matrix(value, source, key)
+def _camera_matrix(k: Array, source: str, key: str) -> Array:
+    """Check a camera matrix's shape and form: ``[[fx, 0, cx], [0, fy, cy], [0, 0, 1]]``."""
     if k.shape != (3, 3):
         raise FileFormatError(source, key, f"expected a 3x3 matrix, got {k.shape[0]}x{k.shape[1]}")
     if k[1, 0] != 0.0 or k[2, 0] != 0.0 or k[2, 1] != 0.0 or k[2, 2] != 1.0:
@@ -723,14 +736,24 @@ def _camera_from_filestorage(document: Mapping[str, object], source: str, mount:
         )
     if k[0, 1] != 0.0:
         raise FileFormatError(source, key, f"expected zero skew (element [0][1]), got {k[0, 1]}")
-    dkey, dvalue = _find(document, "distortion_coefficients", source)
-    d = _matrix(dvalue, source, dkey)
+    return k
+
+
+def _vector(d: Array, source: str, key: str) -> Array:
+    """Return a distortion matrix's coefficients: it must be one row or one column."""
     if 1 not in d.shape:
-        raise FileFormatError(source, dkey, f"expected a 1xN or Nx1 matrix, got {d.shape[0]}x{d.shape[1]}")
-    distortion = _distortion(d.ravel(), source, dkey)
-    wkey, width = _find(document, "image_width", source)
-    hkey, height = _find(document, "image_height", source)
-    size = (_side(width, source, wkey), _side(height, source, hkey))
+        raise FileFormatError(source, key, f"expected a 1xN or Nx1 matrix, got {d.shape[0]}x{d.shape[1]}")
+    return d.ravel()
+
+
+def _intrinsics(
+    k: Array,
+    key: str,
+    distortion: tuple[float, float, float, float, float],
+    size: tuple[int, int],
+    source: str,
+) -> CameraIntrinsics:
+    """Return the intrinsics of a checked camera matrix (:func:`_camera_matrix`), in :data:`KEY_RANGES`."""
     for name, (row, col) in (("fx", (0, 0)), ("fy", (1, 1)), ("cx", (0, 2)), ("cy", (1, 2))):
         bounds = KEY_RANGES["intrinsics"][name]
         if not bounds.contains(float(k[row, col])):
@@ -738,21 +761,137 @@ def _camera_from_filestorage(document: Mapping[str, object], source: str, mount:
                 source, f"{key} {name}", f"expected {bounds.text()}, got {float(k[row, col])!r}"
             )
     try:
-        intrinsics = CameraIntrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2], size[0], size[1], distortion)
+        return CameraIntrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2], size[0], size[1], distortion)
     except InputError as exc:
         raise _reraise(source, key, exc) from None
-    return Camera(intrinsics, mount)
+
+
+def _intrinsics_from_filestorage(document: Mapping[str, object], source: str) -> CameraIntrinsics:
+    key, value = _find(document, "camera_matrix", source)
+    k = _camera_matrix(_matrix(value, source, key), source, key)
+    dkey, dvalue = _find(document, "distortion_coefficients", source)
+    distortion = _distortion(_vector(_matrix(dvalue, source, dkey), source, dkey), source, dkey)
+    wkey, width = _find(document, "image_width", source)
+    hkey, height = _find(document, "image_height", source)
+    size = (_side(width, source, wkey), _side(height, source, hkey))
+    return _intrinsics(k, key, distortion, size, source)
+
+
+# ----------------------------------------------------------------- ROS calibration YAML
+
+#: The distortion models of ROS's ``sensor_msgs/CameraInfo`` that aura-ums models, each with
+#: the numbers of coefficients it takes (plumb_bob is OpenCV's k1, k2, p1, p2, k3;
+#: rational_polynomial adds k4-k6, which :func:`opencv_distortion` requires to be zero).
+_ROS_MODELS: dict[str, tuple[tuple[int, ...], str]] = {
+    "plumb_bob": ((4, 5), "4 or 5 (k1, k2, p1, p2[, k3])"),
+    "rational_polynomial": ((8,), "8 (k1, k2, p1, p2, k3, k4, k5, k6)"),
+}
+#: Keys only a ROS calibration has (camera_calibration_parsers writes them all).
+_ROS_ONLY = ("camera_name", "distortion_model", "rectification_matrix", "projection_matrix")
+_ROS_SIZE = ("image_width", "image_height")
+#: The first line of a header-less YAML document: ``key:``.
+_KEY_LINE = re.compile(r"[A-Za-z_][\w-]*\s*:(\s|$)")
+
+
+def _is_ros(document: Mapping[str, object]) -> bool:
+    """Whether a header-less YAML document is a ROS calibration: no ``!!opencv-matrix``, ROS's keys."""
+    if any(isinstance(value, _Matrix) for value in document.values()):
+        return False  # a FileStorage file that lost its header
+    return any(key in document for key in ("camera_matrix", *_ROS_ONLY))
+
+
+def _ros_key(document: Mapping[str, object], key: str, source: str) -> object:
+    # ROS's reader matches its keys exactly (FileStorage's spellings are not ROS's).
+    if key not in document:
+        raise FileFormatError(source, key, f"expected the key {key}, got no such key")
+    return document[key]
+
+
+def _intrinsics_from_ros(document: Mapping[str, object], source: str) -> CameraIntrinsics:
+    """Return the intrinsics of a ROS calibration (camera_calibration_parsers' YAML: CameraInfo's fields)."""
+    key = "camera_matrix"
+    k = _camera_matrix(_matrix(_ros_key(document, key, source), source, key, opencv=False), source, key)
+    # ROS's own reader takes a file without distortion_model (older ones) as plumb_bob.
+    model = document.get("distortion_model", "plumb_bob")
+    if not isinstance(model, str) or model not in _ROS_MODELS:
+        raise FileFormatError(
+            source,
+            "distortion_model",
+            f"expected distortion_model {' or '.join(_ROS_MODELS)}, got {describe(model)}",
+        )
+    dkey = "distortion_coefficients"
+    d = _vector(_matrix(_ros_key(document, dkey, source), source, dkey, opencv=False), source, dkey)
+    counts, names = _ROS_MODELS[model]
+    if d.size not in counts:
+        raise FileFormatError(
+            source, dkey, f"expected {names} coefficients for distortion_model {model}, got {d.size}"
+        )
+    distortion = _distortion(d, source, dkey)
+    rkey = "rectification_matrix"
+    if rkey in document:  # absent: none, as ROS's writer takes a missing one for the identity
+        r = _matrix(document[rkey], source, rkey, opencv=False)
+        # A stereo pair's rectification turns the camera: its pixels are no longer those of K and D
+        # on the raw image, which is what aura-ums models. A monocular calibration writes the identity.
+        if r.shape != (3, 3) or not np.array_equal(r, np.eye(3)):
+            raise FileFormatError(
+                source,
+                rkey,
+                f"expected the identity (a monocular camera: aura-ums models no rectification), "
+                f"got {r.tolist()}",
+            )
+    width, height = (_side(_ros_key(document, name, source), source, name) for name in _ROS_SIZE)
+    return _intrinsics(k, key, distortion, (width, height), source)
+
+
+def _read_calibration(path: str | Path) -> CameraIntrinsics:
+    """Return the intrinsics of an OpenCV (YAML, JSON) or ROS calibration file, told by its content."""
+    source = str(path)
+    text = read_text(path, kind="calibration")
+    start, suffix = text.lstrip(), Path(path).suffix.lower()
+    if start.startswith("%YAML"):
+        return _intrinsics_from_filestorage(_parse_yaml(text, source), source)
+    if start.startswith("{") or suffix == ".json":
+        return _intrinsics_from_filestorage(_parse_json(text, source), source)
+    raw = text.splitlines()
+    first = next((i for i, line in enumerate(raw) if line.strip()), None)
+    content = next((line for line in raw if line.strip() and not line.lstrip().startswith("#")), "")
+    if suffix in (".yml", ".yaml") or _KEY_LINE.match(content):
+        document = _parse_yaml(text, source, header=False)
+        if not _is_ros(document):
+            raise _no_header(source, raw, first)
+        return _intrinsics_from_ros(document, source)
+    found = describe(start.splitlines()[0][:40]) if start else "an empty file"
+    raise FileFormatError(
+        source,
+        "",
+        f"expected a FileStorage YAML ('%YAML:1.0') or JSON ('{{') file, or a ROS calibration YAML, "
+        f"got {found}",
+        line=1,
+    )
 
 
 def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
-    """Read an OpenCV ``cv::FileStorage`` calibration (YAML or JSON) and put it on a mount.
+    r"""Read an OpenCV or ROS camera calibration and put it on a mount.
 
-    Reads ``camera_matrix`` (an ``opencv-matrix``: rows, cols, dt, data; zero skew),
-    ``distortion_coefficients`` (4 or 5 coefficients, or 8/12/14 whose terms beyond k3
-    are zero), ``image_width`` and ``image_height``. Key names are matched ignoring case
-    and underscores, and OpenCV's other spellings are accepted (``cameraMatrix``,
-    ``Camera_Matrix``, ``distCoeffs``, ``Distortion_Coefficients``); other keys are
-    ignored. The format is told by the content (a ``%YAML`` header or a JSON object).
+    An OpenCV ``cv::FileStorage`` calibration (YAML or JSON): ``camera_matrix`` (an
+    ``opencv-matrix``: rows, cols, dt, data; zero skew), ``distortion_coefficients`` (4 or
+    5 coefficients, or 8/12/14 whose terms beyond k3 are zero), ``image_width`` and
+    ``image_height``. Key names are matched ignoring case and underscores, and OpenCV's
+    other spellings are accepted (``cameraMatrix``, ``Camera_Matrix``, ``distCoeffs``,
+    ``Distortion_Coefficients``); other keys are ignored.
+
+    A ROS calibration (camera_calibration_parsers' YAML: a camera_info_manager file, the
+    calibrator's ``ost.yaml``): the same four keys, exactly so spelled, with matrices as
+    plain ``{rows, cols, data}`` mappings; ``distortion_model`` ``plumb_bob`` (4 or 5
+    coefficients, OpenCV's k1, k2, p1, p2, k3; the model taken when the key is absent, as
+    ROS does) or ``rational_polynomial`` (8, whose k4-k6 are zero); any other model
+    (``equidistant``...) is refused. ``rectification_matrix``, when given, must be the
+    identity (a monocular calibration's): a stereo camera's rectified pixels are not
+    those of the raw image this camera model describes. ``projection_matrix`` (the
+    rectified image's) and ``camera_name`` are ignored.
+
+    The format is told by the content: a ``%YAML`` header (FileStorage), a JSON object
+    (FileStorage), or YAML without a header holding ROS's keys and no ``!!opencv-matrix``.
 
     Parameters
     ----------
@@ -770,7 +909,8 @@ def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
     ------
     FileFormatError
         Naming the file and the line or key: missing file, malformed YAML/JSON, missing
-        keys, wrong matrix shapes, non-finite values, unsupported distortion terms.
+        keys, wrong matrix shapes, non-finite values, unsupported distortion terms or
+        models, a rectification.
 
     Examples
     --------
@@ -783,6 +923,18 @@ def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
     ...     '"data": [0.0, 0.0, 0.0, 0.0]}}')
     >>> load_opencv_calibration(file, CameraMount(1.0)).intrinsics.distortion  # 4 given: k3 = 0
     (0.0, 0.0, 0.0, 0.0, 0.0)
+    >>> ros = file.with_name("ost.yaml")   # as ROS's camera_calibration_parsers write it
+    >>> _ = ros.write_text("image_width: 640\nimage_height: 480\ncamera_name: narrow_stereo\n"
+    ...     "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1]\n"
+    ...     "distortion_model: plumb_bob\n"
+    ...     "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]\n")
+    >>> load_opencv_calibration(ros, CameraMount(1.0)).intrinsics.fx
+    554.25
+    >>> _ = ros.write_text(ros.read_text().replace("plumb_bob", "equidistant"))
+    >>> load_opencv_calibration(ros, CameraMount(1.0))
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: ...ost.yaml: distortion_model: expected ..., got 'equidistant'
     >>> load_opencv_calibration(file.with_name("missing.yml"), CameraMount(1.0))
     Traceback (most recent call last):
     ...
@@ -790,16 +942,4 @@ def load_opencv_calibration(path: str | Path, mount: CameraMount) -> Camera:
     """
     if not isinstance(mount, CameraMount):
         raise InputError(f"mount: expected CameraMount, got {type(mount).__name__}")
-    source = str(path)
-    text = read_text(path, kind="calibration")
-    start, suffix = text.lstrip(), Path(path).suffix.lower()
-    if start.startswith("%YAML") or (suffix in (".yml", ".yaml") and not start.startswith("{")):
-        document = _parse_yaml(text, source)
-    elif start.startswith("{") or suffix == ".json":
-        document = _parse_json(text, source)
-    else:
-        found = describe(start.splitlines()[0][:40]) if start else "an empty file"
-        raise FileFormatError(
-            source, "", f"expected a FileStorage YAML ('%YAML:1.0') or JSON ('{{') file, got {found}", line=1
-        )
-    return _camera_from_filestorage(document, source, mount)
+    return Camera(_read_calibration(path), mount)
