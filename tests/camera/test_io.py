@@ -5,16 +5,20 @@ from __future__ import annotations
 import json
 import math
 import re
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from aura_ums.camera import (
     CalibrationBounds,
     Camera,
     CameraIntrinsics,
     CameraMount,
+    camera_calibration_file,
     camera_to_toml,
     load_calibration_bounds,
     load_camera,
@@ -670,3 +674,129 @@ def test_a_header_less_yaml_of_neither_kind_is_refused(tmp_path: Path) -> None:
         r"calibration \(camera_matrix: rows, cols, data\), got '# a calibration\?'$",
     ):
         load_opencv_calibration(path, ROS_MOUNT)
+
+
+@given(
+    focal=st.floats(100.0, 2000.0),
+    aspect=st.floats(0.9, 1.1),
+    centre=st.tuples(st.floats(-50.0, 50.0), st.floats(-50.0, 50.0)),
+    size=st.tuples(st.integers(1, 4000), st.integers(1, 4000)),
+    distortion=st.tuples(
+        st.floats(-0.3, 0.3),
+        st.floats(-0.1, 0.1),
+        st.floats(-0.01, 0.01),
+        st.floats(-0.01, 0.01),
+        st.floats(-0.05, 0.05),
+    ),
+    rational=st.booleans(),
+)
+@settings(max_examples=40, deadline=None)
+def test_any_ros_calibration_reads_as_its_toml(
+    focal: float,
+    aspect: float,
+    centre: tuple[float, float],
+    size: tuple[int, int],
+    distortion: tuple[float, ...],
+    rational: bool,
+) -> None:
+    """Whatever the numbers (written with repr, as exactly as the TOML), both files read the same camera."""
+    width, height = size
+    fx, fy, cx, cy = focal, focal * aspect, width / 2 + centre[0], height / 2 + centre[1]
+    coefficients = [*distortion, 0.0, 0.0, 0.0] if rational else list(distortion)
+    numbers = ", ".join(repr(c) for c in coefficients)
+    ros = (
+        f"image_width: {width}\nimage_height: {height}\ncamera_name: cam\n"
+        f"camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{fx!r}, 0, {cx!r}, 0, {fy!r}, {cy!r}, 0, 0, 1]\n"
+        f"distortion_model: {'rational_polynomial' if rational else 'plumb_bob'}\n"
+        f"distortion_coefficients:\n  rows: 1\n  cols: {len(coefficients)}\n  data: [{numbers}]\n"
+    )
+    toml = (
+        f"[intrinsics]\nfx = {fx!r}\nfy = {fy!r}\ncx = {cx!r}\ncy = {cy!r}\n"
+        f"width = {width}\nheight = {height}\n"
+        f"distortion = [{', '.join(repr(c) for c in distortion)}]\n[mount]\nheight = 0.3\n"
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        ost = write(Path(folder), "ost.yaml", ros)
+        named = write(
+            Path(folder), "named.toml", '[intrinsics]\ncalibration = "ost.yaml"\n[mount]\nheight = 0.3\n'
+        )
+        expected = load_camera(write(Path(folder), "cam.toml", toml))
+        assert load_opencv_calibration(ost, ROS_MOUNT) == expected
+        assert load_camera(named) == expected
+
+
+# ------------------------------------------------------- a camera TOML naming a calibration
+
+NAMING_TOML = """\
+[intrinsics]
+calibration = "calibrations/ost.yaml"   # relative to this file
+
+[mount]
+height = 0.3
+
+[calibration_bounds]
+fx = 3.0
+"""
+
+
+def test_a_camera_toml_may_name_its_calibration(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "robot" / "calibrations").mkdir(parents=True)
+    write(tmp_path / "robot" / "calibrations", "ost.yaml", ROS_YAML)
+    toml = write(tmp_path / "robot", "camera.toml", NAMING_TOML)
+    monkeypatch.chdir(tmp_path)  # the calibration is found beside the TOML, not in the current folder
+    relative = Path("robot") / "camera.toml"
+    assert load_camera(relative) == load_camera(write(tmp_path, "same.toml", ROS_AS_TOML))
+    assert load_calibration_bounds(relative) == CalibrationBounds(fx=3.0)
+    assert camera_calibration_file(relative) == Path("robot") / "calibrations" / "ost.yaml"
+    assert camera_calibration_file(toml) == tmp_path / "robot" / "calibrations" / "ost.yaml"
+    assert camera_calibration_file(tmp_path / "same.toml") is None
+    # An OpenCV FileStorage calibration, named by an absolute path, reads the same way.
+    opencv = write(tmp_path, "calib.yml", GOOD_YAML)
+    text = NAMING_TOML.replace('"calibrations/ost.yaml"', json.dumps(str(opencv)))
+    assert (
+        load_camera(write(tmp_path, "opencv.toml", text)).intrinsics
+        == load_opencv_calibration(opencv, MOUNT).intrinsics
+    )
+
+
+def test_calibration_and_numbers_together_are_refused(tmp_path: Path) -> None:
+    write(tmp_path, "ost.yaml", ROS_YAML)
+    text = NAMING_TOML.replace('"calibrations/ost.yaml"', '"ost.yaml"\nfx = 554.25\ncy = 240.5')
+    with pytest.raises(
+        FileFormatError, match=r"cam\.toml: \[intrinsics\] fx: expected calibration or fx, cy, got both$"
+    ):
+        load_camera(write(tmp_path, "cam.toml", text))
+
+
+def test_a_missing_calibration_file_is_refused_naming_both_files(tmp_path: Path) -> None:
+    toml = write(tmp_path, "cam.toml", NAMING_TOML)
+    missing = tmp_path / "calibrations" / "ost.yaml"
+    for read in (load_camera, load_calibration_bounds, camera_calibration_file):
+        with pytest.raises(
+            FileFormatError,
+            match=re.escape(
+                f"{toml}: [intrinsics] calibration: expected an OpenCV or ROS calibration file that reads, "
+                f"got: {missing}: expected an existing calibration file, got no such file"
+            ),
+        ):
+            read(toml)
+
+
+@pytest.mark.parametrize(
+    ("calibration", "match"),
+    [
+        ("3", r"cam\.toml: \[intrinsics\] calibration: expected a non-empty string, got 3$"),
+        ('""', r"cam\.toml: \[intrinsics\] calibration: expected a non-empty string, got ''$"),
+        (
+            '"ost.yaml"',
+            r"cam\.toml: \[intrinsics\] calibration: expected an OpenCV or ROS calibration file that reads, "
+            r"got: .*ost\.yaml: distortion_model: expected distortion_model plumb_bob or "
+            r"rational_polynomial, got 'equidistant'$",
+        ),
+    ],
+)
+def test_a_bad_calibration_entry_is_named_with_its_file(tmp_path: Path, calibration: str, match: str) -> None:
+    write(tmp_path, "ost.yaml", ros_edit("distortion_model: plumb_bob", "distortion_model: equidistant"))
+    text = NAMING_TOML.replace('"calibrations/ost.yaml"', calibration)
+    with pytest.raises(FileFormatError, match=match):
+        load_camera(write(tmp_path, "cam.toml", text))

@@ -7,6 +7,7 @@ turn them into observations of landmarks.
 """
 
 from aura_ums.camera._io import (
+    camera_calibration_file,
     camera_to_toml,
     load_calibration_bounds,
     load_camera,
@@ -39,6 +40,7 @@ __all__ = [
     "bound_ground_line",
     "bound_point",
     "bound_vertical_line",
+    "camera_calibration_file",
     "camera_to_toml",
     "distort",
     "fold_radius",

@@ -28,6 +28,13 @@ The TOML camera file::
     [calibration_bounds]      # optional: half-widths, see CalibrationBounds
     fx = 3.0
     pan_deg = 0.5
+
+``[intrinsics]`` may instead name a calibration file, OpenCV's or ROS's (read by
+:func:`load_opencv_calibration`), for the numbers above; the mount, which no calibration
+holds, stays in the TOML::
+
+    [intrinsics]
+    calibration = "ost.yaml"  # relative to this file's folder; no fx... beside it
 """
 
 from __future__ import annotations
@@ -153,13 +160,45 @@ def _check_keys(table: Mapping[str, object], allowed: tuple[str, ...], source: s
     Fields(source).keys(table, allowed, where)
 
 
-def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
+def _calibrated(table: Mapping[str, object], path: str | Path, source: str) -> tuple[CameraIntrinsics, Path]:
+    """Return the intrinsics of the calibration file ``[intrinsics] calibration`` names, and its path."""
+    given = [key for key in _INTRINSIC_KEYS if key in table]
+    if given:
+        # Two sources of the same numbers: which one the user meant is not ours to guess.
+        raise FileFormatError(
+            source, f"[intrinsics] {given[0]}", f"expected calibration or {', '.join(given)}, got both"
+        )
+    name = Fields(source).string(table["calibration"], "[intrinsics] calibration", nonempty=True)
+    file = Path(name)
+    if not file.is_absolute():
+        file = Path(path).parent / file  # relative to the camera file, wherever it is run from
+    try:
+        return _read_calibration(file), file
+    except FileFormatError as exc:
+        raise FileFormatError(
+            source,
+            "[intrinsics] calibration",
+            f"expected an OpenCV or ROS calibration file that reads, got: {exc}",
+        ) from None
+
+
+def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds, Path | None]:
     source = str(path)
     document = load_toml(path, kind="camera TOML")
     _check_keys(document, ("intrinsics", "mount", "calibration_bounds"), source, "")
 
     table = _table(document, "intrinsics", source, required=True)
-    _check_keys(table, _INTRINSIC_KEYS, source, "[intrinsics]")
+    _check_keys(table, (*_INTRINSIC_KEYS, "calibration"), source, "[intrinsics]")
+    if "calibration" in table:
+        intrinsics, calibration = _calibrated(table, path, source)
+    else:
+        intrinsics, calibration = _listed(table, source), None
+    mount, bounds = _mount_and_bounds(document, source, intrinsics)
+    return Camera(intrinsics, mount), bounds, calibration
+
+
+def _listed(table: Mapping[str, object], source: str) -> CameraIntrinsics:
+    """Return the intrinsics given in ``[intrinsics]`` itself."""
     missing = [key for key in _INTRINSIC_KEYS[:6] if key not in table]
     if missing:
         raise FileFormatError(
@@ -180,10 +219,14 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
         numbers = [_number(v, source, f"[intrinsics] distortion[{i}]") for i, v in enumerate(raw)]
         distortion = _distortion(np.array(numbers, dtype=np.float64), source, "[intrinsics] distortion")
     try:
-        intrinsics = CameraIntrinsics(fx, fy, cx, cy, width, height, distortion)
+        return CameraIntrinsics(fx, fy, cx, cy, width, height, distortion)
     except InputError as exc:
         raise _reraise(source, "[intrinsics]", exc) from None
 
+
+def _mount_and_bounds(
+    document: Mapping[str, object], source: str, intrinsics: CameraIntrinsics
+) -> tuple[CameraMount, CalibrationBounds]:
     table = _table(document, "mount", source, required=True)
     _check_keys(table, ("height", "forward", "left", "pan", "pan_deg", "tilt", "tilt_deg"), source, "[mount]")
     if "height" not in table:
@@ -222,7 +265,7 @@ def _parse_toml(path: str | Path) -> tuple[Camera, CalibrationBounds]:
                 f"[calibration_bounds] {key}",
                 f"expected a bound below [intrinsics] {key} ({focal!r} px), got {getattr(bounds, key)!r}",
             )
-    return Camera(intrinsics, mount), bounds
+    return mount, bounds
 
 
 def _lengths_and_angles(
@@ -246,9 +289,11 @@ def load_camera(path: str | Path) -> Camera:
 
     The format is in this module's documentation: ``[intrinsics]`` (fx, fy, cx, cy in
     pixels; width, height integers; optional ``distortion`` list of 4 or 5 OpenCV
-    coefficients, or 8/12/14 whose extra terms are zero), ``[mount]`` (height, forward,
-    left in metres; ``pan``/``tilt`` in radians or ``pan_deg``/``tilt_deg`` in degrees)
-    and the optional ``[calibration_bounds]`` (read by :func:`load_calibration_bounds`).
+    coefficients, or 8/12/14 whose extra terms are zero), or instead ``calibration``, the
+    path of an OpenCV or ROS calibration file (:func:`load_opencv_calibration`) relative
+    to the TOML file's folder; ``[mount]`` (height, forward, left in metres;
+    ``pan``/``tilt`` in radians or ``pan_deg``/``tilt_deg`` in degrees) and the optional
+    ``[calibration_bounds]`` (read by :func:`load_calibration_bounds`).
 
     Parameters
     ----------
@@ -264,7 +309,9 @@ def load_camera(path: str | Path) -> Camera:
     ------
     FileFormatError
         Naming the file and the table/key: missing or unreadable file, malformed TOML,
-        missing or unknown keys, wrong types, non-finite or out-of-range values.
+        missing or unknown keys, wrong types, non-finite or out-of-range values; both
+        ``calibration`` and numbers in ``[intrinsics]``; and, naming both files, a
+        calibration file that is missing or does not read.
 
     Examples
     --------
@@ -326,6 +373,50 @@ def load_calibration_bounds(path: str | Path) -> CalibrationBounds:
     aura_ums.errors.FileFormatError: ...bad.toml: [calibration_bounds] fx: expected a number in ..., got -1.0
     """
     return _parse_toml(path)[1]
+
+
+def camera_calibration_file(path: str | Path) -> Path | None:
+    r"""Return the calibration file a camera TOML file names (``[intrinsics] calibration``).
+
+    Resolved against the TOML file's folder when relative. For a command's list of the
+    files it reads, which a camera file naming a calibration extends by one. The whole
+    file is validated as by :func:`load_camera`, the calibration file read too.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    Path or None
+        The calibration file; None when ``[intrinsics]`` gives the numbers itself.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`load_camera`.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "ost.yaml").write_text(   # a ROS calibration
+    ...     "image_width: 640\nimage_height: 480\n"
+    ...     "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+    ...     "distortion_model: plumb_bob\n"
+    ...     "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n")
+    >>> _ = (folder / "cam.toml").write_text(
+    ...     '[intrinsics]\ncalibration = "ost.yaml"\n[mount]\nheight = 1.0\n')
+    >>> camera_calibration_file(folder / "cam.toml") == folder / "ost.yaml"
+    True
+    >>> load_camera(folder / "cam.toml").intrinsics.fx
+    500.0
+    >>> _ = (folder / "plain.toml").write_text(camera_to_toml(load_camera(folder / "cam.toml")))
+    >>> camera_calibration_file(folder / "plain.toml") is None   # the numbers are in the file
+    True
+    """
+    return _parse_toml(path)[2]
 
 
 def camera_to_toml(camera: Camera, bounds: CalibrationBounds | None = None) -> str:
