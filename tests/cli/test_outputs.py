@@ -927,3 +927,51 @@ def test_a_folder_holding_only_a_killed_commands_scratch_files_is_refused_saying
     (out / "notes.txt").write_text("mine")
     refused(invoke(*arguments), f"got {out}, which holds files (pass --overwrite")
     assert sorted(path.name for path in out.iterdir()) == [".meta.toml.0123456789abcdef.tmp", "notes.txt"]
+
+
+# The camera of scenarios/paper_camera.toml as a ROS calibration (camera_calibration_parsers' YAML).
+PAPER_OST = """\
+image_width: 512
+image_height: 480
+camera_name: paper
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [549, 0, 255.5, 0, 549, 239.5, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [0, 0, 0, 0, 0]
+"""
+NAMING_CAMERA = '[intrinsics]\ncalibration = "ost.yaml"\n[mount]\nheight = 1.2\ntilt_deg = 3.0\n'
+
+
+def test_the_calibration_a_camera_file_names_is_an_input(inputs: Path, tmp_path: Path) -> None:
+    """replay --camera, and simulate of a scenario whose camera names one, never write onto it."""
+    for file in ("four_terrains.toml", "four_terrains.geojson"):
+        shutil.copy(SCENARIO.with_name(file), tmp_path / file)
+    (tmp_path / "paper_camera.toml").write_text(NAMING_CAMERA)
+    calibration = tmp_path / "ost.yaml"
+    calibration.write_text(PAPER_OST)
+    before = calibration.read_bytes()
+    for option in ("--metrics-json", "--mcap"):
+        result = invoke(
+            "simulate", tmp_path / "four_terrains.toml", "--runs", "1", option, calibration, "--overwrite"
+        )
+        refused(result, option, "SCENARIO's camera's calibration", str(calibration))
+    common = (
+        "replay",
+        inputs / "log",
+        "--terrain",
+        inputs / "terrain.toml",
+        "--camera",
+        tmp_path / "paper_camera.toml",
+    )
+    for logs in ((), (EXAMPLES / "logs" / "r1",)):  # one log, and several (each replayed on its own)
+        for option in ("--metrics-json", "--steps-csv"):
+            if logs and option == "--steps-csv":
+                continue  # one log's output only
+            result = invoke(*common, *logs, option, calibration, "--overwrite", "--quiet")
+            refused(result, option, "the input --camera's [intrinsics] calibration", str(calibration))
+    assert calibration.read_bytes() == before

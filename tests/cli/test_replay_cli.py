@@ -252,6 +252,85 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
     )
 
 
+SAMPLE = VIRTUAL_CAMERA.parent / "logs" / "r1"
+# examples/virtual_camera_60deg.toml's intrinsics, with a little barrel distortion, as ROS's
+# camera_calibration_parsers writes a calibration.
+VIRTUAL_OST = """\
+image_width: 640
+image_height: 480
+camera_name: virtual
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [554.2562584220407, 0, 319.5, 0, 554.2562584220407, 239.5, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.05, 0.002, 0, 0, 0]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+projection_matrix:
+  rows: 3
+  cols: 4
+  data: [554.2562584220407, 0, 319.5, 0, 0, 554.2562584220407, 239.5, 0, 0, 0, 1, 0]
+"""
+
+
+def test_replay_with_a_camera_naming_a_ros_calibration_scores_as_its_toml(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    given = VIRTUAL_CAMERA.read_text(encoding="utf-8")
+    inline = tmp_path / "inline.toml"
+    inline.write_text(given.replace("height = 480\n", "height = 480\ndistortion = [-0.05, 0.002, 0, 0, 0]\n"))
+    (tmp_path / "robot" / "calibration").mkdir(parents=True)
+    (tmp_path / "robot" / "calibration" / "ost.yaml").write_text(VIRTUAL_OST)
+    mount = given[given.index("[mount]") :]
+    (tmp_path / "robot" / "camera.toml").write_text(
+        '[intrinsics]\ncalibration = "calibration/ost.yaml"   # beside this file\n\n' + mount
+    )
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")  # the calibration is found beside the TOML
+    metrics = {}
+    for name, camera in (("inline", inline), ("named", Path("..") / "robot" / "camera.toml")):
+        out = tmp_path / f"{name}.json"
+        result = runner.invoke(
+            app,
+            ["replay", str(SAMPLE), "--terrain", str(terrain), "--camera", str(camera), "-q",
+             "--metrics-json", str(out)],
+        )  # fmt: skip
+        assert result.exit_code == 0, result.output
+        metrics[name] = strict_json(out.read_text())
+        metrics[name].pop("median_update_us")  # a timing
+    assert metrics["named"] == metrics["inline"]
+    assert metrics["named"]["window_observations"] > 100
+
+
+def test_replay_refuses_a_camera_whose_calibration_is_missing_or_doubled(tmp_path: Path) -> None:
+    terrain = tmp_path / "terrain.toml"
+    terrain.write_text(FLOOR_TOML)
+    camera = tmp_path / "camera.toml"
+    camera.write_text('[intrinsics]\ncalibration = "ost.yaml"\n[mount]\nheight = 0.3\n')
+    out = tmp_path / "m.json"
+    arguments = ["replay", str(SAMPLE), "--terrain", str(terrain), "--camera", str(camera), "-q"]
+    result = runner.invoke(app, [*arguments, "--metrics-json", str(out)])
+    assert result.exit_code == 2
+    assert result.stderr == (
+        f"error: {camera}: [intrinsics] calibration: expected an OpenCV or ROS calibration file that reads, "
+        f"got: {tmp_path / 'ost.yaml'}: expected an existing calibration file, got no such file\n"
+    )
+    (tmp_path / "ost.yaml").write_text(VIRTUAL_OST)
+    camera.write_text('[intrinsics]\ncalibration = "ost.yaml"\nfx = 554.0\n[mount]\nheight = 0.3\n')
+    result = runner.invoke(app, arguments)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {camera}: [intrinsics] fx: expected calibration or fx, got both\n"
+    assert not out.exists()
+
+
 def test_replay_reads_the_sensors_file_calibrate_wrote_beside_the_terrain(
     log_folder: Path, tmp_path: Path
 ) -> None:

@@ -477,3 +477,33 @@ def test_legs_end_when_rounding_leaves_a_frame_just_short_of_its_place(spacing: 
     assert min(leg.run for leg in legs) > 1e-6
     short = [leg.run for leg in legs if leg.run < spacing * (1.0 - 1e-6)]
     assert len(short) <= 2 * len(paper.commands)
+
+
+def test_a_scenario_camera_may_name_its_calibration(folder: Path) -> None:
+    """The camera file's [intrinsics] calibration is read, and listed among the files the scenario reads."""
+    (folder / "calibration").mkdir()
+    (folder / "calibration" / "ost.yaml").write_text(
+        "image_width: 512\nimage_height: 480\ncamera_name: paper\n"
+        "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [549, 0, 255.5, 0, 549, 239.5, 0, 0, 1]\n"
+        "distortion_model: plumb_bob\n"
+        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]\n"
+    )
+    (folder / "named.toml").write_text(
+        '[intrinsics]\ncalibration = "calibration/ost.yaml"\n[mount]\nheight = 1.2\ntilt_deg = 3.0\n'
+    )
+    (folder / "m.toml").write_text(GOOD.replace('camera = "cam.toml"', 'camera = "named.toml"'))
+    scenario = Scenario.from_toml(folder / "m.toml")
+    assert scenario.camera.intrinsics.distortion == (-0.1, 0.01, 0.0, 0.0, 0.0)
+    assert scenario.camera.intrinsics.fx == Scenario.from_toml(folder / "good.toml").camera.intrinsics.fx
+    assert [(key, path.relative_to(folder).as_posix()) for key, path in scenario.files] == [
+        ("camera", "named.toml"),
+        ("camera's calibration", "calibration/ost.yaml"),
+    ]
+    (folder / "calibration" / "ost.yaml").unlink()
+    with pytest.raises(
+        FileFormatError,
+        match=r"m\.toml: camera: expected a camera file that loads, got: .*named\.toml: "
+        r"\[intrinsics\] calibration: expected an OpenCV or ROS calibration file that reads, got: "
+        r".*ost\.yaml: expected an existing calibration file, got no such file$",
+    ):
+        Scenario.from_toml(folder / "m.toml")

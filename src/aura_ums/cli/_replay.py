@@ -135,7 +135,8 @@ _Camera = Annotated[
     typer.Option(
         "--camera",
         readable=False,
-        help="Camera TOML (e.g. examples/virtual_camera_60deg.toml): judge each observation's image window.",
+        help="Camera TOML (e.g. examples/virtual_camera_60deg.toml; its [intrinsics] may name an OpenCV or "
+        "ROS calibration file instead of giving fx...): judge each observation's image window.",
     ),
 ]
 _WindowMargin = Annotated[
@@ -185,6 +186,17 @@ def _terrain_table(terrain: Path, name: str, log_dir: Path) -> TerrainTable:
     except InputError as exc:
         raise fail(str(exc)) from None
     return table
+
+
+def _calibration_source(camera: Path | None) -> Source | None:
+    """Return the calibration file the --camera file names (``[intrinsics] calibration``) as an input.
+
+    Reads the camera file (an AuraUmsError for a malformed one, as loading it would give).
+    """
+    from aura_ums.camera import camera_calibration_file
+
+    named = None if camera is None else camera_calibration_file(camera)
+    return None if named is None else Source("--camera's [intrinsics] calibration", named)
 
 
 def _sensors_source(sensors: Path | None, terrain: Path) -> Source | None:
@@ -566,6 +578,8 @@ def replay(
                     None if camera is None else Source("--camera", camera)]  # fmt: skip
         check_outputs([json_target], sources, overwrite=overwrite)
         try:
+            # The calibration file the camera file names is an input too.
+            check_outputs([json_target], [*sources, _calibration_source(camera)], overwrite=overwrite)
             many = TerrainTable.from_toml(terrain)
             options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)
             lens = None if camera is None else load_camera(camera)
@@ -603,6 +617,7 @@ def replay(
         log = LoadLog(max_truth_gap)(log_dir) if whole else _open(log_dir, max_truth_gap)
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
+        sources.append(_calibration_source(camera))  # the calibration file the camera file names
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
         table = _terrain_table(terrain, log.meta.terrain, log_dir)
         options = _options(classes, _sensors_file(sensors, terrain), settings.over(), reverse)

@@ -75,7 +75,7 @@ from aura_ums._validate import (
     nonnegative_float,
     read_only,
 )
-from aura_ums.camera import Camera, load_camera
+from aura_ums.camera import Camera, camera_calibration_file, load_camera
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.expecter import Expecter
 from aura_ums.geometry import wrap_angle
@@ -421,7 +421,8 @@ class Scenario:
         The file it was read from (``""`` when built in code).
     files : tuple of (str, Path)
         The files that file names, each with its key (``("camera", Path(...))``, as read:
-        relative to the scenario's folder); empty when built in code.
+        relative to the scenario's folder), and the calibration file its camera file names
+        (``"camera's calibration"``); empty when built in code.
 
     Examples
     --------
@@ -652,8 +653,11 @@ class Scenario:
         camera_path = reader.path(document["camera"], "camera", base)
         try:
             camera = load_camera(camera_path)
+            calibration = camera_calibration_file(camera_path)
         except FileFormatError as exc:
             raise reader.fail("camera", f"expected a camera file that loads, got: {exc}") from None
+        if calibration is not None:  # the calibration file the camera file names is read too
+            reader.files.append(("camera's calibration", calibration))
         _check_strategies(meadow_map, camera, reader, str(document["map"]))
         landmark_ids = _landmark_ids(document, reader, meadow_map)
         start = _start(reader.table(document, "start", required=True), reader, meadow_map)
