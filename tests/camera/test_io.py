@@ -7,6 +7,7 @@ import math
 import re
 import tempfile
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from aura_ums.camera import (
     CameraIntrinsics,
     CameraMount,
     camera_calibration_file,
+    camera_info_intrinsics,
     camera_to_toml,
     load_calibration_bounds,
     load_camera,
@@ -800,3 +802,63 @@ def test_a_bad_calibration_entry_is_named_with_its_file(tmp_path: Path, calibrat
     text = NAMING_TOML.replace('"calibrations/ost.yaml"', calibration)
     with pytest.raises(FileFormatError, match=match):
         load_camera(write(tmp_path, "cam.toml", text))
+
+
+# ------------------------------------------------------- a CameraInfo message (ROS 1 or 2)
+
+
+def camera_info(**fields: object) -> SimpleNamespace:
+    """A sensor_msgs/CameraInfo as rosbags deserializes it (ROS 2 field names; arrays as numpy)."""
+    values: dict[str, object] = {
+        "width": 640,
+        "height": 480,
+        "distortion_model": "plumb_bob",
+        "d": np.array([-0.1, 0.01, 0.0, 0.0, 0.0]),
+        "k": np.array([554.25, 0.0, 320.5, 0.0, 554.25, 240.5, 0.0, 0.0, 1.0]),
+        "r": np.eye(3).ravel(),
+        "binning_x": 0,
+        "binning_y": 0,
+        "roi": SimpleNamespace(x_offset=0, y_offset=0, width=0, height=0),
+    }
+    return SimpleNamespace(**{**values, **fields})
+
+
+def test_a_camera_info_reads_as_the_ros_calibration_file(tmp_path: Path) -> None:
+    expected = load_opencv_calibration(write(tmp_path, "ost.yaml", ROS_YAML), ROS_MOUNT).intrinsics
+    assert camera_info_intrinsics(camera_info(), "run.bag", "topic /info, message 0") == expected
+    ros1 = camera_info()  # ROS 1's upper-case D, K, R
+    for name in ("d", "k", "r"):
+        setattr(ros1, name.upper(), getattr(ros1, name))
+        delattr(ros1, name)
+    assert camera_info_intrinsics(ros1, "run.bag", "topic /info, message 0") == expected
+    full = camera_info(roi=SimpleNamespace(x_offset=0, y_offset=0, width=640, height=480), binning_x=1)
+    assert camera_info_intrinsics(full, "run.bag", "topic /info, message 0") == expected
+
+
+@pytest.mark.parametrize(
+    ("fields", "match"),
+    [
+        (
+            {"k": np.zeros(8)},
+            r"run\.bag: topic /info, message 0, k: expected 9 numbers \(a 3x3 matrix\), got 8$",
+        ),
+        ({"r": "identity"}, r"message 0, r: expected an array of numbers, got 'identity'$"),
+        ({"d": [0.1, "x", 0, 0, 0]}, r"message 0, d\[1\]: expected a finite number, got 'x'$"),
+        ({"distortion_model": ""}, r"message 0, distortion_model: expected distortion_model plumb_bob or "),
+        ({"height": 480.5}, r"message 0, height: expected an integer >= 1, got 480\.5$"),
+        ({"binning_y": 4}, r"message 0, binning_y: expected 0 or 1 \(an unbinned image\), got 4$"),
+    ],
+)
+def test_a_camera_info_is_checked_as_a_calibration_file(fields: dict[str, object], match: str) -> None:
+    with pytest.raises(FileFormatError, match=match):
+        camera_info_intrinsics(camera_info(**fields), "run.bag", "topic /info, message 0")
+
+
+def test_a_camera_info_without_a_field_is_refused() -> None:
+    message = camera_info()
+    del message.k
+    with pytest.raises(
+        FileFormatError,
+        match=r"run\.bag: topic /info, message 0: expected a CameraInfo with the field k, got none$",
+    ):
+        camera_info_intrinsics(message, "run.bag", "topic /info, message 0")

@@ -8,6 +8,7 @@ turn them into observations of landmarks.
 
 from aura_ums.camera._io import (
     camera_calibration_file,
+    camera_info_intrinsics,
     camera_to_toml,
     load_calibration_bounds,
     load_camera,
@@ -41,6 +42,7 @@ __all__ = [
     "bound_point",
     "bound_vertical_line",
     "camera_calibration_file",
+    "camera_info_intrinsics",
     "camera_to_toml",
     "distort",
     "fold_radius",

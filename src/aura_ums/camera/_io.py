@@ -900,38 +900,180 @@ def _ros_key(document: Mapping[str, object], key: str, source: str) -> object:
 
 def _intrinsics_from_ros(document: Mapping[str, object], source: str) -> CameraIntrinsics:
     """Return the intrinsics of a ROS calibration (camera_calibration_parsers' YAML: CameraInfo's fields)."""
-    key = "camera_matrix"
-    k = _camera_matrix(_matrix(_ros_key(document, key, source), source, key, opencv=False), source, key)
+    k = _matrix(_ros_key(document, "camera_matrix", source), source, "camera_matrix", opencv=False)
+    _camera_matrix(k, source, "camera_matrix")
     # ROS's own reader takes a file without distortion_model (older ones) as plumb_bob.
     model = document.get("distortion_model", "plumb_bob")
-    if not isinstance(model, str) or model not in _ROS_MODELS:
-        raise FileFormatError(
-            source,
-            "distortion_model",
-            f"expected distortion_model {' or '.join(_ROS_MODELS)}, got {describe(model)}",
-        )
+    _ros_model(model, source, "distortion_model")
     dkey = "distortion_coefficients"
     d = _vector(_matrix(_ros_key(document, dkey, source), source, dkey, opencv=False), source, dkey)
-    counts, names = _ROS_MODELS[model]
+    rkey = "rectification_matrix"
+    # Absent: none, as ROS's writer takes a missing one for the identity.
+    r = _matrix(document[rkey], source, rkey, opencv=False) if rkey in document else None
+    width, height = (_ros_key(document, name, source) for name in _ROS_SIZE)
+    return _ros_intrinsics(k, model, d, r, (width, height), source, _ROS_FILE_NAMES)
+
+
+#: How the messages of a ROS calibration file name its parts: by their keys.
+_ROS_FILE_NAMES = {
+    "k": "camera_matrix",
+    "model": "distortion_model",
+    "d": "distortion_coefficients",
+    "r": "rectification_matrix",
+    "width": "image_width",
+    "height": "image_height",
+}
+
+
+def _ros_model(model: object, source: str, where: str) -> str:
+    """Return a ``distortion_model`` aura-ums models (:data:`_ROS_MODELS`), or refuse it."""
+    if not isinstance(model, str) or model not in _ROS_MODELS:
+        raise FileFormatError(
+            source, where, f"expected distortion_model {' or '.join(_ROS_MODELS)}, got {describe(model)}"
+        )
+    return model
+
+
+def _ros_intrinsics(
+    k: Array,
+    model: object,
+    d: Array,
+    r: Array | None,
+    size: tuple[object, object],
+    source: str,
+    names: Mapping[str, str],
+) -> CameraIntrinsics:
+    """Return the intrinsics of a ROS calibration's parts (a file's, a CameraInfo message's).
+
+    ``names`` says how messages name each part (:data:`_ROS_FILE_NAMES`' keys).
+    """
+    _camera_matrix(k, source, names["k"])
+    model = _ros_model(model, source, names["model"])
+    counts, expected = _ROS_MODELS[model]
     if d.size not in counts:
         raise FileFormatError(
-            source, dkey, f"expected {names} coefficients for distortion_model {model}, got {d.size}"
+            source, names["d"], f"expected {expected} coefficients for distortion_model {model}, got {d.size}"
         )
-    distortion = _distortion(d, source, dkey)
-    rkey = "rectification_matrix"
-    if rkey in document:  # absent: none, as ROS's writer takes a missing one for the identity
-        r = _matrix(document[rkey], source, rkey, opencv=False)
-        # A stereo pair's rectification turns the camera: its pixels are no longer those of K and D
-        # on the raw image, which is what aura-ums models. A monocular calibration writes the identity.
-        if r.shape != (3, 3) or not np.array_equal(r, np.eye(3)):
+    distortion = _distortion(d, source, names["d"])
+    # A stereo pair's rectification turns the camera: its pixels are no longer those of K and D
+    # on the raw image, which is what aura-ums models. A monocular calibration writes the identity.
+    if r is not None and (r.shape != (3, 3) or not np.array_equal(r, np.eye(3))):
+        raise FileFormatError(
+            source,
+            names["r"],
+            f"expected the identity (a monocular camera: aura-ums models no rectification), got {r.tolist()}",
+        )
+    width, height = (
+        _side(value, source, names[name]) for value, name in zip(size, ("width", "height"), strict=True)
+    )
+    return _intrinsics(k, names["k"], distortion, (width, height), source)
+
+
+def camera_info_intrinsics(message: object, source: str, where: str) -> CameraIntrinsics:
+    """Return the intrinsics of a ROS ``sensor_msgs/CameraInfo`` message, checked as a ROS calibration file.
+
+    Reads ``width``, ``height``, ``distortion_model``, ``d``, ``k`` and ``r`` (ROS 1's
+    ``D``, ``K``, ``R`` too) as :func:`load_opencv_calibration` reads a ROS calibration
+    file's keys: the same models, the same identity rectification. The image must be the
+    full, unbinned one the calibration describes (``binning_x``, ``binning_y`` 0 or 1; an
+    empty or full ``roi``). For readers of ROS messages (:func:`aura_ums.logs.read_camera_info`).
+
+    Parameters
+    ----------
+    message : object
+        The message, as deserialized (any object with those attributes).
+    source : str
+        Where it was read (a bag), for messages.
+    where : str
+        The message's place in it (a topic and index), for messages.
+
+    Returns
+    -------
+    CameraIntrinsics
+        The calibrated intrinsics.
+
+    Raises
+    ------
+    FileFormatError
+        Naming ``source``, ``where`` and the field, as for a calibration file.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as Message
+    >>> info = Message(width=640, height=480, distortion_model="plumb_bob", d=[-0.1, 0.01, 0, 0, 0],
+    ...                k=[554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1], r=[1, 0, 0, 0, 1, 0, 0, 0, 1])
+    >>> camera_info_intrinsics(info, "run.bag", "topic /camera_info, message 0").fx
+    554.25
+    >>> info.k = [0.0] * 9    # an uncalibrated camera's
+    >>> camera_info_intrinsics(info, "run.bag", "topic /camera_info, message 0")
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: run.bag: topic /camera_info, message 0, k: expected [[fx, 0, cx], ...
+    """
+    fields = Fields(source)
+
+    def field(name: str) -> object:
+        for spelling in (name, name.upper()):  # ROS 2's d, k, r; ROS 1's D, K, R
+            if hasattr(message, spelling):
+                return getattr(message, spelling)
+        raise FileFormatError(source, where, f"expected a CameraInfo with the field {name}, got none")
+
+    def numbers(name: str) -> Array:
+        values = field(name)
+        # rosbags gives arrays as numpy arrays (a float64[9] of ROS 2, a float64[] of either).
+        if isinstance(values, np.ndarray):
+            values = values.tolist()
+        if not isinstance(values, (list, tuple)):
             raise FileFormatError(
-                source,
-                rkey,
-                f"expected the identity (a monocular camera: aura-ums models no rectification), "
-                f"got {r.tolist()}",
+                source, f"{where}, {name}", f"expected an array of numbers, got {describe(values)}"
             )
-    width, height = (_side(_ros_key(document, name, source), source, name) for name in _ROS_SIZE)
-    return _intrinsics(k, key, distortion, (width, height), source)
+        items = [fields.number(value, f"{where}, {name}[{i}]") for i, value in enumerate(values)]
+        return np.array(items, dtype=np.float64)
+
+    k = numbers("k")
+    if k.size != 9:
+        raise FileFormatError(source, f"{where}, k", f"expected 9 numbers (a 3x3 matrix), got {k.size}")
+    r = numbers("r")
+    if r.size != 9:
+        raise FileFormatError(source, f"{where}, r", f"expected 9 numbers (a 3x3 matrix), got {r.size}")
+    for name in ("binning_x", "binning_y"):
+        binning = getattr(message, name, 0)
+        if binning not in (0, 1):
+            raise FileFormatError(
+                source, f"{where}, {name}", f"expected 0 or 1 (an unbinned image), got {describe(binning)}"
+            )
+    size = (field("width"), field("height"))
+    _full_image(getattr(message, "roi", None), size, source, f"{where}, roi")
+    names = {
+        key: f"{where}, {name}"
+        for key, name in (
+            ("k", "k"),
+            ("model", "distortion_model"),
+            ("d", "d"),
+            ("r", "r"),
+            ("width", "width"),
+            ("height", "height"),
+        )
+    }
+    return _ros_intrinsics(
+        k.reshape(3, 3), field("distortion_model"), numbers("d"), r.reshape(3, 3), size, source, names
+    )
+
+
+def _full_image(roi: object, size: tuple[object, object], source: str, where: str) -> None:
+    """Refuse a region of interest other than none (all zero) or the whole image: K is the full image's."""
+    if roi is None:
+        return
+    offset = (getattr(roi, "x_offset", 0), getattr(roi, "y_offset", 0))
+    extent = (getattr(roi, "width", 0), getattr(roi, "height", 0))
+    if offset == (0, 0) and (extent == (0, 0) or extent == size):
+        return
+    raise FileFormatError(
+        source,
+        where,
+        f"expected no region of interest (the full image the calibration describes), got x_offset "
+        f"{offset[0]!r}, y_offset {offset[1]!r}, width {extent[0]!r}, height {extent[1]!r}",
+    )
 
 
 def _read_calibration(path: str | Path) -> CameraIntrinsics:
