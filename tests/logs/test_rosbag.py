@@ -17,9 +17,10 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.store import Typestore
 
+from aura_ums.camera import Camera, CameraIntrinsics, CameraMount
 from aura_ums.errors import FileFormatError, InputError, MissingDependencyError
 from aura_ums.logs import LogLandmark, LogMeta, load_log
-from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+from aura_ums.logs._rosbag import import_rosbag, read_camera_info, read_rosbag
 
 T0 = 1_700_000_000  # epoch seconds of the first stamp
 LANDMARKS = (
@@ -544,3 +545,138 @@ def test_a_topic_the_bags_index_counts_as_empty_is_read_when_it_has_messages(
     assert miscounted != text
     metadata.write_text(miscounted)
     assert len(read(path).observations) == len(run.observations)
+
+
+# --- a camera's calibration: sensor_msgs/CameraInfo -------------------------------------------
+
+# The calibration of tests/camera/test_io.py's ROS_YAML, as a driver publishes it.
+CAMERA_INFO = {
+    "width": 640,
+    "height": 480,
+    "distortion_model": "plumb_bob",
+    "d": [-0.1, 0.01, 0.0, 0.0, 0.0],
+    "k": [554.25, 0.0, 320.5, 0.0, 554.25, 240.5, 0.0, 0.0, 1.0],
+    "r": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+    "p": [554.25, 0.0, 320.5, 0.0, 0.0, 554.25, 240.5, 0.0, 0.0, 0.0, 1.0, 0.0],
+}
+ROS_CAMERA = Camera(
+    CameraIntrinsics(554.25, 554.25, 320.5, 240.5, 640, 480, (-0.1, 0.01, 0.0, 0.0, 0.0)), CameraMount(0.3)
+)
+
+
+def camera_info(store: Typestore, seconds: float, ros1: bool = False, **fields: Any) -> Any:
+    t = store.types
+    values = {**CAMERA_INFO, **fields}
+    arrays = {name: np.array(values[name], dtype=np.float64) for name in ("d", "k", "r", "p")}
+    if ros1:
+        arrays = {name.upper(): array for name, array in arrays.items()}
+        head = t["std_msgs/msg/Header"](seq=0, stamp=stamp(store, seconds), frame_id="camera")
+    else:
+        head = header(store, seconds, "camera")
+    roi = t["sensor_msgs/msg/RegionOfInterest"](
+        **{
+            "x_offset": 0,
+            "y_offset": 0,
+            "height": 0,
+            "width": 0,
+            "do_rectify": False,
+            **values.get("roi", {}),
+        }
+    )
+    return t["sensor_msgs/msg/CameraInfo"](
+        header=head,
+        height=values["height"],
+        width=values["width"],
+        distortion_model=values["distortion_model"],
+        binning_x=values.get("binning_x", 0),
+        binning_y=values.get("binning_y", 0),
+        roi=roi,
+        **arrays,
+    )
+
+
+def camera_bag(path: Path, *messages: Any) -> Path:
+    info = [(ns(T0 + i), message) for i, message in enumerate(messages)]
+    return write_bag(path, {"/camera/camera_info": ("sensor_msgs/msg/CameraInfo", info)})
+
+
+def test_a_camera_info_reads_as_the_ros_calibration_file(tmp_path: Path) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    # The first message is the calibration; later ones are not read.
+    bag = camera_bag(
+        tmp_path / "cam", camera_info(store, T0), camera_info(store, T0 + 1, distortion_model="x")
+    )
+    assert read_camera_info(bag, "/camera/camera_info", CameraMount(0.3)) == ROS_CAMERA
+    extras = camera_info(
+        store, T0, distortion_model="rational_polynomial", d=[-0.1, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    )
+    bag = camera_bag(tmp_path / "rational", extras)
+    assert read_camera_info(bag, "/camera/camera_info", CameraMount(0.3)) == ROS_CAMERA
+
+
+def test_a_ros1_camera_info_is_read_too(tmp_path: Path) -> None:
+    from rosbags.rosbag1 import Writer as Writer1
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    with Writer1(tmp_path / "old.bag") as writer:
+        connection = writer.add_connection("/camera_info", "sensor_msgs/msg/CameraInfo", typestore=store)
+        message = camera_info(store, 10.0, ros1=True)
+        writer.write(connection, ns(10.0), store.serialize_ros1(message, "sensor_msgs/msg/CameraInfo"))
+    assert read_camera_info(tmp_path / "old.bag", "/camera_info", CameraMount(0.3)) == ROS_CAMERA
+
+
+@pytest.mark.parametrize(
+    ("fields", "match"),
+    [
+        (
+            {"distortion_model": "equidistant", "d": [0.1, 0.0, 0.0, 0.0]},
+            r"topic /camera/camera_info, message 0, distortion_model: expected distortion_model plumb_bob or "
+            r"rational_polynomial, got 'equidistant'$",
+        ),
+        (
+            {"r": [0.9998, 0.02, 0.0, -0.02, 0.9998, 0.0, 0.0, 0.0, 1.0]},
+            r"message 0, r: expected the identity \(a monocular camera: aura-ums models no rectification\)",
+        ),
+        ({"k": [0.0] * 9}, r"message 0, k: expected \[\[fx, 0, cx\], \[0, fy, cy\], \[0, 0, 1\]\], got"),
+        (
+            {"d": []},
+            r"message 0, d: expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients for distortion_model ",
+        ),
+        (
+            {"k": [554.25, 0.0, 320.5, 0.0, math.nan, 240.5, 0.0, 0.0, 1.0]},
+            r"message 0, k\[4\]: expected a finite",
+        ),
+        ({"width": 0}, r"message 0, width: expected an integer >= 1, got 0$"),
+        ({"binning_x": 2}, r"message 0, binning_x: expected 0 or 1 \(an unbinned image\), got 2$"),
+        (
+            {"roi": {"x_offset": 10, "width": 320, "height": 240}},
+            r"message 0, roi: expected no region of interest \(the full image the calibration describes\), "
+            r"got x_offset 10, y_offset 0, width 320, height 240$",
+        ),
+    ],
+)
+def test_a_camera_info_aura_ums_does_not_model_is_refused(
+    tmp_path: Path, fields: dict[str, Any], match: str
+) -> None:
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    bag = camera_bag(tmp_path / "cam", camera_info(store, T0, **fields))
+    with pytest.raises(FileFormatError, match=match) as caught:
+        read_camera_info(bag, "/camera/camera_info", CameraMount(0.3))
+    assert caught.value.path == str(bag)
+
+
+def test_a_camera_info_topic_must_be_there_and_of_its_type(bag: Path, tmp_path: Path) -> None:
+    with pytest.raises(
+        FileFormatError,
+        match=r"walk: topic /camera_info: expected the camera info topic in the bag, got no such",
+    ):
+        read_camera_info(bag, "/camera_info", CameraMount(0.3))
+    with pytest.raises(
+        FileFormatError,
+        match=r"topic /odom: expected camera info messages of type sensor_msgs/msg/CameraInfo, got nav_msgs",
+    ):
+        read_camera_info(bag, "/odom", CameraMount(0.3))
+    with pytest.raises(InputError, match=r"mount: expected CameraMount, got float$"):
+        read_camera_info(bag, "/odom", 0.3)  # type: ignore[arg-type]
+    with pytest.raises(FileFormatError, match=r"nowhere: expected a ROS bag \(a rosbag2 folder or a ROS 1"):
+        read_camera_info(tmp_path / "nowhere", "/camera_info", CameraMount(0.3))

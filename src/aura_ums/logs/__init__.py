@@ -60,7 +60,7 @@ from aura_ums.logs._replay import (
     observation_for,
     replay_log,
 )
-from aura_ums.logs._rosbag import import_rosbag, read_rosbag
+from aura_ums.logs._rosbag import import_rosbag, read_camera_info, read_rosbag
 from aura_ums.logs._state import ReplayState
 from aura_ums.logs._stream import LogStream, open_log
 from aura_ums.logs._synthetic import synthetic_log
@@ -107,6 +107,7 @@ __all__ = [
     "odometry_report_arrays",
     "odometry_to_commands",
     "open_log",
+    "read_camera_info",
     "read_mrclam",
     "read_rosbag",
     "replay_log",

@@ -34,6 +34,10 @@ Times are seconds: the header stamp (``sec + nanosec * 1e-9``); a stamp of exact
 (unset) takes the bag's receive time. Each topic's messages are sorted by time;
 odometry and ground truth need distinct times. Every error names the bag, the topic and,
 for a bad message, its index in the topic (0 for the first).
+
+**The camera** (:func:`read_camera_info`): the first ``sensor_msgs/msg/CameraInfo`` of a
+topic (``width``, ``height``, ``distortion_model``, ``d``, ``k``, ``r``; ROS 1's ``D``,
+``K``, ``R``), checked as a ROS calibration file is.
 """
 
 from __future__ import annotations
@@ -45,6 +49,7 @@ import os
 import stat
 import struct
 from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -53,6 +58,7 @@ import numpy as np
 
 from aura_ums._files import as_path, present
 from aura_ums._validate import ROW_GAP
+from aura_ums.camera import Camera, CameraMount, camera_info_intrinsics
 from aura_ums.errors import AuraUmsError, FileFormatError, InputError, MissingDependencyError
 from aura_ums.logs._io import (
     COLUMN_RANGES,
@@ -78,6 +84,8 @@ from aura_ums.logs._log import (
 MOTION_TYPES = ("nav_msgs/msg/Odometry", "geometry_msgs/msg/TwistStamped", "geometry_msgs/msg/Twist")
 #: The message type of observations (see the convention in :mod:`aura_ums.logs._rosbag`).
 OBSERVATION_TYPE = "geometry_msgs/msg/PointStamped"
+#: The message type of a camera's calibration (:func:`read_camera_info`).
+CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
 #: Message types read as ground truth (poses).
 GROUNDTRUTH_TYPES = (
     "nav_msgs/msg/Odometry",
@@ -335,6 +343,44 @@ def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple
     return tuple(observation for _, _, observation in found)
 
 
+def _bag_path(bag_path: object) -> Path:
+    """Return ``bag_path`` as a Path to something present, and neither a pipe nor a device."""
+    path = as_path(bag_path, "bag_path", "a path")
+    if not present(path):
+        raise FileFormatError(
+            str(path),
+            "",
+            "expected a ROS bag (a rosbag2 folder or a ROS 1 .bag file), got no such file or folder",
+        )
+    _no_pipes(path)
+    return path
+
+
+@contextmanager
+def _opened(path: Path) -> Iterator[_Bag]:
+    """Open a bag; every failure of rosbags while it is read becomes a FileFormatError naming it."""
+    _require_rosbags()
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.rosbag1 import ReaderError as Bag1Error
+    from rosbags.rosbag2 import ReaderError as Bag2Error
+    from rosbags.typesys import Stores, get_typestore
+
+    try:
+        with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as reader:
+            yield _Bag(reader, path, AnyReaderError)
+    except AuraUmsError:
+        raise
+    except (AnyReaderError, Bag1Error, Bag2Error, OSError) as exc:  # no metadata.yaml, unreadable, damaged
+        raise FileFormatError(str(path), "", f"expected a readable ROS bag, got {exc}") from exc
+    except (ValueError, LookupError, EOFError, struct.error, TypeError, ArithmeticError, MemoryError) as exc:
+        # Bytes that are no bag at all, or a damaged one: rosbags' parsers fail as they meet them
+        # (a UnicodeDecodeError on a header, a short read, an ord() of nothing, a length beyond
+        # any size), not with AnyReaderError.
+        raise FileFormatError(
+            str(path), "", f"expected a readable ROS bag, got {type(exc).__name__}: {exc}"
+        ) from exc
+
+
 def read_rosbag(
     bag_path: str | os.PathLike[str],
     *,
@@ -398,43 +444,17 @@ def read_rosbag(
     truth = None if groundtruth_topic is None else _topic(groundtruth_topic, "groundtruth_topic")
     if meta is not None and not isinstance(meta, LogMeta):
         raise InputError(f"meta: expected a LogMeta or None, got {type(meta).__name__}")
-    path = as_path(bag_path, "bag_path", "a path")
-    if not present(path):
-        raise FileFormatError(
-            str(path),
-            "",
-            "expected a ROS bag (a rosbag2 folder or a ROS 1 .bag file), got no such file or folder",
-        )
-    _no_pipes(path)
+    path = _bag_path(bag_path)
     listed = _landmarks(landmarks)
-    _require_rosbags()
-    from rosbags.highlevel import AnyReader, AnyReaderError
-    from rosbags.rosbag1 import ReaderError as Bag1Error
-    from rosbags.rosbag2 import ReaderError as Bag2Error
-    from rosbags.typesys import Stores, get_typestore
-
-    try:
-        with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as reader:
-            bag = _Bag(reader, path, AnyReaderError)
-            kinds = {odom: bag.check(odom, MOTION_TYPES, "motion")}
-            kinds[observed] = bag.check(observed, (OBSERVATION_TYPE,), "observation")
-            if truth is not None:
-                kinds[truth] = bag.check(truth, GROUNDTRUTH_TYPES, "ground truth")
-            odometry = _motion(bag, odom, kinds[odom])
-            observations = _observations(bag, observed, {item.id: item for item in listed})
-            groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
-            notes = bag.notes
-    except AuraUmsError:
-        raise
-    except (AnyReaderError, Bag1Error, Bag2Error, OSError) as exc:  # no metadata.yaml, unreadable, damaged
-        raise FileFormatError(str(path), "", f"expected a readable ROS bag, got {exc}") from exc
-    except (ValueError, LookupError, EOFError, struct.error, TypeError, ArithmeticError, MemoryError) as exc:
-        # Bytes that are no bag at all, or a damaged one: rosbags' parsers fail as they meet them
-        # (a UnicodeDecodeError on a header, a short read, an ord() of nothing, a length beyond
-        # any size), not with AnyReaderError.
-        raise FileFormatError(
-            str(path), "", f"expected a readable ROS bag, got {type(exc).__name__}: {exc}"
-        ) from exc
+    with _opened(path) as bag:
+        kinds = {odom: bag.check(odom, MOTION_TYPES, "motion")}
+        kinds[observed] = bag.check(observed, (OBSERVATION_TYPE,), "observation")
+        if truth is not None:
+            kinds[truth] = bag.check(truth, GROUNDTRUTH_TYPES, "ground truth")
+        odometry = _motion(bag, odom, kinds[odom])
+        observations = _observations(bag, observed, {item.id: item for item in listed})
+        groundtruth = None if truth is None else _groundtruth(bag, truth, kinds[truth])
+        notes = bag.notes
     if meta is None:
         topics = f"motion {odom}, observations {observed}" + (f", ground truth {truth}" if truth else "")
         # A file name may hold what a log name may not (a line break): kept readable, as printed.
@@ -453,6 +473,57 @@ def read_rosbag(
     if problem is not None:
         raise FileFormatError(str(path), "", problem)
     return log
+
+
+def read_camera_info(bag_path: str | os.PathLike[str], topic: str, mount: CameraMount) -> Camera:
+    """Read the camera of a bag's first ``sensor_msgs/CameraInfo`` on ``topic``, on a mount.
+
+    The message is checked as a ROS calibration file is
+    (:func:`~aura_ums.camera.camera_info_intrinsics`, :func:`~aura_ums.camera.load_opencv_calibration`):
+    ``distortion_model`` ``plumb_bob`` or ``rational_polynomial`` (k4-k6 zero), an identity
+    ``r``, an unbinned full image. A driver publishes the same calibration with every image:
+    the first message is taken, the others are not read.
+
+    Parameters
+    ----------
+    bag_path : str or path-like
+        A rosbag2 folder or a ROS 1 ``.bag`` file.
+    topic : str
+        The CameraInfo topic (``/camera/camera_info``).
+    mount : CameraMount
+        Where the camera sits on the robot (a CameraInfo does not say).
+
+    Returns
+    -------
+    Camera
+        The calibrated camera.
+
+    Raises
+    ------
+    MissingDependencyError
+        When ``rosbags`` is not installed (``pip install aura-ums[ros]``).
+    InputError
+        For arguments of the wrong type.
+    FileFormatError
+        Naming the bag, the topic and the message's field: a missing bag or topic, a
+        topic of another type or empty, a calibration aura-ums does not model.
+
+    Examples
+    --------
+    >>> read_camera_info("no_such_bag", "/camera_info", CameraMount(0.3))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aura_ums.errors.FileFormatError: no_such_bag: expected a ROS bag (...), got no such file or folder
+    """
+    name = _topic(topic, "topic")
+    if not isinstance(mount, CameraMount):
+        raise InputError(f"mount: expected CameraMount, got {type(mount).__name__}")
+    path = _bag_path(bag_path)
+    with _opened(path) as bag:
+        bag.check(name, (CAMERA_INFO_TYPE,), "camera info")
+        index, _, message = next(bag.messages(name))
+        intrinsics = camera_info_intrinsics(message, str(path), f"topic {name}, message {index}")
+    return Camera(intrinsics, mount)
 
 
 def import_rosbag(
