@@ -901,10 +901,8 @@ def _ros_key(document: Mapping[str, object], key: str, source: str) -> object:
 def _intrinsics_from_ros(document: Mapping[str, object], source: str) -> CameraIntrinsics:
     """Return the intrinsics of a ROS calibration (camera_calibration_parsers' YAML: CameraInfo's fields)."""
     k = _matrix(_ros_key(document, "camera_matrix", source), source, "camera_matrix", opencv=False)
-    _camera_matrix(k, source, "camera_matrix")
     # ROS's own reader takes a file without distortion_model (older ones) as plumb_bob.
     model = document.get("distortion_model", "plumb_bob")
-    _ros_model(model, source, "distortion_model")
     dkey = "distortion_coefficients"
     d = _vector(_matrix(_ros_key(document, dkey, source), source, dkey, opencv=False), source, dkey)
     rkey = "rectification_matrix"
