@@ -7,7 +7,8 @@ The guarantee: the reader returns, or raises an :class:`AuraUmsError` that is a
 (no ``KeyError``, ``TypeError``, ``RecursionError``, ``UnicodeDecodeError``...), and
 never a hang: each case runs under a time limit (:data:`CASE_SECONDS`, SIGALRM).
 
-The readers: terrain tables, cameras (TOML, OpenCV YAML and JSON), scenarios, sensor
+The readers: terrain tables, cameras (TOML, also naming a calibration file; OpenCV YAML and
+JSON; ROS calibration YAML), scenarios, sensor
 calibrations, a log folder's ``meta.toml`` and CSV files (odometry, commands,
 observations, landmarks, ground truth), saved manager and blackboard state, GeoJSON meadow
 maps, the MRCLAM ``.dat`` files, York Urban's ``segments.csv``, and the files
@@ -113,6 +114,29 @@ OPENCV_JSON = json.dumps(
     },
     indent=1,
 ).encode()
+ROS_YAML = b"""image_width: 640
+image_height: 480
+camera_name: narrow_stereo
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [674.9, 0, 307.5, 0, 674.9, 251.4, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.12, 0.045, 0.001, -0.002, 0]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+projection_matrix:
+  rows: 3
+  cols: 4
+  data: [674.9, 0, 307.5, 0, 0, 674.9, 251.4, 0, 0, 0, 1, 0]
+"""
+#: A camera TOML whose intrinsics are a ROS calibration file beside it (``ost.yaml``).
+CALIBRATED_CAMERA_TOML = b'[intrinsics]\ncalibration = "ost.yaml"\n\n[mount]\nheight = 1.2\ntilt_deg = 5.0\n'
 LOG_FILES: dict[str, bytes] = {
     "meta.toml": (
         b'name = "tiny"\nterrain = "tile"\n\n[units]\nangle = "deg"\n\n[sensor]\nbearing_error = 2.0\n'
@@ -255,6 +279,8 @@ def test_the_valid_files_load(tmp_path: Path) -> None:
         "cam.toml": CAMERA_TOML,
         "calib.yml": OPENCV_YAML,
         "calib.json": OPENCV_JSON,
+        "ost.yaml": ROS_YAML,
+        "named.toml": CALIBRATED_CAMERA_TOML,
         "walk.toml": SCENARIO,
         "sensors.toml": SENSORS,
         "world.geojson": _geojson_text(),
@@ -265,6 +291,10 @@ def test_the_valid_files_load(tmp_path: Path) -> None:
     assert load_camera(tmp_path / "cam.toml").intrinsics.width > 0
     assert load_opencv_calibration(tmp_path / "calib.yml", MOUNT).intrinsics.distortion is not None
     assert load_opencv_calibration(tmp_path / "calib.json", MOUNT).intrinsics.fx == 674.9
+    ros = load_opencv_calibration(tmp_path / "ost.yaml", MOUNT).intrinsics
+    assert ros.fx == 674.9
+    assert ros.distortion == (-0.12, 0.045, 0.001, -0.002, 0.0)
+    assert load_camera(tmp_path / "named.toml").intrinsics == ros
     assert len(Scenario.from_toml(tmp_path / "walk.toml").commands) == 3
     assert load_sensors(tmp_path / "sensors.toml")[0].delay_s == 0.1
     assert MeadowMap.from_geojson(tmp_path / "world.geojson", terrain_table=TABLE) == WORLD
@@ -325,6 +355,24 @@ def test_opencv_json(tmp_path: Path, data: bytes) -> None:
     path = tmp_path / "calib.json"
     path.write_bytes(data)
     assert_clean(outcome(lambda: load_opencv_calibration(path, MOUNT)), "calib.json")
+
+
+@FUZZ
+@given(data=contents(ROS_YAML))
+def test_ros_calibration_yaml(tmp_path: Path, data: bytes) -> None:
+    path = tmp_path / "ost.yaml"
+    path.write_bytes(data)
+    assert_clean(outcome(lambda: load_opencv_calibration(path, MOUNT)), "ost.yaml")
+
+
+@FUZZ
+@given(toml=contents(CALIBRATED_CAMERA_TOML), calibration=contents(ROS_YAML))
+def test_camera_toml_naming_a_calibration(tmp_path: Path, toml: bytes, calibration: bytes) -> None:
+    # Either file may be the bad one: the error names the camera file (and the calibration's).
+    (tmp_path / "ost.yaml").write_bytes(calibration)
+    path = tmp_path / "named.toml"
+    path.write_bytes(toml)
+    assert_clean(outcome(lambda: load_camera(path)), "named.toml")
 
 
 @FUZZ
