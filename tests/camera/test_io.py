@@ -480,6 +480,34 @@ def test_a_flow_sequence_cut_after_a_comma_is_a_clean_error(tmp_path: Path) -> N
         load_opencv_calibration(path, MOUNT)
 
 
+@pytest.mark.parametrize(
+    ("old", "new", "where", "match"),
+    [
+        (
+            "image_width: 640",
+            "image_width: " + "9" * 5000,
+            "image_width",
+            "expected an integer >= 1, got inf$",
+        ),
+        (
+            "data: [554.25,",
+            "data: [" + "9" * 5000 + ",",
+            "camera_matrix.data[0]",
+            "expected a finite number, got inf$",
+        ),
+    ],
+    ids=["size", "matrix"],
+)
+def test_an_integer_of_thousands_of_digits_is_a_clean_error(
+    tmp_path: Path, old: str, new: str, where: str, match: str
+) -> None:
+    # Python refuses to convert integers over 4300 digits (a ValueError, which escaped).
+    path = write(tmp_path, "ost.yaml", ROS_YAML.replace(old, new, 1))
+    with pytest.raises(FileFormatError, match=match) as caught:
+        load_opencv_calibration(path, ROS_MOUNT)
+    assert where in location(caught.value)
+
+
 def test_a_focal_bound_not_below_the_focal_length_is_refused_by_the_file(tmp_path: Path) -> None:
     """Named with the file when read, not at the first observation that uses it."""
     camera = Camera(CameraIntrinsics(500, 400, 320, 240, 640, 480), CameraMount(1.0))

@@ -486,7 +486,10 @@ _SPECIAL = {".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": mat
 def _scalar(text: str) -> object:
     """Convert a plain YAML scalar to int, float (OpenCV writes ``1.``, ``.Inf``, ``.Nan``) or string."""
     if _INT.fullmatch(text):
-        return int(text)
+        try:
+            return int(text)
+        except ValueError:  # past Python's 4300-digit limit: a float, inf as "1e400" reads
+            return float(text)
     if _FLOAT.fullmatch(text):
         return float(text)
     return _SPECIAL.get(text.lower(), text)
