@@ -44,9 +44,26 @@ Quiet = Annotated[
 _OFF = "{}__off"
 
 
+#: Control characters (and the line breaks Python splits lines at) as escapes: a file name
+#: holding a newline or a terminal escape still prints as one line, and prints nothing else.
+_CONTROLS = {code: repr(chr(code))[1:-1] for code in (*range(0x20), *range(0x7F, 0xA0), 0x2028, 0x2029)}
+
+
+def one_line(message: str) -> str:
+    r"""Return ``message`` with its control characters escaped: one line on any terminal.
+
+    Examples
+    --------
+    >>> name = "lo" + chr(10) + "g" + chr(27) + "[2J"   # a newline, a terminal escape
+    >>> print(one_line(name + ": expected a log folder, got no such folder"))
+    lo\ng\x1b[2J: expected a log folder, got no such folder
+    """
+    return message.translate(_CONTROLS)
+
+
 def fail(message: str) -> typer.Exit:
-    """Print ``error: <message>`` (markup-safe) on stderr; return the exit (code 2) to raise."""
-    err_console.print(f"[red]error:[/red] {escape(message)}", highlight=False)
+    """Print ``error: <message>`` (markup-safe, one line) on stderr; return the exit (code 2) to raise."""
+    err_console.print(f"[red]error:[/red] {escape(one_line(message))}", highlight=False)
     return typer.Exit(code=2)
 
 
@@ -63,8 +80,8 @@ def none_or_float(text: str) -> float | None:
 
 
 def warn(message: str) -> None:
-    """Print ``warning: <message>`` (markup-safe) on stderr: the command goes on."""
-    err_console.print(f"[yellow]warning:[/yellow] {escape(message)}", highlight=False)
+    """Print ``warning: <message>`` (markup-safe, one line) on stderr: the command goes on."""
+    err_console.print(f"[yellow]warning:[/yellow] {escape(one_line(message))}", highlight=False)
 
 
 def refuse_alone(context: typer.Context, rules: Sequence[tuple[str, str, str, bool]]) -> None:
