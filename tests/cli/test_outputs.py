@@ -255,6 +255,26 @@ def test_replay_plot_stays_in_its_folder(name: str, inputs: Path, tmp_path: Path
     assert [p.name for p in plots.iterdir()] == [f"{safe_name(name)}_replay.png"]
 
 
+@pytest.mark.parametrize(
+    "arguments",
+    [["figures", "--out", "/", "--overwrite"], ["demo", "--out", "///", "--runs", "1", "--overwrite"]],
+    ids=["figures", "demo"],
+)
+def test_the_root_is_refused_as_an_output_folder(arguments: list[str]) -> None:
+    # An output folder is staged beside it: the root has no place beside it (a ValueError escaped).
+    refused(invoke(*arguments), "error: --out: expected a folder other than the file system's root, got /\n")
+
+
+def test_replay_refuses_the_root_as_its_plot_folder_writing_nothing(
+    inputs: Path, tmp_path: Path, untouched: object
+) -> None:
+    metrics = tmp_path / "m.json"
+    args = ("replay", inputs / "log", "--terrain", inputs / "terrain.toml", "--metrics-json", metrics)
+    result = invoke(*args, "--plot", "/", "--quiet")
+    refused(result, "error: --plot: expected a folder other than the file system's root, got /\n")
+    assert not metrics.exists()
+
+
 def test_every_command_that_writes_takes_the_same_overwrite() -> None:
     root = get_command(app)
     assert isinstance(root, typer.core.TyperGroup)

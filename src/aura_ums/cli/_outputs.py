@@ -147,6 +147,8 @@ def check_outputs(
     for target in (t for t in targets if t is not None):
         _named(target)
         where = resolved(target.path)
+        if target.folder:
+            refuse_root(target.option, target.path)
         for source, origin in inputs:
             _apart(target, where, source, origin)
         for other, taken in seen:
@@ -171,6 +173,17 @@ def check_outputs(
             _writable(target, where)
         except OSError as exc:  # e.g. a folder of the path that cannot be looked into
             raise _unwritable(target, target.path, exc) from None
+
+
+def refuse_root(option: str, folder: Path) -> None:
+    """Refuse (exit 2) the file system's root as an output folder: none is written beside it.
+
+    An output folder is written in a scratch folder beside it and moved in whole; the root
+    has no place beside it.
+    """
+    where = resolved(folder)
+    if where.parent == where:
+        raise fail(f"{option}: expected a folder other than the file system's root, got {folder}")
 
 
 def _named(target: Target) -> None:

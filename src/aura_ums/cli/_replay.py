@@ -57,6 +57,7 @@ from aura_ums.cli._outputs import (
     Target,
     check_outputs,
     placed,
+    refuse_root,
     resolved,
     safe_name,
     staged,
@@ -617,6 +618,8 @@ def replay(
         log = LoadLog(max_truth_gap)(log_dir) if whole else _open(log_dir, max_truth_gap)
         figure = f"{safe_name(log.meta.name)}{_FIGURE}"
         plot_target = None if plot is None else Target("--plot", plot / figure)
+        if plot is not None:
+            refuse_root("--plot", plot)  # the figure is drawn in a scratch folder beside it
         sources.append(_calibration_source(camera))  # the calibration file the camera file names
         check_outputs([*targets, plot_target], sources, overwrite=overwrite)
         table = _terrain_table(terrain, log.meta.terrain, log_dir)
