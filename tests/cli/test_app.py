@@ -70,6 +70,8 @@ def test_bad_numbers_are_refused_before_any_work(arguments: list[str], message: 
         (["simulate", "s.toml", "--runs", "1.5"], "--runs: expected an integer, got '1.5'"),
         (["simulate", "s.toml", "--runs=x"], "--runs: expected an integer, got 'x'"),
         (["import", "mrclam", "d", "o", "--robot", "abc"], "--robot: expected an integer, got 'abc'"),
+        # past Python's 4300-digit conversion limit: "Unable to parse input string as an integer"
+        (["simulate", "s.toml", "--runs", "9" * 4400], f"--runs: expected an integer, got '{'9' * 4400}'"),
         (
             ["import", "rosbag", "b", "o", "--odom", "/o", "--observations", "/x"],
             "--landmarks: expected a value (the option is required), got none",

@@ -550,7 +550,8 @@ def _usage_error(exc: UsageError, given: Sequence[str], command: str) -> str | N
         if flag in flags:
             typed = value if equals else given[index + 1] if index + 1 < len(given) else None
     reason = exc.message.removeprefix("Value error, ")
-    expected = {"valid integer": "an integer", "valid number": "a number"}
+    # ("as an integer": one of more digits than Python converts, 4300)
+    expected = {"valid integer": "an integer", "as an integer": "an integer", "valid number": "a number"}
     what = next((words for key, words in expected.items() if key in reason), None)
     if what is None and " is not one of " in reason:
         what = "one of " + reason.split(" is not one of ", 1)[1].rstrip(".").replace("'", "")
