@@ -145,6 +145,28 @@ def test_replay_of_several_logs_names_the_terrain_file_and_the_log_without_its_t
     )
 
 
+@pytest.mark.parametrize(
+    ("until", "message"),
+    [
+        ("-1", "--until: expected a time at or after the replay's start (0.0 s), got -1.0"),
+        (
+            "0.01",
+            "{log}: --until: expected a frame (an observation time) between the replay's start (0 s) "
+            "and 0.01 s, got none",
+        ),
+    ],
+    ids=["before-start", "before-first-frame"],
+)
+def test_replay_of_several_logs_names_until_as_the_option(
+    log_folders: list[Path], floor_terrain: Path, until: str, message: str
+) -> None:
+    # was "until: expected ..." and "LOG: until: expected ...": the library's argument, not the option
+    args = ["replay", *map(str, log_folders), "--terrain", str(floor_terrain), "-q", "--until", until]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {message.format(log=log_folders[0])}\n"
+
+
 def test_replay_of_several_logs_refuses_the_outputs_of_one(log_folders: list[Path], tmp_path: Path) -> None:
     args = ["replay", *map(str, log_folders), "--terrain", str(tmp_path / "t.toml")]
     result = runner.invoke(app, [*args, "--steps-csv", str(tmp_path / "s.csv")])

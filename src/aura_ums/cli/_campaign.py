@@ -7,6 +7,7 @@ several logs is :func:`replay_logs`.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -146,7 +147,8 @@ def replay_logs(
         with progress_bar("replay: logs", quiet=quiet, total=len(log_dirs)) as advance:
             campaign = run_campaign(job, log_dirs, settings, progress=advance)
     except AuraUmsError as exc:
-        raise fail(campaign_failure(exc)) from None
+        # The library names its argument ("until: ..."; "LOG: until: ..." from a run): the user typed --until.
+        raise fail(re.sub(r"(^|: )until: ", r"\1--until: ", campaign_failure(exc), count=1)) from None
     metrics = Metrics({"replays": campaign.values, "runs_retried": campaign.retried})
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
