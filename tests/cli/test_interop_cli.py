@@ -128,6 +128,10 @@ def test_import_rosbag_writes_the_log_and_a_summary(bag: Path, landmarks: Path, 
         ),
         (("--odom", "/seen"), "topic /seen: expected motion messages of type nav_msgs/msg/Odometry"),
         (("--groundtruth", "/cmd"), "topic /cmd: expected ground truth messages of type"),
+        # was "odom_topic: ...": read_rosbag's argument, not the option typed
+        (("--odom", ""), "error: --odom: expected a topic name such as '/odom', got ''"),
+        (("--observations", ""), "error: --observations: expected a topic name such as '/odom', got ''"),
+        (("--groundtruth", ""), "error: --groundtruth: expected a topic name such as '/odom', got ''"),
     ],
 )
 def test_bad_topics_are_clean_errors(

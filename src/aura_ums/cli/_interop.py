@@ -107,9 +107,19 @@ def rosbag_command(
         with progress_bar(f"{out_dir}: files", quiet=quiet) as advance:
             folder = write_log(log, out_dir, overwrite=overwrite, progress=advance)
     except AuraUmsError as exc:
-        raise fail(str(exc)) from None
+        # "odom_topic: expected ...": read_rosbag names its argument, the user typed the option.
+        field, _, rest = str(exc).partition(": ")
+        raise fail(f"{_TOPIC_OPTIONS[field]}: {rest}" if field in _TOPIC_OPTIONS else str(exc)) from None
     wrote(folder)
     print_log_summary(dataclasses.replace(log, path=folder))
+
+
+#: read_rosbag's topic arguments, as ``import rosbag`` spells them.
+_TOPIC_OPTIONS = {
+    "odom_topic": "--odom",
+    "observations_topic": "--observations",
+    "groundtruth_topic": "--groundtruth",
+}
 
 
 # --- MCAP export, for the commands that run or replay (``--mcap``) ---------------------------
