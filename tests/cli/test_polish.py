@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import itertools
 import json
@@ -534,6 +535,32 @@ def test_a_resume_with_other_inputs_is_refused_naming_the_option(
         assert f"{state} (--resume)" in result.stderr
         assert "Traceback" not in result.output
     invoke("replay", folder, "--terrain", terrain, "--classes", "II", "--resume", state, "-q")
+
+
+def test_log_times_in_replay_messages_keep_their_digits(tmp_path: Path) -> None:
+    # A log on Unix time (a ROS bag's stamps): the --until warning read "1.7e+09 s is after the
+    # last frame of ... (1.7e+09 s)", and the resume refusal "saved at 1.7e+09 s".
+    log = synthetic_log(np.random.default_rng(6), duration=10.0)
+    shift = 1_700_000_000.0
+    assert log.groundtruth is not None
+    unix = dataclasses.replace(
+        log,
+        observations=tuple(dataclasses.replace(o, time=o.time + shift) for o in log.observations),
+        commands=tuple(dataclasses.replace(c, time=c.time + shift) for c in log.commands or ()),
+        groundtruth=dataclasses.replace(log.groundtruth, time=log.groundtruth.time + shift),
+    )
+    folder = write_log(unix, tmp_path / "log")
+    terrain = floor_terrain(tmp_path / "terrain.toml")
+    last = max(o.time for o in unix.observations)
+    state = tmp_path / "end.json"
+    args = ("replay", folder, "--terrain", terrain, "--quiet")
+    after = invoke(*args, "--until", "1700000300", "--save-state", state)
+    assert f"--until: 1700000300 s is after the last frame of {folder} ({last:.15g} s)" in after.stderr
+    assert "e+09" not in after.stderr
+    result = runner.invoke(app, [str(a) for a in (*args, "--resume", state)])
+    assert result.exit_code == 2, result.output
+    assert f"saved at {last:.15g} s: nothing is left to replay" in result.stderr
+    assert "e+09" not in result.stderr
 
 
 def test_a_state_is_not_saved_from_a_replay_growing_from_anchors(

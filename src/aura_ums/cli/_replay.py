@@ -678,15 +678,15 @@ def replay(
             if resume is None and save_state is None:
                 result.require_steps(until)
             elif saved is not None and save_state is None and not result.trace.time.size:
-                bounded = "" if until is None else f" (--until {until:g})"
+                bounded = "" if until is None else f" (--until {until:.15g})"
                 raise fail(
                     f"--resume: expected a state with frames left after it, got {resume}, saved at "
-                    f"{saved.last_time:g} s{bounded}: nothing is left to replay"
+                    f"{saved.last_time:.15g} s{bounded}: nothing is left to replay"
                 )
             if mcap_target is not None and not result.steps:
                 # A state saved before any frame has no step to export: refused before any
                 # output is written (the MCAP writer refused it after the others were).
-                early = "" if until is None else f" (--until {until:g} comes before the first frame)"
+                early = "" if until is None else f" (--until {until:.15g} comes before the first frame)"
                 raise fail(f"--mcap: expected a replay of at least one frame to export, got none{early}")
     except AuraUmsError as exc:
         message = str(exc)
@@ -775,7 +775,7 @@ def _warn_until_after_the_end(until: float | None, result: ReplayResult, log_dir
     if until is not None and not result.cut_short and result.trace.time.size:
         last = float(result.trace.time[-1])
         warn(
-            f"--until: {until:g} s is after the last frame of {log_dir} ({last:g} s): every frame was "
+            f"--until: {until:.15g} s is after the last frame of {log_dir} ({last:.15g} s): every frame was "
             "replayed (--until is in seconds, whatever the time unit of the log's files)"
         )
 

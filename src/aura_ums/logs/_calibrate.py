@@ -596,8 +596,8 @@ def _record_spans(log: RobotLog) -> str:
     motion = ODOMETRY if log.odometry is not None else COMMANDS
     where = f"{log.path}: " if log.path is not None else f"log {log.meta.name!r}: "
     return (
-        f"{where}{motion} {first:g} to {last:g} s, "
-        f"{GROUNDTRUTH} {float(truth.time[0]):g} to {float(truth.time[-1]):g} s"
+        f"{where}{motion} {first:.15g} to {last:.15g} s, "
+        f"{GROUNDTRUTH} {float(truth.time[0]):.15g} to {float(truth.time[-1]):.15g} s"
     )
 
 

@@ -505,7 +505,7 @@ class ReplayResult:
         if until is not None:
             raise InputError(
                 f"until: expected a frame (an observation time) between the replay's start "
-                f"({self.start_time:g} s) and {until:g} s, got none"
+                f"({self.start_time:.15g} s) and {until:.15g} s, got none"
             )
         why = (
             "the log has no observation at all"
@@ -515,7 +515,7 @@ class ReplayResult:
         )
         raise InputError(
             f"log {self.log.meta.name!r}: expected a frame (an observation time) after the replay's start, "
-            f"{self.start_time:g} s, got none: {why}"
+            f"{self.start_time:.15g} s, got none: {why}"
         )
 
     @property
@@ -624,7 +624,7 @@ def _truth_start(meta: LogMeta, start: float, pose: NDArray[np.float64], max_gap
         )
         raise InputError(
             f"log {meta.name!r}: groundtruth.csv: expected a ground-truth pose at the replay's start, "
-            f"{start:g} s (meta.toml gives no [start] pose), got none: the start lies between two "
+            f"{start:.15g} s (meta.toml gives no [start] pose), got none: the start lies between two "
             f"rows more than {max_gap:g} s apart (--max-truth-gap) or after the last row{delayed}"
         )
     return Pose(x, y, heading)
