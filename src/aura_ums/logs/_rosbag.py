@@ -31,8 +31,9 @@ message definitions:
 (m, world frame) and the yaw of ``orientation`` (rad).
 
 Times are seconds: the header stamp (``sec + nanosec * 1e-9``); a stamp of exactly zero
-(unset) takes the bag's receive time. Each topic's messages are sorted by time;
-odometry and ground truth need distinct times. Every error names the bag, the topic and,
+(unset) takes the bag's receive time. Each topic's messages are sorted by time; of
+odometry or ground-truth messages stamped with one time, the last in the topic is kept
+(counted in the log's ``source``). Every error names the bag, the topic and,
 for a bad message, its index in the topic (0 for the first).
 
 **The camera** (:func:`read_camera_info`): the first ``sensor_msgs/msg/CameraInfo`` of a
