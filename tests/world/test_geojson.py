@@ -422,7 +422,14 @@ BAD_DOCUMENTS: list[tuple[str, Callable[[Document], Any], str, str]] = [
         "unknown strategy",
         feature(2, strategy="LINE_FINDER"),
         "features[2] (id 'pole') properties.strategy",
-        "expected one of interest_operator, line_finder, region_segmenter, got 'LINE_FINDER'",
+        "expected line_finder or region_segmenter for a Class I landmark, got 'LINE_FINDER'",
+    ),
+    (
+        # Naming the three strategies sent a point's author to line_finder, refused in turn.
+        "a point without a strategy",
+        drop(3, "strategy"),
+        "features[3] (id 'corner') properties.strategy",
+        "expected interest_operator for a Class II landmark, got nothing",
     ),
     (
         "parameters not an object",

@@ -264,9 +264,13 @@ class _Reader:
 
         strategy_name = props.get("strategy")
         if not isinstance(strategy_name, str) or strategy_name not in _STRATEGIES:
+            # Those the landmark's class supports: naming all three sent a Class II point's
+            # author from a missing strategy to "line_finder", refused in turn.
+            supported = PerceptualStrategy.for_class(landmark.landmark_class)
             self.fail(
                 f"{where} properties.strategy",
-                f"expected one of {', '.join(sorted(_STRATEGIES))}, got {_kind(strategy_name)}",
+                f"expected {' or '.join(item.value for item in supported)} for a Class {klass} "
+                f"landmark, got {_kind(strategy_name)}",
             )
         parameters = props.get("parameters", {})
         if not isinstance(parameters, Mapping):
