@@ -587,6 +587,23 @@ def test_ros_calibration_as_the_python_calibrator_writes_it(tmp_path: Path) -> N
     assert load_opencv_calibration(path, ROS_MOUNT) == load_camera(write(tmp_path, "c.toml", ROS_AS_TOML))
 
 
+def test_ros_empty_distortion_is_none(tmp_path: Path) -> None:
+    # camera_calibration_parsers writes an empty D as rows 1, cols 0, data []; ROS reads it as
+    # no distortion. It was refused ("cols: expected an integer >= 1, got 0").
+    text = ros_edit("cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 0\n  data: []")
+    camera = load_opencv_calibration(write(tmp_path, "ost.yaml", text), ROS_MOUNT)
+    assert camera.intrinsics.distortion == (0.0, 0.0, 0.0, 0.0, 0.0)
+    with pytest.raises(FileFormatError, match=r"camera_matrix.cols: expected an integer >= 1, got 0$"):
+        load_opencv_calibration(
+            write(
+                tmp_path,
+                "k.yaml",
+                ros_edit("rows: 3\n  cols: 3\n  data: [554", "rows: 3\n  cols: 0\n  data: [554"),
+            ),
+            ROS_MOUNT,
+        )
+
+
 def test_ros_rational_polynomial_with_zero_extra_terms(tmp_path: Path) -> None:
     text = ros_edit("distortion_model: plumb_bob", "distortion_model: rational_polynomial").replace(
         "cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 8\n  data: [-0.1, 0.01, 0.001, 0, 0.002, 0, 0, 0]"
@@ -635,13 +652,14 @@ def test_ros_rational_polynomial_with_zero_extra_terms(tmp_path: Path) -> None:
                 "cols: 5\n  data: [-0.1, 0.01, 0, 0, 0]", "cols: 8\n  data: [-0.1, 0.01, 0, 0, 0, 0, 0, 0]"
             ),
             "distortion_coefficients",
-            r"expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients for distortion_model plumb_bob, got 8$",
+            r"expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients \(or none: no distortion\) for "
+            r"distortion_model plumb_bob, got 8$",
         ),
         (
             ros_edit("distortion_model: plumb_bob", "distortion_model: rational_polynomial"),
             "distortion_coefficients",
-            r"expected 8 \(k1, k2, p1, p2, k3, k4, k5, k6\) coefficients for distortion_model "
-            r"rational_polynomial, got 5$",
+            r"expected 8 \(k1, k2, p1, p2, k3, k4, k5, k6\) coefficients \(or none: no distortion\) for "
+            r"distortion_model rational_polynomial, got 5$",
         ),
         (
             ros_edit("camera_matrix:", "K:"),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import shutil
@@ -614,6 +615,17 @@ def test_a_camera_info_reads_as_the_ros_calibration_file(tmp_path: Path) -> None
     assert read_camera_info(bag, "/camera/camera_info", CameraMount(0.3)) == ROS_CAMERA
 
 
+def test_an_empty_distortion_vector_is_no_distortion(tmp_path: Path) -> None:
+    # As ROS's image_geometry reads it (a rectified or simulated camera's); it was refused.
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    for model in ("plumb_bob", "rational_polynomial"):
+        bag = camera_bag(tmp_path / model, camera_info(store, T0, distortion_model=model, d=[]))
+        camera = read_camera_info(bag, "/camera/camera_info", CameraMount(0.3))
+        assert camera == dataclasses.replace(
+            ROS_CAMERA, intrinsics=dataclasses.replace(ROS_CAMERA.intrinsics, distortion=(0.0,) * 5)
+        )
+
+
 def test_a_ros1_camera_info_is_read_too(tmp_path: Path) -> None:
     from rosbags.rosbag1 import Writer as Writer1
 
@@ -639,8 +651,9 @@ def test_a_ros1_camera_info_is_read_too(tmp_path: Path) -> None:
         ),
         ({"k": [0.0] * 9}, r"message 0, k: expected \[\[fx, 0, cx\], \[0, fy, cy\], \[0, 0, 1\]\], got"),
         (
-            {"d": []},
-            r"message 0, d: expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients for distortion_model ",
+            {"d": [-0.1, 0.01]},
+            r"message 0, d: expected 4 or 5 \(k1, k2, p1, p2\[, k3\]\) coefficients \(or none: no "
+            r"distortion\) for distortion_model plumb_bob, got 2$",
         ),
         (
             {"k": [554.25, 0.0, 320.5, 0.0, math.nan, 240.5, 0.0, 0.0, 1.0]},

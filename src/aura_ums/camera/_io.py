@@ -785,11 +785,12 @@ def _find(document: Mapping[str, object], label: str, source: str) -> tuple[str,
     return found[0]
 
 
-def _matrix(value: object, source: str, key: str, *, opencv: bool = True) -> Array:
+def _matrix(value: object, source: str, key: str, *, opencv: bool = True, empty: bool = False) -> Array:
     """Return a matrix mapping's ``data`` as rows x cols.
 
     With ``opencv`` FileStorage's ``opencv-matrix`` (``type_id`` and ``dt`` too), else ROS's
-    mapping (rows, cols and data alone).
+    mapping (rows, cols and data alone). With ``empty``, ``cols`` may be 0 (ROS writes an
+    empty distortion vector as ``rows: 1, cols: 0, data: []``).
     """
     kind = "an opencv-matrix" if opencv else "a matrix"
     if not isinstance(value, dict):
@@ -802,7 +803,7 @@ def _matrix(value: object, source: str, key: str, *, opencv: bool = True) -> Arr
         if field not in value:
             raise FileFormatError(source, f"{key}.{field}", f"expected this field of {kind}, got none")
     rows = _integer(value["rows"], source, f"{key}.rows")
-    cols = _integer(value["cols"], source, f"{key}.cols")
+    cols = Fields(source).integer(value["cols"], f"{key}.cols", minimum=0 if empty else 1)
     if opencv:
         dt = value["dt"]
         if not isinstance(dt, str) or not re.fullmatch(r"[ucswifd]", dt):
@@ -907,7 +908,9 @@ def _intrinsics_from_ros(document: Mapping[str, object], source: str) -> CameraI
     # ROS's own reader takes a file without distortion_model (older ones) as plumb_bob.
     model = document.get("distortion_model", "plumb_bob")
     dkey = "distortion_coefficients"
-    d = _vector(_matrix(_ros_key(document, dkey, source), source, dkey, opencv=False), source, dkey)
+    d = _vector(
+        _matrix(_ros_key(document, dkey, source), source, dkey, opencv=False, empty=True), source, dkey
+    )
     rkey = "rectification_matrix"
     # Absent: none, as ROS's writer takes a missing one for the identity.
     r = _matrix(document[rkey], source, rkey, opencv=False) if rkey in document else None
@@ -951,11 +954,16 @@ def _ros_intrinsics(
     _camera_matrix(k, source, names["k"])
     model = _ros_model(model, source, names["model"])
     counts, expected = _ROS_MODELS[model]
-    if d.size not in counts:
+    if d.size and d.size not in counts:
         raise FileFormatError(
-            source, names["d"], f"expected {expected} coefficients for distortion_model {model}, got {d.size}"
+            source,
+            names["d"],
+            f"expected {expected} coefficients (or none: no distortion) for distortion_model {model}, "
+            f"got {d.size}",
         )
-    distortion = _distortion(d, source, names["d"])
+    # ROS (image_geometry) takes an empty distortion vector for no distortion, as a driver of a
+    # rectified or simulated camera publishes it and camera_calibration_parsers writes it.
+    distortion = _distortion(d, source, names["d"]) if d.size else (0.0, 0.0, 0.0, 0.0, 0.0)
     # A stereo pair's rectification turns the camera: its pixels are no longer those of K and D
     # on the raw image, which is what aura-ums models. A monocular calibration writes the identity.
     if r is not None and (r.shape != (3, 3) or not np.array_equal(r, np.eye(3))):
