@@ -91,6 +91,19 @@ def bounded_count(value: object, name: str, minimum: int, maximum: int, cost: st
     return int(value)
 
 
+def exact_text(value: float) -> str:
+    """Return a number as it reads back exactly (its repr), without a trailing ``.0``.
+
+    For times in messages: ``:g`` keeps six digits, and a log on Unix time read "1.7e+09 s is
+    after the last frame (1.7e+09 s)".
+
+    >>> exact_text(1700000197.8), exact_text(30000.0), exact_text(-5.0), exact_text(0.25)
+    ('1700000197.8', '30000', '-5', '0.25')
+    """
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
 def _refuse_choice(kind: type[enum.Enum], value: object) -> NoReturn:
     choices = ", ".join(repr(member.value) for member in kind)
     raise InputError(f"{kind.__name__}: expected one of {choices}, got {value!r}")

@@ -555,12 +555,14 @@ def test_log_times_in_replay_messages_keep_their_digits(tmp_path: Path) -> None:
     state = tmp_path / "end.json"
     args = ("replay", folder, "--terrain", terrain, "--quiet")
     after = invoke(*args, "--until", "1700000300", "--save-state", state)
-    assert f"--until: 1700000300 s is after the last frame of {folder} ({last:.15g} s)" in after.stderr
+    assert f"--until: 1700000300 s is after the last frame of {folder} ({last!r} s)" in after.stderr
     assert "e+09" not in after.stderr
     result = runner.invoke(app, [str(a) for a in (*args, "--resume", state)])
     assert result.exit_code == 2, result.output
-    assert f"saved at {last:.15g} s: nothing is left to replay" in result.stderr
+    assert f"saved at {last!r} s: nothing is left to replay" in result.stderr
     assert "e+09" not in result.stderr
+    # Stopping at the last frame itself is no mistake: it was warned of as "after" it.
+    assert "--until:" not in invoke(*args, "--until", repr(last)).stderr
 
 
 def test_a_state_is_not_saved_from_a_replay_growing_from_anchors(

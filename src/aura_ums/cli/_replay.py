@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.table import Table
 
-from aura_ums._validate import IMAGE_SIDE
+from aura_ums._validate import IMAGE_SIDE, exact_text
 from aura_ums.cli._campaign import (
     DEFAULTS,
     Retries,
@@ -678,15 +678,17 @@ def replay(
             if resume is None and save_state is None:
                 result.require_steps(until)
             elif saved is not None and save_state is None and not result.trace.time.size:
-                bounded = "" if until is None else f" (--until {until:.15g})"
+                bounded = "" if until is None else f" (--until {exact_text(until)})"
                 raise fail(
                     f"--resume: expected a state with frames left after it, got {resume}, saved at "
-                    f"{saved.last_time:.15g} s{bounded}: nothing is left to replay"
+                    f"{exact_text(saved.last_time)} s{bounded}: nothing is left to replay"
                 )
             if mcap_target is not None and not result.steps:
                 # A state saved before any frame has no step to export: refused before any
                 # output is written (the MCAP writer refused it after the others were).
-                early = "" if until is None else f" (--until {until:.15g} comes before the first frame)"
+                early = (
+                    "" if until is None else f" (--until {exact_text(until)} comes before the first frame)"
+                )
                 raise fail(f"--mcap: expected a replay of at least one frame to export, got none{early}")
     except AuraUmsError as exc:
         message = str(exc)
@@ -771,12 +773,17 @@ def _warn_early(early: int, start: float, log_dir: Path) -> None:
 
 
 def _warn_until_after_the_end(until: float | None, result: ReplayResult, log_dir: Path) -> None:
-    """Say so when ``--until`` cut nothing: a value meant in another unit (ms) replays the whole log."""
+    """Say so when ``--until`` is after the last frame: a value meant in ms replays the whole log.
+
+    An ``--until`` at the last frame itself (a script stopping there) is no mistake: nothing is said.
+    """
     if until is not None and not result.cut_short and result.trace.time.size:
         last = float(result.trace.time[-1])
+        if until <= last:
+            return
         warn(
-            f"--until: {until:.15g} s is after the last frame of {log_dir} ({last:.15g} s): every frame was "
-            "replayed (--until is in seconds, whatever the time unit of the log's files)"
+            f"--until: {exact_text(until)} s is after the last frame of {log_dir} ({exact_text(last)} s): "
+            "every frame was replayed (--until is in seconds, whatever the time unit of the log's files)"
         )
 
 

@@ -32,6 +32,7 @@ from aura_ums._validate import (
     ODOMETRY_SCALE,
     SIGMAS,
     Range,
+    exact_text,
     finite_float,
     items_of,
     positive_float,
@@ -596,8 +597,8 @@ def _record_spans(log: RobotLog) -> str:
     motion = ODOMETRY if log.odometry is not None else COMMANDS
     where = f"{log.path}: " if log.path is not None else f"log {log.meta.name!r}: "
     return (
-        f"{where}{motion} {first:.15g} to {last:.15g} s, "
-        f"{GROUNDTRUTH} {float(truth.time[0]):.15g} to {float(truth.time[-1]):.15g} s"
+        f"{where}{motion} {exact_text(first)} to {exact_text(last)} s, "
+        f"{GROUNDTRUTH} {exact_text(float(truth.time[0]))} to {exact_text(float(truth.time[-1]))} s"
     )
 
 

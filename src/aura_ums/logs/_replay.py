@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from aura_ums._files import as_path, atomic_path
 from aura_ums._metrics import STEPS_CSV, Metrics
-from aura_ums._validate import ACTIVATION_RANGE, finite_float, nonnegative_float, positive_float
+from aura_ums._validate import ACTIVATION_RANGE, exact_text, finite_float, nonnegative_float, positive_float
 from aura_ums.errors import FileFormatError, InputError
 from aura_ums.geometry import POSITION_TOLERANCE, ConvexPolygon, edge_distances, polygon_area, wedges_contain
 from aura_ums.logs._calibrate import MotionCalibration, SensorBounds
@@ -505,7 +505,7 @@ class ReplayResult:
         if until is not None:
             raise InputError(
                 f"until: expected a frame (an observation time) between the replay's start "
-                f"({self.start_time:.15g} s) and {until:.15g} s, got none"
+                f"({exact_text(self.start_time)} s) and {exact_text(until)} s, got none"
             )
         why = (
             "the log has no observation at all"
@@ -515,7 +515,7 @@ class ReplayResult:
         )
         raise InputError(
             f"log {self.log.meta.name!r}: expected a frame (an observation time) after the replay's start, "
-            f"{self.start_time:.15g} s, got none: {why}"
+            f"{exact_text(self.start_time)} s, got none: {why}"
         )
 
     @property
@@ -624,7 +624,7 @@ def _truth_start(meta: LogMeta, start: float, pose: NDArray[np.float64], max_gap
         )
         raise InputError(
             f"log {meta.name!r}: groundtruth.csv: expected a ground-truth pose at the replay's start, "
-            f"{start:.15g} s (meta.toml gives no [start] pose), got none: the start lies between two "
+            f"{exact_text(start)} s (meta.toml gives no [start] pose), got none: the start lies between two "
             f"rows more than {max_gap:g} s apart (--max-truth-gap) or after the last row{delayed}"
         )
     return Pose(x, y, heading)
