@@ -401,8 +401,21 @@ def test_bad_arguments(bag: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     with pytest.raises(FileFormatError, match=r"nothing: expected a ROS bag .* got no such file or folder"):
         read(tmp_path / "nothing")
     (tmp_path / "folder").mkdir()
-    with pytest.raises(FileFormatError, match=r"folder: expected a readable ROS bag, got .*metadata"):
+    # rosbags' own message named the folder as the missing metadata file.
+    with pytest.raises(
+        FileFormatError,
+        match=r"folder: expected a rosbag2 folder holding metadata\.yaml \(ros2 bag record writes it\), "
+        r"got none$",
+    ):
         read(tmp_path / "folder")
+    lone = tmp_path / "lone"
+    lone.mkdir()
+    shutil.copy(next(bag.glob("*.mcap")), lone / "run.mcap")
+    with pytest.raises(
+        FileFormatError, match=r"got none; name a storage file to read it alone \(.*lone/run\.mcap\)$"
+    ):
+        read(lone)
+    assert read(lone / "run.mcap").odometry is not None
     with pytest.raises(InputError, match=r"odom_topic: expected a topic name such as '/odom', got ''"):
         read(bag, odom_topic="")
     with pytest.raises(InputError, match=r"meta: expected a LogMeta or None, got str"):

@@ -361,6 +361,21 @@ def _bag_path(bag_path: object) -> Path:
 def _opened(path: Path) -> Iterator[_Bag]:
     """Open a bag; every failure of rosbags while it is read becomes a FileFormatError naming it."""
     _require_rosbags()
+    try:
+        bare = path.is_dir() and not (path / "metadata.yaml").exists()
+        lone = (
+            sorted(item.name for item in path.iterdir() if item.suffix in (".db3", ".mcap")) if bare else []
+        )
+    except OSError:  # unreadable: the reader says so, naming the bag
+        bare, lone = False, []
+    if bare:
+        # rosbags' own message named the folder as the missing metadata file.
+        hint = f"; name a storage file to read it alone ({path / lone[0]})" if lone else ""
+        raise FileFormatError(
+            str(path),
+            "",
+            f"expected a rosbag2 folder holding metadata.yaml (ros2 bag record writes it), got none{hint}",
+        )
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.rosbag1 import ReaderError as Bag1Error
     from rosbags.rosbag2 import ReaderError as Bag2Error
