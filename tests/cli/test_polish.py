@@ -586,3 +586,23 @@ def test_an_until_after_the_last_frame_is_said(walk: tuple[Path, Path]) -> None:
     assert "every frame was replayed (--until is in seconds" in after.stderr
     for cut in (("--until", "20"), ()):
         assert "--until:" not in invoke("replay", folder, "--terrain", terrain, "--quiet", *cut).stderr
+
+
+def test_observations_with_their_own_bounds_over_a_calibration_are_said(tmp_path: Path) -> None:
+    # A bag's point.z became every row's bearing_error, which silently won over the calibrated
+    # bounds (helper-72: containment 0.975 with rows tighter than the true noise).
+    log = synthetic_log(np.random.default_rng(6), duration=20.0)
+    folder = write_log(log, tmp_path / "log")
+    terrain = tmp_path / "cal" / "terrain.toml"
+    invoke("calibrate", folder, "--out", terrain, "--quiet")
+    lines = (folder / "observations.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    own = [*lines[:header], lines[header] + ",bearing_error"]
+    own += [line if line.startswith("#") else line + ",0.05" for line in lines[header + 1 :]]
+    (folder / "observations.csv").write_text("\n".join(own) + "\n")
+    said = invoke("replay", folder, "--terrain", terrain, "--quiet")
+    assert "of the observations replayed carry their own bearing_error or range_error" in said.stderr
+    assert "take precedence over the calibrated bounds of" in said.stderr
+    # Without a sensors file the row's bound is the only one given: nothing to say.
+    (tmp_path / "cal" / "terrain.sensors.toml").unlink()
+    assert "their own bearing_error" not in invoke("replay", folder, "--terrain", terrain, "--quiet").stderr

@@ -6,6 +6,7 @@ import dataclasses
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -363,3 +364,20 @@ def test_a_replay_says_whether_until_left_frames(folder: Path) -> None:
         assert replay_log(open_it(folder), FLOOR, until=50.0).cut_short
         assert not replay_log(open_it(folder), FLOOR, until=1e6).cut_short
         assert not replay_log(open_it(folder), FLOOR).cut_short
+
+
+def test_a_replay_counts_the_observations_with_bounds_of_their_own(folder: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "own"
+    shutil.copytree(folder, copy)
+    lines = (copy / "observations.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    assert "bearing_error" not in lines[header]
+    own = [*lines[:header], lines[header] + ",bearing_error"]
+    # Every other row gives its own bound, the others leave it empty (the meta's applies).
+    rows = [line for line in lines[header + 1 :] if not line.startswith("#")]
+    own += [line + (",0.05" if index % 2 == 0 else ",") for index, line in enumerate(rows)]
+    (copy / "observations.csv").write_text("\n".join(own) + "\n")
+    for open_it in (load_log, lambda path: open_log(path, block_bytes=300)):
+        assert replay_log(open_it(folder), FLOOR).own_bounds == 0
+        replayed = replay_log(open_it(copy), FLOOR)
+        assert replayed.own_bounds == sum(1 for index, _ in enumerate(rows) if index % 2 == 0)

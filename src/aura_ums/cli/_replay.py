@@ -715,6 +715,7 @@ def replay(
     _warn_unscored(log, log_dir, metrics)
     _warn_early(result.early_observations, result.start_time, log_dir)
     _warn_until_after_the_end(until, result, log_dir)
+    _warn_own_bounds(result, _sensors_source(sensors, terrain), log_dir)
     for line in metrics.lines():
         console.print(line, highlight=False, markup=False)
     if json_target is not None:
@@ -769,6 +770,16 @@ def _warn_early(early: int, start: float, log_dir: Path) -> None:
             f"{log_dir}: {early} observation{'s' if early != 1 else ''} at or before the replay's start "
             f"({start!r} s: the first motion, or the first ground truth when later) not replayed "
             "(observations_before_start)"
+        )
+
+
+def _warn_own_bounds(result: ReplayResult, sensors: Source | None, log_dir: Path) -> None:
+    """Say so when observations' own bounds took precedence over a calibrated sensors file's."""
+    if sensors is not None and result.own_bounds:
+        warn(
+            f"{log_dir}: {result.own_bounds} of the observations replayed carry their own bearing_error or "
+            f"range_error (observations.csv), which take precedence over the calibrated bounds of "
+            f"{sensors.path}"
         )
 
 

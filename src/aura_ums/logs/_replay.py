@@ -400,6 +400,10 @@ class ReplayResult:
     cut_short : bool
         Whether ``until`` left frames of the log unreplayed (False: the replay reached the
         log's last frame).
+    own_bounds : int
+        Observations replayed with a bound of their own (an ``observations.csv`` row's
+        ``bearing_error`` or ``range_error``), which takes precedence over
+        :attr:`ReplayOptions.working` and the meta's.
 
     Examples
     --------
@@ -474,6 +478,7 @@ class ReplayResult:
     start_time: float = math.nan
     early_observations: int = 0
     cut_short: bool = False
+    own_bounds: int = 0
 
     def require_steps(self, until: float | None = None) -> None:
         """Refuse a replay that made no step: its figures would all be undefined.
@@ -1014,6 +1019,7 @@ def replay_log(
     done = source.first
     identified = board.identified
     nominal = _STATES[0]
+    own_bounds = 0
     with _StepsCsv(steps_csv) as writer:
         for chunk in source.chunks:
             due_arrays = reports.until(chunk.times)
@@ -1036,6 +1042,7 @@ def replay_log(
             rows, offsets = chunk.rows, chunk.offsets
             # The chunk's observations at once (each frame's are a slice): a call a chunk, not a frame.
             chunk_working = _observations(rows, bearing_only, working_bounds, offset)
+            own_bounds += sum(1 for row in rows if row[4] is not None or row[5] is not None)
             chunk_envelope = _observations(rows, bearing_only, envelope_bounds, offset) if robust else None
             # Each step's figures, into the trace's arrays once the chunk is done (or at
             # once for after_step, which reads them).
@@ -1136,6 +1143,7 @@ def replay_log(
         source.start_time,
         source.early[0],
         source.cut[0],
+        own_bounds,
     )
 
 
