@@ -310,11 +310,20 @@ def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
 def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple[LogObservation, ...]:
     found: list[tuple[float, int, LogObservation]] = []
     listed = ", ".join(list(known)[:20]) + (", ..." if len(known) > 20 else "")
+    # Sightings of what the landmark list does not hold (other markers, other robots) are
+    # dropped and counted, as import mrclam drops unknown barcodes; a bag of nothing else is refused.
+    unknown: dict[str, int] = {}
+    first_unknown = ""
     for index, received, message in bag.messages(topic):
         where = f"topic {topic}, message {index}"
         ident = message.header.frame_id
         if ident not in known:
-            raise bag.fail(where, f"expected header.frame_id to be a landmark id ({listed}), got {ident!r}")
+            if not unknown:
+                first_unknown = (
+                    f"{where}: expected header.frame_id to be a landmark id ({listed}), got {ident!r}"
+                )
+            unknown[ident] = unknown.get(ident, 0) + 1
+            continue
         x, y, z = float(message.point.x), float(message.point.y), float(message.point.z)
         if not math.isfinite(y):
             raise bag.fail(where, f"expected point.y to be a finite bearing (rad), got {y!r}")
@@ -339,6 +348,16 @@ def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple
             line=index,
         )
         found.append((time, index, observation))
+    if unknown and not found:
+        where, _, message = first_unknown.partition(": ")
+        raise bag.fail(where, f"{message} (and no message names one)")
+    if unknown:
+        shown = ", ".join(f"{ident!r} {count}" for ident, count in sorted(unknown.items())[:10])
+        more = ", ..." if len(unknown) > 10 else ""
+        bag.notes.append(
+            f"dropped {plural(sum(unknown.values()), 'observation')} on {topic} of ids not in the landmark "
+            f"list ({shown}{more})"
+        )
     found.sort(key=lambda item: (item[0], item[1]))
     _no_clock_jump(bag, topic, [(time, index) for time, index, _ in found], "observation")
     return tuple(observation for _, _, observation in found)
@@ -442,10 +461,11 @@ def read_rosbag(
         For arguments of the wrong type.
     FileFormatError
         Naming the bag and topic: a missing bag, a missing topic (listing those present),
-        a topic of another message type, an empty topic, a bad message (with its index:
-        unknown landmark id, negative range, non-finite values, a clock jump). Of motion or
-        ground-truth messages stamped with one time the last is kept, and the log's ``source``
-        says how many were dropped.
+        a topic of another message type, an empty topic, an observation topic naming no
+        listed landmark, a bad message (with its index: negative range, non-finite values, a
+        clock jump). Of motion or ground-truth messages stamped with one time the last is
+        kept, and observations of ids not in the landmark list are dropped; the log's
+        ``source`` says how many of each.
 
     Examples
     --------
