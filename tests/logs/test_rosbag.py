@@ -363,6 +363,11 @@ def test_missing_wrong_and_empty_topics(bag: Path, run: Run, tmp_path: Path) -> 
         (lambda m: setattr(m.point, "x", -1.0), r"message 0: expected point\.x to be a range >= 0 m"),
         (lambda m: setattr(m.point, "y", math.nan), r"message 0: expected point\.y to be a finite bearing"),
         (lambda m: setattr(m.point, "z", -0.1), r"message 0: expected point\.z to be a bearing error bound"),
+        # 1.5e9 ns were carried into the seconds (1.5 s late), a stamp no ROS clock writes
+        (
+            lambda m: setattr(m.header.stamp, "nanosec", 1_500_000_000),
+            r"message 0: expected header\.stamp\.nanosec in \[0, 1e9\), got 1500000000",
+        ),
     ],
 )
 def test_bad_observations_name_the_message(

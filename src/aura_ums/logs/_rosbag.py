@@ -216,10 +216,14 @@ class _Bag:
             yield index, received, message
 
 
-def _time(header: Any, received: int) -> float:
+def _time(bag: _Bag, where: str, header: Any, received: int) -> float:
+    """Return a message's time, s: its header's stamp, or the receive time when the stamp is unset (zero)."""
     stamp = header.stamp
     if stamp.sec == 0 and stamp.nanosec == 0:
         return received * 1e-9
+    if not 0 <= stamp.nanosec < 1_000_000_000:
+        # A stamp's nanoseconds are its fraction of a second: more was carried into the seconds.
+        raise bag.fail(where, f"expected header.stamp.nanosec in [0, 1e9), got {stamp.nanosec!r}")
     return float(stamp.sec) + float(stamp.nanosec) * 1e-9
 
 
@@ -259,10 +263,11 @@ def _no_clock_jump(bag: _Bag, topic: str, times: list[tuple[float, int]], role: 
 def _motion(bag: _Bag, topic: str, kind: str) -> Odometry:
     rows: list[tuple[float, int, tuple[float, ...]]] = []
     for index, received, message in bag.messages(topic):
+        where = f"topic {topic}, message {index}"
         if kind == "nav_msgs/msg/Odometry":
-            time, twist = _time(message.header, received), message.twist.twist
+            time, twist = _time(bag, where, message.header, received), message.twist.twist
         elif kind == "geometry_msgs/msg/TwistStamped":
-            time, twist = _time(message.header, received), message.twist
+            time, twist = _time(bag, where, message.header, received), message.twist
         else:
             time, twist = received * 1e-9, message
         v, omega = float(twist.linear.x), float(twist.angular.z)
@@ -297,8 +302,9 @@ def _groundtruth(bag: _Bag, topic: str, kind: str) -> GroundTruth:
                 f"expected a finite pose and a unit orientation quaternion, got x {x!r}, y {y!r}, "
                 f"orientation {_quaternion(pose.orientation)}",
             )
-        _in_range(bag, f"topic {topic}, message {index}", {"x": x, "y": y})
-        rows.append((_time(message.header, received), index, (x, y, heading)))
+        where = f"topic {topic}, message {index}"
+        _in_range(bag, where, {"x": x, "y": y})
+        rows.append((_time(bag, where, message.header, received), index, (x, y, heading)))
     table, repeats = _sorted_rows(bag, topic, rows, "ground truth")
     if repeats:
         bag.notes.append(
@@ -338,7 +344,7 @@ def _observations(bag: _Bag, topic: str, known: dict[str, LogLandmark]) -> tuple
             )
         values = {"bearing": y, "range": x if x > 0.0 else math.nan}
         _in_range(bag, where, {**values, "bearing_error": z if z > 0.0 else math.nan})
-        time = _time(message.header, received)
+        time = _time(bag, where, message.header, received)
         observation = LogObservation(
             time,
             ident,
