@@ -191,3 +191,33 @@ def test_simulate_mcap_option(tmp_path: Path) -> None:
     assert bad.exit_code == 2
     # Past the command's own checks (this app has none): the library's refusal, worded for the option.
     assert f"--mcap: expected a writable place, got {tmp_path / 'file' / 'x.mcap'}: " in bad.output
+
+
+def test_import_camera_info_writes_the_camera_toml_replay_reads(tmp_path: Path) -> None:
+    # A bag's CameraInfo to a camera TOML from the command line (it took Python before).
+    from aura_ums.camera import CameraMount, load_camera
+    from aura_ums.cli import app
+    from tests.logs.test_rosbag import T0, camera_bag, camera_info
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    bag = camera_bag(tmp_path / "cam", camera_info(store, T0))
+    out = tmp_path / "camera.toml"
+    arguments = ["import", "camera-info", str(bag), "--topic", "/camera/camera_info", "--out", str(out)]
+    done = CliRunner().invoke(app, [*arguments, "--height", "0.3", "--tilt-deg", "5"])
+    assert done.exit_code == 0, done.output
+    camera = load_camera(out)
+    assert camera.intrinsics.fx == 554.25
+    assert camera.intrinsics.distortion == (-0.1, 0.01, 0.0, 0.0, 0.0)
+    assert camera.mount == CameraMount(0.3, tilt=math.radians(5.0))
+    refused = {
+        # an existing output is replaced only with --overwrite
+        ("--height", "0.3"): "--out: expected a new file",
+        ("--height", "0.3", "--overwrite", "--tilt-deg", "90"): "--tilt-deg: expected |tilt| < pi/2",
+        ("--height", "0.3", "--overwrite", "--topic", "/nothing"): "/nothing",
+    }
+    for extra, message in refused.items():
+        result = CliRunner().invoke(app, [*arguments, *extra])
+        assert result.exit_code == 2, result.output
+        assert message in result.stderr, result.stderr
+        assert "Traceback" not in result.output
+    assert load_camera(out) == camera  # refused: the file written before is as it was

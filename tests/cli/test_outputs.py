@@ -296,6 +296,7 @@ def test_every_command_that_writes_takes_the_same_overwrite() -> None:
         "compare",
         "import mrclam",
         "import rosbag",
+        "import camera-info",
     }
     assert len(set(helps.values())) == 1, helps
 

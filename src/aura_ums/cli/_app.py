@@ -47,6 +47,7 @@ from aura_ums.cli._interop import (
     LivePort,
     LiveRate,
     LiveWait,
+    camera_info_command,
     live_rules,
     live_simulation,
     rosbag_command,
@@ -299,6 +300,7 @@ def simulate(
 
 # Commands on recorded logs, and the dataset importers (``aura-ums import ...``).
 import_app.command("rosbag", cls=PlainCommand)(interruptible(rosbag_command))
+import_app.command("camera-info", cls=PlainCommand)(interruptible(camera_info_command))
 app.add_typer(import_app, name="import")
 app.command(cls=PlainCommand)(interruptible(calibrate))
 app.command(cls=PlainCommand)(interruptible(replay))

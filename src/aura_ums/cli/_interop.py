@@ -23,10 +23,11 @@ from aura_ums.cli._common import (
     fail,
     folder_argument,
     none_or_float,
+    output_file,
     print_log_summary,
     progress_bar,
 )
-from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, placed, wrote
+from aura_ums.cli._outputs import Overwrite, Source, Target, check_outputs, placed, write_text, wrote
 from aura_ums.export import LiveOptions
 
 if TYPE_CHECKING:
@@ -112,6 +113,70 @@ def rosbag_command(
         raise fail(f"{_TOPIC_OPTIONS[field]}: {rest}" if field in _TOPIC_OPTIONS else str(exc)) from None
     wrote(folder)
     print_log_summary(dataclasses.replace(log, path=folder))
+
+
+def camera_info_command(
+    bag: Annotated[
+        Path,
+        typer.Argument(
+            help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.",
+            parser=folder_argument("BAG", "a ROS bag"),
+        ),
+    ],
+    topic: Annotated[
+        str, typer.Option("--topic", help="sensor_msgs/msg/CameraInfo topic (its first message is read).")
+    ],
+    out: Annotated[Path, output_file("--out", "camera.toml", "Camera TOML to write (replay --camera).")],
+    height: Annotated[
+        float,
+        typer.Option(
+            "--height", help="Optical centre above the ground plane, m (a CameraInfo has no mount)."
+        ),
+    ],
+    forward: Annotated[
+        float, typer.Option("--forward", help="Optical centre ahead of the robot's reference point, m.")
+    ] = 0.0,
+    left: Annotated[
+        float, typer.Option("--left", help="Optical centre left of the reference point, m.")
+    ] = 0.0,
+    pan_deg: Annotated[
+        float, typer.Option("--pan-deg", help="Degrees, counter-clockwise (to the left) positive.")
+    ] = 0.0,
+    tilt_deg: Annotated[
+        float, typer.Option("--tilt-deg", help="Degrees, positive when the camera looks below the horizon.")
+    ] = 0.0,
+    overwrite: Overwrite = False,
+) -> None:
+    """Write the camera of BAG's CameraInfo topic, on the mount given, as a camera TOML (docs/interop.md)."""
+    from aura_ums._files import path_mode
+    from aura_ums.camera import CameraMount, camera_to_toml
+    from aura_ums.errors import AuraUmsError
+    from aura_ums.logs import read_camera_info
+
+    target = Target("--out", out)
+    check_outputs([target], [Source("BAG", bag, folder=stat.S_ISDIR(path_mode(bag)))], overwrite=overwrite)
+    try:
+        mount = CameraMount(height, forward, left, math.radians(pan_deg), math.radians(tilt_deg))
+    except AuraUmsError as exc:  # "CameraMount.tilt: expected ...": the user typed --tilt-deg
+        field, _, rest = str(exc).partition(": ")
+        option = _MOUNT_OPTIONS.get(field.removeprefix("CameraMount."))
+        raise fail(f"{option}: {rest}" if option is not None else str(exc)) from None
+    try:
+        camera = read_camera_info(bag, topic, mount)
+    except AuraUmsError as exc:
+        field, _, rest = str(exc).partition(": ")
+        raise fail(f"--topic: {rest}" if field == "topic" else str(exc)) from None
+    write_text(target, camera_to_toml(camera))
+
+
+#: CameraMount's fields, as ``import camera-info`` spells them.
+_MOUNT_OPTIONS = {
+    "height": "--height",
+    "forward": "--forward",
+    "left": "--left",
+    "pan": "--pan-deg",
+    "tilt": "--tilt-deg",
+}
 
 
 #: read_rosbag's topic arguments, as ``import rosbag`` spells them.
