@@ -37,14 +37,18 @@ if TYPE_CHECKING:
     from aura_ums.sim import PerceptionMode, Scenario
 
 
+#: The BAG argument of the ``import`` commands that read a ROS bag.
+_Bag = Annotated[
+    Path,
+    typer.Argument(
+        help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.",
+        parser=folder_argument("BAG", "a ROS bag"),
+    ),
+]
+
+
 def rosbag_command(
-    bag: Annotated[
-        Path,
-        typer.Argument(
-            help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.",
-            parser=folder_argument("BAG", "a ROS bag"),
-        ),
-    ],
+    bag: _Bag,
     out_dir: NewLogFolder,
     odom: Annotated[
         str,
@@ -116,13 +120,7 @@ def rosbag_command(
 
 
 def camera_info_command(
-    bag: Annotated[
-        Path,
-        typer.Argument(
-            help="ROS bag: a rosbag2 folder (sqlite3 or MCAP) or a ROS 1 .bag file.",
-            parser=folder_argument("BAG", "a ROS bag"),
-        ),
-    ],
+    bag: _Bag,
     topic: Annotated[
         str, typer.Option("--topic", help="sensor_msgs/msg/CameraInfo topic (its first message is read).")
     ],
