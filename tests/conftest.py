@@ -118,3 +118,20 @@ def full_disk(monkeypatch: pytest.MonkeyPatch) -> Callable[[str, str], None]:
         monkeypatch.setattr(Path, "open", opening)
 
     return arm
+
+
+def ros_calibration_yaml(name: str, k: str, d: str, p: str) -> str:
+    """A 640 x 480 camera's calibration as ROS's camera_calibration_parsers writes it.
+
+    ``k``, ``d`` and ``p`` are the camera matrix's 9, the distortion's 5 and the projection
+    matrix's 12 numbers as the file spells them (``"554.25, 0, 320.5, ..."``); the
+    rectification is the identity.
+    """
+    return (
+        f"image_width: 640\nimage_height: 480\ncamera_name: {name}\n"
+        f"camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{k}]\n"
+        f"distortion_model: plumb_bob\n"
+        f"distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [{d}]\n"
+        f"rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+        f"projection_matrix:\n  rows: 3\n  cols: 4\n  data: [{p}]\n"
+    )

@@ -46,6 +46,7 @@ from aura_ums.perception._york_urban import load_york_urban
 from aura_ums.sim import Scenario
 from aura_ums.uncertainty import BearingObservation, Pose, SpatialUncertaintyMap, TerrainTable, TurnAndRun
 from aura_ums.world import MeadowMap, make_grid_world
+from tests.conftest import ros_calibration_yaml
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 CAMERA_TOML = (REPOSITORY / "scenarios" / "paper_camera.toml").read_bytes()
@@ -114,27 +115,12 @@ OPENCV_JSON = json.dumps(
     },
     indent=1,
 ).encode()
-ROS_YAML = b"""image_width: 640
-image_height: 480
-camera_name: narrow_stereo
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [674.9, 0, 307.5, 0, 674.9, 251.4, 0, 0, 1]
-distortion_model: plumb_bob
-distortion_coefficients:
-  rows: 1
-  cols: 5
-  data: [-0.12, 0.045, 0.001, -0.002, 0]
-rectification_matrix:
-  rows: 3
-  cols: 3
-  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
-projection_matrix:
-  rows: 3
-  cols: 4
-  data: [674.9, 0, 307.5, 0, 0, 674.9, 251.4, 0, 0, 0, 1, 0]
-"""
+ROS_YAML = ros_calibration_yaml(
+    "narrow_stereo",
+    "674.9, 0, 307.5, 0, 674.9, 251.4, 0, 0, 1",
+    "-0.12, 0.045, 0.001, -0.002, 0",
+    "674.9, 0, 307.5, 0, 0, 674.9, 251.4, 0, 0, 0, 1, 0",
+).encode()
 #: A camera TOML whose intrinsics are a ROS calibration file beside it (``ost.yaml``).
 CALIBRATED_CAMERA_TOML = b'[intrinsics]\ncalibration = "ost.yaml"\n\n[mount]\nheight = 1.2\ntilt_deg = 5.0\n'
 LOG_FILES: dict[str, bytes] = {

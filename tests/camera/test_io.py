@@ -27,6 +27,7 @@ from aura_ums.camera import (
     load_opencv_calibration,
 )
 from aura_ums.errors import FileFormatError
+from tests.conftest import ros_calibration_yaml
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "camera.toml"
 MOUNT = CameraMount(height=1.1, forward=0.2, pan=0.1, tilt=0.05)
@@ -525,28 +526,12 @@ def test_a_focal_bound_not_below_the_focal_length_is_refused_by_the_file(tmp_pat
 
 # As ROS's camera_calibration_parsers writes it (camera_info_manager's files, the calibrator's
 # ost.yaml): no '%YAML' header, matrices as plain {rows, cols, data} mappings.
-ROS_YAML = """\
-image_width: 640
-image_height: 480
-camera_name: narrow_stereo
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1]
-distortion_model: plumb_bob
-distortion_coefficients:
-  rows: 1
-  cols: 5
-  data: [-0.1, 0.01, 0, 0, 0]
-rectification_matrix:
-  rows: 3
-  cols: 3
-  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
-projection_matrix:
-  rows: 3
-  cols: 4
-  data: [554.25, 0, 320.5, 0, 0, 554.25, 240.5, 0, 0, 0, 1, 0]
-"""
+ROS_YAML = ros_calibration_yaml(
+    "narrow_stereo",
+    "554.25, 0, 320.5, 0, 554.25, 240.5, 0, 0, 1",
+    "-0.1, 0.01, 0, 0, 0",
+    "554.25, 0, 320.5, 0, 0, 554.25, 240.5, 0, 0, 0, 1, 0",
+)
 # The same camera in aura-ums' TOML.
 ROS_AS_TOML = """\
 [intrinsics]

@@ -17,6 +17,7 @@ from aura_ums import ManagerSettings, Metrics
 from aura_ums.cli import app
 from aura_ums.logs import ReverseMotion, load_noise, synthetic_log, write_log
 from aura_ums.uncertainty import TerrainTable
+from tests.conftest import ros_calibration_yaml
 from tests.logs.log_helpers import VALID_FILES, long_odometry_log, write_files
 
 runner = CliRunner()
@@ -255,28 +256,12 @@ def test_windows_csv_needs_a_camera_and_a_bad_camera_is_named(log_folder: Path, 
 SAMPLE = VIRTUAL_CAMERA.parent / "logs" / "r1"
 # examples/virtual_camera_60deg.toml's intrinsics, with a little barrel distortion, as ROS's
 # camera_calibration_parsers writes a calibration.
-VIRTUAL_OST = """\
-image_width: 640
-image_height: 480
-camera_name: virtual
-camera_matrix:
-  rows: 3
-  cols: 3
-  data: [554.2562584220407, 0, 319.5, 0, 554.2562584220407, 239.5, 0, 0, 1]
-distortion_model: plumb_bob
-distortion_coefficients:
-  rows: 1
-  cols: 5
-  data: [-0.05, 0.002, 0, 0, 0]
-rectification_matrix:
-  rows: 3
-  cols: 3
-  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
-projection_matrix:
-  rows: 3
-  cols: 4
-  data: [554.2562584220407, 0, 319.5, 0, 0, 554.2562584220407, 239.5, 0, 0, 0, 1, 0]
-"""
+VIRTUAL_OST = ros_calibration_yaml(
+    "virtual",
+    "554.2562584220407, 0, 319.5, 0, 554.2562584220407, 239.5, 0, 0, 1",
+    "-0.05, 0.002, 0, 0, 0",
+    "554.2562584220407, 0, 319.5, 0, 0, 554.2562584220407, 239.5, 0, 0, 0, 1, 0",
+)
 
 
 def test_replay_with_a_camera_naming_a_ros_calibration_scores_as_its_toml(
